@@ -1,0 +1,95 @@
+//! `bmlr`: the command-line front end of the BML realizer (DESIGN §5).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use bml_realizer::bml::{self, Severity};
+use clap::{Parser, Subcommand};
+
+/// The BML realizer command line.
+#[derive(Parser)]
+#[command(
+    name = "bmlr",
+    version,
+    about = "Realize, plan and check BML 1.0 (+BMLA/BMLT) blocks"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Parse and check BML files; print file:line:col diagnostics. Exit 1 if any file is invalid.
+    Validate {
+        /// BML files (one <bml> block each).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Print nothing for valid files.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Validate { files, quiet } => validate(&files, quiet),
+    }
+}
+
+fn validate(files: &[PathBuf], quiet: bool) -> ExitCode {
+    let (mut invalid, mut unreadable) = (0usize, 0usize);
+    for f in files {
+        let text = match std::fs::read_to_string(f) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("{}: cannot read: {e}", f.display());
+                unreadable += 1;
+                continue;
+            }
+        };
+        let (_, diags) = bml::check(&text);
+        let errors = diags
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .count();
+        for d in &diags {
+            println!("{}:{d}", f.display());
+        }
+        if errors > 0 {
+            invalid += 1;
+        } else if !quiet {
+            let warnings = diags.len();
+            if warnings == 0 {
+                println!("{}: valid", f.display());
+            } else {
+                println!(
+                    "{}: valid ({warnings} warning{})",
+                    f.display(),
+                    if warnings == 1 { "" } else { "s" }
+                );
+            }
+        }
+    }
+    let total = files.len();
+    eprintln!(
+        "{} file{} checked: {} valid, {} invalid{}",
+        total,
+        if total == 1 { "" } else { "s" },
+        total - invalid - unreadable,
+        invalid,
+        if unreadable > 0 {
+            format!(", {unreadable} unreadable")
+        } else {
+            String::new()
+        }
+    );
+    if unreadable > 0 {
+        ExitCode::from(2)
+    } else if invalid > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}

@@ -1,0 +1,56 @@
+//! The BML language layer: the typed model of BML 1.0 blocks with the BMLA/BMLT extensions, the
+//! streaming parser, static validation, constraint extraction and the writer.
+//!
+//! ```
+//! use bml_realizer::bml;
+//! let parsed = bml::load(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b1">
+//!     <speech id="s1"><text>Hello <sync id="w"/>world</text></speech>
+//!     <gesture id="g1" lexeme="BEAT" stroke="s1:w"/>
+//! </bml>"#).unwrap();
+//! let constraints = bml::extract(&parsed.block);
+//! assert_eq!(constraints[0].to_string(), "g1:stroke = s1:w");
+//! ```
+
+mod constraints;
+mod diagnostic;
+mod kinds;
+mod model;
+mod parser;
+mod syncref;
+mod validate;
+mod writer;
+
+pub use constraints::{extract, Anchor, Constraint, Relation, Source};
+pub use diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos, Severity};
+pub use kinds::{ALL_STANDARD_SYNCS, FACE_SYNCS, GAZE_SYNCS, GESTURE_SYNCS, START_END};
+pub use model::*;
+pub use parser::{parse, parse_with_diagnostics, Parsed};
+pub use syncref::{SyncPoint, SyncRef, SyncRefError, ANTICIPATORS};
+pub use validate::validate;
+pub use writer::write;
+
+/// Parses and validates one block: the block plus warnings, or every diagnostic if any is an error.
+pub fn load(src: &str) -> Result<Parsed, BmlError> {
+    let (block, mut diags) = check(src);
+    match block {
+        Some(block) if !diags.iter().any(Diagnostic::is_error) => Ok(Parsed {
+            block,
+            warnings: diags,
+        }),
+        _ => {
+            diags.sort_by_key(|d| (d.pos.line, d.pos.col));
+            Err(BmlError(diags))
+        }
+    }
+}
+
+/// Parses and validates as far as possible, returning the block (if the text is a `<bml>`
+/// document) and every diagnostic in source order.
+pub fn check(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
+    let (block, mut diags) = parse_with_diagnostics(src);
+    if let Some(b) = &block {
+        diags.extend(validate(b));
+        diags.sort_by_key(|d| (d.pos.line, d.pos.col));
+    }
+    (block, diags)
+}

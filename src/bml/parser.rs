@@ -1,0 +1,1574 @@
+//! The streaming BML parser (quick-xml): text → [`Block`], with every problem reported as a
+//! [`Diagnostic`] at its line:column. Structure, attribute values and sync reference syntax are
+//! checked here; cross-references are checked by `validate.rs`.
+
+use std::borrow::Cow;
+
+use quick_xml::events::Event;
+use quick_xml::name::ResolveResult;
+use quick_xml::NsReader;
+
+use super::diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos};
+use super::model::*;
+use super::syncref::{parse_seconds, SyncRef};
+
+/// A parsed block together with the warnings found while reading it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parsed {
+    /// The block.
+    pub block: Block,
+    /// Warnings (unsupported extensions, unknown lexemes, ...), in source order.
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// Parses one `<bml>` block. Returns every diagnostic as an error if any of them is an error.
+/// Cross-reference checks are not done here: use [`super::load`] for parse + validation.
+pub fn parse(src: &str) -> Result<Parsed, BmlError> {
+    let (block, diags) = parse_with_diagnostics(src);
+    match block {
+        Some(block) if !diags.iter().any(Diagnostic::is_error) => Ok(Parsed {
+            block,
+            warnings: diags,
+        }),
+        _ => Err(BmlError(diags)),
+    }
+}
+
+/// Parses as far as possible: the block (unless the text is not a `<bml>` document at all) and all
+/// diagnostics, errors included.
+pub fn parse_with_diagnostics(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
+    let mut p = Parser::new(src);
+    let block = p.document();
+    let mut diags = p.diags;
+    diags.sort_by_key(|d| (d.pos.line, d.pos.col));
+    (block, diags)
+}
+
+/// The namespace of an element or attribute, as far as this parser cares.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Ns {
+    /// No namespace (unprefixed attribute, or element without a default namespace).
+    None,
+    /// BML 1.0 core.
+    Bml,
+    /// BML 1.0 core extensions.
+    CoreExt,
+    /// BMLA.
+    Bmla,
+    /// BMLT.
+    Bmlt,
+    /// Anything else.
+    Other(String),
+}
+
+impl Ns {
+    fn from_uri(uri: &[u8]) -> Ns {
+        match uri {
+            b"http://www.bml-initiative.org/bml/bml-1.0" => Ns::Bml,
+            b"http://www.bml-initiative.org/bml/coreextensions-1.0" => Ns::CoreExt,
+            b"http://www.asap-project.org/bmla" => Ns::Bmla,
+            b"http://hmi.ewi.utwente.nl/bmlt" => Ns::Bmlt,
+            other => Ns::Other(String::from_utf8_lossy(other).into_owned()),
+        }
+    }
+
+    fn uri(&self) -> &str {
+        match self {
+            Ns::None => "",
+            Ns::Bml => NS_BML,
+            Ns::CoreExt => NS_CORE_EXT,
+            Ns::Bmla => NS_BMLA,
+            Ns::Bmlt => NS_BMLT,
+            Ns::Other(u) => u,
+        }
+    }
+
+    /// Core BML elements may be written without a namespace.
+    fn is_core(&self) -> bool {
+        matches!(self, Ns::None | Ns::Bml)
+    }
+
+    fn is_ext(&self) -> bool {
+        matches!(self, Ns::Bmla | Ns::Bmlt)
+    }
+}
+
+#[derive(Debug, Clone)]
+struct RawAttr {
+    ns: Ns,
+    name: String,
+    value: String,
+    offset: usize,
+}
+
+#[derive(Debug)]
+struct El {
+    ns: Ns,
+    name: String,
+    qname: String,
+    attrs: Vec<RawAttr>,
+    empty: bool,
+    offset: usize,
+    inner_start: usize,
+}
+
+#[derive(Debug)]
+enum Tok {
+    Start(El),
+    End { offset: usize, after: usize },
+    Text { text: String, offset: usize },
+    Eof,
+}
+
+/// Fatal XML error: parsing stops.
+struct Fatal;
+
+struct Parser<'i> {
+    src: &'i str,
+    reader: NsReader<&'i [u8]>,
+    lines: LineIndex,
+    diags: Vec<Diagnostic>,
+    pending: Option<Tok>,
+}
+
+/// Remaining attributes of an element, taken one by one by name.
+struct Attrs {
+    items: Vec<Option<RawAttr>>,
+}
+
+impl Attrs {
+    fn take(&mut self, name: &str) -> Option<RawAttr> {
+        self.items
+            .iter_mut()
+            .find(|a| matches!(a, Some(a) if a.ns == Ns::None && a.name == name))
+            .and_then(Option::take)
+    }
+
+    fn take_ext(&mut self, names: &[&str]) -> Option<RawAttr> {
+        self.items
+            .iter_mut()
+            .find(|a| matches!(a, Some(a) if a.ns.is_ext() && names.contains(&a.name.as_str())))
+            .and_then(Option::take)
+    }
+
+    fn rest(self) -> impl Iterator<Item = RawAttr> {
+        self.items.into_iter().flatten()
+    }
+}
+
+impl<'i> Parser<'i> {
+    fn new(src: &'i str) -> Self {
+        Parser {
+            src,
+            reader: NsReader::from_str(src),
+            lines: LineIndex::new(src),
+            diags: Vec::new(),
+            pending: None,
+        }
+    }
+
+    fn pos(&self, offset: usize) -> Pos {
+        self.lines.pos(self.src, offset)
+    }
+
+    fn error(&mut self, code: Code, offset: usize, msg: impl Into<String>) {
+        let pos = self.pos(offset);
+        self.diags.push(Diagnostic::error(code, pos, msg));
+    }
+
+    fn warn(&mut self, code: Code, offset: usize, msg: impl Into<String>) {
+        let pos = self.pos(offset);
+        self.diags.push(Diagnostic::warning(code, pos, msg));
+    }
+
+    fn offset_in_src(&self, bytes: &[u8], fallback: usize) -> usize {
+        let base = self.src.as_ptr() as usize;
+        let p = bytes.as_ptr() as usize;
+        if p >= base && p <= base + self.src.len() {
+            p - base
+        } else {
+            fallback
+        }
+    }
+
+    fn xml_error(&mut self, e: impl std::fmt::Display) -> Fatal {
+        let at = self.reader.error_position() as usize;
+        self.error(Code::NotXml, at, format!("not well-formed XML: {e}"));
+        Fatal
+    }
+
+    /// Reads the next token, merging adjacent text, character references and CDATA.
+    fn next(&mut self) -> Result<Tok, Fatal> {
+        if let Some(t) = self.pending.take() {
+            return Ok(t);
+        }
+        let mut text: Option<(String, usize)> = None;
+        loop {
+            let before = self.reader.buffer_position() as usize;
+            let (ns, ev) = match self.reader.read_resolved_event() {
+                Ok((res, ev)) => {
+                    let ns = match res {
+                        ResolveResult::Bound(n) => Ok(Ns::from_uri(n.as_ref())),
+                        ResolveResult::Unbound => Ok(Ns::None),
+                        ResolveResult::Unknown(p) => Err(String::from_utf8_lossy(&p).into_owned()),
+                    };
+                    (ns, ev)
+                }
+                Err(e) => return Err(self.xml_error(e)),
+            };
+            let tok = match ev {
+                Event::Start(e) => Tok::Start(self.element(e, false, ns, before)?),
+                Event::Empty(e) => Tok::Start(self.element(e, true, ns, before)?),
+                Event::End(_) => Tok::End {
+                    offset: before,
+                    after: self.reader.buffer_position() as usize,
+                },
+                Event::Eof => Tok::Eof,
+                Event::Text(t) => {
+                    let s = match t.xml_content() {
+                        Ok(s) => s,
+                        Err(e) => return Err(self.xml_error(e)),
+                    };
+                    push_text(&mut text, &s, before);
+                    continue;
+                }
+                Event::CData(c) => {
+                    let s = match c.decode() {
+                        Ok(s) => s,
+                        Err(e) => return Err(self.xml_error(e)),
+                    };
+                    push_text(&mut text, &s, before);
+                    continue;
+                }
+                Event::GeneralRef(r) => {
+                    let resolved: Cow<str> = match r.resolve_char_ref() {
+                        Ok(Some(c)) => c.to_string().into(),
+                        Ok(None) => {
+                            let name = r.decode().map(|n| n.into_owned()).unwrap_or_default();
+                            match quick_xml::escape::resolve_predefined_entity(&name) {
+                                Some(v) => v.into(),
+                                None => {
+                                    self.error(
+                                        Code::NotXml,
+                                        before,
+                                        format!("unknown entity '&{name};'"),
+                                    );
+                                    return Err(Fatal);
+                                }
+                            }
+                        }
+                        Err(e) => return Err(self.xml_error(e)),
+                    };
+                    push_text(&mut text, &resolved, before);
+                    continue;
+                }
+                _ => continue, // comments, processing instructions, declarations, doctype
+            };
+            return Ok(match text {
+                Some((text, offset)) => {
+                    self.pending = Some(tok);
+                    Tok::Text { text, offset }
+                }
+                None => tok,
+            });
+        }
+    }
+
+    /// Turns a start (or empty-element) tag into an [`El`], resolving attribute namespaces while
+    /// the element's namespace scope is current.
+    fn element(
+        &mut self,
+        e: quick_xml::events::BytesStart<'i>,
+        empty: bool,
+        ns: Result<Ns, String>,
+        before: usize,
+    ) -> Result<El, Fatal> {
+        let qname = String::from_utf8_lossy(e.name().as_ref()).into_owned();
+        let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+        let ns = match ns {
+            Ok(ns) => ns,
+            Err(prefix) => {
+                self.error(
+                    Code::NotXml,
+                    before,
+                    format!("namespace prefix '{prefix}' of <{qname}> is not declared"),
+                );
+                Ns::Other(prefix)
+            }
+        };
+        let mut attrs = Vec::new();
+        for a in e.attributes() {
+            let a = match a {
+                Ok(a) => a,
+                Err(err) => {
+                    self.error(
+                        Code::NotXml,
+                        before,
+                        format!("not well-formed XML in the attributes of <{qname}>: {err}"),
+                    );
+                    return Err(Fatal);
+                }
+            };
+            let key = a.key.as_ref();
+            if key == b"xmlns" || key.starts_with(b"xmlns:") {
+                continue;
+            }
+            let offset = self.offset_in_src(key, before);
+            let aname = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
+            let ans = match self.reader.resolve_attribute(a.key).0 {
+                ResolveResult::Bound(n) => match Ns::from_uri(n.as_ref()) {
+                    Ns::Bml => Ns::None,
+                    other => other,
+                },
+                ResolveResult::Unbound => Ns::None,
+                ResolveResult::Unknown(p) => {
+                    let p = String::from_utf8_lossy(&p).into_owned();
+                    self.error(
+                        Code::NotXml,
+                        offset,
+                        format!(
+                            "namespace prefix '{p}' of attribute '{}' is not declared",
+                            String::from_utf8_lossy(key)
+                        ),
+                    );
+                    Ns::Other(p)
+                }
+            };
+            let value = match a.unescape_value() {
+                Ok(v) => v.into_owned(),
+                Err(err) => {
+                    self.error(
+                        Code::NotXml,
+                        offset,
+                        format!(
+                            "attribute '{}' has a bad character or entity reference: {err}",
+                            String::from_utf8_lossy(key)
+                        ),
+                    );
+                    String::from_utf8_lossy(&a.value).into_owned()
+                }
+            };
+            attrs.push(RawAttr {
+                ns: ans,
+                name: aname,
+                value,
+                offset,
+            });
+        }
+        let inner_start = self.reader.buffer_position() as usize;
+        Ok(El {
+            ns,
+            name,
+            qname,
+            attrs,
+            empty,
+            offset: before,
+            inner_start,
+        })
+    }
+
+    /// Skips the rest of an element whose start tag was just read; returns the raw inner XML and
+    /// the offset just after the end tag.
+    fn skip(&mut self, el: &El) -> Result<(String, usize), Fatal> {
+        if el.empty {
+            return Ok((String::new(), el.inner_start));
+        }
+        let mut depth = 0usize;
+        loop {
+            match self.next()? {
+                Tok::Start(e) if !e.empty => depth += 1,
+                Tok::End { offset, after } => {
+                    if depth == 0 {
+                        return Ok((self.src[el.inner_start..offset].to_string(), after));
+                    }
+                    depth -= 1;
+                }
+                Tok::Eof => return Err(self.unexpected_eof(el)),
+                _ => {}
+            }
+        }
+    }
+
+    fn unexpected_eof(&mut self, el: &El) -> Fatal {
+        self.error(
+            Code::NotXml,
+            el.offset,
+            format!("<{}> is never closed", el.qname),
+        );
+        Fatal
+    }
+
+    /// Iterates the children of `el`: calls `f` for each child element (which must consume it,
+    /// e.g. via `skip`), reports non-whitespace text unless `text` handles it.
+    fn children(
+        &mut self,
+        el: &El,
+        mut on_child: impl FnMut(&mut Self, El) -> Result<(), Fatal>,
+    ) -> Result<usize, Fatal> {
+        if el.empty {
+            return Ok(el.inner_start);
+        }
+        loop {
+            match self.next()? {
+                Tok::Start(child) => on_child(self, child)?,
+                Tok::End { after, .. } => return Ok(after),
+                Tok::Text { text, offset } => {
+                    if !text.trim().is_empty() {
+                        let lead = text.len() - text.trim_start().len();
+                        self.error(
+                            Code::UnexpectedText,
+                            offset + lead,
+                            format!(
+                                "unexpected text '{}' inside <{}>",
+                                abbreviate(text.trim()),
+                                el.qname
+                            ),
+                        );
+                    }
+                }
+                Tok::Eof => return Err(self.unexpected_eof(el)),
+            }
+        }
+    }
+
+    fn document(&mut self) -> Option<Block> {
+        self.document_inner().ok().flatten()
+    }
+
+    fn document_inner(&mut self) -> Result<Option<Block>, Fatal> {
+        let root = loop {
+            match self.next()? {
+                Tok::Start(el) => break el,
+                Tok::Text { text, offset } if !text.trim().is_empty() => {
+                    self.error(
+                        Code::NotXml,
+                        offset,
+                        "text before the root element; expected <bml>",
+                    );
+                    return Err(Fatal);
+                }
+                Tok::Text { .. } => {}
+                Tok::End { offset, .. } => {
+                    self.error(Code::NotXml, offset, "end tag without a start tag");
+                    return Err(Fatal);
+                }
+                Tok::Eof => {
+                    self.error(
+                        Code::NotXml,
+                        0,
+                        "no XML element found; expected a <bml> block",
+                    );
+                    return Err(Fatal);
+                }
+            }
+        };
+        if root.name != "bml" || !root.ns.is_core() {
+            let ns = if root.ns.is_core() {
+                String::new()
+            } else {
+                format!(" in namespace {}", root.ns.uri())
+            };
+            self.error(
+                Code::WrongRoot,
+                root.offset,
+                format!(
+                    "root element is <{}>{ns}; expected <bml> (BML 1.0 block)",
+                    root.qname
+                ),
+            );
+            return Ok(None);
+        }
+        let block = self.block(root)?;
+        loop {
+            match self.next()? {
+                Tok::Eof => break,
+                Tok::Text { text, offset } if !text.trim().is_empty() => {
+                    self.error(
+                        Code::NotXml,
+                        offset,
+                        "text after the end of the <bml> element",
+                    );
+                    break;
+                }
+                Tok::Start(el) => {
+                    self.error(
+                        Code::NotXml,
+                        el.offset,
+                        format!(
+                            "<{}> after the end of the <bml> element: one block per document",
+                            el.qname
+                        ),
+                    );
+                    break;
+                }
+                _ => {}
+            }
+        }
+        Ok(Some(block))
+    }
+
+    fn bool_attr(&mut self, a: &RawAttr) -> bool {
+        match a.value.trim().to_ascii_lowercase().as_str() {
+            "true" => true,
+            "false" => false,
+            _ => {
+                self.error(
+                    Code::InvalidNumber,
+                    a.offset,
+                    format!(
+                        "attribute '{}' is '{}'; expected true or false",
+                        a.name, a.value
+                    ),
+                );
+                false
+            }
+        }
+    }
+
+    fn block(&mut self, el: El) -> Result<Block, Fatal> {
+        let mut block = Block {
+            pos: self.pos(el.offset),
+            ..Block::default()
+        };
+        let mut attrs = Attrs {
+            items: el.attrs.iter().cloned().map(Some).collect(),
+        };
+        match attrs.take("id") {
+            Some(a) if !a.value.trim().is_empty() => {
+                block.id = a.value.trim().to_string();
+                if block.id.contains(':') {
+                    self.error(
+                        Code::InvalidId,
+                        a.offset,
+                        format!(
+                            "block id '{}' contains ':', so it cannot be referred to",
+                            block.id
+                        ),
+                    );
+                }
+            }
+            Some(a) => self.error(
+                Code::MissingBlockId,
+                a.offset,
+                "the <bml> block has an empty id",
+            ),
+            None => self.error(
+                Code::MissingBlockId,
+                el.offset,
+                "the <bml> block has no id attribute; every block needs one",
+            ),
+        }
+        block.character_id = attrs.take("characterId").map(|a| a.value);
+        let composition = attrs.take("composition");
+        let scheduling = attrs.take("scheduling");
+        if let (Some(_), Some(s)) = (&composition, &scheduling) {
+            self.warn(
+                Code::UnknownAttribute,
+                s.offset,
+                "both composition and its draft alias scheduling are given; scheduling is ignored",
+            );
+        }
+        if let Some(a) = composition.or(scheduling) {
+            match Composition::parse(&a.value) {
+                Some(c) => block.composition = c,
+                None => self.error(
+                    Code::UnknownComposition,
+                    a.offset,
+                    format!(
+                        "unknown composition '{}'; expected MERGE, APPEND, REPLACE or APPEND-AFTER(block,...)",
+                        a.value
+                    ),
+                ),
+            }
+        }
+        if let Some(a) = attrs.take_ext(&["preplan"]) {
+            block.ext.preplan = self.bool_attr(&a);
+        }
+        if let Some(a) = attrs.take_ext(&["allowexternalrefs", "allowExternalRefs"]) {
+            block.ext.allow_external_refs = self.bool_attr(&a);
+        }
+        let lists: [(&str, &mut Vec<String>); 6] = [
+            ("onStart", &mut block.ext.on_start),
+            ("interrupt", &mut block.ext.interrupt),
+            ("appendAfter", &mut block.ext.append_after),
+            ("chunkAfter", &mut block.ext.chunk_after),
+            ("chunkBefore", &mut block.ext.chunk_before),
+            ("prependBefore", &mut block.ext.prepend_before),
+        ];
+        for (name, target) in lists {
+            if let Some(a) = attrs.take_ext(&[name]) {
+                *target = split_id_list(&a.value);
+            }
+        }
+        block.foreign_attrs = self.leftover_attrs(attrs, "<bml>");
+
+        let mut behaviours = Vec::new();
+        let mut constraints = Vec::new();
+        self.children(&el, |p, child| {
+            p.block_child(child, false, &mut behaviours, &mut constraints)
+        })?;
+        block.behaviours = behaviours;
+        block.constraints = constraints;
+        Ok(block)
+    }
+
+    /// Reports leftover attributes: unprefixed ones are errors, extension ones warnings (kept).
+    fn leftover_attrs(&mut self, attrs: Attrs, on: &str) -> Vec<ForeignAttr> {
+        let mut kept = Vec::new();
+        for a in attrs.rest() {
+            if a.ns == Ns::None {
+                self.error(
+                    Code::UnknownAttribute,
+                    a.offset,
+                    format!("attribute '{}' is not defined on {on}", a.name),
+                );
+            } else {
+                self.warn(
+                    Code::UnsupportedAttribute,
+                    a.offset,
+                    format!(
+                        "extension attribute '{}' (namespace {}) on {on} is not supported and is ignored",
+                        a.name,
+                        a.ns.uri()
+                    ),
+                );
+                kept.push(ForeignAttr {
+                    ns: a.ns.uri().to_string(),
+                    name: a.name,
+                    value: a.value,
+                });
+            }
+        }
+        kept
+    }
+
+    fn block_child(
+        &mut self,
+        child: El,
+        required: bool,
+        behaviours: &mut Vec<Behaviour>,
+        constraints: &mut Vec<ConstraintElement>,
+    ) -> Result<(), Fatal> {
+        if child.ns.is_core() && child.name == "constraint" {
+            if let Some(c) = self.constraint(child, required)? {
+                constraints.push(c);
+            }
+        } else if child.ns.is_core() && child.name == "required" {
+            if required {
+                self.error(
+                    Code::UnknownElement,
+                    child.offset,
+                    "<required> cannot be nested in <required>",
+                );
+            }
+            for a in &child.attrs {
+                self.error(
+                    Code::UnknownAttribute,
+                    a.offset,
+                    format!("attribute '{}' is not defined on <required>", a.name),
+                );
+            }
+            self.children(&child, |p, c| {
+                p.block_child(c, true, behaviours, constraints)
+            })?;
+        } else if let Some(b) = self.behaviour(child, required)? {
+            behaviours.push(b);
+        }
+        Ok(())
+    }
+
+    fn sync_ref(&mut self, a: &RawAttr, on: &str) -> Option<SyncRef> {
+        match SyncRef::parse(&a.value) {
+            Ok(r) => Some(r),
+            Err(e) => {
+                self.error(
+                    e.code,
+                    a.offset,
+                    format!("{on}, attribute {}: {}", a.name, e.message),
+                );
+                None
+            }
+        }
+    }
+
+    fn constraint(&mut self, el: El, required: bool) -> Result<Option<ConstraintElement>, Fatal> {
+        let mut attrs = Attrs {
+            items: el.attrs.iter().cloned().map(Some).collect(),
+        };
+        let id = attrs.take("id").map(|a| a.value);
+        let _ = self.leftover_attrs(attrs, "<constraint>");
+        let mut items = Vec::new();
+        let mut ok = true;
+        self.children(&el, |p, item| {
+            let kind = match (item.ns.is_core(), item.name.as_str()) {
+                (true, k @ ("synchronize" | "before" | "after")) => k.to_string(),
+                _ => {
+                    p.error(
+                        Code::UnknownElement,
+                        item.offset,
+                        format!("<{}> is not allowed in <constraint>; expected <synchronize>, <before> or <after>", item.qname),
+                    );
+                    p.skip(&item)?;
+                    ok = false;
+                    return Ok(());
+                }
+            };
+            let on = format!("<{kind}>");
+            let mut attrs = Attrs {
+                items: item.attrs.iter().cloned().map(Some).collect(),
+            };
+            let reference = match attrs.take("ref") {
+                Some(a) => {
+                    let r = p.sync_ref(&a, &on);
+                    ok &= r.is_some();
+                    r
+                }
+                None if kind == "synchronize" => None,
+                None => {
+                    p.error(Code::MissingAttribute, item.offset, format!("{on} needs a ref attribute"));
+                    ok = false;
+                    None
+                }
+            };
+            let _ = p.leftover_attrs(attrs, &on);
+            let mut syncs = Vec::new();
+            p.children(&item, |p, s| {
+                if !(s.ns.is_core() && s.name == "sync") {
+                    p.error(Code::UnknownElement, s.offset, format!("<{}> is not allowed in {on}; expected <sync ref>", s.qname));
+                    ok = false;
+                    p.skip(&s)?;
+                    return Ok(());
+                }
+                let mut attrs = Attrs {
+                    items: s.attrs.iter().cloned().map(Some).collect(),
+                };
+                match attrs.take("ref") {
+                    Some(a) => match p.sync_ref(&a, "<sync>") {
+                        Some(r) => syncs.push(ConstraintSync {
+                            reference: r,
+                            pos: p.pos(s.offset),
+                        }),
+                        None => ok = false,
+                    },
+                    None => {
+                        p.error(Code::MissingAttribute, s.offset, "<sync> needs a ref attribute");
+                        ok = false;
+                    }
+                }
+                let _ = p.leftover_attrs(attrs, "<sync>");
+                p.skip(&s)?;
+                Ok(())
+            })?;
+            let pos = p.pos(item.offset);
+            let needed = if reference.is_some() { 1 } else { 2 };
+            if ok && syncs.len() < needed {
+                p.error(
+                    Code::InvalidConstraint,
+                    item.offset,
+                    format!("{on} relates nothing: it needs {} <sync ref> child{}", needed, if needed == 1 { "" } else { "ren" }),
+                );
+                ok = false;
+            }
+            match (kind.as_str(), reference) {
+                ("before", Some(reference)) => items.push(ConstraintItem::Before { reference, syncs, pos }),
+                ("after", Some(reference)) => items.push(ConstraintItem::After { reference, syncs, pos }),
+                ("synchronize", reference) => items.push(ConstraintItem::Synchronize { reference, syncs, pos }),
+                _ => {} // missing ref: already reported
+            }
+            Ok(())
+        })?;
+        Ok(ok.then(|| ConstraintElement {
+            id,
+            items,
+            required,
+            pos: self.pos(el.offset),
+        }))
+    }
+
+    fn behaviour(&mut self, el: El, required: bool) -> Result<Option<Behaviour>, Fatal> {
+        let core = el.ns.is_core();
+        let known = match (core, &el.ns, el.name.as_str()) {
+            (
+                true,
+                _,
+                "speech" | "gesture" | "pointing" | "head" | "headDirectionShift" | "gaze"
+                | "gazeShift" | "face" | "faceLexeme" | "faceFacs" | "faceShift" | "posture"
+                | "postureShift" | "locomotion" | "wait",
+            ) => true,
+            (_, Ns::CoreExt, "faceFacs") => true,
+            (_, Ns::Bmla | Ns::Bmlt, "interrupt" | "activate" | "parametervaluechange") => true,
+            (
+                _,
+                Ns::Bmlt,
+                "procanimation"
+                | "procanimationgesture"
+                | "keyframe"
+                | "controller"
+                | "audiofile"
+                | "noise"
+                | "facemorph"
+                | "transition"
+                | "text",
+            ) => true,
+            _ => false,
+        };
+        if !known && core {
+            self.error(
+                Code::UnknownElement,
+                el.offset,
+                format!("<{}> is not a BML 1.0 behaviour or block element", el.qname),
+            );
+            self.skip(&el)?;
+            return Ok(None);
+        }
+        let on = format!("<{}>", el.qname);
+        let mut attrs = Attrs {
+            items: el.attrs.iter().cloned().map(Some).collect(),
+        };
+        let id = match attrs.take("id") {
+            Some(a) if !a.value.trim().is_empty() => {
+                let id = a.value.trim().to_string();
+                if id.contains(':') {
+                    self.error(
+                        Code::InvalidId,
+                        a.offset,
+                        format!("behaviour id '{id}' contains ':', so it cannot be referred to"),
+                    );
+                }
+                Some(id)
+            }
+            _ => {
+                self.error(
+                    Code::MissingId,
+                    el.offset,
+                    format!("{on} has no id attribute; every behaviour needs one"),
+                );
+                None
+            }
+        };
+        let on = match &id {
+            Some(id) => format!("<{} id=\"{id}\">", el.qname),
+            None => on,
+        };
+        if !known {
+            self.warn(
+                Code::UnsupportedExtension,
+                el.offset,
+                format!("unsupported extension behaviour {on} (namespace {}); it is kept but will not be realized", el.ns.uri()),
+            );
+            let syncs = self.sync_attrs(&mut attrs, super::kinds::ALL_STANDARD_SYNCS, &on);
+            let (content, _) = self.skip(&el)?;
+            let kind = BehaviourKind::Unknown(UnknownBehaviour {
+                ns: el.ns.uri().to_string(),
+                name: el.name.clone(),
+                attrs: attrs
+                    .rest()
+                    .map(|a| ForeignAttr {
+                        ns: a.ns.uri().to_string(),
+                        name: a.name,
+                        value: a.value,
+                    })
+                    .collect(),
+                content,
+            });
+            return Ok(id.map(|id| Behaviour {
+                id,
+                kind,
+                syncs,
+                required,
+                descriptions: Vec::new(),
+                foreign_attrs: Vec::new(),
+                pos: self.pos(el.offset),
+            }));
+        }
+
+        let mut kb = KindBuilder::new(self, &mut attrs, &on, &el);
+        let kind = kb.build();
+        let Some(mut kind) = kind else {
+            self.skip(&el)?;
+            return Ok(None);
+        };
+        let syncs = self.sync_attrs(&mut attrs, kind.standard_syncs(), &on);
+        let foreign_attrs = self.leftover_attrs(attrs, &on);
+        let descriptions = self.behaviour_children(&el, &mut kind, &on)?;
+        Ok(id.map(|id| Behaviour {
+            id,
+            kind,
+            syncs,
+            required,
+            descriptions,
+            foreign_attrs,
+            pos: self.pos(el.offset),
+        }))
+    }
+
+    fn sync_attrs(&mut self, attrs: &mut Attrs, names: &[&str], on: &str) -> Vec<SyncAttr> {
+        let mut out: Vec<(usize, SyncAttr)> = Vec::new();
+        for &name in names {
+            if let Some(a) = attrs.take(name) {
+                if let Some(value) = self.sync_ref(&a, on) {
+                    out.push((
+                        a.offset,
+                        SyncAttr {
+                            sync: name.to_string(),
+                            value,
+                            pos: self.pos(a.offset),
+                        },
+                    ));
+                }
+            }
+        }
+        out.sort_by_key(|(o, _)| *o);
+        out.into_iter().map(|(_, s)| s).collect()
+    }
+
+    /// Reads the children of a known behaviour into `kind`; returns its descriptions.
+    fn behaviour_children(
+        &mut self,
+        el: &El,
+        kind: &mut BehaviourKind,
+        on: &str,
+    ) -> Result<Vec<Description>, Fatal> {
+        let mut descriptions = Vec::new();
+        let mut saw_text = false;
+        let mut saw_stance = false;
+        let mut saw_trajectory = false;
+        self.children(el, |p, c| {
+            let core = c.ns.is_core();
+            match (&mut *kind, c.name.as_str()) {
+                (_, "description") if core => {
+                    let mut attrs = Attrs {
+                        items: c.attrs.iter().cloned().map(Some).collect(),
+                    };
+                    let priority =
+                        attrs
+                            .take("priority")
+                            .and_then(|a| match a.value.trim().parse::<i64>() {
+                                Ok(v) => Some(v),
+                                Err(_) => {
+                                    p.error(
+                                        Code::InvalidNumber,
+                                        a.offset,
+                                        format!(
+                                            "description priority '{}' is not an integer",
+                                            a.value
+                                        ),
+                                    );
+                                    None
+                                }
+                            });
+                    let kind_attr = attrs.take("type");
+                    if kind_attr.is_none() {
+                        p.error(
+                            Code::MissingAttribute,
+                            c.offset,
+                            format!("<description> in {on} needs a type attribute"),
+                        );
+                    }
+                    let _ = p.leftover_attrs(attrs, "<description>");
+                    let (content, _) = p.skip(&c)?;
+                    descriptions.push(Description {
+                        priority,
+                        kind: kind_attr.map(|a| a.value).unwrap_or_default(),
+                        content,
+                        pos: p.pos(c.offset),
+                    });
+                }
+                (BehaviourKind::Speech(s) | BehaviourKind::Text(s), "text")
+                    if core || c.ns == Ns::Bmlt =>
+                {
+                    if saw_text {
+                        p.error(
+                            Code::UnknownElement,
+                            c.offset,
+                            format!("{on} has more than one <text>"),
+                        );
+                    }
+                    saw_text = true;
+                    for a in &c.attrs {
+                        p.error(
+                            Code::UnknownAttribute,
+                            a.offset,
+                            format!("attribute '{}' is not defined on <text>", a.name),
+                        );
+                    }
+                    p.speech_text(&c, &mut s.text)?;
+                }
+                (BehaviourKind::Posture(post) | BehaviourKind::PostureShift(post), "stance")
+                    if core =>
+                {
+                    if saw_stance {
+                        p.error(
+                            Code::UnknownElement,
+                            c.offset,
+                            format!("{on} has more than one <stance>"),
+                        );
+                    }
+                    saw_stance = true;
+                    let mut attrs = Attrs {
+                        items: c.attrs.iter().cloned().map(Some).collect(),
+                    };
+                    if let Some(t) = p.req_enum(
+                        &mut attrs,
+                        "type",
+                        "<stance>",
+                        c.offset,
+                        StanceType::parse,
+                        StanceType::expected,
+                    ) {
+                        post.stance = t;
+                    }
+                    let _ = p.leftover_attrs(attrs, "<stance>");
+                    p.skip(&c)?;
+                }
+                (BehaviourKind::Posture(post) | BehaviourKind::PostureShift(post), "pose")
+                    if core =>
+                {
+                    let mut attrs = Attrs {
+                        items: c.attrs.iter().cloned().map(Some).collect(),
+                    };
+                    let part = p.req_enum(
+                        &mut attrs,
+                        "part",
+                        "<pose>",
+                        c.offset,
+                        PosePart::parse,
+                        PosePart::expected,
+                    );
+                    let lexeme = p.req_str(&mut attrs, "lexeme", "<pose>", c.offset);
+                    let _ = p.leftover_attrs(attrs, "<pose>");
+                    if let (Some(part), Some(lexeme)) = (part, lexeme) {
+                        post.poses.push(Pose { part, lexeme });
+                    }
+                    p.skip(&c)?;
+                }
+                (BehaviourKind::ParameterValueChange(pvc), "trajectory")
+                    if c.ns.is_ext() || c.ns == Ns::None =>
+                {
+                    if saw_trajectory {
+                        p.error(
+                            Code::UnknownElement,
+                            c.offset,
+                            format!("{on} has more than one <trajectory>"),
+                        );
+                    }
+                    saw_trajectory = true;
+                    let mut attrs = Attrs {
+                        items: c.attrs.iter().cloned().map(Some).collect(),
+                    };
+                    let t = p.req_enum(
+                        &mut attrs,
+                        "type",
+                        "<trajectory>",
+                        c.offset,
+                        TrajectoryType::parse,
+                        TrajectoryType::expected,
+                    );
+                    let initial = p.opt_f64(&mut attrs, "initialValue");
+                    let target = p.req_str(&mut attrs, "targetValue", "<trajectory>", c.offset);
+                    let _ = p.leftover_attrs(attrs, "<trajectory>");
+                    if let Some(t) = t {
+                        pvc.trajectory.kind = t;
+                    }
+                    pvc.trajectory.initial_value = initial;
+                    if let Some(v) = target {
+                        match parse_seconds(&v) {
+                            Some(v) => pvc.trajectory.target_value = v,
+                            None => p.error(
+                                Code::InvalidNumber,
+                                c.offset,
+                                format!("<trajectory> targetValue '{v}' is not a number"),
+                            ),
+                        }
+                    }
+                    p.skip(&c)?;
+                }
+                (
+                    BehaviourKind::ProcAnimation(Animation { params, .. })
+                    | BehaviourKind::ProcAnimationGesture(Animation { params, .. })
+                    | BehaviourKind::Keyframe(Animation { params, .. })
+                    | BehaviourKind::Controller(Controller { params, .. })
+                    | BehaviourKind::Noise(Noise { params, .. })
+                    | BehaviourKind::Transition(Transition { params, .. }),
+                    "parameter",
+                ) if c.ns == Ns::Bmlt || c.ns == Ns::None => {
+                    let mut attrs = Attrs {
+                        items: c.attrs.iter().cloned().map(Some).collect(),
+                    };
+                    let name = p.req_str(&mut attrs, "name", "<parameter>", c.offset);
+                    let value = p.req_str(&mut attrs, "value", "<parameter>", c.offset);
+                    let _ = p.leftover_attrs(attrs, "<parameter>");
+                    if let (Some(name), Some(value)) = (name, value) {
+                        params.push(Param { name, value });
+                    }
+                    p.skip(&c)?;
+                }
+                (
+                    BehaviourKind::ProcAnimation(a)
+                    | BehaviourKind::ProcAnimationGesture(a)
+                    | BehaviourKind::Keyframe(a),
+                    _,
+                ) if !core => {
+                    let (_, after) = p.skip(&c)?;
+                    a.content.push_str(&p.src[c.offset..after]);
+                }
+                _ => {
+                    if core {
+                        p.error(
+                            Code::UnknownElement,
+                            c.offset,
+                            format!("<{}> is not allowed in {on}", c.qname),
+                        );
+                    } else {
+                        p.warn(
+                            Code::UnsupportedExtension,
+                            c.offset,
+                            format!(
+                                "extension element <{}> in {on} is not supported and is ignored",
+                                c.qname
+                            ),
+                        );
+                    }
+                    p.skip(&c)?;
+                }
+            }
+            Ok(())
+        })?;
+        match kind {
+            BehaviourKind::Speech(_) | BehaviourKind::Text(_) if !saw_text => {
+                self.error(
+                    Code::MissingElement,
+                    el.offset,
+                    format!("{on} has no <text> child"),
+                );
+            }
+            BehaviourKind::Posture(_) | BehaviourKind::PostureShift(_) if !saw_stance => {
+                self.error(
+                    Code::MissingElement,
+                    el.offset,
+                    format!("{on} has no <stance> child"),
+                );
+            }
+            BehaviourKind::ParameterValueChange(_) if !saw_trajectory => {
+                self.error(
+                    Code::MissingElement,
+                    el.offset,
+                    format!("{on} has no <trajectory> child"),
+                );
+            }
+            _ => {}
+        }
+        Ok(descriptions)
+    }
+
+    fn speech_text(&mut self, el: &El, out: &mut Vec<TextPart>) -> Result<(), Fatal> {
+        if el.empty {
+            return Ok(());
+        }
+        loop {
+            match self.next()? {
+                Tok::Text { text, .. } => match out.last_mut() {
+                    Some(TextPart::Text(t)) => t.push_str(&text),
+                    _ => out.push(TextPart::Text(text)),
+                },
+                Tok::Start(c) => {
+                    if c.ns.is_core() && c.name == "sync" {
+                        let mut attrs = Attrs {
+                            items: c.attrs.iter().cloned().map(Some).collect(),
+                        };
+                        match attrs.take("id") {
+                            Some(a) if !a.value.trim().is_empty() => {
+                                out.push(TextPart::Sync(a.value.trim().to_string()))
+                            }
+                            _ => self.error(
+                                Code::MissingId,
+                                c.offset,
+                                "<sync> in speech text has no id",
+                            ),
+                        }
+                        let _ = self.leftover_attrs(attrs, "<sync>");
+                    } else if c.ns.is_core() {
+                        self.error(
+                            Code::UnknownElement,
+                            c.offset,
+                            format!(
+                                "<{}> is not allowed in speech <text>; only <sync id> is",
+                                c.qname
+                            ),
+                        );
+                    } else {
+                        self.warn(Code::UnsupportedExtension, c.offset, format!("extension element <{}> in speech text is not supported and is ignored", c.qname));
+                    }
+                    self.skip(&c)?;
+                }
+                Tok::End { .. } => return Ok(()),
+                Tok::Eof => return Err(self.unexpected_eof(el)),
+            }
+        }
+    }
+
+    fn req_str(&mut self, attrs: &mut Attrs, name: &str, on: &str, at: usize) -> Option<String> {
+        match attrs.take(name) {
+            Some(a) => Some(a.value),
+            None => {
+                self.error(
+                    Code::MissingAttribute,
+                    at,
+                    format!("{on} needs a {name} attribute"),
+                );
+                None
+            }
+        }
+    }
+
+    fn opt_f64(&mut self, attrs: &mut Attrs, name: &str) -> Option<f64> {
+        let a = attrs.take(name)?;
+        let v = parse_seconds(&a.value);
+        if v.is_none() {
+            self.error(
+                Code::InvalidNumber,
+                a.offset,
+                format!("attribute '{name}' is '{}'; expected a number", a.value),
+            );
+        }
+        v
+    }
+
+    fn opt_u32(&mut self, attrs: &mut Attrs, name: &str) -> Option<u32> {
+        let a = attrs.take(name)?;
+        let v = a.value.trim().parse::<u32>().ok();
+        if v.is_none() {
+            self.error(
+                Code::InvalidNumber,
+                a.offset,
+                format!(
+                    "attribute '{name}' is '{}'; expected a non-negative integer",
+                    a.value
+                ),
+            );
+        }
+        v
+    }
+
+    fn opt_enum<T>(
+        &mut self,
+        attrs: &mut Attrs,
+        name: &str,
+        on: &str,
+        parse: fn(&str) -> Option<T>,
+        expected: fn() -> String,
+    ) -> Option<T> {
+        let a = attrs.take(name)?;
+        let v = parse(a.value.trim());
+        if v.is_none() {
+            self.error(
+                Code::InvalidEnumValue,
+                a.offset,
+                format!(
+                    "{on}: {name}=\"{}\" is not valid; expected one of {}",
+                    a.value,
+                    expected()
+                ),
+            );
+        }
+        v
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn req_enum<T>(
+        &mut self,
+        attrs: &mut Attrs,
+        name: &str,
+        on: &str,
+        at: usize,
+        parse: fn(&str) -> Option<T>,
+        expected: fn() -> String,
+    ) -> Option<T> {
+        if attrs
+            .items
+            .iter()
+            .flatten()
+            .all(|a| !(a.ns == Ns::None && a.name == name))
+        {
+            self.error(
+                Code::MissingAttribute,
+                at,
+                format!("{on} needs a {name} attribute (one of {})", expected()),
+            );
+            return None;
+        }
+        self.opt_enum(attrs, name, on, parse, expected)
+    }
+}
+
+/// Builds the kind-specific part of a known behaviour from its attributes.
+struct KindBuilder<'a, 'i> {
+    p: &'a mut Parser<'i>,
+    attrs: &'a mut Attrs,
+    on: &'a str,
+    el: &'a El,
+}
+
+impl<'a, 'i> KindBuilder<'a, 'i> {
+    fn new(p: &'a mut Parser<'i>, attrs: &'a mut Attrs, on: &'a str, el: &'a El) -> Self {
+        KindBuilder { p, attrs, on, el }
+    }
+
+    fn req(&mut self, name: &str) -> Option<String> {
+        self.p.req_str(self.attrs, name, self.on, self.el.offset)
+    }
+    fn opt(&mut self, name: &str) -> Option<String> {
+        self.attrs.take(name).map(|a| a.value)
+    }
+    fn f64(&mut self, name: &str) -> Option<f64> {
+        self.p.opt_f64(self.attrs, name)
+    }
+    fn u32(&mut self, name: &str) -> Option<u32> {
+        self.p.opt_u32(self.attrs, name)
+    }
+    fn mode(&mut self) -> Option<Mode> {
+        self.p
+            .opt_enum(self.attrs, "mode", self.on, Mode::parse, Mode::expected)
+    }
+    fn list(&mut self, name: &str) -> Vec<String> {
+        self.opt(name)
+            .map(|v| split_id_list(&v))
+            .unwrap_or_default()
+    }
+    fn gaze(&mut self) -> Option<Gaze> {
+        let target = self.req("target");
+        let influence = self.p.opt_enum(
+            self.attrs,
+            "influence",
+            self.on,
+            Influence::parse,
+            Influence::expected,
+        );
+        let offset_angle = self.f64("offsetAngle");
+        let offset_direction = self.p.opt_enum(
+            self.attrs,
+            "offsetDirection",
+            self.on,
+            OffsetDirection::parse,
+            OffsetDirection::expected,
+        );
+        Some(Gaze {
+            target: target?,
+            influence,
+            offset_angle,
+            offset_direction,
+        })
+    }
+    fn face_lexeme(&mut self) -> Option<FaceLexeme> {
+        let lexeme = self.req("lexeme");
+        let amount = self.f64("amount");
+        Some(FaceLexeme {
+            lexeme: lexeme?,
+            amount,
+        })
+    }
+    fn animation(&mut self) -> Animation {
+        let name = self.opt("name");
+        let file_name = self.opt("fileName").or_else(|| self.opt("filename"));
+        Animation {
+            name,
+            file_name,
+            params: Vec::new(),
+            content: String::new(),
+        }
+    }
+
+    fn build(&mut self) -> Option<BehaviourKind> {
+        let placeholder_posture = || Posture {
+            stance: StanceType::Standing,
+            poses: Vec::new(),
+        };
+        Some(match self.el.name.as_str() {
+            "speech" => BehaviourKind::Speech(Speech::default()),
+            "text" => BehaviourKind::Text(Speech::default()),
+            "gesture" => {
+                let lexeme = self.req("lexeme");
+                let mode = self.mode();
+                BehaviourKind::Gesture(Gesture {
+                    lexeme: lexeme?,
+                    mode,
+                })
+            }
+            "pointing" => {
+                let target = self.req("target");
+                let mode = self.mode();
+                BehaviourKind::Pointing(Pointing {
+                    target: target?,
+                    mode,
+                })
+            }
+            "head" => {
+                let lexeme = self.req("lexeme");
+                let repetition = self.u32("repetition");
+                let amount = self.f64("amount");
+                BehaviourKind::Head(Head {
+                    lexeme: lexeme?,
+                    repetition,
+                    amount,
+                })
+            }
+            "headDirectionShift" => BehaviourKind::HeadDirectionShift {
+                target: self.req("target")?,
+            },
+            "gaze" => BehaviourKind::Gaze(self.gaze()?),
+            "gazeShift" => BehaviourKind::GazeShift(self.gaze()?),
+            "face" => {
+                let lexeme = self.opt("lexeme");
+                let au = self.u32("au");
+                let side =
+                    self.p
+                        .opt_enum(self.attrs, "side", self.on, Side::parse, Side::expected);
+                let amount = self.f64("amount");
+                if lexeme.is_none() && au.is_none() {
+                    self.p.error(
+                        Code::MissingAttribute,
+                        self.el.offset,
+                        format!("{} needs a lexeme or an au attribute", self.on),
+                    );
+                    return None;
+                }
+                BehaviourKind::Face(Face {
+                    lexeme,
+                    au,
+                    side,
+                    amount,
+                })
+            }
+            "faceLexeme" => BehaviourKind::FaceLexeme(self.face_lexeme()?),
+            "faceShift" => BehaviourKind::FaceShift(self.face_lexeme()?),
+            "faceFacs" => {
+                let au = match self
+                    .attrs
+                    .items
+                    .iter()
+                    .flatten()
+                    .any(|a| a.ns == Ns::None && a.name == "au")
+                {
+                    true => self.u32("au"),
+                    false => {
+                        self.req("au");
+                        None
+                    }
+                };
+                let side =
+                    self.p
+                        .opt_enum(self.attrs, "side", self.on, Side::parse, Side::expected);
+                let amount = self.f64("amount");
+                BehaviourKind::FaceFacs(FaceFacs {
+                    au: au?,
+                    side,
+                    amount,
+                })
+            }
+            "posture" => BehaviourKind::Posture(placeholder_posture()),
+            "postureShift" => BehaviourKind::PostureShift(placeholder_posture()),
+            "locomotion" => {
+                let target = self.req("target");
+                let manner = self.opt("manner");
+                BehaviourKind::Locomotion(Locomotion {
+                    target: target?,
+                    manner,
+                })
+            }
+            "wait" => BehaviourKind::Wait(Wait {
+                max_wait: self.f64("max-wait"),
+            }),
+            "interrupt" => {
+                let target = self.req("target");
+                let include = self.list("include");
+                let exclude = self.list("exclude");
+                BehaviourKind::Interrupt(Interrupt {
+                    target: target?,
+                    include,
+                    exclude,
+                })
+            }
+            "activate" => BehaviourKind::Activate(Activate {
+                target: self.req("target")?,
+            }),
+            "parametervaluechange" => {
+                let target = self.req("target");
+                let param_id = self.req("paramId");
+                let target = target?;
+                let (target_block, target_behaviour) = match target.split_once(':') {
+                    Some((b, beh)) => (Some(b.trim().to_string()), beh.trim().to_string()),
+                    None => (None, target.trim().to_string()),
+                };
+                BehaviourKind::ParameterValueChange(ParameterValueChange {
+                    target_block,
+                    target_behaviour,
+                    param_id: param_id?,
+                    trajectory: Trajectory {
+                        kind: TrajectoryType::Linear,
+                        initial_value: None,
+                        target_value: 0.0,
+                    },
+                })
+            }
+            "procanimation" => BehaviourKind::ProcAnimation(self.animation()),
+            "procanimationgesture" => BehaviourKind::ProcAnimationGesture(self.animation()),
+            "keyframe" => BehaviourKind::Keyframe(self.animation()),
+            "controller" => {
+                let class = self.req("class");
+                let name = self.opt("name");
+                BehaviourKind::Controller(Controller {
+                    class: class?,
+                    name,
+                    params: Vec::new(),
+                })
+            }
+            "audiofile" => {
+                let file = self.opt("fileName").or_else(|| self.opt("filename"));
+                match file {
+                    Some(file_name) => BehaviourKind::AudioFile { file_name },
+                    None => {
+                        self.req("fileName");
+                        return None;
+                    }
+                }
+            }
+            "noise" => {
+                let joint = self.req("joint");
+                let kind = self.req("type");
+                BehaviourKind::Noise(Noise {
+                    joint: joint?,
+                    kind: kind?,
+                    params: Vec::new(),
+                })
+            }
+            "facemorph" => {
+                let target_name = self.req("targetname");
+                let intensity = self.f64("intensity");
+                BehaviourKind::FaceMorph(FaceMorph {
+                    target_name: target_name?,
+                    intensity,
+                })
+            }
+            "transition" => BehaviourKind::Transition(Transition {
+                class: self.req("class")?,
+                params: Vec::new(),
+            }),
+            _ => return None,
+        })
+    }
+}
+
+fn push_text(acc: &mut Option<(String, usize)>, s: &str, offset: usize) {
+    match acc {
+        Some((t, _)) => t.push_str(s),
+        None => *acc = Some((s.to_string(), offset)),
+    }
+}
+
+fn abbreviate(s: &str) -> String {
+    let mut out: String = s.chars().take(40).collect();
+    if s.chars().count() > 40 {
+        out.push('…');
+    }
+    out
+}

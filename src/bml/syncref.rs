@@ -1,0 +1,372 @@
+//! Sync references (`6`, `beh:sync`, `beh:sync+o`, `block:beh:sync-o`, `anticipators:id:sync+o`):
+//! the typed form, a strict whitespace-tolerant parser with precise errors, and the canonical text.
+
+use std::fmt;
+
+use super::diagnostic::Code;
+
+/// The reserved first part of an anticipator reference (`anticipators:ID:SYNC`).
+pub const ANTICIPATORS: &str = "anticipators";
+
+/// What a sync reference points at.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SyncRef {
+    /// An offset in seconds from the start of the block.
+    Time(f64),
+    /// A sync point plus an offset in seconds: time(point) + offset.
+    Point {
+        /// The sync point referred to.
+        point: SyncPoint,
+        /// Offset in seconds added to the sync point's time.
+        offset: f64,
+    },
+}
+
+/// A named sync point: of a behaviour in this block, of a behaviour in another block, or of an
+/// anticipator.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum SyncPoint {
+    /// `beh:sync` — a behaviour of the same block.
+    Local {
+        /// Behaviour id.
+        behaviour: String,
+        /// Sync point id.
+        sync: String,
+    },
+    /// `block:beh:sync` — a behaviour of another block (BMLA/BMLT external reference).
+    External {
+        /// Block id.
+        block: String,
+        /// Behaviour id.
+        behaviour: String,
+        /// Sync point id.
+        sync: String,
+    },
+    /// `anticipators:id:sync` — a predicted time of an anticipator (R10).
+    Anticipator {
+        /// Anticipator id.
+        anticipator: String,
+        /// Sync id of the anticipator.
+        sync: String,
+    },
+}
+
+impl SyncPoint {
+    /// A local sync point `behaviour:sync`.
+    pub fn local(behaviour: &str, sync: &str) -> Self {
+        SyncPoint::Local {
+            behaviour: behaviour.to_string(),
+            sync: sync.to_string(),
+        }
+    }
+
+    /// The sync id part.
+    pub fn sync(&self) -> &str {
+        match self {
+            SyncPoint::Local { sync, .. }
+            | SyncPoint::External { sync, .. }
+            | SyncPoint::Anticipator { sync, .. } => sync,
+        }
+    }
+}
+
+impl fmt::Display for SyncPoint {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SyncPoint::Local { behaviour, sync } => write!(f, "{behaviour}:{sync}"),
+            SyncPoint::External {
+                block,
+                behaviour,
+                sync,
+            } => write!(f, "{block}:{behaviour}:{sync}"),
+            SyncPoint::Anticipator { anticipator, sync } => {
+                write!(f, "{ANTICIPATORS}:{anticipator}:{sync}")
+            }
+        }
+    }
+}
+
+/// Writes a number of seconds in the shortest form that reads back to the same `f64`.
+pub(crate) fn fmt_seconds(f: &mut impl fmt::Write, v: f64) -> fmt::Result {
+    if v == v.trunc() && v.abs() < 1e15 {
+        write!(f, "{}", v as i64)
+    } else {
+        write!(f, "{v}")
+    }
+}
+
+impl fmt::Display for SyncRef {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SyncRef::Time(t) => fmt_seconds(f, *t),
+            SyncRef::Point { point, offset } => {
+                write!(f, "{point}")?;
+                if *offset > 0.0 {
+                    f.write_str("+")?;
+                    fmt_seconds(f, *offset)
+                } else if *offset < 0.0 {
+                    f.write_str("-")?;
+                    fmt_seconds(f, -*offset)
+                } else {
+                    Ok(())
+                }
+            }
+        }
+    }
+}
+
+/// Why a sync reference could not be parsed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SyncRefError {
+    /// [`Code::EmptySyncRef`], [`Code::MalformedOffset`] or [`Code::MalformedSyncRef`].
+    pub code: Code,
+    /// What is wrong, for people.
+    pub message: String,
+}
+
+fn err(code: Code, message: String) -> SyncRefError {
+    SyncRefError { code, message }
+}
+
+/// Parses a decimal number of seconds: optional sign, digits with an optional fraction and an
+/// optional exponent. Rejects `inf`, `NaN`, hex and empty text.
+pub(crate) fn parse_seconds(s: &str) -> Option<f64> {
+    let s = s.trim();
+    let body = s.strip_prefix(['+', '-']).unwrap_or(s);
+    let (mantissa, exp) = match body.find(['e', 'E']) {
+        Some(i) => (&body[..i], Some(&body[i + 1..])),
+        None => (body, None),
+    };
+    let digits_ok = !mantissa.is_empty()
+        && mantissa.chars().any(|c| c.is_ascii_digit())
+        && mantissa.chars().all(|c| c.is_ascii_digit() || c == '.')
+        && mantissa.matches('.').count() <= 1;
+    let exp_ok = exp.is_none_or(|e| {
+        let e = e.strip_prefix(['+', '-']).unwrap_or(e);
+        !e.is_empty() && e.chars().all(|c| c.is_ascii_digit())
+    });
+    if !(digits_ok && exp_ok) {
+        return None;
+    }
+    s.parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+fn check_id(part: &str, what: &str, text: &str) -> Result<String, SyncRefError> {
+    if part.is_empty() {
+        return Err(err(
+            Code::MalformedSyncRef,
+            format!("sync reference '{text}' has an empty {what}"),
+        ));
+    }
+    if part.chars().any(char::is_whitespace) {
+        return Err(err(
+            Code::MalformedSyncRef,
+            format!("sync reference '{text}': {what} '{part}' contains whitespace"),
+        ));
+    }
+    Ok(part.to_string())
+}
+
+impl SyncRef {
+    /// Parses a sync reference. Whitespace around parts, the sign and the offset is ignored.
+    ///
+    /// The last part is a sync id optionally followed by `+o` or `-o`; sync ids therefore cannot
+    /// contain `+` or `-`. A first part `anticipators` makes a three-part reference an anticipator
+    /// reference.
+    pub fn parse(text: &str) -> Result<SyncRef, SyncRefError> {
+        let t = text.trim();
+        if t.is_empty() {
+            return Err(err(
+                Code::EmptySyncRef,
+                "empty sync reference: expected a time in seconds or behaviour:sync".into(),
+            ));
+        }
+        if !t.contains(':') {
+            return parse_seconds(t).map(SyncRef::Time).ok_or_else(|| {
+                err(
+                    Code::MalformedSyncRef,
+                    format!(
+                        "sync reference '{t}' is neither a number of seconds nor of the form behaviour:sync"
+                    ),
+                )
+            });
+        }
+        let parts: Vec<&str> = t.split(':').map(str::trim).collect();
+        if parts.len() > 3 {
+            return Err(err(
+                Code::MalformedSyncRef,
+                format!(
+                    "sync reference '{t}' has {} parts; expected behaviour:sync, block:behaviour:sync or anticipators:id:sync",
+                    parts.len()
+                ),
+            ));
+        }
+        let last = parts[parts.len() - 1];
+        let (sync, offset) = match last.find(['+', '-']) {
+            None => (last.trim(), 0.0),
+            Some(i) => {
+                let sign = if last.as_bytes()[i] == b'-' {
+                    -1.0
+                } else {
+                    1.0
+                };
+                let num = last[i + 1..].trim();
+                if num.starts_with(['+', '-']) {
+                    return Err(err(
+                        Code::MalformedOffset,
+                        format!("sync reference '{t}' has a doubled sign in its offset"),
+                    ));
+                }
+                let v = parse_seconds(num).ok_or_else(|| {
+                    err(
+                        Code::MalformedOffset,
+                        if num.is_empty() {
+                            format!("sync reference '{t}' has a sign but no offset after it")
+                        } else {
+                            format!(
+                                "sync reference '{t}' has offset '{num}', which is not a number of seconds"
+                            )
+                        },
+                    )
+                })?;
+                (last[..i].trim(), sign * v)
+            }
+        };
+        let sync = check_id(sync, "sync id", t)?;
+        let point = match parts.len() {
+            2 => {
+                if parts[0] == ANTICIPATORS {
+                    return Err(err(
+                        Code::MalformedSyncRef,
+                        format!("anticipator reference '{t}' needs the form anticipators:ID:SYNC"),
+                    ));
+                }
+                SyncPoint::Local {
+                    behaviour: check_id(parts[0], "behaviour id", t)?,
+                    sync,
+                }
+            }
+            _ if parts[0] == ANTICIPATORS => SyncPoint::Anticipator {
+                anticipator: check_id(parts[1], "anticipator id", t)?,
+                sync,
+            },
+            _ => SyncPoint::External {
+                block: check_id(parts[0], "block id", t)?,
+                behaviour: check_id(parts[1], "behaviour id", t)?,
+                sync,
+            },
+        };
+        Ok(SyncRef::Point { point, offset })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn local(b: &str, s: &str, o: f64) -> SyncRef {
+        SyncRef::Point {
+            point: SyncPoint::local(b, s),
+            offset: o,
+        }
+    }
+
+    #[test]
+    fn parses_every_form_of_r10() {
+        assert_eq!(SyncRef::parse("6").unwrap(), SyncRef::Time(6.0));
+        assert_eq!(SyncRef::parse(" 0.5 ").unwrap(), SyncRef::Time(0.5));
+        assert_eq!(
+            SyncRef::parse("g1:start").unwrap(),
+            local("g1", "start", 0.0)
+        );
+        assert_eq!(
+            SyncRef::parse("g1:end+0.5").unwrap(),
+            local("g1", "end", 0.5)
+        );
+        assert_eq!(
+            SyncRef::parse("g1:start-2").unwrap(),
+            local("g1", "start", -2.0)
+        );
+        assert_eq!(
+            SyncRef::parse("bml1:speech1:s1+1").unwrap(),
+            SyncRef::Point {
+                point: SyncPoint::External {
+                    block: "bml1".into(),
+                    behaviour: "speech1".into(),
+                    sync: "s1".into()
+                },
+                offset: 1.0
+            }
+        );
+        assert_eq!(
+            SyncRef::parse("anticipators:speechStopAnticipator:stop+1").unwrap(),
+            SyncRef::Point {
+                point: SyncPoint::Anticipator {
+                    anticipator: "speechStopAnticipator".into(),
+                    sync: "stop".into()
+                },
+                offset: 1.0
+            }
+        );
+        assert_eq!(
+            SyncRef::parse("anticipators:ex:squatdown-0.5").unwrap(),
+            SyncRef::Point {
+                point: SyncPoint::Anticipator {
+                    anticipator: "ex".into(),
+                    sync: "squatdown".into()
+                },
+                offset: -0.5
+            }
+        );
+    }
+
+    #[test]
+    fn tolerates_whitespace_around_parts_and_offsets() {
+        assert_eq!(
+            SyncRef::parse(" g1 : end + 0.5 ").unwrap(),
+            local("g1", "end", 0.5)
+        );
+        assert_eq!(
+            SyncRef::parse("g1:end -  2").unwrap(),
+            local("g1", "end", -2.0)
+        );
+    }
+
+    #[test]
+    fn malformed_references_get_specific_errors() {
+        let code = |s: &str| SyncRef::parse(s).unwrap_err().code;
+        assert_eq!(code(""), Code::EmptySyncRef);
+        assert_eq!(code("   "), Code::EmptySyncRef);
+        assert_eq!(code("s1:start+abc"), Code::MalformedOffset);
+        assert_eq!(code("s1:start+"), Code::MalformedOffset);
+        assert_eq!(code("s1:start+-1"), Code::MalformedOffset);
+        assert_eq!(code("s1:start+inf"), Code::MalformedOffset);
+        assert_eq!(code("s1:start+1.2.3"), Code::MalformedOffset);
+        assert_eq!(code("abc"), Code::MalformedSyncRef);
+        assert_eq!(code("NaN"), Code::MalformedSyncRef);
+        assert_eq!(code(":start"), Code::MalformedSyncRef);
+        assert_eq!(code("g1:"), Code::MalformedSyncRef);
+        assert_eq!(code("a:b:c:d"), Code::MalformedSyncRef);
+        assert_eq!(code("anticipators:stop"), Code::MalformedSyncRef);
+        assert_eq!(code("g 1:start"), Code::MalformedSyncRef);
+        let m = SyncRef::parse("s1:start+abc").unwrap_err().message;
+        assert!(m.contains("'abc'"), "{m}");
+    }
+
+    #[test]
+    fn display_is_canonical_and_reparses() {
+        for s in [
+            "6",
+            "0.25",
+            "g1:end+0.5",
+            "g1:start-2",
+            "b:g:s",
+            "anticipators:a:s+1.5",
+        ] {
+            let r = SyncRef::parse(s).unwrap();
+            assert_eq!(r.to_string(), s);
+            assert_eq!(SyncRef::parse(&r.to_string()).unwrap(), r);
+        }
+        assert_eq!(SyncRef::parse("g1:end + 0").unwrap().to_string(), "g1:end");
+    }
+}

@@ -1,0 +1,393 @@
+//! The BML writer: [`Block`] → BML 1.0 XML text, such that parsing the text gives the block back.
+
+use std::fmt::Write as _;
+
+use quick_xml::escape::escape;
+
+use super::model::*;
+use super::syncref::fmt_seconds;
+
+/// Fixed prefixes for namespaces the writer knows.
+const KNOWN_PREFIXES: &[(&str, &str)] = &[
+    ("bmla", NS_BMLA),
+    ("bmlt", NS_BMLT),
+    ("bmlce", NS_CORE_EXT),
+    ("bmlis", "http://www.asap-project.org/bmlis"),
+];
+
+struct Writer {
+    out: String,
+    prefixes: Vec<(String, String)>, // (prefix, uri)
+}
+
+/// Writes a block as BML 1.0 XML (one behaviour per line).
+pub fn write(block: &Block) -> String {
+    let mut w = Writer {
+        out: String::with_capacity(256 + 128 * block.behaviours.len()),
+        prefixes: KNOWN_PREFIXES
+            .iter()
+            .map(|(p, u)| (p.to_string(), u.to_string()))
+            .collect(),
+    };
+    w.collect_namespaces(block);
+    w.block(block);
+    w.out
+}
+
+fn num(v: f64) -> String {
+    let mut s = String::new();
+    let _ = fmt_seconds(&mut s, v);
+    s
+}
+
+impl Writer {
+    fn collect_namespaces(&mut self, block: &Block) {
+        let mut uris: Vec<&str> = block.foreign_attrs.iter().map(|a| a.ns.as_str()).collect();
+        for b in &block.behaviours {
+            uris.extend(b.foreign_attrs.iter().map(|a| a.ns.as_str()));
+            if let BehaviourKind::Unknown(u) = &b.kind {
+                uris.extend(u.attrs.iter().map(|a| a.ns.as_str()));
+            }
+        }
+        for uri in uris {
+            if !uri.is_empty() && !self.prefixes.iter().any(|(_, u)| u == uri) {
+                let p = format!("ns{}", self.prefixes.len() - KNOWN_PREFIXES.len() + 1);
+                self.prefixes.push((p, uri.to_string()));
+            }
+        }
+    }
+
+    fn prefix(&self, uri: &str) -> &str {
+        self.prefixes
+            .iter()
+            .find(|(_, u)| u == uri)
+            .map_or("", |(p, _)| p.as_str())
+    }
+
+    fn attr(&mut self, name: &str, value: &str) {
+        let _ = write!(self.out, " {name}=\"{}\"", escape(value));
+    }
+
+    fn foreign(&mut self, attrs: &[ForeignAttr]) {
+        for a in attrs {
+            let name = if a.ns.is_empty() {
+                a.name.clone()
+            } else {
+                format!("{}:{}", self.prefix(&a.ns), a.name)
+            };
+            self.attr(&name, &a.value);
+        }
+    }
+
+    fn list(&mut self, name: &str, ids: &[String]) {
+        if !ids.is_empty() {
+            self.attr(name, &ids.join(","));
+        }
+    }
+
+    fn block(&mut self, b: &Block) {
+        self.out.push_str("<bml");
+        self.attr("xmlns", NS_BML);
+        for (p, u) in self.prefixes.clone() {
+            self.attr(&format!("xmlns:{p}"), &u);
+        }
+        self.attr("id", &b.id);
+        if let Some(c) = &b.character_id {
+            self.attr("characterId", c);
+        }
+        if b.composition != Composition::Merge {
+            self.attr("composition", &b.composition.to_bml());
+        }
+        let e = &b.ext;
+        if e.preplan {
+            self.attr("bmla:preplan", "true");
+        }
+        if e.allow_external_refs {
+            self.attr("bmla:allowexternalrefs", "true");
+        }
+        self.list("bmla:onStart", &e.on_start);
+        self.list("bmla:interrupt", &e.interrupt);
+        self.list("bmla:appendAfter", &e.append_after);
+        self.list("bmla:chunkAfter", &e.chunk_after);
+        self.list("bmla:chunkBefore", &e.chunk_before);
+        self.list("bmla:prependBefore", &e.prepend_before);
+        self.foreign(&b.foreign_attrs);
+        if b.behaviours.is_empty() && b.constraints.is_empty() {
+            self.out.push_str("/>\n");
+            return;
+        }
+        self.out.push_str(">\n");
+        let mut in_required = false;
+        for beh in &b.behaviours {
+            self.required_switch(&mut in_required, beh.required);
+            self.behaviour(beh, if in_required { "    " } else { "  " });
+        }
+        self.required_switch(&mut in_required, false);
+        for c in &b.constraints {
+            self.required_switch(&mut in_required, c.required);
+            self.constraint(c, if in_required { "    " } else { "  " });
+        }
+        self.required_switch(&mut in_required, false);
+        self.out.push_str("</bml>\n");
+    }
+
+    fn required_switch(&mut self, state: &mut bool, want: bool) {
+        if *state != want {
+            self.out.push_str(if want {
+                "  <required>\n"
+            } else {
+                "  </required>\n"
+            });
+            *state = want;
+        }
+    }
+
+    fn qname(&self, kind: &BehaviourKind) -> String {
+        match kind {
+            BehaviourKind::Unknown(_) => kind.element_name().to_string(),
+            k if k.namespace() == NS_BML => k.element_name().to_string(),
+            k => format!("{}:{}", self.prefix(k.namespace()), k.element_name()),
+        }
+    }
+
+    fn behaviour(&mut self, b: &Behaviour, indent: &str) {
+        let q = self.qname(&b.kind);
+        let ext = self.prefix(b.kind.namespace()).to_string();
+        let _ = write!(self.out, "{indent}<{q}");
+        if let BehaviourKind::Unknown(u) = &b.kind {
+            self.attr("xmlns", &u.ns);
+        }
+        self.attr("id", &b.id);
+        self.kind_attrs(&b.kind);
+        for s in &b.syncs {
+            self.attr(&s.sync, &s.value.to_string());
+        }
+        self.foreign(&b.foreign_attrs);
+        let mut body = String::new();
+        self.kind_body(&b.kind, &ext, &mut body);
+        for d in &b.descriptions {
+            body.push_str("<description");
+            if let Some(p) = d.priority {
+                let _ = write!(body, " priority=\"{p}\"");
+            }
+            let _ = write!(
+                body,
+                " type=\"{}\">{}</description>",
+                escape(&d.kind),
+                d.content
+            );
+        }
+        if body.is_empty() {
+            self.out.push_str("/>\n");
+        } else {
+            let _ = writeln!(self.out, ">{body}</{q}>");
+        }
+    }
+
+    fn kind_attrs(&mut self, kind: &BehaviourKind) {
+        let opt = |w: &mut Writer, name: &str, v: &Option<String>| {
+            if let Some(v) = v {
+                w.attr(name, v);
+            }
+        };
+        let optf = |w: &mut Writer, name: &str, v: Option<f64>| {
+            if let Some(v) = v {
+                w.attr(name, &num(v));
+            }
+        };
+        match kind {
+            BehaviourKind::Speech(_) | BehaviourKind::Text(_) => {}
+            BehaviourKind::Gesture(g) => {
+                self.attr("lexeme", &g.lexeme);
+                if let Some(m) = g.mode {
+                    self.attr("mode", m.as_str());
+                }
+            }
+            BehaviourKind::Pointing(p) => {
+                self.attr("target", &p.target);
+                if let Some(m) = p.mode {
+                    self.attr("mode", m.as_str());
+                }
+            }
+            BehaviourKind::Head(h) => {
+                self.attr("lexeme", &h.lexeme);
+                if let Some(r) = h.repetition {
+                    self.attr("repetition", &r.to_string());
+                }
+                optf(self, "amount", h.amount);
+            }
+            BehaviourKind::HeadDirectionShift { target } => self.attr("target", target),
+            BehaviourKind::Gaze(g) | BehaviourKind::GazeShift(g) => {
+                self.attr("target", &g.target);
+                if let Some(i) = g.influence {
+                    self.attr("influence", i.as_str());
+                }
+                optf(self, "offsetAngle", g.offset_angle);
+                if let Some(d) = g.offset_direction {
+                    self.attr("offsetDirection", d.as_str());
+                }
+            }
+            BehaviourKind::Face(f) => {
+                opt(self, "lexeme", &f.lexeme);
+                if let Some(au) = f.au {
+                    self.attr("au", &au.to_string());
+                }
+                if let Some(s) = f.side {
+                    self.attr("side", s.as_str());
+                }
+                optf(self, "amount", f.amount);
+            }
+            BehaviourKind::FaceLexeme(f) | BehaviourKind::FaceShift(f) => {
+                self.attr("lexeme", &f.lexeme);
+                optf(self, "amount", f.amount);
+            }
+            BehaviourKind::FaceFacs(f) => {
+                self.attr("au", &f.au.to_string());
+                if let Some(s) = f.side {
+                    self.attr("side", s.as_str());
+                }
+                optf(self, "amount", f.amount);
+            }
+            BehaviourKind::Posture(_) | BehaviourKind::PostureShift(_) => {}
+            BehaviourKind::Locomotion(l) => {
+                self.attr("target", &l.target);
+                opt(self, "manner", &l.manner);
+            }
+            BehaviourKind::Wait(w) => optf(self, "max-wait", w.max_wait),
+            BehaviourKind::Interrupt(i) => {
+                self.attr("target", &i.target);
+                self.list("include", &i.include);
+                self.list("exclude", &i.exclude);
+            }
+            BehaviourKind::Activate(a) => self.attr("target", &a.target),
+            BehaviourKind::ParameterValueChange(p) => {
+                let target = match &p.target_block {
+                    Some(b) => format!("{b}:{}", p.target_behaviour),
+                    None => p.target_behaviour.clone(),
+                };
+                self.attr("target", &target);
+                self.attr("paramId", &p.param_id);
+            }
+            BehaviourKind::ProcAnimation(a)
+            | BehaviourKind::ProcAnimationGesture(a)
+            | BehaviourKind::Keyframe(a) => {
+                opt(self, "name", &a.name);
+                opt(self, "fileName", &a.file_name);
+            }
+            BehaviourKind::Controller(c) => {
+                self.attr("class", &c.class);
+                opt(self, "name", &c.name);
+            }
+            BehaviourKind::AudioFile { file_name } => self.attr("fileName", file_name),
+            BehaviourKind::Noise(n) => {
+                self.attr("joint", &n.joint);
+                self.attr("type", &n.kind);
+            }
+            BehaviourKind::FaceMorph(f) => {
+                self.attr("targetname", &f.target_name);
+                optf(self, "intensity", f.intensity);
+            }
+            BehaviourKind::Transition(t) => self.attr("class", &t.class),
+            BehaviourKind::Unknown(u) => {
+                self.foreign(&u.attrs);
+            }
+        }
+    }
+
+    fn kind_body(&self, kind: &BehaviourKind, ext: &str, body: &mut String) {
+        let params = |body: &mut String, params: &[Param]| {
+            for p in params {
+                let _ = write!(
+                    body,
+                    "<bmlt:parameter name=\"{}\" value=\"{}\"/>",
+                    escape(&p.name),
+                    escape(&p.value)
+                );
+            }
+        };
+        match kind {
+            BehaviourKind::Speech(s) | BehaviourKind::Text(s) => {
+                let tag = if matches!(kind, BehaviourKind::Text(_)) {
+                    "bmlt:text"
+                } else {
+                    "text"
+                };
+                let _ = write!(body, "<{tag}>");
+                for part in &s.text {
+                    match part {
+                        TextPart::Text(t) => body.push_str(&escape(t)),
+                        TextPart::Sync(id) => {
+                            let _ = write!(body, "<sync id=\"{}\"/>", escape(id));
+                        }
+                    }
+                }
+                let _ = write!(body, "</{tag}>");
+            }
+            BehaviourKind::Posture(p) | BehaviourKind::PostureShift(p) => {
+                let _ = write!(body, "<stance type=\"{}\"/>", p.stance.as_str());
+                for pose in &p.poses {
+                    let _ = write!(
+                        body,
+                        "<pose part=\"{}\" lexeme=\"{}\"/>",
+                        pose.part.as_str(),
+                        escape(&pose.lexeme)
+                    );
+                }
+            }
+            BehaviourKind::ParameterValueChange(p) => {
+                let t = &p.trajectory;
+                let _ = write!(body, "<{ext}:trajectory type=\"{}\"", t.kind.as_str());
+                if let Some(v) = t.initial_value {
+                    let _ = write!(body, " initialValue=\"{}\"", num(v));
+                }
+                let _ = write!(body, " targetValue=\"{}\"/>", num(t.target_value));
+            }
+            BehaviourKind::ProcAnimation(a)
+            | BehaviourKind::ProcAnimationGesture(a)
+            | BehaviourKind::Keyframe(a) => {
+                params(body, &a.params);
+                body.push_str(&a.content);
+            }
+            BehaviourKind::Controller(c) => params(body, &c.params),
+            BehaviourKind::Noise(n) => params(body, &n.params),
+            BehaviourKind::Transition(t) => params(body, &t.params),
+            BehaviourKind::Unknown(u) => body.push_str(&u.content),
+            _ => {}
+        }
+    }
+
+    fn constraint(&mut self, c: &ConstraintElement, indent: &str) {
+        let _ = write!(self.out, "{indent}<constraint");
+        if let Some(id) = &c.id {
+            self.attr("id", id);
+        }
+        self.out.push_str(">\n");
+        for item in &c.items {
+            let (tag, reference, syncs) = match item {
+                ConstraintItem::Synchronize {
+                    reference, syncs, ..
+                } => ("synchronize", reference.as_ref(), syncs),
+                ConstraintItem::Before {
+                    reference, syncs, ..
+                } => ("before", Some(reference), syncs),
+                ConstraintItem::After {
+                    reference, syncs, ..
+                } => ("after", Some(reference), syncs),
+            };
+            let _ = write!(self.out, "{indent}  <{tag}");
+            if let Some(r) = reference {
+                self.attr("ref", &r.to_string());
+            }
+            self.out.push('>');
+            for s in syncs {
+                let _ = write!(
+                    self.out,
+                    "<sync ref=\"{}\"/>",
+                    escape(s.reference.to_string())
+                );
+            }
+            let _ = writeln!(self.out, "</{tag}>");
+        }
+        let _ = writeln!(self.out, "{indent}</constraint>");
+    }
+}

@@ -1,0 +1,292 @@
+//! BML 1.0 feedback: typed messages (block progress, sync-point progress, predictions, warnings,
+//! with the BMLA status and posix-time extensions), the listener trait, and the two line codecs of
+//! DESIGN §4 — XML (one element per line) and JSON lines.
+
+mod json;
+mod xml;
+
+use std::fmt;
+
+pub use json::{from_json, to_json};
+pub use xml::{from_xml, to_xml};
+
+/// Namespace of feedback elements (BML 1.0).
+pub const NS_FEEDBACK: &str = "http://www.bml-initiative.org/bml/bml-1.0";
+/// Namespace of the BMLA feedback attributes (`bmla:status`, `bmla:posixTime`).
+pub const NS_BMLA: &str = "http://www.asap-project.org/bmla";
+
+/// Declares a closed set of upper-case feedback constants.
+macro_rules! constants {
+    ($(#[$m:meta])* $name:ident { $($(#[$vm:meta])* $var:ident = $s:literal),+ $(,)? }) => {
+        $(#[$m])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum $name { $($(#[$vm])* $var),+ }
+        impl $name {
+            /// Every value.
+            pub const ALL: &'static [$name] = &[$($name::$var),+];
+            /// The feedback spelling.
+            pub fn as_str(self) -> &'static str { match self { $($name::$var => $s),+ } }
+            /// Parses the feedback spelling.
+            pub fn parse(s: &str) -> Option<Self> { match s { $($s => Some($name::$var),)+ _ => None } }
+        }
+        impl fmt::Display for $name {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result { f.write_str(self.as_str()) }
+        }
+    };
+}
+
+constants!(
+    /// BMLA block status.
+    BlockStatus {
+        /// Being scheduled.
+        InPrep = "IN_PREP",
+        /// Scheduled, waiting for activation (pre-planned) or start.
+        Pending = "PENDING",
+        /// Scheduled, waiting for blocks it is appended to.
+        Lurking = "LURKING",
+        /// Executing.
+        InExec = "IN_EXEC",
+        /// Only retractions remain.
+        Subsiding = "SUBSIDING",
+        /// Finished.
+        Done = "DONE",
+        /// Stopped while executing.
+        Interrupted = "INTERRUPTED",
+        /// Removed before it started.
+        Revoked = "REVOKED",
+    }
+);
+
+/// The `type` of a warning. The named constants are those of DESIGN §4; `Other` keeps any other
+/// type read from a log.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum WarningType {
+    /// A known warning type.
+    Known(KnownWarning),
+    /// Any other type string.
+    Other(String),
+}
+
+constants!(
+    /// The warning types of DESIGN §4.
+    KnownWarning {
+        /// The BML could not be parsed.
+        ParsingFailure = "PARSING_FAILURE",
+        /// A referenced block, behaviour or target does not exist.
+        NoSuchTarget = "NO_SUCH_TARGET",
+        /// A behaviour could not be placed in time.
+        ImpossibleToSchedule = "IMPOSSIBLE_TO_SCHEDULE",
+        /// No engine realizes this behaviour kind.
+        BehaviorTypeNotSupported = "BEHAVIOR_TYPE_NOT_SUPPORTED",
+        /// An extension attribute is not interpreted.
+        CustomAttributeNotSupported = "CUSTOM_ATTRIBUTE_NOT_SUPPORTED",
+        /// The constraints cannot all hold.
+        CannotSatisfyConstraints = "CANNOT_SATISFY_CONSTRAINTS",
+        /// A timing that breaks sync order or block start.
+        InvalidTiming = "INVALID_TIMING",
+        /// An engine failed while executing.
+        ExecutionFailure = "EXECUTION_FAILURE",
+    }
+);
+
+impl WarningType {
+    /// The type string.
+    pub fn as_str(&self) -> &str {
+        match self {
+            WarningType::Known(k) => k.as_str(),
+            WarningType::Other(s) => s,
+        }
+    }
+
+    /// Reads a type string.
+    pub fn parse(s: &str) -> WarningType {
+        KnownWarning::parse(s).map_or_else(|| WarningType::Other(s.to_string()), WarningType::Known)
+    }
+}
+
+impl From<KnownWarning> for WarningType {
+    fn from(k: KnownWarning) -> Self {
+        WarningType::Known(k)
+    }
+}
+
+/// `<blockProgress id="B:sync" globalTime>`: a block started or ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockProgress {
+    /// Block id.
+    pub block: String,
+    /// `start` or `end` (other block sync ids are accepted when reading).
+    pub sync: String,
+    /// Global time in seconds.
+    pub global_time: f64,
+    /// Character, if any.
+    pub character_id: Option<String>,
+    /// BMLA status after the event.
+    pub status: Option<BlockStatus>,
+    /// BMLA wall-clock time, ms since the Unix epoch (omitted on the virtual clock).
+    pub posix_time: Option<u64>,
+}
+
+/// `<syncPointProgress id="B:beh:sync" time globalTime>`: a behaviour passed a sync point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SyncPointProgress {
+    /// Block id.
+    pub block: String,
+    /// Behaviour id.
+    pub behaviour: String,
+    /// Sync point id.
+    pub sync: String,
+    /// Time relative to the block start, seconds.
+    pub time: f64,
+    /// Global time in seconds.
+    pub global_time: f64,
+    /// Character, if any.
+    pub character_id: Option<String>,
+    /// BMLA wall-clock time, ms since the Unix epoch.
+    pub posix_time: Option<u64>,
+}
+
+/// A `<bml id globalStart globalEnd bmla:status>` child of a prediction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockPrediction {
+    /// Block id.
+    pub id: String,
+    /// Predicted global start.
+    pub global_start: Option<f64>,
+    /// Predicted global end (absent while unknown).
+    pub global_end: Option<f64>,
+    /// Block status at prediction time.
+    pub status: Option<BlockStatus>,
+}
+
+/// A behaviour child of a prediction: element name, `id="B:beh"` and predicted sync times
+/// (relative to block start).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BehaviourPrediction {
+    /// Behaviour element name, e.g. `gesture`.
+    pub kind: String,
+    /// Block id.
+    pub block: String,
+    /// Behaviour id.
+    pub behaviour: String,
+    /// (sync id, predicted time) in sync order.
+    pub syncs: Vec<(String, f64)>,
+}
+
+/// `<predictionFeedback>`: predicted timing of blocks and behaviours.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PredictionFeedback {
+    /// Character, if any.
+    pub character_id: Option<String>,
+    /// Block predictions.
+    pub blocks: Vec<BlockPrediction>,
+    /// Behaviour predictions.
+    pub behaviours: Vec<BehaviourPrediction>,
+}
+
+/// `<warningFeedback id type>text</warningFeedback>`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WarningFeedback {
+    /// `B` or `B:beh` (`<no id>` when the block id is unknown).
+    pub id: String,
+    /// Warning type.
+    pub kind: WarningType,
+    /// Character, if any.
+    pub character_id: Option<String>,
+    /// Human explanation.
+    pub text: String,
+}
+
+/// One feedback message.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Feedback {
+    /// Block start/end.
+    BlockProgress(BlockProgress),
+    /// A sync point passed.
+    SyncPointProgress(SyncPointProgress),
+    /// Predicted timing.
+    Prediction(PredictionFeedback),
+    /// Something was dropped, changed or failed.
+    Warning(WarningFeedback),
+}
+
+impl Feedback {
+    /// The element name (`blockProgress`, `syncPointProgress`, `predictionFeedback`,
+    /// `warningFeedback`).
+    pub fn element_name(&self) -> &'static str {
+        match self {
+            Feedback::BlockProgress(_) => "blockProgress",
+            Feedback::SyncPointProgress(_) => "syncPointProgress",
+            Feedback::Prediction(_) => "predictionFeedback",
+            Feedback::Warning(_) => "warningFeedback",
+        }
+    }
+}
+
+/// The line format of a feedback log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Format {
+    /// BML 1.0 XML, one element per line.
+    #[default]
+    Xml,
+    /// JSON lines.
+    Jsonl,
+}
+
+impl Format {
+    /// Encodes one message as one line (without the newline).
+    pub fn encode(self, fb: &Feedback) -> String {
+        match self {
+            Format::Xml => to_xml(fb),
+            Format::Jsonl => to_json(fb),
+        }
+    }
+}
+
+/// Decodes one log line in either format (JSON if it starts with `{`).
+pub fn from_line(line: &str) -> Result<Feedback, FeedbackError> {
+    if line.trim_start().starts_with('{') {
+        from_json(line)
+    } else {
+        from_xml(line)
+    }
+}
+
+/// Why a feedback line could not be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("bad feedback: {0}")]
+pub struct FeedbackError(pub String);
+
+/// Receives feedback messages as the realizer produces them.
+pub trait FeedbackListener {
+    /// Called once per message, in order.
+    fn feedback(&mut self, fb: &Feedback);
+}
+
+impl FeedbackListener for Vec<Feedback> {
+    fn feedback(&mut self, fb: &Feedback) {
+        self.push(fb.clone());
+    }
+}
+
+impl<F: FnMut(&Feedback)> FeedbackListener for F {
+    fn feedback(&mut self, fb: &Feedback) {
+        self(fb)
+    }
+}
+
+/// Rounds seconds to the millisecond precision of the logs.
+pub fn round_ms(t: f64) -> f64 {
+    (t * 1000.0).round() / 1000.0
+}
+
+/// Splits `a:b` ids; `n` is the number of parts expected.
+pub(crate) fn split_id(id: &str, n: usize, what: &str) -> Result<Vec<String>, FeedbackError> {
+    let parts: Vec<String> = id.split(':').map(str::to_string).collect();
+    if parts.len() != n || parts.iter().any(String::is_empty) {
+        return Err(FeedbackError(format!(
+            "{what} id '{id}' should have {n} non-empty parts separated by ':'"
+        )));
+    }
+    Ok(parts)
+}

@@ -1,0 +1,349 @@
+//! The XML line codec of feedback: one BML 1.0 feedback element per line, times with millisecond
+//! precision, BMLA attributes prefixed `bmla:`.
+
+use std::fmt::Write as _;
+
+use quick_xml::escape::escape;
+use quick_xml::events::{BytesStart, Event};
+use quick_xml::name::ResolveResult;
+use quick_xml::NsReader;
+
+use super::*;
+
+fn t(v: f64) -> String {
+    format!("{:.3}", round_ms(v))
+}
+
+fn open(out: &mut String, name: &str, bmla: bool) {
+    let _ = write!(out, "<{name} xmlns=\"{NS_FEEDBACK}\"");
+    if bmla {
+        let _ = write!(out, " xmlns:bmla=\"{NS_BMLA}\"");
+    }
+}
+
+fn attr(out: &mut String, name: &str, value: &str) {
+    let _ = write!(out, " {name}=\"{}\"", escape(value));
+}
+
+/// Encodes one message as a single line of XML (no trailing newline).
+pub fn to_xml(fb: &Feedback) -> String {
+    let mut o = String::with_capacity(160);
+    match fb {
+        Feedback::BlockProgress(b) => {
+            open(
+                &mut o,
+                "blockProgress",
+                b.status.is_some() || b.posix_time.is_some(),
+            );
+            attr(&mut o, "id", &format!("{}:{}", b.block, b.sync));
+            attr(&mut o, "globalTime", &t(b.global_time));
+            if let Some(c) = &b.character_id {
+                attr(&mut o, "characterId", c);
+            }
+            if let Some(s) = b.status {
+                attr(&mut o, "bmla:status", s.as_str());
+            }
+            if let Some(p) = b.posix_time {
+                attr(&mut o, "bmla:posixTime", &p.to_string());
+            }
+            o.push_str("/>");
+        }
+        Feedback::SyncPointProgress(s) => {
+            open(&mut o, "syncPointProgress", s.posix_time.is_some());
+            attr(
+                &mut o,
+                "id",
+                &format!("{}:{}:{}", s.block, s.behaviour, s.sync),
+            );
+            attr(&mut o, "time", &t(s.time));
+            attr(&mut o, "globalTime", &t(s.global_time));
+            if let Some(c) = &s.character_id {
+                attr(&mut o, "characterId", c);
+            }
+            if let Some(p) = s.posix_time {
+                attr(&mut o, "bmla:posixTime", &p.to_string());
+            }
+            o.push_str("/>");
+        }
+        Feedback::Prediction(p) => {
+            open(
+                &mut o,
+                "predictionFeedback",
+                p.blocks.iter().any(|b| b.status.is_some()),
+            );
+            if let Some(c) = &p.character_id {
+                attr(&mut o, "characterId", c);
+            }
+            if p.blocks.is_empty() && p.behaviours.is_empty() {
+                o.push_str("/>");
+                return o;
+            }
+            o.push('>');
+            for b in &p.blocks {
+                o.push_str("<bml");
+                attr(&mut o, "id", &b.id);
+                if let Some(v) = b.global_start {
+                    attr(&mut o, "globalStart", &t(v));
+                }
+                if let Some(v) = b.global_end {
+                    attr(&mut o, "globalEnd", &t(v));
+                }
+                if let Some(s) = b.status {
+                    attr(&mut o, "bmla:status", s.as_str());
+                }
+                o.push_str("/>");
+            }
+            for b in &p.behaviours {
+                let _ = write!(o, "<{}", b.kind);
+                attr(&mut o, "id", &format!("{}:{}", b.block, b.behaviour));
+                for (sync, v) in &b.syncs {
+                    attr(&mut o, sync, &t(*v));
+                }
+                o.push_str("/>");
+            }
+            o.push_str("</predictionFeedback>");
+        }
+        Feedback::Warning(w) => {
+            open(&mut o, "warningFeedback", false);
+            attr(&mut o, "id", &w.id);
+            attr(&mut o, "type", w.kind.as_str());
+            if let Some(c) = &w.character_id {
+                attr(&mut o, "characterId", c);
+            }
+            o.push('>');
+            // keep the message on one line: newlines become character references
+            o.push_str(
+                &escape(&w.text)
+                    .replace('\n', "&#10;")
+                    .replace('\r', "&#13;"),
+            );
+            o.push_str("</warningFeedback>");
+        }
+    }
+    o
+}
+
+/// Attributes of one element: (is BMLA, local name, value).
+type Attrs = Vec<(bool, String, String)>;
+
+fn attrs(r: &NsReader<&[u8]>, e: &BytesStart) -> Result<Attrs, FeedbackError> {
+    let mut out = Vec::new();
+    for a in e.attributes() {
+        let a = a.map_err(|e| FeedbackError(format!("malformed attribute: {e}")))?;
+        if a.key.as_ref() == b"xmlns" || a.key.as_ref().starts_with(b"xmlns:") {
+            continue;
+        }
+        let bmla = matches!(r.resolve_attribute(a.key).0, ResolveResult::Bound(n) if n.as_ref() == NS_BMLA.as_bytes());
+        let name = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
+        let value = a
+            .unescape_value()
+            .map_err(|e| FeedbackError(format!("attribute {name}: {e}")))?
+            .into_owned();
+        out.push((bmla, name, value));
+    }
+    Ok(out)
+}
+
+fn get<'a>(a: &'a Attrs, bmla: bool, name: &str) -> Option<&'a str> {
+    a.iter()
+        .find(|(b, n, _)| *b == bmla && n == name)
+        .map(|(_, _, v)| v.as_str())
+}
+
+fn req<'a>(a: &'a Attrs, name: &str, el: &str) -> Result<&'a str, FeedbackError> {
+    get(a, false, name).ok_or_else(|| FeedbackError(format!("<{el}> has no {name} attribute")))
+}
+
+fn num(v: &str, name: &str) -> Result<f64, FeedbackError> {
+    v.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| FeedbackError(format!("{name}='{v}' is not a number")))
+}
+
+fn opt_num(a: &Attrs, bmla: bool, name: &str) -> Result<Option<f64>, FeedbackError> {
+    get(a, bmla, name).map(|v| num(v, name)).transpose()
+}
+
+fn posix(a: &Attrs, name: &str) -> Result<Option<u64>, FeedbackError> {
+    get(a, true, name)
+        .map(|v| {
+            v.trim().parse::<u64>().map_err(|_| {
+                FeedbackError(format!("bmla:{name}='{v}' is not a whole number of ms"))
+            })
+        })
+        .transpose()
+}
+
+fn status(a: &Attrs) -> Result<Option<BlockStatus>, FeedbackError> {
+    get(a, true, "status")
+        .map(|v| {
+            BlockStatus::parse(v).ok_or_else(|| FeedbackError(format!("unknown bmla:status '{v}'")))
+        })
+        .transpose()
+}
+
+fn is_feedback_ns(res: &ResolveResult) -> bool {
+    match res {
+        ResolveResult::Bound(n) => n.as_ref() == NS_FEEDBACK.as_bytes(),
+        ResolveResult::Unbound => true,
+        ResolveResult::Unknown(_) => false,
+    }
+}
+
+/// Decodes one XML feedback element (one log line).
+pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
+    let mut r = NsReader::from_str(line);
+    let xml_err = |e: quick_xml::Error| FeedbackError(format!("not well-formed XML: {e}"));
+    loop {
+        let (res, ev) = r.read_resolved_event().map_err(xml_err)?;
+        let (e, empty) = match ev {
+            Event::Start(e) => (e, false),
+            Event::Empty(e) => (e, true),
+            Event::Eof => return Err(FeedbackError("no feedback element".into())),
+            Event::Text(t) if t.iter().all(u8::is_ascii_whitespace) => continue,
+            Event::Decl(_) | Event::Comment(_) | Event::PI(_) | Event::DocType(_) => continue,
+            _ => return Err(FeedbackError("expected a feedback element".into())),
+        };
+        if !is_feedback_ns(&res) {
+            return Err(FeedbackError(
+                "feedback element is not in the BML 1.0 namespace".into(),
+            ));
+        }
+        let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+        let a = attrs(&r, &e)?;
+        let character_id = get(&a, false, "characterId").map(str::to_string);
+        return match name.as_str() {
+            "blockProgress" => {
+                let id = req(&a, "id", &name)?;
+                let (block, sync) = id
+                    .rsplit_once(':')
+                    .filter(|(b, s)| !b.is_empty() && !s.is_empty())
+                    .ok_or_else(|| {
+                        FeedbackError(format!("blockProgress id '{id}' should be block:sync"))
+                    })?;
+                Ok(Feedback::BlockProgress(BlockProgress {
+                    block: block.to_string(),
+                    sync: sync.to_string(),
+                    global_time: num(req(&a, "globalTime", &name)?, "globalTime")?,
+                    character_id,
+                    status: status(&a)?,
+                    posix_time: posix(&a, "posixTime")?,
+                }))
+            }
+            "syncPointProgress" => {
+                let p = split_id(req(&a, "id", &name)?, 3, "syncPointProgress")?;
+                let [block, behaviour, sync] = <[String; 3]>::try_from(p).expect("three parts");
+                Ok(Feedback::SyncPointProgress(SyncPointProgress {
+                    block,
+                    behaviour,
+                    sync,
+                    time: num(req(&a, "time", &name)?, "time")?,
+                    global_time: num(req(&a, "globalTime", &name)?, "globalTime")?,
+                    character_id,
+                    posix_time: posix(&a, "posixTime")?,
+                }))
+            }
+            "warningFeedback" => {
+                let id = req(&a, "id", &name)?.to_string();
+                let kind = WarningType::parse(req(&a, "type", &name)?);
+                let text = if empty {
+                    String::new()
+                } else {
+                    element_text(&mut r)?
+                };
+                Ok(Feedback::Warning(WarningFeedback {
+                    id,
+                    kind,
+                    character_id,
+                    text,
+                }))
+            }
+            "predictionFeedback" => {
+                let mut p = PredictionFeedback {
+                    character_id,
+                    ..Default::default()
+                };
+                if !empty {
+                    prediction_children(&mut r, &mut p)?;
+                }
+                Ok(Feedback::Prediction(p))
+            }
+            other => Err(FeedbackError(format!("unknown feedback element <{other}>"))),
+        };
+    }
+}
+
+/// The text content of the element whose start tag was just read, up to its end tag.
+fn element_text(r: &mut NsReader<&[u8]>) -> Result<String, FeedbackError> {
+    let xml_err = |e: quick_xml::Error| FeedbackError(format!("not well-formed XML: {e}"));
+    let mut text = String::new();
+    loop {
+        match r.read_event().map_err(xml_err)? {
+            Event::Text(t) => {
+                text.push_str(&t.xml_content().map_err(|e| FeedbackError(e.to_string()))?)
+            }
+            Event::CData(c) => {
+                text.push_str(&c.decode().map_err(|e| FeedbackError(e.to_string()))?)
+            }
+            Event::GeneralRef(g) => match g.resolve_char_ref().map_err(xml_err)? {
+                Some(c) => text.push(c),
+                None => {
+                    let name = g.decode().map_err(|e| FeedbackError(e.to_string()))?;
+                    let v = quick_xml::escape::resolve_predefined_entity(&name)
+                        .ok_or_else(|| FeedbackError(format!("unknown entity &{name};")))?;
+                    text.push_str(v);
+                }
+            },
+            Event::End(_) => return Ok(text),
+            Event::Eof => return Err(FeedbackError("warningFeedback is not closed".into())),
+            _ => return Err(FeedbackError("warningFeedback may hold text only".into())),
+        }
+    }
+}
+
+fn prediction_children(
+    r: &mut NsReader<&[u8]>,
+    p: &mut PredictionFeedback,
+) -> Result<(), FeedbackError> {
+    let xml_err = |e: quick_xml::Error| FeedbackError(format!("not well-formed XML: {e}"));
+    loop {
+        let (_, ev) = r.read_resolved_event().map_err(xml_err)?;
+        let (e, empty) = match ev {
+            Event::Start(e) => (e, false),
+            Event::Empty(e) => (e, true),
+            Event::End(_) => return Ok(()),
+            Event::Eof => return Err(FeedbackError("predictionFeedback is not closed".into())),
+            _ => continue,
+        };
+        let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+        let a = attrs(r, &e)?;
+        if !empty {
+            r.read_to_end(e.name()).map_err(xml_err)?;
+        }
+        if name == "bml" {
+            p.blocks.push(BlockPrediction {
+                id: req(&a, "id", "bml")?.to_string(),
+                global_start: opt_num(&a, false, "globalStart")?,
+                global_end: opt_num(&a, false, "globalEnd")?,
+                status: status(&a)?,
+            });
+        } else {
+            let parts = split_id(req(&a, "id", &name)?, 2, "behaviour prediction")?;
+            let [block, behaviour] = <[String; 2]>::try_from(parts).expect("two parts");
+            let mut syncs = Vec::new();
+            for (bmla, n, v) in &a {
+                if !bmla && n != "id" {
+                    syncs.push((n.clone(), num(v, n)?));
+                }
+            }
+            p.behaviours.push(BehaviourPrediction {
+                kind: name,
+                block,
+                behaviour,
+                syncs,
+            });
+        }
+    }
+}

@@ -1,0 +1,11 @@
+//! `bml_realizer`: a realizer for the Behavior Markup Language (BML 1.0 with the BMLA/BMLT
+//! continuous-interaction extensions) for virtual humans.
+//!
+//! Layers (see `docs/architecture.md`):
+//! - [`bml`]: the language — typed model, parser, validation, constraint extraction, writer;
+//! - [`feedback`]: BML 1.0 feedback messages and their XML and JSON-lines codecs.
+
+#![warn(missing_docs)]
+
+pub mod bml;
+pub mod feedback;
