@@ -31,6 +31,40 @@ pub const ALL_STANDARD_SYNCS: &[&str] = &[
     "end",
 ];
 
+/// The 15 BML 1.0 core behaviour elements (`faceFacs` is also accepted in the core-extensions
+/// namespace).
+pub const CORE_BEHAVIOURS: &[&str] = &[
+    "speech",
+    "gesture",
+    "pointing",
+    "head",
+    "headDirectionShift",
+    "gaze",
+    "gazeShift",
+    "face",
+    "faceLexeme",
+    "faceFacs",
+    "faceShift",
+    "posture",
+    "postureShift",
+    "locomotion",
+    "wait",
+];
+/// The control behaviours, accepted in both the BMLA and the BMLT namespace.
+pub const CONTROL_BEHAVIOURS: &[&str] = &["interrupt", "activate", "parametervaluechange"];
+/// The BMLT behaviour elements.
+pub const BMLT_BEHAVIOURS: &[&str] = &[
+    "procanimation",
+    "procanimationgesture",
+    "keyframe",
+    "controller",
+    "audiofile",
+    "noise",
+    "facemorph",
+    "transition",
+    "text",
+];
+
 impl BehaviourKind {
     /// The element's local name.
     pub fn element_name(&self) -> &str {

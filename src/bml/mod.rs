@@ -22,7 +22,10 @@ mod writer;
 
 pub use constraints::{extract, Anchor, Constraint, Relation, Source};
 pub use diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos, Severity};
-pub use kinds::{ALL_STANDARD_SYNCS, FACE_SYNCS, GAZE_SYNCS, GESTURE_SYNCS, START_END};
+pub use kinds::{
+    ALL_STANDARD_SYNCS, BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS, FACE_SYNCS,
+    GAZE_SYNCS, GESTURE_SYNCS, START_END,
+};
 pub use model::*;
 pub use parser::{parse, parse_with_diagnostics, Parsed};
 pub use syncref::{SyncPoint, SyncRef, SyncRefError, ANTICIPATORS};

@@ -9,6 +9,7 @@ use quick_xml::name::ResolveResult;
 use quick_xml::NsReader;
 
 use super::diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos};
+use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
 
@@ -787,31 +788,11 @@ impl<'i> Parser<'i> {
 
     fn behaviour(&mut self, el: El, required: bool) -> Result<Option<Behaviour>, Fatal> {
         let core = el.ns.is_core();
-        let known = match (core, &el.ns, el.name.as_str()) {
-            (
-                true,
-                _,
-                "speech" | "gesture" | "pointing" | "head" | "headDirectionShift" | "gaze"
-                | "gazeShift" | "face" | "faceLexeme" | "faceFacs" | "faceShift" | "posture"
-                | "postureShift" | "locomotion" | "wait",
-            ) => true,
-            (_, Ns::CoreExt, "faceFacs") => true,
-            (_, Ns::Bmla | Ns::Bmlt, "interrupt" | "activate" | "parametervaluechange") => true,
-            (
-                _,
-                Ns::Bmlt,
-                "procanimation"
-                | "procanimationgesture"
-                | "keyframe"
-                | "controller"
-                | "audiofile"
-                | "noise"
-                | "facemorph"
-                | "transition"
-                | "text",
-            ) => true,
-            _ => false,
-        };
+        let name = el.name.as_str();
+        let known = (core && CORE_BEHAVIOURS.contains(&name))
+            || (el.ns == Ns::CoreExt && name == "faceFacs")
+            || (el.ns.is_ext() && CONTROL_BEHAVIOURS.contains(&name))
+            || (el.ns == Ns::Bmlt && BMLT_BEHAVIOURS.contains(&name));
         if !known && core {
             self.error(
                 Code::UnknownElement,
@@ -1108,7 +1089,7 @@ impl<'i> Parser<'i> {
                     | BehaviourKind::ProcAnimationGesture(a)
                     | BehaviourKind::Keyframe(a),
                     _,
-                ) if !core => {
+                ) => {
                     let (_, after) = p.skip(&c)?;
                     a.content.push_str(&p.src[c.offset..after]);
                 }

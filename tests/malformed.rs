@@ -1,0 +1,220 @@
+//! Malformed BML: each problem gets its own diagnostic code at the right line:column, and no input
+//! makes the parser panic.
+
+use bml_realizer::bml::{self, Code, Severity};
+use proptest::prelude::*;
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// The errors of `src` as (code, line, col).
+fn errors(src: &str) -> Vec<(Code, u32, u32)> {
+    let err = bml::load(src).expect_err("input should be rejected");
+    err.errors()
+        .map(|d| (d.code, d.pos.line, d.pos.col))
+        .collect()
+}
+
+fn block(body: &str) -> String {
+    format!("<bml {NS} id=\"b1\">\n{body}\n</bml>")
+}
+
+#[test]
+fn not_xml() {
+    assert_eq!(errors("this is not xml")[0].0, Code::NotXml);
+    let e = bml::load(&block("  <speech id=\"s1\"><text>hi</speech>")).unwrap_err();
+    let d = e.first();
+    assert_eq!(d.code, Code::NotXml);
+    assert_eq!(d.pos.line, 2, "{d}");
+    assert_eq!(errors("")[0].0, Code::NotXml);
+}
+
+#[test]
+fn wrong_root() {
+    assert_eq!(
+        errors("<?xml version=\"1.0\"?>\n<foo id=\"x\"/>"),
+        [(Code::WrongRoot, 2, 1)]
+    );
+    let e = bml::load(r#"<bml xmlns="urn:other" id="x"/>"#).unwrap_err();
+    assert_eq!(e.first().code, Code::WrongRoot);
+    assert!(e.first().message.contains("urn:other"));
+}
+
+#[test]
+fn missing_block_id() {
+    let e = bml::load(&format!("<bml {NS}/>")).unwrap_err();
+    assert_eq!(e.first().code, Code::MissingBlockId);
+    assert!(e.first().message.contains("no id"), "{}", e.first().message);
+    assert_eq!(
+        errors(&format!("<bml {NS} id=\" \"/>")),
+        [(Code::MissingBlockId, 1, 56)]
+    );
+}
+
+#[test]
+fn duplicate_behaviour_id() {
+    let src = block("  <gesture id=\"g1\" lexeme=\"BEAT\"/>\n  <head id=\"g1\" lexeme=\"NOD\"/>");
+    assert_eq!(errors(&src), [(Code::DuplicateId, 3, 3)]);
+    let e = bml::load(&src).unwrap_err();
+    assert!(
+        e.first().message.contains("already used at 2:3"),
+        "{}",
+        e.first().message
+    );
+}
+
+#[test]
+fn reference_to_unknown_behaviour() {
+    let src = block("  <gesture id=\"g1\" lexeme=\"BEAT\" start=\"speech9:start\"/>");
+    assert_eq!(errors(&src), [(Code::UnknownBehaviour, 2, 34)]);
+}
+
+#[test]
+fn unknown_sync_point() {
+    let src = block(
+        "  <speech id=\"speech1\"><text>Hi <sync id=\"s1\"/>there</text></speech>\n  <head id=\"h\" lexeme=\"NOD\" start=\"speech1:unknown\"/>",
+    );
+    assert_eq!(errors(&src), [(Code::UnknownSyncPoint, 3, 29)]);
+    let msg = bml::load(&src).unwrap_err().first().message.clone();
+    assert!(msg.contains("start, s1, end"), "{msg}");
+    // a sync that exists on one kind but not another
+    let src = block(
+        "  <gaze id=\"g\" target=\"x\"/>\n  <head id=\"h\" lexeme=\"NOD\" start=\"g:stroke\"/>",
+    );
+    assert_eq!(errors(&src)[0].0, Code::UnknownSyncPoint);
+}
+
+#[test]
+fn malformed_offset() {
+    let src = block("  <gesture id=\"s1\" lexeme=\"BEAT\"/>\n  <head id=\"h\" lexeme=\"NOD\" start=\"s1:start+abc\"/>");
+    assert_eq!(errors(&src), [(Code::MalformedOffset, 3, 29)]);
+}
+
+#[test]
+fn empty_sync_ref() {
+    let src = block("  <head id=\"h\" lexeme=\"NOD\" start=\"\"/>");
+    assert_eq!(errors(&src), [(Code::EmptySyncRef, 2, 29)]);
+    let src = block("  <head id=\"h\" lexeme=\"NOD\"/>\n  <constraint><synchronize ref=\"h:start\"><sync ref=\" \"/></synchronize></constraint>");
+    assert_eq!(errors(&src), [(Code::EmptySyncRef, 3, 48)]);
+}
+
+#[test]
+fn unknown_composition() {
+    assert_eq!(
+        errors(&format!("<bml {NS} id=\"b\" composition=\"SOMETIMES\"/>")),
+        [(Code::UnknownComposition, 1, 63)]
+    );
+    assert_eq!(
+        errors(&format!(
+            "<bml {NS} id=\"b\" composition=\"APPEND-AFTER()\"/>"
+        ))[0]
+            .0,
+        Code::UnknownComposition
+    );
+}
+
+#[test]
+fn other_specific_errors() {
+    let code = |body: &str| errors(&block(body))[0].0;
+    assert_eq!(code("<gesture lexeme=\"BEAT\"/>"), Code::MissingId);
+    assert_eq!(code("<gesture id=\"g\"/>"), Code::MissingAttribute);
+    assert_eq!(
+        code("<gesture id=\"g\" lexeme=\"BEAT\" mode=\"LEFT\"/>"),
+        Code::InvalidEnumValue
+    );
+    assert_eq!(
+        code("<gaze id=\"g\" target=\"t\" influence=\"KNEES\"/>"),
+        Code::InvalidEnumValue
+    );
+    assert_eq!(
+        code("<head id=\"h\" lexeme=\"NOD\" repetition=\"two\"/>"),
+        Code::InvalidNumber
+    );
+    assert_eq!(
+        code("<head id=\"h\" lexeme=\"NOD\" colour=\"red\"/>"),
+        Code::UnknownAttribute
+    );
+    assert_eq!(code("<dance id=\"d\"/>"), Code::UnknownElement);
+    assert_eq!(code("<speech id=\"s\"/>"), Code::MissingElement);
+    assert_eq!(code("hello"), Code::UnexpectedText);
+    assert_eq!(
+        code("<head id=\"h\" lexeme=\"NOD\" start=\"-1\"/>"),
+        Code::InvalidConstraint
+    );
+    assert_eq!(code("<constraint><synchronize><sync ref=\"1\"/><sync ref=\"2\"/></synchronize></constraint>"), Code::InvalidConstraint);
+    assert_eq!(
+        code("<head id=\"h\" lexeme=\"NOD\" start=\"a:b:c:d\"/>"),
+        Code::MalformedSyncRef
+    );
+    assert_eq!(code("<head id=\"h:1\" lexeme=\"NOD\"/>"), Code::InvalidId);
+}
+
+#[test]
+fn every_error_is_reported_not_just_the_first() {
+    let src = block("  <gesture id=\"g1\"/>\n  <head id=\"h\" lexeme=\"NOD\" start=\"x:start+abc\" mode=\"?\"/>");
+    let codes: Vec<Code> = errors(&src).into_iter().map(|e| e.0).collect();
+    assert_eq!(
+        codes,
+        [
+            Code::MissingAttribute,
+            Code::MalformedOffset,
+            Code::UnknownAttribute
+        ]
+    );
+}
+
+#[test]
+fn unknown_extensions_are_warnings_and_kept() {
+    let src = block(
+        "  <x:dance xmlns:x=\"urn:dance\" id=\"d1\" start=\"1\" x:style=\"tango\"><x:step/></x:dance>\n  <head id=\"h\" lexeme=\"NOD\" x:tilt=\"3\" xmlns:x=\"urn:dance\"/>",
+    );
+    let parsed = bml::load(&src).expect("only warnings");
+    assert!(parsed
+        .warnings
+        .iter()
+        .all(|w| w.severity == Severity::Warning));
+    let codes: Vec<Code> = parsed.warnings.iter().map(|w| w.code).collect();
+    assert_eq!(
+        codes,
+        [Code::UnsupportedExtension, Code::UnsupportedAttribute]
+    );
+    let d = parsed.block.behaviour("d1").unwrap();
+    match &d.kind {
+        bml::BehaviourKind::Unknown(u) => {
+            assert_eq!(u.ns, "urn:dance");
+            assert_eq!(u.name, "dance");
+            assert_eq!(u.attrs[0].name, "style");
+            assert_eq!(u.content, "<x:step/>");
+        }
+        k => panic!("{k:?}"),
+    }
+    assert_eq!(d.syncs[0].sync, "start");
+    assert_eq!(
+        parsed.block.behaviour("h").unwrap().foreign_attrs[0].value,
+        "3"
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// Arbitrary text never panics the parser and always yields a diagnostic or a block.
+    #[test]
+    fn arbitrary_text_never_panics(s in "\\PC{0,200}") {
+        let (block, diags) = bml::check(&s);
+        prop_assert!(block.is_some() || diags.iter().any(|d| d.severity == Severity::Error));
+    }
+
+    /// Cutting or corrupting a real block anywhere never panics.
+    #[test]
+    fn corrupted_fixture_never_panics(cut in 0usize..2000, byte in 0u8..128, at in 0usize..2000) {
+        let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/realizertester/bml-1/core/testspeechgestures.xml")).unwrap();
+        let mut bytes = src.into_bytes();
+        bytes.truncate(cut.min(bytes.len()));
+        if !bytes.is_empty() {
+            let i = at % bytes.len();
+            bytes[i] = byte;
+        }
+        let text = String::from_utf8_lossy(&bytes);
+        let _ = bml::check(&text);
+    }
+}
