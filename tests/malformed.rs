@@ -149,6 +149,45 @@ fn other_specific_errors() {
 }
 
 #[test]
+fn reserved_and_forbidden_xml_is_rejected() {
+    // found by the fuzzer: an element with the reserved prefix xmlns
+    let src = block("  <xmlns:x id=\"i1\"/>");
+    assert_eq!(errors(&src), [(Code::NotXml, 2, 3)]);
+    let src = block("  <bmlt:/audiofile xmlns:bmlt=\"urn:t\" id=\"a\"/>");
+    assert_eq!(errors(&src), [(Code::NotXml, 2, 3)]);
+    let src = block("  <speech id=\"s\"><text>bell \u{7}</text></speech>");
+    let e = bml::load(&src).unwrap_err();
+    assert_eq!(e.first().code, Code::NotXml);
+    assert!(
+        e.first().message.contains("U+0007"),
+        "{}",
+        e.first().message
+    );
+}
+
+#[test]
+fn byte_order_mark_does_not_shift_positions_or_raw_content() {
+    let src = format!("\u{feff}{}", block("  <bmlt:keyframe xmlns:bmlt=\"http://hmi.ewi.utwente.nl/bmlt\" id=\"k\"><Frame t=\"0\"/></bmlt:keyframe>\n  <head id=\"h\" lexeme=\"NOD\" start=\"x:start\"/>"));
+    let (block, diags) = bml::check(&src);
+    let bml::BehaviourKind::Keyframe(k) = &block.unwrap().behaviours[0].kind else {
+        panic!()
+    };
+    assert_eq!(k.content, "<Frame t=\"0\"/>");
+    assert_eq!(
+        (diags[0].code, diags[0].pos.line, diags[0].pos.col),
+        (Code::UnknownBehaviour, 3, 29)
+    );
+}
+
+#[test]
+fn xml_lang_survives_a_write_parse_round_trip() {
+    let src = block("  <speech id=\"s\" xml:lang=\"nl\"><text>Hallo</text></speech>");
+    let b = bml::parse(&src).unwrap().block;
+    assert_eq!(b.behaviours[0].foreign_attrs[0].value, "nl");
+    assert_eq!(bml::parse(&bml::write(&b)).unwrap().block, b);
+}
+
+#[test]
 fn every_error_is_reported_not_just_the_first() {
     let src = block("  <gesture id=\"g1\"/>\n  <head id=\"h\" lexeme=\"NOD\" start=\"x:start+abc\" mode=\"?\"/>");
     let codes: Vec<Code> = errors(&src).into_iter().map(|e| e.0).collect();

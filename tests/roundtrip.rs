@@ -90,6 +90,23 @@ fn speech() -> impl Strategy<Value = Speech> {
     })
 }
 
+/// Raw XML content with the namespace bindings it relies on.
+fn raw_content() -> impl Strategy<Value = (&'static str, Vec<(String, String)>)> {
+    prop_oneof![
+        Just(("", vec![])),
+        Just(("<step/>", vec![])),
+        Just(("a &amp; b", vec![])),
+        Just((
+            "<q:speak q:rate=\"1\">Hi</q:speak>",
+            vec![("q".to_string(), "urn:q".to_string())]
+        )),
+        Just((
+            "<bmlt:procanimation id=\"x\" name=\"n\"/>",
+            vec![("bmlt".to_string(), NS_BMLT.to_string())]
+        )),
+    ]
+}
+
 fn params() -> impl Strategy<Value = Vec<Param>> {
     vec(
         (text(), text()).prop_map(|(name, value)| Param { name, value }),
@@ -141,6 +158,7 @@ fn kind() -> impl Strategy<Value = BehaviourKind> {
                 file_name,
                 params,
                 content,
+                namespaces: vec![],
             })
     };
     prop_oneof![
@@ -241,30 +259,30 @@ fn kind() -> impl Strategy<Value = BehaviourKind> {
             prop_oneof![Just("urn:x"), Just("urn:y")],
             "[a-z]{1,8}",
             foreign(),
-            prop_oneof![Just(""), Just("<step/>"), Just("a &amp; b")]
+            raw_content(),
         )
             .prop_map(|(ns, name, attrs, content)| {
                 BehaviourKind::Unknown(UnknownBehaviour {
                     ns: ns.into(),
                     name,
                     attrs,
-                    content: content.into(),
+                    content: content.0.into(),
+                    namespaces: content.1,
                 })
             }),
     ]
 }
 
 fn behaviour() -> impl Strategy<Value = Behaviour> {
-    let description = (
-        option::of(any::<i64>()),
-        text(),
-        prop_oneof![Just(""), Just("<speak>Hi</speak>"), Just("x &lt; y")],
-    )
-        .prop_map(|(priority, kind, content)| Description {
-            priority,
-            kind,
-            content: content.into(),
-            pos: Pos::default(),
+    let description =
+        (option::of(any::<i64>()), text(), raw_content()).prop_map(|(priority, kind, content)| {
+            Description {
+                priority,
+                kind,
+                content: content.0.into(),
+                namespaces: content.1,
+                pos: Pos::default(),
+            }
         });
     (
         id(),

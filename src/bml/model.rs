@@ -238,6 +238,8 @@ pub struct Description {
     pub kind: String,
     /// The raw XML between the description tags.
     pub content: String,
+    /// Namespace prefixes (prefix, URI) declared outside the content and used in it.
+    pub namespaces: Vec<(String, String)>,
     /// Where the description starts.
     pub pos: Pos,
 }
@@ -469,6 +471,8 @@ pub struct Animation {
     pub params: Vec<Param>,
     /// Other content (e.g. an inline SkeletonInterpolator) as raw XML.
     pub content: String,
+    /// Namespace prefixes (prefix, URI) declared outside the content and used in it.
+    pub namespaces: Vec<(String, String)>,
 }
 
 /// BMLT `<controller class name>`.
@@ -522,6 +526,8 @@ pub struct UnknownBehaviour {
     pub attrs: Vec<ForeignAttr>,
     /// Raw XML content.
     pub content: String,
+    /// Namespace prefixes (prefix, URI) declared outside the content and used in it.
+    pub namespaces: Vec<(String, String)>,
 }
 
 /// Every behaviour kind with its specific attributes.

@@ -13,6 +13,9 @@ use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
 
+/// The namespace reserved for `xmlns` declarations; no element may be in it.
+const XMLNS_URI: &str = "http://www.w3.org/2000/xmlns/";
+
 /// A parsed block together with the warnings found while reading it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Parsed {
@@ -63,13 +66,14 @@ enum Ns {
 }
 
 impl Ns {
-    fn from_uri(uri: &[u8]) -> Ns {
-        match uri {
+    fn from_uri(raw: &[u8]) -> Ns {
+        let uri = namespace_uri(raw);
+        match uri.as_bytes() {
             b"http://www.bml-initiative.org/bml/bml-1.0" => Ns::Bml,
             b"http://www.bml-initiative.org/bml/coreextensions-1.0" => Ns::CoreExt,
             b"http://www.asap-project.org/bmla" => Ns::Bmla,
             b"http://hmi.ewi.utwente.nl/bmlt" => Ns::Bmlt,
-            other => Ns::Other(String::from_utf8_lossy(other).into_owned()),
+            _ => Ns::Other(uri),
         }
     }
 
@@ -107,6 +111,8 @@ struct El {
     ns: Ns,
     name: String,
     qname: String,
+    /// Namespace prefixes used by the tag (element and attribute names).
+    prefixes: Vec<String>,
     attrs: Vec<RawAttr>,
     empty: bool,
     offset: usize,
@@ -119,6 +125,16 @@ enum Tok {
     End { offset: usize, after: usize },
     Text { text: String, offset: usize },
     Eof,
+}
+
+/// What [`Parser::skip`] passed over.
+struct Skipped {
+    /// The raw XML between the start and end tags.
+    content: String,
+    /// Offset just after the end tag.
+    after: usize,
+    /// Namespace prefixes used by the tags inside.
+    prefixes: Vec<String>,
 }
 
 /// Fatal XML error: parsing stops.
@@ -159,6 +175,8 @@ impl Attrs {
 
 impl<'i> Parser<'i> {
     fn new(src: &'i str) -> Self {
+        // A byte-order mark is not content; quick-xml skips it, so offsets are relative to the rest.
+        let src = src.strip_prefix('\u{feff}').unwrap_or(src);
         Parser {
             src,
             reader: NsReader::from_str(src),
@@ -297,6 +315,30 @@ impl<'i> Parser<'i> {
                 Ns::Other(prefix)
             }
         };
+        if !is_ncname(&name)
+            || e.name()
+                .prefix()
+                .is_some_and(|p| !is_ncname(&String::from_utf8_lossy(p.as_ref())))
+        {
+            self.error(
+                Code::NotXml,
+                before,
+                format!("<{qname}> is not a valid qualified name"),
+            );
+            return Err(Fatal);
+        }
+        if ns == Ns::Other(XMLNS_URI.to_string()) {
+            self.error(
+                Code::NotXml,
+                before,
+                format!("<{qname}>: the prefix xmlns is reserved for namespace declarations"),
+            );
+            return Err(Fatal);
+        }
+        let mut prefixes = Vec::new();
+        if let Some(p) = e.name().prefix() {
+            prefixes.push(String::from_utf8_lossy(p.as_ref()).into_owned());
+        }
         let mut attrs = Vec::new();
         for a in e.attributes() {
             let a = match a {
@@ -312,10 +354,37 @@ impl<'i> Parser<'i> {
             };
             let key = a.key.as_ref();
             if key == b"xmlns" || key.starts_with(b"xmlns:") {
+                if let Err(err) = a.unescape_value() {
+                    let at = self.offset_in_src(key, before);
+                    self.error(
+                        Code::NotXml,
+                        at,
+                        format!(
+                            "namespace declaration has a bad character or entity reference: {err}"
+                        ),
+                    );
+                    return Err(Fatal);
+                }
                 continue;
             }
             let offset = self.offset_in_src(key, before);
+            if let Some(p) = a.key.prefix() {
+                prefixes.push(String::from_utf8_lossy(p.as_ref()).into_owned());
+            }
             let aname = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
+            if !is_ncname(&aname)
+                || a.key
+                    .prefix()
+                    .is_some_and(|p| !is_ncname(&String::from_utf8_lossy(p.as_ref())))
+            {
+                let q = String::from_utf8_lossy(key);
+                self.error(
+                    Code::NotXml,
+                    offset,
+                    format!("attribute '{q}' is not a valid qualified name"),
+                );
+                return Err(Fatal);
+            }
             let ans = match self.reader.resolve_attribute(a.key).0 {
                 ResolveResult::Bound(n) => match Ns::from_uri(n.as_ref()) {
                     Ns::Bml => Ns::None,
@@ -361,6 +430,7 @@ impl<'i> Parser<'i> {
             ns,
             name,
             qname,
+            prefixes,
             attrs,
             empty,
             offset: before,
@@ -368,19 +438,47 @@ impl<'i> Parser<'i> {
         })
     }
 
-    /// Skips the rest of an element whose start tag was just read; returns the raw inner XML and
-    /// the offset just after the end tag.
-    fn skip(&mut self, el: &El) -> Result<(String, usize), Fatal> {
+    /// The prefixed namespace bindings in scope now (call right after reading a start tag).
+    fn scope(&self) -> Vec<(String, String)> {
+        self.reader
+            .resolver()
+            .bindings()
+            .filter_map(|(decl, ns)| match decl {
+                quick_xml::name::PrefixDeclaration::Named(p) if p != b"xml" => Some((
+                    String::from_utf8_lossy(p).into_owned(),
+                    namespace_uri(ns.as_ref()),
+                )),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Skips the rest of an element whose start tag was just read, returning what it held.
+    fn skip(&mut self, el: &El) -> Result<Skipped, Fatal> {
+        let mut prefixes = Vec::new();
         if el.empty {
-            return Ok((String::new(), el.inner_start));
+            return Ok(Skipped {
+                content: String::new(),
+                after: el.inner_start,
+                prefixes,
+            });
         }
         let mut depth = 0usize;
         loop {
             match self.next()? {
-                Tok::Start(e) if !e.empty => depth += 1,
+                Tok::Start(e) => {
+                    prefixes.extend(e.prefixes);
+                    if !e.empty {
+                        depth += 1;
+                    }
+                }
                 Tok::End { offset, after } => {
                     if depth == 0 {
-                        return Ok((self.src[el.inner_start..offset].to_string(), after));
+                        return Ok(Skipped {
+                            content: self.src[el.inner_start..offset].to_string(),
+                            after,
+                            prefixes,
+                        });
                     }
                     depth -= 1;
                 }
@@ -437,6 +535,19 @@ impl<'i> Parser<'i> {
     }
 
     fn document_inner(&mut self) -> Result<Option<Block>, Fatal> {
+        // XML 1.0 forbids most C0 control characters anywhere in a document.
+        if let Some((at, c)) = self
+            .src
+            .char_indices()
+            .find(|&(_, c)| (c as u32) < 0x20 && !matches!(c, '\t' | '\n' | '\r'))
+        {
+            self.error(
+                Code::NotXml,
+                at,
+                format!("character U+{:04X} is not allowed in XML", c as u32),
+            );
+            return Err(Fatal);
+        }
         let root = loop {
             match self.next()? {
                 Tok::Start(el) => break el,
@@ -838,7 +949,11 @@ impl<'i> Parser<'i> {
                 format!("unsupported extension behaviour {on} (namespace {}); it is kept but will not be realized", el.ns.uri()),
             );
             let syncs = self.sync_attrs(&mut attrs, super::kinds::ALL_STANDARD_SYNCS, &on);
-            let (content, _) = self.skip(&el)?;
+            let scope = self.scope();
+            let Skipped {
+                content, prefixes, ..
+            } = self.skip(&el)?;
+            let namespaces = used_prefixes(scope, &prefixes, &[]);
             let kind = BehaviourKind::Unknown(UnknownBehaviour {
                 ns: el.ns.uri().to_string(),
                 name: el.name.clone(),
@@ -851,6 +966,7 @@ impl<'i> Parser<'i> {
                     })
                     .collect(),
                 content,
+                namespaces,
             });
             return Ok(id.map(|id| Behaviour {
                 id,
@@ -947,10 +1063,14 @@ impl<'i> Parser<'i> {
                         );
                     }
                     let _ = p.leftover_attrs(attrs, "<description>");
-                    let (content, _) = p.skip(&c)?;
+                    let scope = p.scope();
+                    let Skipped {
+                        content, prefixes, ..
+                    } = p.skip(&c)?;
                     descriptions.push(Description {
                         priority,
                         kind: kind_attr.map(|a| a.value).unwrap_or_default(),
+                        namespaces: used_prefixes(scope, &prefixes, &[]),
                         content,
                         pos: p.pos(c.offset),
                     });
@@ -1090,8 +1210,15 @@ impl<'i> Parser<'i> {
                     | BehaviourKind::Keyframe(a),
                     _,
                 ) => {
-                    let (_, after) = p.skip(&c)?;
+                    let scope = p.scope();
+                    let Skipped {
+                        after,
+                        mut prefixes,
+                        ..
+                    } = p.skip(&c)?;
+                    prefixes.extend(c.prefixes.iter().cloned());
                     a.content.push_str(&p.src[c.offset..after]);
+                    a.namespaces = used_prefixes(scope, &prefixes, &a.namespaces);
                 }
                 _ => {
                     if core {
@@ -1354,8 +1481,7 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
         Animation {
             name,
             file_name,
-            params: Vec::new(),
-            content: String::new(),
+            ..Animation::default()
         }
     }
 
@@ -1537,6 +1663,50 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
             _ => return None,
         })
     }
+}
+
+/// Whether `s` is an XML name without colons (the NCName production of Namespaces in XML).
+fn is_ncname(s: &str) -> bool {
+    fn start(c: char) -> bool {
+        matches!(c, 'A'..='Z' | '_' | 'a'..='z' | '\u{C0}'..='\u{D6}' | '\u{D8}'..='\u{F6}'
+            | '\u{F8}'..='\u{2FF}' | '\u{370}'..='\u{37D}' | '\u{37F}'..='\u{1FFF}'
+            | '\u{200C}'..='\u{200D}' | '\u{2070}'..='\u{218F}' | '\u{2C00}'..='\u{2FEF}'
+            | '\u{3001}'..='\u{D7FF}' | '\u{F900}'..='\u{FDCF}' | '\u{FDF0}'..='\u{FFFD}'
+            | '\u{10000}'..='\u{EFFFF}')
+    }
+    fn rest(c: char) -> bool {
+        start(c)
+            || matches!(c, '-' | '.' | '0'..='9' | '\u{B7}' | '\u{300}'..='\u{36F}' | '\u{203F}'..='\u{2040}')
+    }
+    let mut chars = s.chars();
+    chars.next().is_some_and(start) && chars.all(rest)
+}
+
+/// A namespace URI as declared: the resolver hands it out as written, so resolve character
+/// references (declarations were checked to be well-formed when read).
+fn namespace_uri(raw: &[u8]) -> String {
+    let text = String::from_utf8_lossy(raw);
+    match quick_xml::escape::unescape(&text) {
+        Ok(u) => u.into_owned(),
+        Err(_) => text.into_owned(),
+    }
+}
+
+/// The bindings of `scope` whose prefix is in `used`, merged with `known`, sorted by prefix. Raw
+/// content keeps these so that the writer can declare them again.
+fn used_prefixes(
+    scope: Vec<(String, String)>,
+    used: &[String],
+    known: &[(String, String)],
+) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = known.to_vec();
+    for (prefix, uri) in scope {
+        if used.contains(&prefix) && !out.iter().any(|(p, _)| *p == prefix) {
+            out.push((prefix, uri));
+        }
+    }
+    out.sort();
+    out
 }
 
 fn push_text(acc: &mut Option<(String, usize)>, s: &str, offset: usize) {

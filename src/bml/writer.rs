@@ -15,6 +15,9 @@ const KNOWN_PREFIXES: &[(&str, &str)] = &[
     ("bmlis", "http://www.asap-project.org/bmlis"),
 ];
 
+/// The `xml:` namespace, bound by definition and never declared.
+const XML_NS: &str = "http://www.w3.org/XML/1998/namespace";
+
 struct Writer {
     out: String,
     prefixes: Vec<(String, String)>, // (prefix, uri)
@@ -34,6 +37,13 @@ pub fn write(block: &Block) -> String {
     w.out
 }
 
+/// Declares the namespaces raw content relies on, on the element that wraps it.
+fn xmlns(out: &mut String, namespaces: &[(String, String)]) {
+    for (p, u) in namespaces {
+        let _ = write!(out, " xmlns:{p}=\"{}\"", escape(u));
+    }
+}
+
 fn num(v: f64) -> String {
     let mut s = String::new();
     let _ = fmt_seconds(&mut s, v);
@@ -50,7 +60,7 @@ impl Writer {
             }
         }
         for uri in uris {
-            if !uri.is_empty() && !self.prefixes.iter().any(|(_, u)| u == uri) {
+            if !uri.is_empty() && uri != XML_NS && !self.prefixes.iter().any(|(_, u)| u == uri) {
                 let p = format!("ns{}", self.prefixes.len() - KNOWN_PREFIXES.len() + 1);
                 self.prefixes.push((p, uri.to_string()));
             }
@@ -58,6 +68,9 @@ impl Writer {
     }
 
     fn prefix(&self, uri: &str) -> &str {
+        if uri == XML_NS {
+            return "xml";
+        }
         self.prefixes
             .iter()
             .find(|(_, u)| u == uri)
@@ -156,6 +169,13 @@ impl Writer {
         let _ = write!(self.out, "{indent}<{q}");
         if let BehaviourKind::Unknown(u) = &b.kind {
             self.attr("xmlns", &u.ns);
+            xmlns(&mut self.out, &u.namespaces);
+        }
+        if let BehaviourKind::ProcAnimation(a)
+        | BehaviourKind::ProcAnimationGesture(a)
+        | BehaviourKind::Keyframe(a) = &b.kind
+        {
+            xmlns(&mut self.out, &a.namespaces);
         }
         self.attr("id", &b.id);
         self.kind_attrs(&b.kind);
@@ -170,12 +190,9 @@ impl Writer {
             if let Some(p) = d.priority {
                 let _ = write!(body, " priority=\"{p}\"");
             }
-            let _ = write!(
-                body,
-                " type=\"{}\">{}</description>",
-                escape(&d.kind),
-                d.content
-            );
+            let _ = write!(body, " type=\"{}\"", escape(&d.kind));
+            xmlns(&mut body, &d.namespaces);
+            let _ = write!(body, ">{}</description>", d.content);
         }
         if body.is_empty() {
             self.out.push_str("/>\n");
