@@ -335,6 +335,7 @@ fn bmlt_behaviours() {
                 }
             ],
             content: String::new(),
+            namespaces: vec![],
         })
     );
     assert!(
