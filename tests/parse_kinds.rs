@@ -109,7 +109,7 @@ fn gesture_and_pointing() {
             mode: Some(Mode::BothHands)
         })
     );
-    let names: Vec<&str> = b.syncs.iter().map(|s| s.sync.as_str()).collect();
+    let names: Vec<&str> = b.syncs.iter().map(|s| s.sync).collect();
     assert_eq!(names, GESTURE_SYNCS);
     assert_eq!(sync(&b, "strokeEnd"), "5");
     let b = one(r#"<pointing id="p" target="bluebox" mode="LEFT_HAND"/>"#);

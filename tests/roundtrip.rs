@@ -296,7 +296,7 @@ fn behaviour() -> impl Strategy<Value = Behaviour> {
             let names = kind.standard_syncs();
             let mut attrs: Vec<SyncAttr> = Vec::new();
             for (i, value) in syncs {
-                let sync = names[i.index(names.len())].to_string();
+                let sync = names[i.index(names.len())];
                 if !attrs.iter().any(|a| a.sync == sync) {
                     attrs.push(SyncAttr {
                         sync,

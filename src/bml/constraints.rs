@@ -76,7 +76,7 @@ pub enum Source {
         /// The behaviour carrying the attribute.
         behaviour: String,
         /// The attribute (sync point) name.
-        sync: String,
+        sync: &'static str,
     },
     /// A child of a `<constraint>` element.
     Element {
@@ -174,7 +174,7 @@ pub fn extract(block: &Block) -> Vec<Constraint> {
     for b in &block.behaviours {
         for s in &b.syncs {
             let own = SyncRef::Point {
-                point: SyncPoint::local(&b.id, &s.sync),
+                point: SyncPoint::local(&b.id, s.sync),
                 offset: 0.0,
             };
             out.push(Constraint::between(
@@ -184,12 +184,24 @@ pub fn extract(block: &Block) -> Vec<Constraint> {
                 b.required,
                 Source::Attribute {
                     behaviour: b.id.clone(),
-                    sync: s.sync.clone(),
+                    sync: s.sync,
                 },
                 s.pos,
             ));
         }
     }
+    extract_elements_into(block, &mut out);
+    out
+}
+
+/// The constraints of the `<constraint>` elements only.
+pub(crate) fn extract_elements(block: &Block) -> Vec<Constraint> {
+    let mut out = Vec::new();
+    extract_elements_into(block, &mut out);
+    out
+}
+
+fn extract_elements_into(block: &Block, out: &mut Vec<Constraint>) {
     for c in &block.constraints {
         let source = || Source::Element {
             constraint: c.id.clone(),
@@ -227,5 +239,4 @@ pub fn extract(block: &Block) -> Vec<Constraint> {
             }
         }
     }
-    out
 }

@@ -177,6 +177,11 @@ impl Behaviour {
 
     /// Whether `sync` is a known sync point of the behaviour (always true for open kinds).
     pub fn has_sync(&self, sync: &str) -> bool {
-        self.kind.has_open_syncs() || self.sync_points().contains(&sync)
+        match &self.kind {
+            BehaviourKind::Speech(s) | BehaviourKind::Text(s) => {
+                sync == "start" || sync == "end" || s.sync_ids().any(|id| id == sync)
+            }
+            k => k.has_open_syncs() || k.standard_syncs().contains(&sync),
+        }
     }
 }

@@ -222,7 +222,7 @@ impl Block {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SyncAttr {
     /// The sync point of this behaviour that is constrained (the attribute name).
-    pub sync: String,
+    pub sync: &'static str,
     /// What it is synchronised to.
     pub value: SyncRef,
     /// Where the attribute is.

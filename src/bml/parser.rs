@@ -3,6 +3,7 @@
 //! checked here; cross-references are checked by `validate.rs`.
 
 use std::borrow::Cow;
+use std::fmt;
 
 use quick_xml::events::Event;
 use quick_xml::name::ResolveResult;
@@ -67,13 +68,17 @@ enum Ns {
 
 impl Ns {
     fn from_uri(raw: &[u8]) -> Ns {
-        let uri = namespace_uri(raw);
-        match uri.as_bytes() {
+        match raw {
             b"http://www.bml-initiative.org/bml/bml-1.0" => Ns::Bml,
             b"http://www.bml-initiative.org/bml/coreextensions-1.0" => Ns::CoreExt,
             b"http://www.asap-project.org/bmla" => Ns::Bmla,
             b"http://hmi.ewi.utwente.nl/bmlt" => Ns::Bmlt,
-            _ => Ns::Other(uri),
+            _ if raw.contains(&b'&') => match namespace_uri(raw) {
+                // written with character references: compare the resolved text
+                uri if uri.as_bytes() != raw => Ns::from_uri(uri.as_bytes()),
+                uri => Ns::Other(uri),
+            },
+            _ => Ns::Other(String::from_utf8_lossy(raw).into_owned()),
         }
     }
 
@@ -98,43 +103,47 @@ impl Ns {
     }
 }
 
+/// Text borrowed from the source where possible.
+type Str<'i> = Cow<'i, str>;
+
 #[derive(Debug, Clone)]
-struct RawAttr {
+struct RawAttr<'i> {
     ns: Ns,
-    name: String,
-    value: String,
+    name: Str<'i>,
+    value: Str<'i>,
     offset: usize,
 }
 
 #[derive(Debug)]
-struct El {
+struct El<'i> {
     ns: Ns,
-    name: String,
-    qname: String,
+    name: Str<'i>,
+    qname: Str<'i>,
     /// Namespace prefixes used by the tag (element and attribute names).
-    prefixes: Vec<String>,
-    attrs: Vec<RawAttr>,
+    prefixes: Vec<Str<'i>>,
+    /// Attributes (xmlns declarations excluded); `Option` so that they can be taken one by one.
+    attrs: Vec<Option<RawAttr<'i>>>,
     empty: bool,
     offset: usize,
     inner_start: usize,
 }
 
 #[derive(Debug)]
-enum Tok {
-    Start(El),
+enum Tok<'i> {
+    Start(El<'i>),
     End { offset: usize, after: usize },
-    Text { text: String, offset: usize },
+    Text { text: Str<'i>, offset: usize },
     Eof,
 }
 
 /// What [`Parser::skip`] passed over.
-struct Skipped {
+struct Skipped<'i> {
     /// The raw XML between the start and end tags.
     content: String,
     /// Offset just after the end tag.
     after: usize,
     /// Namespace prefixes used by the tags inside.
-    prefixes: Vec<String>,
+    prefixes: Vec<Str<'i>>,
 }
 
 /// Fatal XML error: parsing stops.
@@ -145,30 +154,34 @@ struct Parser<'i> {
     reader: NsReader<&'i [u8]>,
     lines: LineIndex,
     diags: Vec<Diagnostic>,
-    pending: Option<Tok>,
+    pending: Option<Tok<'i>>,
 }
 
 /// Remaining attributes of an element, taken one by one by name.
-struct Attrs {
-    items: Vec<Option<RawAttr>>,
+struct Attrs<'i> {
+    items: Vec<Option<RawAttr<'i>>>,
 }
 
-impl Attrs {
-    fn take(&mut self, name: &str) -> Option<RawAttr> {
+impl<'i> Attrs<'i> {
+    fn new(items: Vec<Option<RawAttr<'i>>>) -> Self {
+        Attrs { items }
+    }
+
+    fn take(&mut self, name: &str) -> Option<RawAttr<'i>> {
         self.items
             .iter_mut()
             .find(|a| matches!(a, Some(a) if a.ns == Ns::None && a.name == name))
             .and_then(Option::take)
     }
 
-    fn take_ext(&mut self, names: &[&str]) -> Option<RawAttr> {
+    fn take_ext(&mut self, names: &[&str]) -> Option<RawAttr<'i>> {
         self.items
             .iter_mut()
-            .find(|a| matches!(a, Some(a) if a.ns.is_ext() && names.contains(&a.name.as_str())))
+            .find(|a| matches!(a, Some(a) if a.ns.is_ext() && names.contains(&a.name.as_ref())))
             .and_then(Option::take)
     }
 
-    fn rest(self) -> impl Iterator<Item = RawAttr> {
+    fn rest(self) -> impl Iterator<Item = RawAttr<'i>> {
         self.items.into_iter().flatten()
     }
 }
@@ -210,6 +223,20 @@ impl<'i> Parser<'i> {
         }
     }
 
+    /// The source text that `bytes` (a slice of the source handed out by quick-xml) covers,
+    /// borrowed; a copy if it is not a slice of the source.
+    fn text_of(&self, bytes: &[u8]) -> Str<'i> {
+        let src: &'i str = self.src;
+        let base = src.as_ptr() as usize;
+        let p = bytes.as_ptr() as usize;
+        if p >= base && p + bytes.len() <= base + src.len() {
+            if let Some(s) = src.get(p - base..p - base + bytes.len()) {
+                return Cow::Borrowed(s);
+            }
+        }
+        Cow::Owned(String::from_utf8_lossy(bytes).into_owned())
+    }
+
     fn xml_error(&mut self, e: impl std::fmt::Display) -> Fatal {
         let at = self.reader.error_position() as usize;
         self.error(Code::NotXml, at, format!("not well-formed XML: {e}"));
@@ -217,11 +244,11 @@ impl<'i> Parser<'i> {
     }
 
     /// Reads the next token, merging adjacent text, character references and CDATA.
-    fn next(&mut self) -> Result<Tok, Fatal> {
+    fn next(&mut self) -> Result<Tok<'i>, Fatal> {
         if let Some(t) = self.pending.take() {
             return Ok(t);
         }
-        let mut text: Option<(String, usize)> = None;
+        let mut text: Option<(Str<'i>, usize)> = None;
         loop {
             let before = self.reader.buffer_position() as usize;
             let (ns, ev) = match self.reader.read_resolved_event() {
@@ -244,23 +271,24 @@ impl<'i> Parser<'i> {
                 },
                 Event::Eof => Tok::Eof,
                 Event::Text(t) => {
-                    let s = match t.xml_content() {
-                        Ok(s) => s,
-                        Err(e) => return Err(self.xml_error(e)),
+                    let s = match self.text_of(&t) {
+                        // XML end-of-line handling: \r\n and lone \r read as \n
+                        s if s.contains('\r') => Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n")),
+                        s => s,
                     };
-                    push_text(&mut text, &s, before);
+                    push_text(&mut text, s, before);
                     continue;
                 }
                 Event::CData(c) => {
                     let s = match c.decode() {
-                        Ok(s) => s,
+                        Ok(s) => Cow::Owned(s.into_owned()),
                         Err(e) => return Err(self.xml_error(e)),
                     };
-                    push_text(&mut text, &s, before);
+                    push_text(&mut text, s, before);
                     continue;
                 }
                 Event::GeneralRef(r) => {
-                    let resolved: Cow<str> = match r.resolve_char_ref() {
+                    let resolved: Str<'i> = match r.resolve_char_ref() {
                         Ok(Some(c)) => c.to_string().into(),
                         Ok(None) => {
                             let name = r.decode().map(|n| n.into_owned()).unwrap_or_default();
@@ -278,7 +306,7 @@ impl<'i> Parser<'i> {
                         }
                         Err(e) => return Err(self.xml_error(e)),
                     };
-                    push_text(&mut text, &resolved, before);
+                    push_text(&mut text, resolved, before);
                     continue;
                 }
                 _ => continue, // comments, processing instructions, declarations, doctype
@@ -301,9 +329,9 @@ impl<'i> Parser<'i> {
         empty: bool,
         ns: Result<Ns, String>,
         before: usize,
-    ) -> Result<El, Fatal> {
-        let qname = String::from_utf8_lossy(e.name().as_ref()).into_owned();
-        let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+    ) -> Result<El<'i>, Fatal> {
+        let qname = self.text_of(e.name().as_ref());
+        let name = self.text_of(e.local_name().as_ref());
         let ns = match ns {
             Ok(ns) => ns,
             Err(prefix) => {
@@ -337,7 +365,7 @@ impl<'i> Parser<'i> {
         }
         let mut prefixes = Vec::new();
         if let Some(p) = e.name().prefix() {
-            prefixes.push(String::from_utf8_lossy(p.as_ref()).into_owned());
+            prefixes.push(self.text_of(p.as_ref()));
         }
         let mut attrs = Vec::new();
         for a in e.attributes() {
@@ -369,9 +397,9 @@ impl<'i> Parser<'i> {
             }
             let offset = self.offset_in_src(key, before);
             if let Some(p) = a.key.prefix() {
-                prefixes.push(String::from_utf8_lossy(p.as_ref()).into_owned());
+                prefixes.push(self.text_of(p.as_ref()));
             }
-            let aname = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
+            let aname = self.text_of(a.key.local_name().as_ref());
             if !is_ncname(&aname)
                 || a.key
                     .prefix()
@@ -404,8 +432,14 @@ impl<'i> Parser<'i> {
                     Ns::Other(p)
                 }
             };
-            let value = match a.unescape_value() {
-                Ok(v) => v.into_owned(),
+            let raw = self.text_of(&a.value);
+            let unescaped = match raw {
+                // the common case: nothing to resolve, borrow the source
+                Cow::Borrowed(s) if !s.contains('&') => Ok(Cow::Borrowed(s)),
+                _ => a.unescape_value().map(|v| Cow::Owned(v.into_owned())),
+            };
+            let value = match unescaped {
+                Ok(v) => v,
                 Err(err) => {
                     self.error(
                         Code::NotXml,
@@ -415,15 +449,15 @@ impl<'i> Parser<'i> {
                             String::from_utf8_lossy(key)
                         ),
                     );
-                    String::from_utf8_lossy(&a.value).into_owned()
+                    Cow::Owned(String::from_utf8_lossy(&a.value).into_owned())
                 }
             };
-            attrs.push(RawAttr {
+            attrs.push(Some(RawAttr {
                 ns: ans,
                 name: aname,
                 value,
                 offset,
-            });
+            }));
         }
         let inner_start = self.reader.buffer_position() as usize;
         Ok(El {
@@ -454,7 +488,7 @@ impl<'i> Parser<'i> {
     }
 
     /// Skips the rest of an element whose start tag was just read, returning what it held.
-    fn skip(&mut self, el: &El) -> Result<Skipped, Fatal> {
+    fn skip(&mut self, el: &El<'i>) -> Result<Skipped<'i>, Fatal> {
         let mut prefixes = Vec::new();
         if el.empty {
             return Ok(Skipped {
@@ -488,7 +522,7 @@ impl<'i> Parser<'i> {
         }
     }
 
-    fn unexpected_eof(&mut self, el: &El) -> Fatal {
+    fn unexpected_eof(&mut self, el: &El<'i>) -> Fatal {
         self.error(
             Code::NotXml,
             el.offset,
@@ -501,8 +535,8 @@ impl<'i> Parser<'i> {
     /// e.g. via `skip`), reports non-whitespace text unless `text` handles it.
     fn children(
         &mut self,
-        el: &El,
-        mut on_child: impl FnMut(&mut Self, El) -> Result<(), Fatal>,
+        el: &El<'i>,
+        mut on_child: impl FnMut(&mut Self, El<'i>) -> Result<(), Fatal>,
     ) -> Result<usize, Fatal> {
         if el.empty {
             return Ok(el.inner_start);
@@ -512,14 +546,14 @@ impl<'i> Parser<'i> {
                 Tok::Start(child) => on_child(self, child)?,
                 Tok::End { after, .. } => return Ok(after),
                 Tok::Text { text, offset } => {
-                    if !text.trim().is_empty() {
-                        let lead = text.len() - text.trim_start().len();
+                    if !text.trim_ascii().is_empty() {
+                        let lead = text.len() - text.trim_ascii_start().len();
                         self.error(
                             Code::UnexpectedText,
                             offset + lead,
                             format!(
                                 "unexpected text '{}' inside <{}>",
-                                abbreviate(text.trim()),
+                                abbreviate(text.trim_ascii()),
                                 el.qname
                             ),
                         );
@@ -536,22 +570,22 @@ impl<'i> Parser<'i> {
 
     fn document_inner(&mut self) -> Result<Option<Block>, Fatal> {
         // XML 1.0 forbids most C0 control characters anywhere in a document.
-        if let Some((at, c)) = self
-            .src
-            .char_indices()
-            .find(|&(_, c)| (c as u32) < 0x20 && !matches!(c, '\t' | '\n' | '\r'))
-        {
+        let forbidden = |b: u8| b < 0x20 && !matches!(b, b'\t' | b'\n' | b'\r');
+        // branch-free pass first (vectorises); locate only when something is there
+        let any = self.src.bytes().fold(false, |acc, b| acc | forbidden(b));
+        if let Some(at) = any.then(|| self.src.bytes().position(forbidden)).flatten() {
+            let c = self.src.as_bytes()[at];
             self.error(
                 Code::NotXml,
                 at,
-                format!("character U+{:04X} is not allowed in XML", c as u32),
+                format!("character U+{c:04X} is not allowed in XML"),
             );
             return Err(Fatal);
         }
         let root = loop {
             match self.next()? {
                 Tok::Start(el) => break el,
-                Tok::Text { text, offset } if !text.trim().is_empty() => {
+                Tok::Text { text, offset } if !text.trim_ascii().is_empty() => {
                     self.error(
                         Code::NotXml,
                         offset,
@@ -594,7 +628,7 @@ impl<'i> Parser<'i> {
         loop {
             match self.next()? {
                 Tok::Eof => break,
-                Tok::Text { text, offset } if !text.trim().is_empty() => {
+                Tok::Text { text, offset } if !text.trim_ascii().is_empty() => {
                     self.error(
                         Code::NotXml,
                         offset,
@@ -619,8 +653,8 @@ impl<'i> Parser<'i> {
         Ok(Some(block))
     }
 
-    fn bool_attr(&mut self, a: &RawAttr) -> bool {
-        match a.value.trim().to_ascii_lowercase().as_str() {
+    fn bool_attr(&mut self, a: &RawAttr<'i>) -> bool {
+        match a.value.trim_ascii().to_ascii_lowercase().as_str() {
             "true" => true,
             "false" => false,
             _ => {
@@ -637,17 +671,15 @@ impl<'i> Parser<'i> {
         }
     }
 
-    fn block(&mut self, el: El) -> Result<Block, Fatal> {
+    fn block(&mut self, mut el: El<'i>) -> Result<Block, Fatal> {
         let mut block = Block {
             pos: self.pos(el.offset),
             ..Block::default()
         };
-        let mut attrs = Attrs {
-            items: el.attrs.iter().cloned().map(Some).collect(),
-        };
+        let mut attrs = Attrs::new(std::mem::take(&mut el.attrs));
         match attrs.take("id") {
-            Some(a) if !a.value.trim().is_empty() => {
-                block.id = a.value.trim().to_string();
+            Some(a) if !a.value.trim_ascii().is_empty() => {
+                block.id = a.value.trim_ascii().to_string();
                 if block.id.contains(':') {
                     self.error(
                         Code::InvalidId,
@@ -670,7 +702,7 @@ impl<'i> Parser<'i> {
                 "the <bml> block has no id attribute; every block needs one",
             ),
         }
-        block.character_id = attrs.take("characterId").map(|a| a.value);
+        block.character_id = attrs.take("characterId").map(|a| a.value.into_owned());
         let composition = attrs.take("composition");
         let scheduling = attrs.take("scheduling");
         if let (Some(_), Some(s)) = (&composition, &scheduling) {
@@ -712,7 +744,7 @@ impl<'i> Parser<'i> {
                 *target = split_id_list(&a.value);
             }
         }
-        block.foreign_attrs = self.leftover_attrs(attrs, "<bml>");
+        block.foreign_attrs = self.leftover_attrs(attrs, &"<bml>");
 
         let mut behaviours = Vec::new();
         let mut constraints = Vec::new();
@@ -725,7 +757,7 @@ impl<'i> Parser<'i> {
     }
 
     /// Reports leftover attributes: unprefixed ones are errors, extension ones warnings (kept).
-    fn leftover_attrs(&mut self, attrs: Attrs, on: &str) -> Vec<ForeignAttr> {
+    fn leftover_attrs(&mut self, attrs: Attrs<'i>, on: &dyn fmt::Display) -> Vec<ForeignAttr> {
         let mut kept = Vec::new();
         for a in attrs.rest() {
             if a.ns == Ns::None {
@@ -746,8 +778,8 @@ impl<'i> Parser<'i> {
                 );
                 kept.push(ForeignAttr {
                     ns: a.ns.uri().to_string(),
-                    name: a.name,
-                    value: a.value,
+                    name: a.name.into_owned(),
+                    value: a.value.into_owned(),
                 });
             }
         }
@@ -756,7 +788,7 @@ impl<'i> Parser<'i> {
 
     fn block_child(
         &mut self,
-        child: El,
+        child: El<'i>,
         required: bool,
         behaviours: &mut Vec<Behaviour>,
         constraints: &mut Vec<ConstraintElement>,
@@ -773,7 +805,7 @@ impl<'i> Parser<'i> {
                     "<required> cannot be nested in <required>",
                 );
             }
-            for a in &child.attrs {
+            for a in child.attrs.iter().flatten() {
                 self.error(
                     Code::UnknownAttribute,
                     a.offset,
@@ -789,7 +821,7 @@ impl<'i> Parser<'i> {
         Ok(())
     }
 
-    fn sync_ref(&mut self, a: &RawAttr, on: &str) -> Option<SyncRef> {
+    fn sync_ref(&mut self, a: &RawAttr<'i>, on: &dyn fmt::Display) -> Option<SyncRef> {
         match SyncRef::parse(&a.value) {
             Ok(r) => Some(r),
             Err(e) => {
@@ -803,16 +835,18 @@ impl<'i> Parser<'i> {
         }
     }
 
-    fn constraint(&mut self, el: El, required: bool) -> Result<Option<ConstraintElement>, Fatal> {
-        let mut attrs = Attrs {
-            items: el.attrs.iter().cloned().map(Some).collect(),
-        };
-        let id = attrs.take("id").map(|a| a.value);
-        let _ = self.leftover_attrs(attrs, "<constraint>");
+    fn constraint(
+        &mut self,
+        mut el: El<'i>,
+        required: bool,
+    ) -> Result<Option<ConstraintElement>, Fatal> {
+        let mut attrs = Attrs::new(std::mem::take(&mut el.attrs));
+        let id = attrs.take("id").map(|a| a.value.into_owned());
+        let _ = self.leftover_attrs(attrs, &"<constraint>");
         let mut items = Vec::new();
         let mut ok = true;
-        self.children(&el, |p, item| {
-            let kind = match (item.ns.is_core(), item.name.as_str()) {
+        self.children(&el, |p, mut item| {
+            let kind = match (item.ns.is_core(), item.name.as_ref()) {
                 (true, k @ ("synchronize" | "before" | "after")) => k.to_string(),
                 _ => {
                     p.error(
@@ -826,9 +860,7 @@ impl<'i> Parser<'i> {
                 }
             };
             let on = format!("<{kind}>");
-            let mut attrs = Attrs {
-                items: item.attrs.iter().cloned().map(Some).collect(),
-            };
+            let mut attrs = Attrs::new(std::mem::take(&mut item.attrs));
             let reference = match attrs.take("ref") {
                 Some(a) => {
                     let r = p.sync_ref(&a, &on);
@@ -844,18 +876,16 @@ impl<'i> Parser<'i> {
             };
             let _ = p.leftover_attrs(attrs, &on);
             let mut syncs = Vec::new();
-            p.children(&item, |p, s| {
+            p.children(&item, |p, mut s| {
                 if !(s.ns.is_core() && s.name == "sync") {
                     p.error(Code::UnknownElement, s.offset, format!("<{}> is not allowed in {on}; expected <sync ref>", s.qname));
                     ok = false;
                     p.skip(&s)?;
                     return Ok(());
                 }
-                let mut attrs = Attrs {
-                    items: s.attrs.iter().cloned().map(Some).collect(),
-                };
+                let mut attrs = Attrs::new(std::mem::take(&mut s.attrs));
                 match attrs.take("ref") {
-                    Some(a) => match p.sync_ref(&a, "<sync>") {
+                    Some(a) => match p.sync_ref(&a, &"<sync>") {
                         Some(r) => syncs.push(ConstraintSync {
                             reference: r,
                             pos: p.pos(s.offset),
@@ -867,7 +897,7 @@ impl<'i> Parser<'i> {
                         ok = false;
                     }
                 }
-                let _ = p.leftover_attrs(attrs, "<sync>");
+                let _ = p.leftover_attrs(attrs, &"<sync>");
                 p.skip(&s)?;
                 Ok(())
             })?;
@@ -897,9 +927,9 @@ impl<'i> Parser<'i> {
         }))
     }
 
-    fn behaviour(&mut self, el: El, required: bool) -> Result<Option<Behaviour>, Fatal> {
+    fn behaviour(&mut self, mut el: El<'i>, required: bool) -> Result<Option<Behaviour>, Fatal> {
         let core = el.ns.is_core();
-        let name = el.name.as_str();
+        let name = el.name.as_ref();
         let known = (core && CORE_BEHAVIOURS.contains(&name))
             || (el.ns == Ns::CoreExt && name == "faceFacs")
             || (el.ns.is_ext() && CONTROL_BEHAVIOURS.contains(&name))
@@ -913,13 +943,10 @@ impl<'i> Parser<'i> {
             self.skip(&el)?;
             return Ok(None);
         }
-        let on = format!("<{}>", el.qname);
-        let mut attrs = Attrs {
-            items: el.attrs.iter().cloned().map(Some).collect(),
-        };
+        let mut attrs = Attrs::new(std::mem::take(&mut el.attrs));
         let id = match attrs.take("id") {
-            Some(a) if !a.value.trim().is_empty() => {
-                let id = a.value.trim().to_string();
+            Some(a) if !a.value.trim_ascii().is_empty() => {
+                let id = a.value.trim_ascii().to_string();
                 if id.contains(':') {
                     self.error(
                         Code::InvalidId,
@@ -933,14 +960,18 @@ impl<'i> Parser<'i> {
                 self.error(
                     Code::MissingId,
                     el.offset,
-                    format!("{on} has no id attribute; every behaviour needs one"),
+                    format!(
+                        "<{}> has no id attribute; every behaviour needs one",
+                        el.qname
+                    ),
                 );
                 None
             }
         };
-        let on = match &id {
-            Some(id) => format!("<{} id=\"{id}\">", el.qname),
-            None => on,
+        let qname = el.qname.clone();
+        let on = On {
+            qname: &qname,
+            id: id.as_deref(),
         };
         if !known {
             self.warn(
@@ -956,13 +987,13 @@ impl<'i> Parser<'i> {
             let namespaces = used_prefixes(scope, &prefixes, &[]);
             let kind = BehaviourKind::Unknown(UnknownBehaviour {
                 ns: el.ns.uri().to_string(),
-                name: el.name.clone(),
+                name: el.name.to_string(),
                 attrs: attrs
                     .rest()
                     .map(|a| ForeignAttr {
                         ns: a.ns.uri().to_string(),
-                        name: a.name,
-                        value: a.value,
+                        name: a.name.into_owned(),
+                        value: a.value.into_owned(),
                     })
                     .collect(),
                 content,
@@ -999,7 +1030,12 @@ impl<'i> Parser<'i> {
         }))
     }
 
-    fn sync_attrs(&mut self, attrs: &mut Attrs, names: &[&str], on: &str) -> Vec<SyncAttr> {
+    fn sync_attrs(
+        &mut self,
+        attrs: &mut Attrs<'i>,
+        names: &[&'static str],
+        on: &dyn fmt::Display,
+    ) -> Vec<SyncAttr> {
         let mut out: Vec<(usize, SyncAttr)> = Vec::new();
         for &name in names {
             if let Some(a) = attrs.take(name) {
@@ -1007,7 +1043,7 @@ impl<'i> Parser<'i> {
                     out.push((
                         a.offset,
                         SyncAttr {
-                            sync: name.to_string(),
+                            sync: name,
                             value,
                             pos: self.pos(a.offset),
                         },
@@ -1022,25 +1058,23 @@ impl<'i> Parser<'i> {
     /// Reads the children of a known behaviour into `kind`; returns its descriptions.
     fn behaviour_children(
         &mut self,
-        el: &El,
+        el: &El<'i>,
         kind: &mut BehaviourKind,
-        on: &str,
+        on: &dyn fmt::Display,
     ) -> Result<Vec<Description>, Fatal> {
         let mut descriptions = Vec::new();
         let mut saw_text = false;
         let mut saw_stance = false;
         let mut saw_trajectory = false;
-        self.children(el, |p, c| {
+        self.children(el, |p, mut c| {
             let core = c.ns.is_core();
-            match (&mut *kind, c.name.as_str()) {
+            match (&mut *kind, c.name.as_ref()) {
                 (_, "description") if core => {
-                    let mut attrs = Attrs {
-                        items: c.attrs.iter().cloned().map(Some).collect(),
-                    };
+                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
                     let priority =
                         attrs
                             .take("priority")
-                            .and_then(|a| match a.value.trim().parse::<i64>() {
+                            .and_then(|a| match a.value.trim_ascii().parse::<i64>() {
                                 Ok(v) => Some(v),
                                 Err(_) => {
                                     p.error(
@@ -1062,14 +1096,14 @@ impl<'i> Parser<'i> {
                             format!("<description> in {on} needs a type attribute"),
                         );
                     }
-                    let _ = p.leftover_attrs(attrs, "<description>");
+                    let _ = p.leftover_attrs(attrs, &"<description>");
                     let scope = p.scope();
                     let Skipped {
                         content, prefixes, ..
                     } = p.skip(&c)?;
                     descriptions.push(Description {
                         priority,
-                        kind: kind_attr.map(|a| a.value).unwrap_or_default(),
+                        kind: kind_attr.map(|a| a.value.into_owned()).unwrap_or_default(),
                         namespaces: used_prefixes(scope, &prefixes, &[]),
                         content,
                         pos: p.pos(c.offset),
@@ -1086,7 +1120,7 @@ impl<'i> Parser<'i> {
                         );
                     }
                     saw_text = true;
-                    for a in &c.attrs {
+                    for a in c.attrs.iter().flatten() {
                         p.error(
                             Code::UnknownAttribute,
                             a.offset,
@@ -1106,38 +1140,34 @@ impl<'i> Parser<'i> {
                         );
                     }
                     saw_stance = true;
-                    let mut attrs = Attrs {
-                        items: c.attrs.iter().cloned().map(Some).collect(),
-                    };
+                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
                     if let Some(t) = p.req_enum(
                         &mut attrs,
                         "type",
-                        "<stance>",
+                        &"<stance>",
                         c.offset,
                         StanceType::parse,
                         StanceType::expected,
                     ) {
                         post.stance = t;
                     }
-                    let _ = p.leftover_attrs(attrs, "<stance>");
+                    let _ = p.leftover_attrs(attrs, &"<stance>");
                     p.skip(&c)?;
                 }
                 (BehaviourKind::Posture(post) | BehaviourKind::PostureShift(post), "pose")
                     if core =>
                 {
-                    let mut attrs = Attrs {
-                        items: c.attrs.iter().cloned().map(Some).collect(),
-                    };
+                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
                     let part = p.req_enum(
                         &mut attrs,
                         "part",
-                        "<pose>",
+                        &"<pose>",
                         c.offset,
                         PosePart::parse,
                         PosePart::expected,
                     );
-                    let lexeme = p.req_str(&mut attrs, "lexeme", "<pose>", c.offset);
-                    let _ = p.leftover_attrs(attrs, "<pose>");
+                    let lexeme = p.req_str(&mut attrs, "lexeme", &"<pose>", c.offset);
+                    let _ = p.leftover_attrs(attrs, &"<pose>");
                     if let (Some(part), Some(lexeme)) = (part, lexeme) {
                         post.poses.push(Pose { part, lexeme });
                     }
@@ -1154,20 +1184,18 @@ impl<'i> Parser<'i> {
                         );
                     }
                     saw_trajectory = true;
-                    let mut attrs = Attrs {
-                        items: c.attrs.iter().cloned().map(Some).collect(),
-                    };
+                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
                     let t = p.req_enum(
                         &mut attrs,
                         "type",
-                        "<trajectory>",
+                        &"<trajectory>",
                         c.offset,
                         TrajectoryType::parse,
                         TrajectoryType::expected,
                     );
                     let initial = p.opt_f64(&mut attrs, "initialValue");
-                    let target = p.req_str(&mut attrs, "targetValue", "<trajectory>", c.offset);
-                    let _ = p.leftover_attrs(attrs, "<trajectory>");
+                    let target = p.req_str(&mut attrs, "targetValue", &"<trajectory>", c.offset);
+                    let _ = p.leftover_attrs(attrs, &"<trajectory>");
                     if let Some(t) = t {
                         pvc.trajectory.kind = t;
                     }
@@ -1193,12 +1221,10 @@ impl<'i> Parser<'i> {
                     | BehaviourKind::Transition(Transition { params, .. }),
                     "parameter",
                 ) if c.ns == Ns::Bmlt || c.ns == Ns::None => {
-                    let mut attrs = Attrs {
-                        items: c.attrs.iter().cloned().map(Some).collect(),
-                    };
-                    let name = p.req_str(&mut attrs, "name", "<parameter>", c.offset);
-                    let value = p.req_str(&mut attrs, "value", "<parameter>", c.offset);
-                    let _ = p.leftover_attrs(attrs, "<parameter>");
+                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
+                    let name = p.req_str(&mut attrs, "name", &"<parameter>", c.offset);
+                    let value = p.req_str(&mut attrs, "value", &"<parameter>", c.offset);
+                    let _ = p.leftover_attrs(attrs, &"<parameter>");
                     if let (Some(name), Some(value)) = (name, value) {
                         params.push(Param { name, value });
                     }
@@ -1269,7 +1295,7 @@ impl<'i> Parser<'i> {
         Ok(descriptions)
     }
 
-    fn speech_text(&mut self, el: &El, out: &mut Vec<TextPart>) -> Result<(), Fatal> {
+    fn speech_text(&mut self, el: &El<'i>, out: &mut Vec<TextPart>) -> Result<(), Fatal> {
         if el.empty {
             return Ok(());
         }
@@ -1277,16 +1303,14 @@ impl<'i> Parser<'i> {
             match self.next()? {
                 Tok::Text { text, .. } => match out.last_mut() {
                     Some(TextPart::Text(t)) => t.push_str(&text),
-                    _ => out.push(TextPart::Text(text)),
+                    _ => out.push(TextPart::Text(text.into_owned())),
                 },
-                Tok::Start(c) => {
+                Tok::Start(mut c) => {
                     if c.ns.is_core() && c.name == "sync" {
-                        let mut attrs = Attrs {
-                            items: c.attrs.iter().cloned().map(Some).collect(),
-                        };
+                        let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
                         match attrs.take("id") {
-                            Some(a) if !a.value.trim().is_empty() => {
-                                out.push(TextPart::Sync(a.value.trim().to_string()))
+                            Some(a) if !a.value.trim_ascii().is_empty() => {
+                                out.push(TextPart::Sync(a.value.trim_ascii().to_string()))
                             }
                             _ => self.error(
                                 Code::MissingId,
@@ -1294,7 +1318,7 @@ impl<'i> Parser<'i> {
                                 "<sync> in speech text has no id",
                             ),
                         }
-                        let _ = self.leftover_attrs(attrs, "<sync>");
+                        let _ = self.leftover_attrs(attrs, &"<sync>");
                     } else if c.ns.is_core() {
                         self.error(
                             Code::UnknownElement,
@@ -1315,9 +1339,15 @@ impl<'i> Parser<'i> {
         }
     }
 
-    fn req_str(&mut self, attrs: &mut Attrs, name: &str, on: &str, at: usize) -> Option<String> {
+    fn req_str(
+        &mut self,
+        attrs: &mut Attrs<'i>,
+        name: &str,
+        on: &dyn fmt::Display,
+        at: usize,
+    ) -> Option<String> {
         match attrs.take(name) {
-            Some(a) => Some(a.value),
+            Some(a) => Some(a.value.into_owned()),
             None => {
                 self.error(
                     Code::MissingAttribute,
@@ -1329,7 +1359,7 @@ impl<'i> Parser<'i> {
         }
     }
 
-    fn opt_f64(&mut self, attrs: &mut Attrs, name: &str) -> Option<f64> {
+    fn opt_f64(&mut self, attrs: &mut Attrs<'i>, name: &str) -> Option<f64> {
         let a = attrs.take(name)?;
         let v = parse_seconds(&a.value);
         if v.is_none() {
@@ -1342,9 +1372,9 @@ impl<'i> Parser<'i> {
         v
     }
 
-    fn opt_u32(&mut self, attrs: &mut Attrs, name: &str) -> Option<u32> {
+    fn opt_u32(&mut self, attrs: &mut Attrs<'i>, name: &str) -> Option<u32> {
         let a = attrs.take(name)?;
-        let v = a.value.trim().parse::<u32>().ok();
+        let v = a.value.trim_ascii().parse::<u32>().ok();
         if v.is_none() {
             self.error(
                 Code::InvalidNumber,
@@ -1360,14 +1390,14 @@ impl<'i> Parser<'i> {
 
     fn opt_enum<T>(
         &mut self,
-        attrs: &mut Attrs,
+        attrs: &mut Attrs<'i>,
         name: &str,
-        on: &str,
+        on: &dyn fmt::Display,
         parse: fn(&str) -> Option<T>,
         expected: fn() -> String,
     ) -> Option<T> {
         let a = attrs.take(name)?;
-        let v = parse(a.value.trim());
+        let v = parse(a.value.trim_ascii());
         if v.is_none() {
             self.error(
                 Code::InvalidEnumValue,
@@ -1385,9 +1415,9 @@ impl<'i> Parser<'i> {
     #[allow(clippy::too_many_arguments)]
     fn req_enum<T>(
         &mut self,
-        attrs: &mut Attrs,
+        attrs: &mut Attrs<'i>,
         name: &str,
-        on: &str,
+        on: &dyn fmt::Display,
         at: usize,
         parse: fn(&str) -> Option<T>,
         expected: fn() -> String,
@@ -1409,16 +1439,36 @@ impl<'i> Parser<'i> {
     }
 }
 
+/// Names an element in messages, e.g. `<gesture id="g1">`; formatted only when a message is made.
+struct On<'a> {
+    qname: &'a str,
+    id: Option<&'a str>,
+}
+
+impl fmt::Display for On<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.id {
+            Some(id) => write!(f, "<{} id=\"{id}\">", self.qname),
+            None => write!(f, "<{}>", self.qname),
+        }
+    }
+}
+
 /// Builds the kind-specific part of a known behaviour from its attributes.
 struct KindBuilder<'a, 'i> {
     p: &'a mut Parser<'i>,
-    attrs: &'a mut Attrs,
-    on: &'a str,
-    el: &'a El,
+    attrs: &'a mut Attrs<'i>,
+    on: &'a dyn fmt::Display,
+    el: &'a El<'i>,
 }
 
 impl<'a, 'i> KindBuilder<'a, 'i> {
-    fn new(p: &'a mut Parser<'i>, attrs: &'a mut Attrs, on: &'a str, el: &'a El) -> Self {
+    fn new(
+        p: &'a mut Parser<'i>,
+        attrs: &'a mut Attrs<'i>,
+        on: &'a dyn fmt::Display,
+        el: &'a El<'i>,
+    ) -> Self {
         KindBuilder { p, attrs, on, el }
     }
 
@@ -1426,7 +1476,7 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
         self.p.req_str(self.attrs, name, self.on, self.el.offset)
     }
     fn opt(&mut self, name: &str) -> Option<String> {
-        self.attrs.take(name).map(|a| a.value)
+        self.attrs.take(name).map(|a| a.value.into_owned())
     }
     fn f64(&mut self, name: &str) -> Option<f64> {
         self.p.opt_f64(self.attrs, name)
@@ -1490,7 +1540,7 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
             stance: StanceType::Standing,
             poses: Vec::new(),
         };
-        Some(match self.el.name.as_str() {
+        Some(match self.el.name.as_ref() {
             "speech" => BehaviourKind::Speech(Speech::default()),
             "text" => BehaviourKind::Text(Speech::default()),
             "gesture" => {
@@ -1603,8 +1653,8 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
                 let param_id = self.req("paramId");
                 let target = target?;
                 let (target_block, target_behaviour) = match target.split_once(':') {
-                    Some((b, beh)) => (Some(b.trim().to_string()), beh.trim().to_string()),
-                    None => (None, target.trim().to_string()),
+                    Some((b, beh)) => (Some(b.trim_ascii().to_string()), beh.trim_ascii().to_string()),
+                    None => (None, target.trim_ascii().to_string()),
                 };
                 BehaviourKind::ParameterValueChange(ParameterValueChange {
                     target_block,
@@ -1667,6 +1717,14 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
 
 /// Whether `s` is an XML name without colons (the NCName production of Namespaces in XML).
 fn is_ncname(s: &str) -> bool {
+    // fast path: ASCII letters, digits, '_', '-', '.'
+    let b = s.as_bytes();
+    if !b.is_empty()
+        && (b[0].is_ascii_alphabetic() || b[0] == b'_')
+        && b.iter().all(|c| c.is_ascii_alphanumeric() || matches!(c, b'_' | b'-' | b'.'))
+    {
+        return true;
+    }
     fn start(c: char) -> bool {
         matches!(c, 'A'..='Z' | '_' | 'a'..='z' | '\u{C0}'..='\u{D6}' | '\u{D8}'..='\u{F6}'
             | '\u{F8}'..='\u{2FF}' | '\u{370}'..='\u{37D}' | '\u{37F}'..='\u{1FFF}'
@@ -1696,12 +1754,12 @@ fn namespace_uri(raw: &[u8]) -> String {
 /// content keeps these so that the writer can declare them again.
 fn used_prefixes(
     scope: Vec<(String, String)>,
-    used: &[String],
+    used: &[Str],
     known: &[(String, String)],
 ) -> Vec<(String, String)> {
     let mut out: Vec<(String, String)> = known.to_vec();
     for (prefix, uri) in scope {
-        if used.contains(&prefix) && !out.iter().any(|(p, _)| *p == prefix) {
+        if used.iter().any(|u| *u == prefix) && !out.iter().any(|(p, _)| *p == prefix) {
             out.push((prefix, uri));
         }
     }
@@ -1709,10 +1767,10 @@ fn used_prefixes(
     out
 }
 
-fn push_text(acc: &mut Option<(String, usize)>, s: &str, offset: usize) {
+fn push_text<'i>(acc: &mut Option<(Str<'i>, usize)>, s: Str<'i>, offset: usize) {
     match acc {
-        Some((t, _)) => t.push_str(s),
-        None => *acc = Some((s.to_string(), offset)),
+        Some((t, _)) => t.to_mut().push_str(&s),
+        None => *acc = Some((s, offset)),
     }
 }
 

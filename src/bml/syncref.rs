@@ -131,7 +131,7 @@ fn err(code: Code, message: String) -> SyncRefError {
 /// Parses a decimal number of seconds: optional sign, digits with an optional fraction and an
 /// optional exponent. Rejects `inf`, `NaN`, hex and empty text.
 pub(crate) fn parse_seconds(s: &str) -> Option<f64> {
-    let s = s.trim();
+    let s = s.trim_ascii();
     let body = s.strip_prefix(['+', '-']).unwrap_or(s);
     let (mantissa, exp) = match body.find(['e', 'E']) {
         Some(i) => (&body[..i], Some(&body[i + 1..])),
@@ -158,7 +158,7 @@ fn check_id(part: &str, what: &str, text: &str) -> Result<String, SyncRefError> 
             format!("sync reference '{text}' has an empty {what}"),
         ));
     }
-    if part.chars().any(char::is_whitespace) {
+    if part.bytes().any(|b| b.is_ascii_whitespace()) {
         return Err(err(
             Code::MalformedSyncRef,
             format!("sync reference '{text}': {what} '{part}' contains whitespace"),
@@ -174,7 +174,7 @@ impl SyncRef {
     /// contain `+` or `-`. A first part `anticipators` makes a three-part reference an anticipator
     /// reference.
     pub fn parse(text: &str) -> Result<SyncRef, SyncRefError> {
-        let t = text.trim();
+        let t = text.trim_ascii();
         if t.is_empty() {
             return Err(err(
                 Code::EmptySyncRef,
@@ -191,26 +191,29 @@ impl SyncRef {
                 )
             });
         }
-        let parts: Vec<&str> = t.split(':').map(str::trim).collect();
-        if parts.len() > 3 {
+        let mut split = t.split(':').map(str::trim_ascii);
+        let parts: [Option<&str>; 3] = [split.next(), split.next(), split.next()];
+        if split.next().is_some() {
             return Err(err(
                 Code::MalformedSyncRef,
                 format!(
                     "sync reference '{t}' has {} parts; expected behaviour:sync, block:behaviour:sync or anticipators:id:sync",
-                    parts.len()
+                    t.split(':').count()
                 ),
             ));
         }
-        let last = parts[parts.len() - 1];
-        let (sync, offset) = match last.find(['+', '-']) {
-            None => (last.trim(), 0.0),
+        let n = parts.iter().flatten().count();
+        let part = |i: usize| parts[i].unwrap_or_default();
+        let last = part(n - 1);
+        let (sync, offset) = match last.bytes().position(|b| b == b'+' || b == b'-') {
+            None => (last.trim_ascii(), 0.0),
             Some(i) => {
                 let sign = if last.as_bytes()[i] == b'-' {
                     -1.0
                 } else {
                     1.0
                 };
-                let num = last[i + 1..].trim();
+                let num = last[i + 1..].trim_ascii();
                 if num.starts_with(['+', '-']) {
                     return Err(err(
                         Code::MalformedOffset,
@@ -229,30 +232,30 @@ impl SyncRef {
                         },
                     )
                 })?;
-                (last[..i].trim(), sign * v)
+                (last[..i].trim_ascii(), sign * v)
             }
         };
         let sync = check_id(sync, "sync id", t)?;
-        let point = match parts.len() {
+        let point = match n {
             2 => {
-                if parts[0] == ANTICIPATORS {
+                if part(0) == ANTICIPATORS {
                     return Err(err(
                         Code::MalformedSyncRef,
                         format!("anticipator reference '{t}' needs the form anticipators:ID:SYNC"),
                     ));
                 }
                 SyncPoint::Local {
-                    behaviour: check_id(parts[0], "behaviour id", t)?,
+                    behaviour: check_id(part(0), "behaviour id", t)?,
                     sync,
                 }
             }
-            _ if parts[0] == ANTICIPATORS => SyncPoint::Anticipator {
-                anticipator: check_id(parts[1], "anticipator id", t)?,
+            _ if part(0) == ANTICIPATORS => SyncPoint::Anticipator {
+                anticipator: check_id(part(1), "anticipator id", t)?,
                 sync,
             },
             _ => SyncPoint::External {
-                block: check_id(parts[0], "block id", t)?,
-                behaviour: check_id(parts[1], "behaviour id", t)?,
+                block: check_id(part(0), "block id", t)?,
+                behaviour: check_id(part(1), "behaviour id", t)?,
                 sync,
             },
         };

@@ -1,30 +1,38 @@
 //! Static validation of a parsed block: ids (missing, duplicate, unusable), references to unknown
 //! behaviours and unknown sync points, constraints that relate nothing, lexemes outside BML 1.0.
 
-use std::collections::HashMap;
-
-use super::constraints::{extract, Anchor};
+use super::constraints::{extract_elements, Anchor, Relation};
 use super::diagnostic::{Code, Diagnostic, Pos};
 use super::model::{BehaviourKind, Block, TextPart, FACE_LEXEMES, HEAD_LEXEMES};
-use super::syncref::SyncPoint;
+use super::syncref::{SyncPoint, SyncRef};
 
 /// Checks a block's cross-references; returns errors and warnings in source order.
 pub fn validate(block: &Block) -> Vec<Diagnostic> {
     let mut diags = Vec::new();
-    let mut seen: HashMap<&str, Pos> = HashMap::new();
-    for b in &block.behaviours {
-        if let Some(first) = seen.get(b.id.as_str()) {
+    // duplicate ids: sort (id, index) pairs once instead of hashing every id
+    let mut ids: Vec<(&str, usize)> = block
+        .behaviours
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (b.id.as_str(), i))
+        .collect();
+    ids.sort_unstable();
+    for pair in ids.windows(2) {
+        let [(id, first), (next, dup)] = [pair[0], pair[1]];
+        if id == next {
+            let b = &block.behaviours[dup];
+            let first = block.behaviours[first].pos;
             diags.push(Diagnostic::error(
                 Code::DuplicateId,
                 b.pos,
                 format!(
-                    "behaviour id '{}' is already used at {first} in block '{}'",
-                    b.id, block.id
+                    "behaviour id '{id}' is already used at {first} in block '{}'",
+                    block.id
                 ),
             ));
-        } else {
-            seen.insert(&b.id, b.pos);
         }
+    }
+    for b in &block.behaviours {
         match &b.kind {
             BehaviourKind::Speech(s) | BehaviourKind::Text(s) => {
                 let mut ids: Vec<&str> = Vec::new();
@@ -62,7 +70,24 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
         }
     }
 
-    for c in extract(block) {
+    // Shorthand attributes (the bulk): checked in place, without building constraints.
+    for b in &block.behaviours {
+        for s in &b.syncs {
+            check_ref(block, &s.value, s.pos, &mut diags);
+            if matches!(s.value, SyncRef::Time(t) if t < 0.0) {
+                diags.push(Diagnostic::error(
+                    Code::InvalidConstraint,
+                    s.pos,
+                    format!(
+                        "{}:{} = {} puts a sync point before the start of its block",
+                        b.id, s.sync, s.value
+                    ),
+                ));
+            }
+        }
+    }
+    // <constraint> elements: checked on their normalised form.
+    for c in extract_elements(block) {
         if c.is_constant() {
             diags.push(Diagnostic::error(
                 Code::InvalidConstraint,
@@ -72,45 +97,56 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
             continue;
         }
         for side in [&c.left, &c.right] {
-            let (behaviour, sync) = match side {
-                Anchor::Point(SyncPoint::Local { behaviour, sync }) => (behaviour, sync),
-                Anchor::Point(SyncPoint::External {
-                    block: blk,
-                    behaviour,
-                    sync,
-                }) if *blk == block.id => (behaviour, sync),
-                _ => continue,
-            };
-            match block.behaviour(behaviour) {
-                None => diags.push(Diagnostic::error(
-                    Code::UnknownBehaviour,
-                    c.pos,
-                    format!("'{behaviour}:{sync}' refers to '{behaviour}', which is not a behaviour of block '{}'", block.id),
-                )),
-                Some(b) if !b.has_sync(sync) => diags.push(Diagnostic::error(
-                    Code::UnknownSyncPoint,
-                    c.pos,
-                    format!(
-                        "<{}> '{behaviour}' has no sync point '{sync}'; its sync points are {}",
-                        b.kind.element_name(),
-                        b.sync_points().join(", ")
-                    ),
-                )),
-                Some(_) => {}
+            if let Anchor::Point(p) = side {
+                check_point(block, p, c.pos, &mut diags);
             }
         }
-        if c.left == Anchor::BlockStart || c.right == Anchor::BlockStart {
-            // absolute time: left = block + offset (normalisation puts the block on the right)
-            let t = c.offset;
-            if t < 0.0 && c.relation != super::constraints::Relation::After {
-                diags.push(Diagnostic::error(
-                    Code::InvalidConstraint,
-                    c.pos,
-                    format!("constraint '{c}' puts a sync point before the start of its block"),
-                ));
-            }
+        // normalisation puts the block start on the right: left REL block + offset
+        if c.right == Anchor::BlockStart && c.offset < 0.0 && c.relation != Relation::After {
+            diags.push(Diagnostic::error(
+                Code::InvalidConstraint,
+                c.pos,
+                format!("constraint '{c}' puts a sync point before the start of its block"),
+            ));
         }
     }
     diags.sort_by_key(|d| (d.pos.line, d.pos.col));
     diags
+}
+
+fn check_ref(block: &Block, r: &SyncRef, pos: Pos, diags: &mut Vec<Diagnostic>) {
+    if let SyncRef::Point { point, .. } = r {
+        check_point(block, point, pos, diags);
+    }
+}
+
+/// A reference to a behaviour of this block must name an existing behaviour and one of its sync
+/// points; references to other blocks and to anticipators are resolved at scheduling time.
+fn check_point(block: &Block, p: &SyncPoint, pos: Pos, diags: &mut Vec<Diagnostic>) {
+    let (behaviour, sync) = match p {
+        SyncPoint::Local { behaviour, sync } => (behaviour, sync),
+        SyncPoint::External {
+            block: blk,
+            behaviour,
+            sync,
+        } if *blk == block.id => (behaviour, sync),
+        _ => return,
+    };
+    match block.behaviour(behaviour) {
+        None => diags.push(Diagnostic::error(
+            Code::UnknownBehaviour,
+            pos,
+            format!("'{behaviour}:{sync}' refers to '{behaviour}', which is not a behaviour of block '{}'", block.id),
+        )),
+        Some(b) if !b.has_sync(sync) => diags.push(Diagnostic::error(
+            Code::UnknownSyncPoint,
+            pos,
+            format!(
+                "<{}> '{behaviour}' has no sync point '{sync}'; its sync points are {}",
+                b.kind.element_name(),
+                b.sync_points().join(", ")
+            ),
+        )),
+        Some(_) => {}
+    }
 }

@@ -180,7 +180,7 @@ impl Writer {
         self.attr("id", &b.id);
         self.kind_attrs(&b.kind);
         for s in &b.syncs {
-            self.attr(&s.sync, &s.value.to_string());
+            self.attr(s.sync, &s.value.to_string());
         }
         self.foreign(&b.foreign_attrs);
         let mut body = String::new();
