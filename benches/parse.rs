@@ -4,7 +4,9 @@
 //! Run: `cargo bench --bench parse`
 
 use bml_realizer::bml;
-use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion};
 
 const FILE: &str = include_str!("../fixtures/realizertester/bml-1/core/testspeechgestures.xml");
 

@@ -181,8 +181,8 @@ fn constraint_records_kind_source_position_and_required() {
     assert_eq!(
         cs[0].source,
         Source::Attribute {
-            behaviour: "nod1".into(),
-            sync: "start".into()
+            behaviour: 2, // nod1
+            sync: "start"
         }
     );
     assert_eq!(

@@ -180,6 +180,20 @@ fn byte_order_mark_does_not_shift_positions_or_raw_content() {
 }
 
 #[test]
+fn duplicate_attributes_are_not_xml_even_through_different_prefixes() {
+    assert_eq!(
+        errors(&block("  <head id=\"h\" lexeme=\"NOD\" lexeme=\"SHAKE\"/>")),
+        [(Code::NotXml, 2, 29)]
+    );
+    let src = block(
+        "  <head id=\"h\" lexeme=\"NOD\" xmlns:a=\"urn:x\" xmlns:b=\"urn:x\" a:k=\"1\" b:k=\"2\"/>",
+    );
+    assert_eq!(errors(&src)[0].0, Code::NotXml);
+    let src = block("  <head id=\"h\" lexeme=\"NOD\" xmlns:a=\"urn:x\" xmlns:a=\"urn:y\"/>");
+    assert_eq!(errors(&src)[0].0, Code::NotXml);
+}
+
+#[test]
 fn xml_lang_survives_a_write_parse_round_trip() {
     let src = block("  <speech id=\"s\" xml:lang=\"nl\"><text>Hallo</text></speech>");
     let b = bml::parse(&src).unwrap().block;

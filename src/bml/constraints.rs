@@ -73,8 +73,9 @@ impl fmt::Display for Anchor {
 pub enum Source {
     /// A shorthand sync attribute, e.g. `<gesture id="g1" stroke="s1:w">`.
     Attribute {
-        /// The behaviour carrying the attribute.
-        behaviour: String,
+        /// Index in `Block::behaviours` of the behaviour carrying the attribute (its own sync point
+        /// is always the constraint's left side).
+        behaviour: usize,
         /// The attribute (sync point) name.
         sync: &'static str,
     },
@@ -170,8 +171,9 @@ impl fmt::Display for Constraint {
 /// Extracts the normalised constraints of a block: first the shorthand attributes (behaviour by
 /// behaviour, in document order), then the `<constraint>` elements.
 pub fn extract(block: &Block) -> Vec<Constraint> {
-    let mut out = Vec::new();
-    for b in &block.behaviours {
+    let attributes: usize = block.behaviours.iter().map(|b| b.syncs.len()).sum();
+    let mut out = Vec::with_capacity(attributes + block.constraints.len());
+    for (index, b) in block.behaviours.iter().enumerate() {
         for s in &b.syncs {
             let own = SyncRef::Point {
                 point: SyncPoint::local(&b.id, s.sync),
@@ -183,7 +185,7 @@ pub fn extract(block: &Block) -> Vec<Constraint> {
                 &s.value,
                 b.required,
                 Source::Attribute {
-                    behaviour: b.id.clone(),
+                    behaviour: index,
                     sync: s.sync,
                 },
                 s.pos,

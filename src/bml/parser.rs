@@ -273,7 +273,9 @@ impl<'i> Parser<'i> {
                 Event::Text(t) => {
                     let s = match self.text_of(&t) {
                         // XML end-of-line handling: \r\n and lone \r read as \n
-                        s if s.contains('\r') => Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n")),
+                        s if s.contains('\r') => {
+                            Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n"))
+                        }
                         s => s,
                     };
                     push_text(&mut text, s, before);
@@ -355,7 +357,7 @@ impl<'i> Parser<'i> {
             );
             return Err(Fatal);
         }
-        if ns == Ns::Other(XMLNS_URI.to_string()) {
+        if matches!(&ns, Ns::Other(u) if u == XMLNS_URI) {
             self.error(
                 Code::NotXml,
                 before,
@@ -367,8 +369,11 @@ impl<'i> Parser<'i> {
         if let Some(p) = e.name().prefix() {
             prefixes.push(self.text_of(p.as_ref()));
         }
-        let mut attrs = Vec::new();
-        for a in e.attributes() {
+        let mut attrs: Vec<Option<RawAttr<'i>>> = Vec::new();
+        // quick-xml's duplicate check allocates per element; duplicates are checked here instead:
+        // declarations by prefix, other attributes by (namespace, local name)
+        let mut declared: Vec<Str<'i>> = Vec::new();
+        for a in e.attributes().with_checks(false) {
             let a = match a {
                 Ok(a) => a,
                 Err(err) => {
@@ -382,6 +387,17 @@ impl<'i> Parser<'i> {
             };
             let key = a.key.as_ref();
             if key == b"xmlns" || key.starts_with(b"xmlns:") {
+                let k = self.text_of(key);
+                if declared.contains(&k) {
+                    let at = self.offset_in_src(key, before);
+                    self.error(
+                        Code::NotXml,
+                        at,
+                        format!("attribute '{k}' appears twice on <{qname}>"),
+                    );
+                    return Err(Fatal);
+                }
+                declared.push(k);
                 if let Err(err) = a.unescape_value() {
                     let at = self.offset_in_src(key, before);
                     self.error(
@@ -452,6 +468,21 @@ impl<'i> Parser<'i> {
                     Cow::Owned(String::from_utf8_lossy(&a.value).into_owned())
                 }
             };
+            if attrs
+                .iter()
+                .flatten()
+                .any(|b| b.ns == ans && b.name == aname)
+            {
+                self.error(
+                    Code::NotXml,
+                    offset,
+                    format!(
+                        "attribute '{}' appears twice on <{qname}>",
+                        String::from_utf8_lossy(key)
+                    ),
+                );
+                return Err(Fatal);
+            }
             attrs.push(Some(RawAttr {
                 ns: ans,
                 name: aname,
@@ -1036,23 +1067,26 @@ impl<'i> Parser<'i> {
         names: &[&'static str],
         on: &dyn fmt::Display,
     ) -> Vec<SyncAttr> {
-        let mut out: Vec<(usize, SyncAttr)> = Vec::new();
-        for &name in names {
-            if let Some(a) = attrs.take(name) {
-                if let Some(value) = self.sync_ref(&a, on) {
-                    out.push((
-                        a.offset,
-                        SyncAttr {
-                            sync: name,
-                            value,
-                            pos: self.pos(a.offset),
-                        },
-                    ));
-                }
+        // in document order
+        let mut out = Vec::new();
+        for slot in attrs.items.iter_mut() {
+            let Some(name) = slot.as_ref().and_then(|a| {
+                (a.ns == Ns::None)
+                    .then(|| names.iter().find(|n| **n == a.name).copied())
+                    .flatten()
+            }) else {
+                continue;
+            };
+            let Some(a) = slot.take() else { continue };
+            if let Some(value) = self.sync_ref(&a, on) {
+                out.push(SyncAttr {
+                    sync: name,
+                    value,
+                    pos: self.pos(a.offset),
+                });
             }
         }
-        out.sort_by_key(|(o, _)| *o);
-        out.into_iter().map(|(_, s)| s).collect()
+        out
     }
 
     /// Reads the children of a known behaviour into `kind`; returns its descriptions.
@@ -1071,23 +1105,19 @@ impl<'i> Parser<'i> {
             match (&mut *kind, c.name.as_ref()) {
                 (_, "description") if core => {
                     let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
-                    let priority =
-                        attrs
-                            .take("priority")
-                            .and_then(|a| match a.value.trim_ascii().parse::<i64>() {
-                                Ok(v) => Some(v),
-                                Err(_) => {
-                                    p.error(
-                                        Code::InvalidNumber,
-                                        a.offset,
-                                        format!(
-                                            "description priority '{}' is not an integer",
-                                            a.value
-                                        ),
-                                    );
-                                    None
-                                }
-                            });
+                    let priority = attrs.take("priority").and_then(|a| {
+                        match a.value.trim_ascii().parse::<i64>() {
+                            Ok(v) => Some(v),
+                            Err(_) => {
+                                p.error(
+                                    Code::InvalidNumber,
+                                    a.offset,
+                                    format!("description priority '{}' is not an integer", a.value),
+                                );
+                                None
+                            }
+                        }
+                    });
                     let kind_attr = attrs.take("type");
                     if kind_attr.is_none() {
                         p.error(
@@ -1653,7 +1683,10 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
                 let param_id = self.req("paramId");
                 let target = target?;
                 let (target_block, target_behaviour) = match target.split_once(':') {
-                    Some((b, beh)) => (Some(b.trim_ascii().to_string()), beh.trim_ascii().to_string()),
+                    Some((b, beh)) => (
+                        Some(b.trim_ascii().to_string()),
+                        beh.trim_ascii().to_string(),
+                    ),
                     None => (None, target.trim_ascii().to_string()),
                 };
                 BehaviourKind::ParameterValueChange(ParameterValueChange {
@@ -1721,7 +1754,8 @@ fn is_ncname(s: &str) -> bool {
     let b = s.as_bytes();
     if !b.is_empty()
         && (b[0].is_ascii_alphabetic() || b[0] == b'_')
-        && b.iter().all(|c| c.is_ascii_alphanumeric() || matches!(c, b'_' | b'-' | b'.'))
+        && b.iter()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, b'_' | b'-' | b'.'))
     {
         return true;
     }

@@ -35,10 +35,13 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
     for b in &block.behaviours {
         match &b.kind {
             BehaviourKind::Speech(s) | BehaviourKind::Text(s) => {
-                let mut ids: Vec<&str> = Vec::new();
-                for part in &s.text {
+                for (i, part) in s.text.iter().enumerate() {
                     let TextPart::Sync(id) = part else { continue };
-                    if ids.contains(&id.as_str()) {
+                    let earlier = &s.text[..i];
+                    if earlier
+                        .iter()
+                        .any(|p| matches!(p, TextPart::Sync(e) if e == id))
+                    {
                         diags.push(Diagnostic::error(
                             Code::DuplicateId,
                             b.pos,
@@ -49,7 +52,6 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
                     } else if id.contains(['+', '-', ':']) || id.chars().any(char::is_whitespace) {
                         diags.push(Diagnostic::error(Code::InvalidId, b.pos, format!("inline sync id '{id}' of speech '{}' contains '+', '-', ':' or whitespace, so it cannot be referred to", b.id)));
                     }
-                    ids.push(id);
                 }
             }
             BehaviourKind::Head(h) if !HEAD_LEXEMES.contains(&h.lexeme.as_str()) => {
