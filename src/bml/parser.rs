@@ -333,7 +333,7 @@ impl<'i> Parser<'i> {
         before: usize,
     ) -> Result<El<'i>, Fatal> {
         let qname = self.text_of(e.name().as_ref());
-        let name = self.text_of(e.local_name().as_ref());
+        let (prefix, name) = split_qname(&qname);
         let ns = match ns {
             Ok(ns) => ns,
             Err(prefix) => {
@@ -345,11 +345,7 @@ impl<'i> Parser<'i> {
                 Ns::Other(prefix)
             }
         };
-        if !is_ncname(&name)
-            || e.name()
-                .prefix()
-                .is_some_and(|p| !is_ncname(&String::from_utf8_lossy(p.as_ref())))
-        {
+        if !is_ncname(&name) || prefix.as_ref().is_some_and(|p| !is_ncname(p)) {
             self.error(
                 Code::NotXml,
                 before,
@@ -365,10 +361,7 @@ impl<'i> Parser<'i> {
             );
             return Err(Fatal);
         }
-        let mut prefixes = Vec::new();
-        if let Some(p) = e.name().prefix() {
-            prefixes.push(self.text_of(p.as_ref()));
-        }
+        let mut prefixes: Vec<Str<'i>> = prefix.into_iter().collect();
         let mut attrs: Vec<Option<RawAttr<'i>>> = Vec::new();
         // quick-xml's duplicate check allocates per element; duplicates are checked here instead:
         // declarations by prefix, other attributes by (namespace, local name)
@@ -386,8 +379,8 @@ impl<'i> Parser<'i> {
                 }
             };
             let key = a.key.as_ref();
-            if key == b"xmlns" || key.starts_with(b"xmlns:") {
-                let k = self.text_of(key);
+            let k = self.text_of(key);
+            if k == "xmlns" || k.starts_with("xmlns:") {
                 if declared.contains(&k) {
                     let at = self.offset_in_src(key, before);
                     self.error(
@@ -412,46 +405,44 @@ impl<'i> Parser<'i> {
                 continue;
             }
             let offset = self.offset_in_src(key, before);
-            if let Some(p) = a.key.prefix() {
-                prefixes.push(self.text_of(p.as_ref()));
-            }
-            let aname = self.text_of(a.key.local_name().as_ref());
-            if !is_ncname(&aname)
-                || a.key
-                    .prefix()
-                    .is_some_and(|p| !is_ncname(&String::from_utf8_lossy(p.as_ref())))
-            {
-                let q = String::from_utf8_lossy(key);
+            let (aprefix, aname) = split_qname(&k);
+            if !is_ncname(&aname) || aprefix.as_ref().is_some_and(|p| !is_ncname(p)) {
                 self.error(
                     Code::NotXml,
                     offset,
-                    format!("attribute '{q}' is not a valid qualified name"),
+                    format!("attribute '{k}' is not a valid qualified name"),
                 );
                 return Err(Fatal);
             }
-            let ans = match self.reader.resolve_attribute(a.key).0 {
-                ResolveResult::Bound(n) => match Ns::from_uri(n.as_ref()) {
-                    Ns::Bml => Ns::None,
-                    other => other,
-                },
-                ResolveResult::Unbound => Ns::None,
-                ResolveResult::Unknown(p) => {
-                    let p = String::from_utf8_lossy(&p).into_owned();
-                    self.error(
-                        Code::NotXml,
-                        offset,
-                        format!(
-                            "namespace prefix '{p}' of attribute '{}' is not declared",
-                            String::from_utf8_lossy(key)
-                        ),
-                    );
-                    Ns::Other(p)
+            let unprefixed = aprefix.is_none();
+            prefixes.extend(aprefix);
+            let ans = if unprefixed {
+                Ns::None // unprefixed attributes are in no namespace
+            } else {
+                match self.reader.resolve_attribute(a.key).0 {
+                    ResolveResult::Bound(n) => match Ns::from_uri(n.as_ref()) {
+                        Ns::Bml => Ns::None,
+                        other => other,
+                    },
+                    ResolveResult::Unbound => Ns::None,
+                    ResolveResult::Unknown(p) => {
+                        let p = String::from_utf8_lossy(&p).into_owned();
+                        self.error(
+                            Code::NotXml,
+                            offset,
+                            format!(
+                                "namespace prefix '{p}' of attribute '{}' is not declared",
+                                String::from_utf8_lossy(key)
+                            ),
+                        );
+                        Ns::Other(p)
+                    }
                 }
             };
             let raw = self.text_of(&a.value);
             let unescaped = match raw {
                 // the common case: nothing to resolve, borrow the source
-                Cow::Borrowed(s) if !s.contains('&') => Ok(Cow::Borrowed(s)),
+                Cow::Borrowed(s) if !s.as_bytes().contains(&b'&') => Ok(Cow::Borrowed(s)),
                 _ => a.unescape_value().map(|v| Cow::Owned(v.into_owned())),
             };
             let value = match unescaped {
@@ -1745,6 +1736,20 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
             }),
             _ => return None,
         })
+    }
+}
+
+/// Splits `prefix:local` at the first colon (what remains may still contain one: not a valid name).
+fn split_qname<'i>(q: &Str<'i>) -> (Option<Str<'i>>, Str<'i>) {
+    match q {
+        Cow::Borrowed(s) => match s.split_once(':') {
+            Some((p, l)) => (Some(Cow::Borrowed(p)), Cow::Borrowed(l)),
+            None => (None, Cow::Borrowed(s)),
+        },
+        Cow::Owned(s) => match s.split_once(':') {
+            Some((p, l)) => (Some(Cow::Owned(p.to_string())), Cow::Owned(l.to_string())),
+            None => (None, Cow::Owned(s.clone())),
+        },
     }
 }
 
