@@ -9,3 +9,4 @@
 
 pub mod bml;
 pub mod feedback;
+mod xmlname;

@@ -141,6 +141,7 @@ fn other_specific_errors() {
         Code::InvalidConstraint
     );
     assert_eq!(code("<constraint><synchronize><sync ref=\"1\"/><sync ref=\"2\"/></synchronize></constraint>"), Code::InvalidConstraint);
+    assert_eq!(code("<constraint/>"), Code::InvalidConstraint);
     assert_eq!(
         code("<head id=\"h\" lexeme=\"NOD\" start=\"a:b:c:d\"/>"),
         Code::MalformedSyncRef

@@ -350,7 +350,7 @@ fn constraint_element() -> impl Strategy<Value = ConstraintElement> {
             pos: Pos::default()
         }),
     ];
-    (option::of(id()), vec(item, 0..3), any::<bool>()).prop_map(|(id, items, required)| {
+    (option::of(id()), vec(item, 1..3), any::<bool>()).prop_map(|(id, items, required)| {
         ConstraintElement {
             id,
             items,

@@ -13,6 +13,7 @@ use super::diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos};
 use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
+use crate::xmlname::is_ncname;
 
 /// The namespace reserved for `xmlns` declarations; no element may be in it.
 const XMLNS_URI: &str = "http://www.w3.org/2000/xmlns/";
@@ -941,6 +942,14 @@ impl<'i> Parser<'i> {
             }
             Ok(())
         })?;
+        if ok && items.is_empty() {
+            self.error(
+                Code::InvalidConstraint,
+                el.offset,
+                "<constraint> is empty; it needs <synchronize>, <before> or <after>",
+            );
+            ok = false;
+        }
         Ok(ok.then(|| ConstraintElement {
             id,
             items,
@@ -1751,32 +1760,6 @@ fn split_qname<'i>(q: &Str<'i>) -> (Option<Str<'i>>, Str<'i>) {
             None => (None, Cow::Owned(s.clone())),
         },
     }
-}
-
-/// Whether `s` is an XML name without colons (the NCName production of Namespaces in XML).
-fn is_ncname(s: &str) -> bool {
-    // fast path: ASCII letters, digits, '_', '-', '.'
-    let b = s.as_bytes();
-    if !b.is_empty()
-        && (b[0].is_ascii_alphabetic() || b[0] == b'_')
-        && b.iter()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, b'_' | b'-' | b'.'))
-    {
-        return true;
-    }
-    fn start(c: char) -> bool {
-        matches!(c, 'A'..='Z' | '_' | 'a'..='z' | '\u{C0}'..='\u{D6}' | '\u{D8}'..='\u{F6}'
-            | '\u{F8}'..='\u{2FF}' | '\u{370}'..='\u{37D}' | '\u{37F}'..='\u{1FFF}'
-            | '\u{200C}'..='\u{200D}' | '\u{2070}'..='\u{218F}' | '\u{2C00}'..='\u{2FEF}'
-            | '\u{3001}'..='\u{D7FF}' | '\u{F900}'..='\u{FDCF}' | '\u{FDF0}'..='\u{FFFD}'
-            | '\u{10000}'..='\u{EFFFF}')
-    }
-    fn rest(c: char) -> bool {
-        start(c)
-            || matches!(c, '-' | '.' | '0'..='9' | '\u{B7}' | '\u{300}'..='\u{36F}' | '\u{203F}'..='\u{2040}')
-    }
-    let mut chars = s.chars();
-    chars.next().is_some_and(start) && chars.all(rest)
 }
 
 /// A namespace URI as declared: the resolver hands it out as written, so resolve character

@@ -229,14 +229,22 @@ pub fn from_json(line: &str) -> Result<Feedback, FeedbackError> {
                 let mut syncs = Vec::new();
                 for (k, v) in b {
                     if k != "id" && k != "feedback" {
+                        check_name(k)?;
                         let t = v.as_f64().ok_or_else(|| {
                             FeedbackError(format!("predicted time \"{k}\" should be a number"))
                         })?;
                         syncs.push((k.clone(), t));
                     }
                 }
+                let kind = str_of(b, "feedback")?;
+                check_name(kind)?;
+                if kind == "bml" {
+                    return Err(FeedbackError(
+                        "a behaviour prediction cannot be named 'bml'".into(),
+                    ));
+                }
                 p.behaviours.push(BehaviourPrediction {
-                    kind: str_of(b, "feedback")?.into(),
+                    kind: kind.into(),
                     block,
                     behaviour,
                     syncs,

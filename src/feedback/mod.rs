@@ -280,6 +280,15 @@ pub fn round_ms(t: f64) -> f64 {
     (t * 1000.0).round() / 1000.0
 }
 
+/// Behaviour element names and predicted sync names become XML names when written: check them.
+pub(crate) fn check_name(name: &str) -> Result<(), FeedbackError> {
+    if crate::xmlname::is_ncname(name) {
+        Ok(())
+    } else {
+        Err(FeedbackError(format!("'{name}' is not an XML name")))
+    }
+}
+
 /// Splits `a:b` ids; `n` is the number of parts expected.
 pub(crate) fn split_id(id: &str, n: usize, what: &str) -> Result<Vec<String>, FeedbackError> {
     let parts: Vec<String> = id.split(':').map(str::to_string).collect();

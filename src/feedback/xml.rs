@@ -318,6 +318,7 @@ fn prediction_children(
             _ => continue,
         };
         let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+        check_name(&name)?;
         let a = attrs(r, &e)?;
         if !empty {
             r.read_to_end(e.name()).map_err(xml_err)?;
@@ -335,6 +336,7 @@ fn prediction_children(
             let mut syncs = Vec::new();
             for (bmla, n, v) in &a {
                 if !bmla && n != "id" {
+                    check_name(n)?;
                     syncs.push((n.clone(), num(v, n)?));
                 }
             }

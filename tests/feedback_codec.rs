@@ -1,0 +1,90 @@
+//! Feedback decoding rejects malformed lines with a reason, and never accepts a line that it could
+//! not write back (regressions found by the `feedback` fuzz target).
+
+use bml_realizer::feedback::*;
+
+fn err(line: &str) -> String {
+    from_line(line).expect_err("line should be rejected").0
+}
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+#[test]
+fn malformed_xml_lines_are_rejected_with_a_reason() {
+    assert!(err("").contains("no feedback element"));
+    assert!(err("<blockProgress").contains("not well-formed"));
+    assert!(err(&format!(r#"<blockProgress {NS} globalTime="1"/>"#)).contains("no id"));
+    assert!(
+        err(&format!(r#"<blockProgress {NS} id="b1" globalTime="1"/>"#)).contains("block:sync")
+    );
+    assert!(err(&format!(
+        r#"<blockProgress {NS} id="b1:start" globalTime="soon"/>"#
+    ))
+    .contains("not a number"));
+    assert!(err(&format!(
+        r#"<syncPointProgress {NS} id="b1:g1" time="0" globalTime="1"/>"#
+    ))
+    .contains("3 non-empty parts"));
+    assert!(err(&format!(
+        r#"<blockProgress {NS} xmlns:bmla="http://www.asap-project.org/bmla" id="b:end" globalTime="1" bmla:status="FINE"/>"#
+    ))
+    .contains("unknown bmla:status"));
+    assert!(
+        err(r#"<blockProgress xmlns="urn:other" id="b:start" globalTime="1"/>"#)
+            .contains("namespace")
+    );
+    assert!(err(&format!(r#"<applause {NS}/>"#)).contains("unknown feedback element"));
+}
+
+#[test]
+fn names_that_cannot_be_written_back_are_rejected() {
+    // found by fuzzing: a JSON key `s'tart` became an XML attribute name that does not parse
+    let json = r#"{"feedback":"predictionFeedback","behaviors":[{"feedback":"gesture","id":"b:g","s'tart":0}]}"#;
+    assert!(err(json).contains("not an XML name"));
+    let line = format!(
+        r#"<predictionFeedback {NS}><gesture id="b:g" st*art="0.000"/></predictionFeedback>"#
+    );
+    let e = err(&line);
+    assert!(e.contains("not an XML name"), "{e}");
+    assert!(err(r#"{"feedback":"predictionFeedback","behaviors":[{"feedback":"gesture","id":"b:g","st art":1}]}"#).contains("not an XML name"));
+    assert!(err(
+        r#"{"feedback":"predictionFeedback","behaviors":[{"feedback":"bml","id":"b:g"}]}"#
+    )
+    .contains("'bml'"));
+}
+
+#[test]
+fn malformed_json_lines_are_rejected_with_a_reason() {
+    assert!(err("{").contains("not JSON"));
+    let e = err("[1]");
+    assert!(e.contains("feedback element"), "{e}");
+    assert!(err(r#"{"id":"b:start"}"#).contains("\"feedback\""));
+    assert!(err(r#"{"feedback":"blockProgress","id":"b:start"}"#).contains("globalTime"));
+    assert!(err(
+        r#"{"feedback":"blockProgress","id":"b:start","globalTime":1,"bmla:posixTime":-5}"#
+    )
+    .contains("posixTime"));
+}
+
+#[test]
+fn both_formats_decode_to_the_same_message() {
+    let xml = format!(
+        r#"<syncPointProgress {NS} id="bml1:g1:stroke" time="0.850" globalTime="12.346"/>"#
+    );
+    let json =
+        r#"{"feedback":"syncPointProgress","id":"bml1:g1:stroke","time":0.85,"globalTime":12.346}"#;
+    let a = from_line(&xml).unwrap();
+    assert_eq!(a, from_line(json).unwrap());
+    let Feedback::SyncPointProgress(s) = a else {
+        panic!()
+    };
+    assert_eq!(
+        (
+            s.block.as_str(),
+            s.behaviour.as_str(),
+            s.sync.as_str(),
+            s.time
+        ),
+        ("bml1", "g1", "stroke", 0.85)
+    );
+}
