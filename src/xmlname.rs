@@ -1,6 +1,12 @@
 //! XML name rules (the NCName production of Namespaces in XML), shared by the BML parser and the
 //! feedback codecs.
 
+/// Whether `c` is outside XML 1.0's `Char` production (C0 controls but tab, LF, CR; U+FFFE, U+FFFF),
+/// i.e. may appear in an XML document neither literally nor as a character reference.
+pub(crate) fn is_forbidden_char(c: char) -> bool {
+    ((c as u32) < 0x20 && !matches!(c, '\t' | '\n' | '\r')) || c == '\u{FFFE}' || c == '\u{FFFF}'
+}
+
 /// Whether `s` is an XML name without colons (the NCName production of Namespaces in XML).
 pub(crate) fn is_ncname(s: &str) -> bool {
     // fast path: ASCII letters, digits, '_', '-', '.'

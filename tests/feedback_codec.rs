@@ -41,6 +41,9 @@ fn names_that_cannot_be_written_back_are_rejected() {
     // found by fuzzing: a JSON key `s'tart` became an XML attribute name that does not parse
     let json = r#"{"feedback":"predictionFeedback","behaviors":[{"feedback":"gesture","id":"b:g","s'tart":0}]}"#;
     assert!(err(json).contains("not an XML name"));
+    // and a sync named xmlns would become a namespace declaration
+    let json = r#"{"feedback":"predictionFeedback","behaviors":[{"feedback":"gesture","id":"b:g","xmlns":0}]}"#;
+    assert!(err(json).contains("not an XML name"));
     let line = format!(
         r#"<predictionFeedback {NS}><gesture id="b:g" st*art="0.000"/></predictionFeedback>"#
     );
@@ -87,4 +90,14 @@ fn both_formats_decode_to_the_same_message() {
         ),
         ("bml1", "g1", "stroke", 0.85)
     );
+}
+
+#[test]
+fn millisecond_rounding_is_idempotent_even_for_huge_times() {
+    // found by fuzzing: 5.5555555555555555e75 changed on every round
+    for t in [5.555_555_555_555_555_5e75, 1e12, 123.4567, -0.0005, 1e-300] {
+        assert_eq!(round_ms(round_ms(t)), round_ms(t), "{t}");
+    }
+    assert_eq!(round_ms(1.2344), 1.234);
+    assert_eq!(round_ms(2.0004), 2.0);
 }

@@ -156,6 +156,11 @@ fn reserved_and_forbidden_xml_is_rejected() {
     assert_eq!(errors(&src), [(Code::NotXml, 2, 3)]);
     let src = block("  <bmlt:/audiofile xmlns:bmlt=\"urn:t\" id=\"a\"/>");
     assert_eq!(errors(&src), [(Code::NotXml, 2, 3)]);
+    // found by the fuzzer: a character reference to a control character
+    let src = block("  <speech id=\"s\"><text>bell &#7;</text></speech>");
+    assert_eq!(errors(&src), [(Code::NotXml, 2, 29)]);
+    let src = block("  <speech id=\"s\" xmlns:x=\"urn:x\" x:a=\"&#x1;\"><text>hi</text></speech>");
+    assert_eq!(errors(&src)[0].0, Code::NotXml);
     let src = block("  <speech id=\"s\"><text>bell \u{7}</text></speech>");
     let e = bml::load(&src).unwrap_err();
     assert_eq!(e.first().code, Code::NotXml);

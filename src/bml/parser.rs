@@ -13,7 +13,7 @@ use super::diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos};
 use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
-use crate::xmlname::is_ncname;
+use crate::xmlname::{is_forbidden_char, is_ncname};
 
 /// The namespace reserved for `xmlns` declarations; no element may be in it.
 const XMLNS_URI: &str = "http://www.w3.org/2000/xmlns/";
@@ -292,6 +292,17 @@ impl<'i> Parser<'i> {
                 }
                 Event::GeneralRef(r) => {
                     let resolved: Str<'i> = match r.resolve_char_ref() {
+                        Ok(Some(c)) if is_forbidden_char(c) => {
+                            self.error(
+                                Code::NotXml,
+                                before,
+                                format!(
+                                    "character reference to U+{:04X}, which XML does not allow",
+                                    c as u32
+                                ),
+                            );
+                            return Err(Fatal);
+                        }
                         Ok(Some(c)) => c.to_string().into(),
                         Ok(None) => {
                             let name = r.decode().map(|n| n.into_owned()).unwrap_or_default();
@@ -447,6 +458,14 @@ impl<'i> Parser<'i> {
                 _ => a.unescape_value().map(|v| Cow::Owned(v.into_owned())),
             };
             let value = match unescaped {
+                Ok(v) if v.chars().any(is_forbidden_char) => {
+                    self.error(
+                        Code::NotXml,
+                        offset,
+                        format!("attribute '{k}' refers to a character that XML does not allow"),
+                    );
+                    return Err(Fatal);
+                }
                 Ok(v) => v,
                 Err(err) => {
                     self.error(

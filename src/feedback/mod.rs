@@ -277,12 +277,17 @@ impl<F: FnMut(&Feedback)> FeedbackListener for F {
 
 /// Rounds seconds to the millisecond precision of the logs.
 pub fn round_ms(t: f64) -> f64 {
-    (t * 1000.0).round() / 1000.0
+    // beyond 1e12 s an f64 has no sub-millisecond digits left: rounding would only add error
+    if t.abs() < 1e12 {
+        (t * 1000.0).round() / 1000.0
+    } else {
+        t
+    }
 }
 
 /// Behaviour element names and predicted sync names become XML names when written: check them.
 pub(crate) fn check_name(name: &str) -> Result<(), FeedbackError> {
-    if crate::xmlname::is_ncname(name) {
+    if crate::xmlname::is_ncname(name) && name != "xmlns" {
         Ok(())
     } else {
         Err(FeedbackError(format!("'{name}' is not an XML name")))
