@@ -101,3 +101,11 @@ fn millisecond_rounding_is_idempotent_even_for_huge_times() {
     assert_eq!(round_ms(1.2344), 1.234);
     assert_eq!(round_ms(2.0004), 2.0);
 }
+
+#[test]
+fn json_times_read_back_exactly() {
+    // found by fuzzing: without serde_json's float_roundtrip 3e50 read back as 3.0000000000000002e50
+    let xml = format!(r#"<blockProgress {NS} id="bml1:end" globalTime="3.e50"/>"#);
+    let fb = from_line(&xml).unwrap();
+    assert_eq!(from_json(&to_json(&fb)).unwrap(), fb);
+}
