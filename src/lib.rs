@@ -3,10 +3,12 @@
 //!
 //! Layers (see `docs/architecture.md`):
 //! - [`bml`]: the language — typed model, parser, validation, constraint extraction, writer;
-//! - [`feedback`]: BML 1.0 feedback messages and their XML and JSON-lines codecs.
+//! - [`feedback`]: BML 1.0 feedback messages and their XML and JSON-lines codecs;
+//! - [`schedule`]: the scheduler (so far its difference-constraint solver).
 
 #![warn(missing_docs)]
 
 pub mod bml;
 pub mod feedback;
+pub mod schedule;
 mod xmlname;

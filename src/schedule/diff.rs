@@ -1,0 +1,260 @@
+//! Difference constraints `x[to] >= x[from] + weight` over numbered variables: the least solution
+//! above per-variable lower bounds (longest paths), or, when the system is infeasible, one positive
+//! cycle of constraints — a minimal conflicting set (removing any one of its constraints breaks it).
+//!
+//! Every BML timing constraint is of this form: `at` (two edges), `before`/`after` (one edge),
+//! absolute constraints against the block-start variable, sync order inside a behaviour, engine
+//! duration bounds. The least solution is unique, so it does not depend on the order in which
+//! constraints were added (the scheduler's order invariance rests on this).
+//!
+//! The solver is a queue-based Bellman–Ford (SPFA): O(V·E) worst case, near-linear on the sparse,
+//! mostly acyclic graphs that BML blocks give. It is written here rather than taken from petgraph
+//! because the scheduler needs the cycle as constraint tags, lower bounds per variable, and no
+//! allocation beyond a few flat vectors per solve.
+
+use std::collections::VecDeque;
+
+/// Improvements smaller than this (seconds) are not propagated: constraints hold within it, and
+/// cycles whose total weight is below it (float rounding of offsets) are not conflicts.
+pub const EPSILON: f64 = 1e-9;
+
+/// One constraint `x[to] >= x[from] + weight`, tagged with the caller's constraint id.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Edge {
+    /// The variable that must come later.
+    pub to: usize,
+    /// The variable it is measured from.
+    pub from: usize,
+    /// Minimum distance `x[to] - x[from]` (may be negative).
+    pub weight: f64,
+    /// The caller's id for the constraint this edge comes from (reported in conflicts).
+    pub tag: usize,
+}
+
+/// A set of difference constraints over `n` variables, each with a lower bound.
+#[derive(Debug, Clone, Default)]
+pub struct DiffSystem {
+    lower: Vec<f64>,
+    edges: Vec<Edge>,
+}
+
+/// The constraints that cannot hold together: the tags of a positive cycle, in cycle order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Conflict {
+    /// Tags of the cycle's edges.
+    pub tags: Vec<usize>,
+    /// The cycle's edges (`to` of each is `from` of the next).
+    pub edges: Vec<Edge>,
+}
+
+impl Conflict {
+    /// Total weight of the cycle: positive (beyond [`EPSILON`]) for a real conflict.
+    pub fn weight(&self) -> f64 {
+        self.edges.iter().map(|e| e.weight).sum()
+    }
+}
+
+impl DiffSystem {
+    /// An empty system.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a variable with lower bound `lower`; returns its index.
+    pub fn var(&mut self, lower: f64) -> usize {
+        self.lower.push(lower);
+        self.lower.len() - 1
+    }
+
+    /// Number of variables.
+    pub fn len(&self) -> usize {
+        self.lower.len()
+    }
+
+    /// Whether there are no variables.
+    pub fn is_empty(&self) -> bool {
+        self.lower.is_empty()
+    }
+
+    /// The constraints added so far.
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+
+    /// `x[to] >= x[from] + weight`.
+    pub fn at_least(&mut self, to: usize, from: usize, weight: f64, tag: usize) {
+        debug_assert!(to < self.len() && from < self.len() && weight.is_finite());
+        self.edges.push(Edge {
+            to,
+            from,
+            weight,
+            tag,
+        });
+    }
+
+    /// `x[a] <= x[b] + offset`.
+    pub fn at_most(&mut self, a: usize, b: usize, offset: f64, tag: usize) {
+        self.at_least(b, a, -offset, tag);
+    }
+
+    /// `x[a] == x[b] + offset`.
+    pub fn equal(&mut self, a: usize, b: usize, offset: f64, tag: usize) {
+        self.at_least(a, b, offset, tag);
+        self.at_most(a, b, offset, tag);
+    }
+
+    /// The least solution with every variable at or above its lower bound, or a conflicting cycle.
+    pub fn solve(&self) -> Result<Vec<f64>, Conflict> {
+        let n = self.len();
+        // adjacency in CSR form: edges grouped by `from`
+        let mut start = vec![0usize; n + 1];
+        for e in &self.edges {
+            start[e.from + 1] += 1;
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut out = vec![0usize; self.edges.len()];
+        for (i, e) in self.edges.iter().enumerate() {
+            out[fill[e.from]] = i;
+            fill[e.from] += 1;
+        }
+
+        let mut x = self.lower.clone();
+        // edges on the path that gave each variable its value; a path longer than n edges repeats
+        // a variable, so it contains a positive cycle
+        let mut path_len = vec![0usize; n];
+        let mut queued = vec![true; n];
+        let mut queue: VecDeque<usize> = (0..n).collect();
+        while let Some(u) = queue.pop_front() {
+            queued[u] = false;
+            for &ei in &out[start[u]..start[u + 1]] {
+                let e = &self.edges[ei];
+                let candidate = x[u] + e.weight;
+                if candidate > x[e.to] + EPSILON {
+                    x[e.to] = candidate;
+                    path_len[e.to] = path_len[u] + 1;
+                    if path_len[e.to] > n {
+                        return Err(self.find_cycle());
+                    }
+                    if !queued[e.to] {
+                        queued[e.to] = true;
+                        queue.push_back(e.to);
+                    }
+                }
+            }
+        }
+        Ok(x)
+    }
+
+    /// Finds a positive cycle (the system is known to be infeasible) with classic Bellman–Ford:
+    /// a variable still raised in round n has a predecessor chain that runs into the cycle. Only the
+    /// error path pays for this.
+    fn find_cycle(&self) -> Conflict {
+        let n = self.len();
+        let mut x = self.lower.clone();
+        let mut pred: Vec<Option<usize>> = vec![None; n];
+        let mut last = None;
+        for _ in 0..n {
+            last = None;
+            for (ei, e) in self.edges.iter().enumerate() {
+                let candidate = x[e.from] + e.weight;
+                if candidate > x[e.to] + EPSILON {
+                    x[e.to] = candidate;
+                    pred[e.to] = Some(ei);
+                    last = Some(e.to);
+                }
+            }
+            if last.is_none() {
+                break;
+            }
+        }
+        let Some(mut u) = last else {
+            return Conflict {
+                tags: Vec::new(),
+                edges: Vec::new(),
+            };
+        };
+        for _ in 0..n {
+            if let Some(ei) = pred[u] {
+                u = self.edges[ei].from;
+            }
+        }
+        let first = u;
+        let mut edges = Vec::new();
+        while let Some(ei) = pred[u] {
+            edges.push(self.edges[ei]);
+            u = self.edges[ei].from;
+            if u == first || edges.len() > n {
+                break;
+            }
+        }
+        edges.reverse();
+        Conflict {
+            tags: edges.iter().map(|e| e.tag).collect(),
+            edges,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn least_solution_of_a_small_chain() {
+        let mut s = DiffSystem::new();
+        let block = s.var(0.0);
+        let a = s.var(0.0);
+        let b = s.var(0.0);
+        s.at_least(a, block, 2.0, 0); // a >= block + 2
+        s.equal(b, a, 1.5, 1); // b = a + 1.5
+        s.at_most(a, b, -1.5, 2); // consistent with the equality
+        assert_eq!(s.solve().unwrap(), vec![0.0, 2.0, 3.5]);
+    }
+
+    #[test]
+    fn lower_bounds_are_respected() {
+        let mut s = DiffSystem::new();
+        let a = s.var(5.0);
+        let b = s.var(0.0);
+        s.at_least(b, a, -10.0, 0);
+        assert_eq!(s.solve().unwrap(), vec![5.0, 0.0]);
+    }
+
+    #[test]
+    fn contradictory_cycle_is_reported_with_its_tags() {
+        // a = b + 1, b = c + 1, c >= a  → a >= a + 2
+        let mut s = DiffSystem::new();
+        let (a, b, c) = (s.var(0.0), s.var(0.0), s.var(0.0));
+        s.equal(a, b, 1.0, 10);
+        s.equal(b, c, 1.0, 11);
+        s.at_least(c, a, 0.0, 12);
+        let conflict = s.solve().unwrap_err();
+        let mut tags = conflict.tags.clone();
+        tags.sort();
+        assert_eq!(tags, vec![10, 11, 12]);
+        assert!((conflict.weight() - 2.0).abs() < 1e-12);
+        for w in conflict.edges.windows(2) {
+            assert_eq!(w[0].to, w[1].from, "edges form a path");
+        }
+        assert_eq!(
+            conflict.edges.last().unwrap().to,
+            conflict.edges[0].from,
+            "and close a cycle"
+        );
+    }
+
+    #[test]
+    fn rounding_sized_cycles_are_not_conflicts() {
+        // 0.1 + 0.2 and 0.3 differ in the last bit
+        let mut s = DiffSystem::new();
+        let (a, b, c) = (s.var(0.0), s.var(0.0), s.var(0.0));
+        s.equal(b, a, 0.1, 0);
+        s.equal(c, b, 0.2, 1);
+        s.equal(c, a, 0.3, 2);
+        let x = s.solve().unwrap();
+        assert!((x[c] - 0.3).abs() < 1e-12);
+    }
+}
