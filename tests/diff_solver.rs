@@ -72,9 +72,9 @@ proptest! {
         for e in s.edges() {
             prop_assert!(holds(e, &x), "{e:?} violated: {} vs {}", x[e.to], x[e.from] + e.weight);
         }
-        for i in 0..x.len() {
-            prop_assert!(x[i] >= c.lower[i] - 1e-12, "below its lower bound");
-            prop_assert!(x[i] <= c.truth[i] + 1e-9, "not the least solution: {} > {}", x[i], c.truth[i]);
+        for ((xi, lo), truth) in x.iter().zip(&c.lower).zip(&c.truth) {
+            prop_assert!(*xi >= lo - 1e-12, "below its lower bound");
+            prop_assert!(*xi <= truth + 1e-9, "not the least solution: {} > {}", xi, truth);
         }
     }
 
