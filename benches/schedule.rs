@@ -1,0 +1,40 @@
+//! Criterion bench `schedule`: the difference-constraint solver under the scheduler on chained
+//! behaviours — N behaviours with 7 ordered sync points each, every behaviour's start tied to the
+//! previous one's end (the shape of a long appended speech/gesture sequence).
+//!
+//! Run: `cargo bench --bench schedule`
+
+use std::hint::black_box;
+
+use bml_realizer::schedule::diff::DiffSystem;
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+
+fn chain(n: usize) -> DiffSystem {
+    let mut s = DiffSystem::new();
+    let block = s.var(0.0);
+    let mut prev_end = block;
+    for b in 0..n {
+        let keys: Vec<usize> = (0..7).map(|_| s.var(0.0)).collect();
+        for k in 1..7 {
+            s.at_least(keys[k], keys[k - 1], 0.1, b); // sync order with a minimum phase length
+        }
+        s.at_least(keys[0], block, 0.0, b); // not before block start
+        s.equal(keys[0], prev_end, 0.0, b); // start = previous end
+        prev_end = keys[6];
+    }
+    s
+}
+
+fn solve(c: &mut Criterion) {
+    let mut g = c.benchmark_group("schedule/diff-chain");
+    for n in [10usize, 100, 1000, 10_000] {
+        let system = chain(n);
+        g.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
+            b.iter(|| black_box(s.solve().unwrap()))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, solve);
+criterion_main!(benches);
