@@ -4,11 +4,13 @@
 //! Layers (see `docs/architecture.md`):
 //! - [`bml`]: the language — typed model, parser, validation, constraint extraction, writer;
 //! - [`feedback`]: BML 1.0 feedback messages and their XML and JSON-lines codecs;
+//! - [`engine`]: what engines tell the scheduler (so far timing models and their defaults);
 //! - [`schedule`]: the scheduler (so far its difference-constraint solver).
 
 #![warn(missing_docs)]
 
 pub mod bml;
+pub mod engine;
 pub mod feedback;
 pub mod schedule;
 mod xmlname;

@@ -1,0 +1,474 @@
+//! Timing models: what an engine tells the scheduler about a behaviour's timing — its sync keys in
+//! order with preferred offsets from the start, whether the timing is rigid (TTS speech, audio) or may
+//! stretch within duration bounds, and whether it persists. Also the default models for every BML
+//! kind, so that the scheduler works before the animation engines exist, and a deterministic
+//! headless speech timing model (syllables at a configurable rate, inline syncs at word boundaries).
+
+use crate::bml::{Behaviour, BehaviourKind, Speech, TextPart};
+
+/// Duration of behaviours that act once and end (interrupt, activate, parametervaluechange): the
+/// smallest step feedback can show (1 ms), so that `end > start` holds.
+pub const INSTANT: f64 = 0.001;
+
+/// Shortest duration of a stretchable behaviour (`end > start`, BML 1.0); engines may set more.
+pub const MIN_DURATION: f64 = 1e-6;
+
+/// How a behaviour's internal timing may change when it is constrained.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Flexibility {
+    /// Internal timing is fixed: the whole behaviour can only move (TTS speech, audio files).
+    Rigid,
+    /// Phases may stretch or shrink, keeping the total duration within bounds.
+    Stretchable {
+        /// Shortest total duration, seconds.
+        min_duration: f64,
+        /// Longest total duration, seconds (may be infinite).
+        max_duration: f64,
+    },
+}
+
+/// A sync point of the model with its preferred offset from the behaviour's start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SyncKey {
+    /// Sync point name (`start`, `stroke`, an inline speech sync, ...).
+    pub name: String,
+    /// Preferred offset from `start`, seconds.
+    pub at: f64,
+}
+
+/// The timing an engine gives the scheduler for one behaviour.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimingModel {
+    /// All sync keys in their required order; the first is `start` at 0, the last is `end`.
+    pub keys: Vec<SyncKey>,
+    /// Rigid or stretchable.
+    pub flexibility: Flexibility,
+    /// Whether the behaviour runs until stopped when its end is not constrained.
+    pub persistent: bool,
+}
+
+impl TimingModel {
+    fn new(keys: &[(&str, f64)], flexibility: Flexibility) -> Self {
+        TimingModel {
+            keys: keys
+                .iter()
+                .map(|(name, at)| SyncKey {
+                    name: name.to_string(),
+                    at: *at,
+                })
+                .collect(),
+            flexibility,
+            persistent: false,
+        }
+    }
+
+    /// A stretchable model with the default bounds.
+    fn stretchable(keys: &[(&str, f64)]) -> Self {
+        Self::new(
+            keys,
+            Flexibility::Stretchable {
+                min_duration: MIN_DURATION,
+                max_duration: f64::INFINITY,
+            },
+        )
+    }
+
+    /// The same keys with every offset multiplied by `factor`.
+    fn scaled(mut self, factor: f64) -> Self {
+        for k in &mut self.keys {
+            k.at *= factor;
+        }
+        self
+    }
+
+    /// The preferred duration (offset of `end`).
+    pub fn preferred_duration(&self) -> f64 {
+        self.keys.last().map_or(0.0, |k| k.at)
+    }
+
+    /// Index of the key named `name`.
+    pub fn key(&self, name: &str) -> Option<usize> {
+        self.keys.iter().position(|k| k.name == name)
+    }
+
+    /// Checks the model's invariants: at least `start` and `end`, `start` first at 0, `end` last and
+    /// after `start`, offsets finite and non-decreasing, names unique.
+    pub fn check(&self) -> Result<(), String> {
+        let (Some(first), Some(last)) = (self.keys.first(), self.keys.last()) else {
+            return Err("a timing model needs at least start and end".into());
+        };
+        if first.name != "start" || first.at != 0.0 {
+            return Err(format!(
+                "the first key must be start at 0, not {} at {}",
+                first.name, first.at
+            ));
+        }
+        if last.name != "end" || self.keys.len() < 2 || last.at <= 0.0 {
+            return Err(format!(
+                "the last key must be end after start, not {} at {}",
+                last.name, last.at
+            ));
+        }
+        for w in self.keys.windows(2) {
+            if !(w[1].at.is_finite() && w[1].at >= w[0].at) {
+                return Err(format!(
+                    "key {} at {} comes before {} at {}",
+                    w[1].name, w[1].at, w[0].name, w[0].at
+                ));
+            }
+        }
+        for (i, k) in self.keys.iter().enumerate() {
+            if self.keys[..i].iter().any(|e| e.name == k.name) {
+                return Err(format!("key {} appears twice", k.name));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Gives the scheduler the timing model of a behaviour. Engines implement this; `None` means the
+/// behaviour kind is not supported (the behaviour is dropped with a warning).
+pub trait TimingModels {
+    /// The model for `behaviour`, or `None` if no engine handles its kind.
+    fn model(&self, behaviour: &Behaviour) -> Option<TimingModel>;
+}
+
+/// Deterministic speech timing without a TTS: each word takes its syllable count times
+/// `syllable_seconds`; punctuation adds a pause after the word; inline syncs sit at word boundaries.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeechTiming {
+    /// Seconds per syllable (default 0.2, about 5 syllables per second).
+    pub syllable_seconds: f64,
+    /// Pause after `,`, `;` or `:` (default 0.15 s).
+    pub comma_pause: f64,
+    /// Pause after `.`, `!` or `?` (default 0.3 s).
+    pub sentence_pause: f64,
+}
+
+impl Default for SpeechTiming {
+    fn default() -> Self {
+        SpeechTiming {
+            syllable_seconds: 0.2,
+            comma_pause: 0.15,
+            sentence_pause: 0.3,
+        }
+    }
+}
+
+/// Syllables of a word, estimated as groups of vowels (a silent final `e` does not count); at least
+/// one for any word with a letter or digit, none for punctuation.
+pub fn syllables(word: &str) -> usize {
+    if !word.chars().any(char::is_alphanumeric) {
+        return 0;
+    }
+    let letters: Vec<char> = word
+        .chars()
+        .filter(|c| c.is_alphabetic())
+        .map(|c| c.to_ascii_lowercase())
+        .collect();
+    let vowel = |c: char| matches!(c, 'a' | 'e' | 'i' | 'o' | 'u' | 'y');
+    let mut groups = 0;
+    let mut prev = false;
+    for &c in &letters {
+        let v = vowel(c);
+        if v && !prev {
+            groups += 1;
+        }
+        prev = v;
+    }
+    let silent_e =
+        letters.len() > 2 && letters.ends_with(&['e']) && !vowel(letters[letters.len() - 2]);
+    if silent_e && groups > 1 {
+        groups -= 1;
+    }
+    groups.max(1)
+}
+
+impl SpeechTiming {
+    /// Time of one word including the pause its trailing punctuation asks for.
+    fn word(&self, w: &str) -> f64 {
+        let pause = match w.chars().last() {
+            Some('.' | '!' | '?') => self.sentence_pause,
+            Some(',' | ';' | ':') => self.comma_pause,
+            _ => 0.0,
+        };
+        syllables(w) as f64 * self.syllable_seconds + pause
+    }
+
+    /// The rigid timing of a speech: `start`, each inline sync at the boundary where it is written,
+    /// `end` after the last word. An empty text lasts one syllable.
+    pub fn model(&self, speech: &Speech) -> TimingModel {
+        let mut keys = vec![SyncKey {
+            name: "start".into(),
+            at: 0.0,
+        }];
+        let mut t = 0.0;
+        for part in &speech.text {
+            match part {
+                TextPart::Text(text) => {
+                    t += text.split_whitespace().map(|w| self.word(w)).sum::<f64>()
+                }
+                TextPart::Sync(id) => keys.push(SyncKey {
+                    name: id.clone(),
+                    at: t,
+                }),
+            }
+        }
+        keys.push(SyncKey {
+            name: "end".into(),
+            at: if t > 0.0 { t } else { self.syllable_seconds },
+        });
+        TimingModel {
+            keys,
+            flexibility: Flexibility::Rigid,
+            persistent: false,
+        }
+    }
+}
+
+/// The built-in models for every BML kind (timing only; the realizing engines refine them).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DefaultTimingModels {
+    /// Speech timing.
+    pub speech: SpeechTiming,
+}
+
+const GESTURE: &[(&str, f64)] = &[
+    ("start", 0.0),
+    ("ready", 0.3),
+    ("strokeStart", 0.4),
+    ("stroke", 0.5),
+    ("strokeEnd", 0.6),
+    ("relax", 0.8),
+    ("end", 1.0),
+];
+const POINTING: &[(&str, f64)] = &[
+    ("start", 0.0),
+    ("ready", 0.5),
+    ("strokeStart", 0.6),
+    ("stroke", 0.8),
+    ("strokeEnd", 1.2),
+    ("relax", 1.5),
+    ("end", 2.0),
+];
+/// One nod or shake; `repetition` multiplies it.
+const HEAD: &[(&str, f64)] = &[
+    ("start", 0.0),
+    ("ready", 0.1),
+    ("strokeStart", 0.15),
+    ("stroke", 0.3),
+    ("strokeEnd", 0.45),
+    ("relax", 0.5),
+    ("end", 0.6),
+];
+const GAZE: &[(&str, f64)] = &[("start", 0.0), ("ready", 0.4), ("relax", 1.6), ("end", 2.0)];
+const POSTURE: &[(&str, f64)] = &[("start", 0.0), ("ready", 1.0), ("relax", 2.0), ("end", 3.0)];
+const FACE: &[(&str, f64)] = &[
+    ("start", 0.0),
+    ("attackPeak", 0.3),
+    ("relax", 1.2),
+    ("end", 1.5),
+];
+
+impl TimingModels for DefaultTimingModels {
+    fn model(&self, b: &Behaviour) -> Option<TimingModel> {
+        let se = |d: f64| TimingModel::stretchable(&[("start", 0.0), ("end", d)]);
+        Some(match &b.kind {
+            BehaviourKind::Speech(s) => self.speech.model(s),
+            BehaviourKind::Text(s) => {
+                // shown text may be stretched, unlike synthesized speech
+                let mut m = self.speech.model(s);
+                m.flexibility = Flexibility::Stretchable {
+                    min_duration: MIN_DURATION,
+                    max_duration: f64::INFINITY,
+                };
+                m
+            }
+            BehaviourKind::Gesture(_) | BehaviourKind::ProcAnimationGesture(_) => {
+                TimingModel::stretchable(GESTURE)
+            }
+            BehaviourKind::Pointing(_) => TimingModel::stretchable(POINTING),
+            BehaviourKind::Head(h) => {
+                TimingModel::stretchable(HEAD).scaled(h.repetition.unwrap_or(1).max(1) as f64)
+            }
+            BehaviourKind::Gaze(_) => TimingModel::stretchable(GAZE),
+            BehaviourKind::Posture(_) => TimingModel::stretchable(POSTURE),
+            BehaviourKind::Face(_)
+            | BehaviourKind::FaceLexeme(_)
+            | BehaviourKind::FaceFacs(_)
+            | BehaviourKind::FaceMorph(_) => TimingModel::stretchable(FACE),
+            BehaviourKind::GazeShift(_)
+            | BehaviourKind::HeadDirectionShift { .. }
+            | BehaviourKind::FaceShift(_) => se(1.0),
+            BehaviourKind::PostureShift(_) => se(2.0),
+            BehaviourKind::Locomotion(_) => se(3.0),
+            BehaviourKind::Wait(w) => se(w.max_wait.filter(|d| *d > 0.0).unwrap_or(1.0)),
+            BehaviourKind::Interrupt(_)
+            | BehaviourKind::Activate(_)
+            | BehaviourKind::ParameterValueChange(_) => {
+                TimingModel::new(&[("start", 0.0), ("end", INSTANT)], Flexibility::Rigid)
+            }
+            BehaviourKind::AudioFile { .. } => {
+                // the file's length decides; until the audio engine reads it, one second
+                TimingModel::new(&[("start", 0.0), ("end", 1.0)], Flexibility::Rigid)
+            }
+            BehaviourKind::ProcAnimation(_)
+            | BehaviourKind::Keyframe(_)
+            | BehaviourKind::Noise(_)
+            | BehaviourKind::Transition(_) => se(1.0),
+            BehaviourKind::Controller(_) => {
+                let mut m = se(1.0);
+                m.persistent = true;
+                m
+            }
+            BehaviourKind::Unknown(_) => return None,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bml;
+
+    fn behaviours(body: &str) -> Vec<Behaviour> {
+        let src = format!(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmla="http://www.asap-project.org/bmla" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b">{body}</bml>"#
+        );
+        bml::load(&src).unwrap().block.behaviours
+    }
+
+    fn keys(m: &TimingModel) -> Vec<(&str, f64)> {
+        m.keys
+            .iter()
+            .map(|k| (k.name.as_str(), (k.at * 1e9).round() / 1e9))
+            .collect()
+    }
+
+    #[test]
+    fn syllable_estimates() {
+        for (w, n) in [
+            ("Hey", 1),
+            ("punk", 1),
+            ("want?", 1),
+            ("Welcome", 2),
+            ("ladies", 2),
+            ("gentlemen!", 3),
+            ("realizer", 3),
+            ("make", 1),
+            (",", 0),
+            ("16", 1),
+        ] {
+            assert_eq!(syllables(w), n, "{w}");
+        }
+    }
+
+    #[test]
+    fn speech_is_rigid_with_syncs_at_word_boundaries() {
+        // RealizerTester core/testspeech2.xml
+        let b = behaviours(
+            r#"<speech id="s"><text>Hey punk <sync id="syncstart1" />what do ya want?</text></speech>"#,
+        );
+        let m = DefaultTimingModels::default().model(&b[0]).unwrap();
+        // Hey(1) punk(1) | what(1) do(1) ya(1) want?(1) + sentence pause: 0.4 | 0.8 + 0.3
+        assert_eq!(
+            keys(&m),
+            [("start", 0.0), ("syncstart1", 0.4), ("end", 1.5)]
+        );
+        assert_eq!(m.flexibility, Flexibility::Rigid);
+        m.check().unwrap();
+    }
+
+    #[test]
+    fn syncs_at_the_edges_of_the_text_coincide_with_start_and_end() {
+        let b = behaviours(
+            r#"<speech id="s"><text><sync id="a"/>One two<sync id="z"/></text></speech>"#,
+        );
+        let m = DefaultTimingModels::default().model(&b[0]).unwrap();
+        assert_eq!(
+            keys(&m),
+            [("start", 0.0), ("a", 0.0), ("z", 0.4), ("end", 0.4)]
+        );
+        let b = behaviours(r#"<speech id="s"><text/></speech>"#);
+        assert_eq!(
+            DefaultTimingModels::default()
+                .model(&b[0])
+                .unwrap()
+                .preferred_duration(),
+            0.2
+        );
+    }
+
+    #[test]
+    fn speech_rate_is_configurable() {
+        let b = behaviours(r#"<speech id="s"><text>one two three</text></speech>"#);
+        let slow = DefaultTimingModels {
+            speech: SpeechTiming {
+                syllable_seconds: 0.5,
+                ..Default::default()
+            },
+        };
+        assert_eq!(slow.model(&b[0]).unwrap().preferred_duration(), 1.5);
+    }
+
+    #[test]
+    fn head_repetition_scales_the_nod() {
+        let b = behaviours(r#"<head id="h" lexeme="NOD" repetition="3"/>"#);
+        let m = DefaultTimingModels::default().model(&b[0]).unwrap();
+        assert!((m.preferred_duration() - 1.8).abs() < 1e-12);
+        assert!((m.keys[m.key("stroke").unwrap()].at - 0.9).abs() < 1e-12);
+    }
+
+    #[test]
+    fn every_kind_has_a_valid_model_whose_keys_match_its_sync_points() {
+        let all = behaviours(concat!(
+            r#"<speech id="a"><text>Hi <sync id="w"/>there</text></speech><gesture id="b" lexeme="BEAT"/><pointing id="c" target="t"/>"#,
+            r#"<head id="d" lexeme="NOD"/><headDirectionShift id="e" target="t"/><gaze id="f" target="t"/><gazeShift id="g" target="t"/>"#,
+            r#"<face id="h" lexeme="SMILE"/><faceLexeme id="i" lexeme="RAISE_BROWS"/><faceFacs id="j" au="1"/><faceShift id="k" lexeme="OPEN_MOUTH"/>"#,
+            r#"<posture id="l"><stance type="STANDING"/></posture><postureShift id="m"><stance type="SITTING"/></postureShift>"#,
+            r#"<locomotion id="n" target="t"/><wait id="o" max-wait="2.5"/><bmla:interrupt id="p" target="x"/><bmla:activate id="q" target="x"/>"#,
+            r#"<bmla:parametervaluechange id="r" target="a" paramId="volume"><bmla:trajectory type="linear" targetValue="1"/></bmla:parametervaluechange>"#,
+            r#"<bmlt:procanimation id="s" name="n"/><bmlt:procanimationgesture id="t" name="n"/><bmlt:keyframe id="u" name="n"/>"#,
+            r#"<bmlt:controller id="v" class="C"/><bmlt:audiofile id="w" fileName="f.wav"/><bmlt:noise id="x" joint="j" type="perlin"/>"#,
+            r#"<bmlt:facemorph id="y" targetname="m"/><bmlt:transition id="z" class="SlerpTransition"/><bmlt:text id="zz"><bmlt:text>a b</bmlt:text></bmlt:text>"#,
+        ));
+        assert_eq!(all.len(), 27);
+        let models = DefaultTimingModels::default();
+        for b in &all {
+            let m = models
+                .model(b)
+                .unwrap_or_else(|| panic!("no model for {}", b.id));
+            m.check().unwrap_or_else(|e| panic!("{}: {e}", b.id));
+            let names: Vec<&str> = m.keys.iter().map(|k| k.name.as_str()).collect();
+            assert_eq!(names, b.sync_points(), "{}", b.id);
+        }
+        let wait = models.model(&all[14]).unwrap();
+        assert_eq!(wait.preferred_duration(), 2.5);
+        assert!(
+            models.model(&all[21]).unwrap().persistent,
+            "controller persists"
+        );
+    }
+
+    #[test]
+    fn unknown_extensions_have_no_model() {
+        let b = behaviours(r#"<x:dance xmlns:x="urn:x" id="d"/>"#);
+        assert_eq!(DefaultTimingModels::default().model(&b[0]), None);
+    }
+
+    #[test]
+    fn check_rejects_broken_models() {
+        let bad = |keys: &[(&str, f64)]| TimingModel::stretchable(keys).check().unwrap_err();
+        assert!(bad(&[]).contains("at least"));
+        assert!(bad(&[("ready", 0.0), ("end", 1.0)]).contains("first key"));
+        assert!(bad(&[("start", 0.0), ("end", 0.0)]).contains("last key"));
+        assert!(bad(&[
+            ("start", 0.0),
+            ("stroke", 0.8),
+            ("ready", 0.5),
+            ("end", 1.0)
+        ])
+        .contains("comes before"));
+        assert!(bad(&[("start", 0.0), ("a", 0.2), ("a", 0.3), ("end", 1.0)]).contains("twice"));
+    }
+}
