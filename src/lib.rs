@@ -5,6 +5,7 @@
 //! - [`bml`]: the language — typed model, parser, validation, constraint extraction, writer;
 //! - [`feedback`]: BML 1.0 feedback messages and their XML and JSON-lines codecs;
 //! - [`engine`]: what engines tell the scheduler (so far timing models and their defaults);
+//! - [`plan`]: the flexible plan (so far the peg board);
 //! - [`schedule`]: the scheduler (so far its difference-constraint solver).
 
 #![warn(missing_docs)]
@@ -12,5 +13,6 @@
 pub mod bml;
 pub mod engine;
 pub mod feedback;
+pub mod plan;
 pub mod schedule;
 mod xmlname;
