@@ -4,3 +4,4 @@
 //! plan, timing models and strategies of issue #3 come next.
 
 pub mod diff;
+pub mod optimal;

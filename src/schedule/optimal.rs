@@ -1,0 +1,583 @@
+//! The `Optimal` scheduling strategy for one block. Every constraint kind is honoured, behaviours
+//! keep their preferred timing as far as the constraints allow, ungrounded clusters start as early
+//! as possible, and the result does not depend on the order of behaviours in the block.
+//!
+//! 1. Feasibility: every sync key becomes a variable of a difference system (explicit constraints,
+//!    sync order, duration bounds, rigid internal timing, nothing before block start). A
+//!    contradictory cycle names the constraints in conflict; a behaviour involved that is not
+//!    required is dropped and the rest tried again. If only required behaviours are involved, the
+//!    block fails.
+//! 2. Fast path: with every behaviour at its preferred timing (one variable per behaviour), the least
+//!    solution of the difference system, if there is one, has zero deviation and the earliest starts.
+//!    No LP is needed.
+//! 3. Otherwise a linear program (good_lp + microlp) first minimises the total deviation from
+//!    preferred timing, measured as stretch `|σ − 1| · duration` plus non-uniformity
+//!    `2 · Σ |phase − σ · preferred phase|`. It then minimises the sum of all sync times with the deviation
+//!    kept at that minimum. The program is built in a canonical order (behaviours sorted by id), so the
+//!    same block in any order gives the same program and the same answer.
+
+use std::collections::HashMap;
+
+use good_lp::{
+    constraint, microlp, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
+};
+
+use super::diff::{DiffSystem, EPSILON};
+use crate::bml::{extract, Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
+use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
+use crate::feedback::KnownWarning;
+
+/// Cost of one second of non-uniform phase change relative to one second of uniform stretch: above
+/// 1, so a behaviour that must change length stretches all its phases alike (as Elckerlyc's
+/// linear stretch does) instead of putting the change into one phase.
+pub const NON_UNIFORM_WEIGHT: f64 = 2.0;
+
+/// Times of references that leave the block (other blocks' syncs, anticipators), block-local.
+pub trait ExternalTimes {
+    /// The block-local time of `point`, or `None` if it is unknown.
+    fn time(&self, point: &SyncPoint) -> Option<f64>;
+}
+
+/// No external references are known.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoExternal;
+
+impl ExternalTimes for NoExternal {
+    fn time(&self, _: &SyncPoint) -> Option<f64> {
+        None
+    }
+}
+
+/// One behaviour's scheduled sync times (block-local seconds; a persistent end is infinite).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScheduledBehaviour {
+    /// Behaviour id.
+    pub id: String,
+    /// (sync id, time) in sync order.
+    pub syncs: Vec<(String, f64)>,
+}
+
+impl ScheduledBehaviour {
+    /// Time of sync `name`.
+    pub fn time(&self, name: &str) -> Option<f64> {
+        self.syncs.iter().find(|(s, _)| s == name).map(|(_, t)| *t)
+    }
+}
+
+/// A behaviour left out of the schedule, with the warning to send.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dropped {
+    /// Behaviour id.
+    pub behaviour: String,
+    /// Warning type.
+    pub warning: KnownWarning,
+    /// Explanation, naming the constraints involved.
+    pub reason: String,
+}
+
+/// The schedule of one block.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BlockSchedule {
+    /// Scheduled behaviours in document order.
+    pub behaviours: Vec<ScheduledBehaviour>,
+    /// Behaviours that could not be scheduled.
+    pub dropped: Vec<Dropped>,
+}
+
+impl BlockSchedule {
+    /// The scheduled behaviour `id`.
+    pub fn behaviour(&self, id: &str) -> Option<&ScheduledBehaviour> {
+        self.behaviours.iter().find(|b| b.id == id)
+    }
+
+    /// Time of `behaviour:sync`.
+    pub fn time(&self, behaviour: &str, sync: &str) -> Option<f64> {
+        self.behaviour(behaviour).and_then(|b| b.time(sync))
+    }
+}
+
+/// The whole block fails (a required behaviour or constraint cannot hold).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("block cannot be scheduled: {reason}")]
+pub struct ScheduleError {
+    /// Why, naming the constraints involved.
+    pub reason: String,
+}
+
+/// The optimal strategy (see the module documentation).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Optimal;
+
+/// A behaviour being scheduled.
+struct Item<'b> {
+    beh: &'b Behaviour,
+    model: TimingModel,
+    /// Number of keys that get times (a persistent end is left out).
+    len: usize,
+}
+
+/// One side of a constraint, resolved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Term {
+    /// Key `k` of item `i`.
+    Key(usize, usize),
+    /// Block start (0) plus a known time.
+    Fixed(f64),
+}
+
+/// A constraint over resolved terms: `left REL right + offset`.
+struct Link {
+    relation: Relation,
+    left: Term,
+    right: Term,
+    offset: f64,
+    text: String,
+}
+
+impl Optimal {
+    /// Schedules `block` with the engines' timing `models`; times of references outside the block
+    /// come from `external`.
+    pub fn schedule(
+        &self,
+        block: &Block,
+        models: &dyn TimingModels,
+        external: &dyn ExternalTimes,
+    ) -> Result<BlockSchedule, ScheduleError> {
+        let mut dropped = Vec::new();
+        // canonical order: by id
+        let mut order: Vec<&Behaviour> = block.behaviours.iter().collect();
+        order.sort_by(|a, b| a.id.cmp(&b.id));
+        let mut items: Vec<Item> = Vec::new();
+        for beh in order {
+            match models.model(beh) {
+                Some(model) => {
+                    let len = if model.persistent && !beh.syncs.iter().any(|s| s.sync == "end") {
+                        model.keys.len() - 1
+                    } else {
+                        model.keys.len()
+                    };
+                    items.push(Item { beh, model, len });
+                }
+                None => dropped.push(Dropped {
+                    behaviour: beh.id.clone(),
+                    warning: KnownWarning::BehaviorTypeNotSupported,
+                    reason: format!("no engine realizes <{}>", beh.kind.element_name()),
+                }),
+            }
+        }
+        let constraints = extract(block);
+        loop {
+            let (links, unusable) = resolve(block, &items, &constraints, external);
+            if let Some((i, warning, reason)) = unusable {
+                if is_required(&items[i], &constraints) {
+                    return Err(ScheduleError { reason });
+                }
+                dropped.push(Dropped {
+                    behaviour: items[i].beh.id.clone(),
+                    warning,
+                    reason,
+                });
+                items.remove(i);
+                continue;
+            }
+            match feasible(&items, &links) {
+                Ok(()) => {
+                    let times =
+                        preferred(&items, &links).unwrap_or_else(|| optimise(&items, &links));
+                    let mut behaviours: Vec<ScheduledBehaviour> = items
+                        .iter()
+                        .zip(times)
+                        .map(|(it, t)| ScheduledBehaviour {
+                            id: it.beh.id.clone(),
+                            syncs: it
+                                .model
+                                .keys
+                                .iter()
+                                .enumerate()
+                                .map(|(k, key)| {
+                                    (key.name.clone(), t.get(k).copied().unwrap_or(f64::INFINITY))
+                                })
+                                .collect(),
+                        })
+                        .collect();
+                    // document order
+                    let pos: HashMap<&str, usize> = block
+                        .behaviours
+                        .iter()
+                        .enumerate()
+                        .map(|(i, b)| (b.id.as_str(), i))
+                        .collect();
+                    behaviours
+                        .sort_by_key(|b| pos.get(b.id.as_str()).copied().unwrap_or(usize::MAX));
+                    return Ok(BlockSchedule {
+                        behaviours,
+                        dropped,
+                    });
+                }
+                Err(involved) => {
+                    let text = involved.texts.join("; ");
+                    // drop the behaviour that brought the most conflicting constraints (a
+                    // behaviour's own sync is the left side of its attributes); ties by id
+                    let candidate = involved
+                        .items
+                        .iter()
+                        .copied()
+                        .filter(|&i| !is_required(&items[i], &constraints))
+                        .max_by_key(|&i| (involved.owned(i), &items[i].beh.id));
+                    let Some(i) = candidate else {
+                        return Err(ScheduleError {
+                            reason: format!("required behaviours cannot satisfy: {text}"),
+                        });
+                    };
+                    dropped.push(Dropped {
+                        behaviour: items[i].beh.id.clone(),
+                        warning: KnownWarning::CannotSatisfyConstraints,
+                        reason: format!(
+                            "'{}' dropped: these constraints contradict each other: {text}",
+                            items[i].beh.id
+                        ),
+                    });
+                    items.remove(i);
+                }
+            }
+        }
+    }
+}
+
+/// A behaviour is required if it sits in `<required>` or a required constraint names it.
+fn is_required(item: &Item, constraints: &[Constraint]) -> bool {
+    item.beh.required
+        || constraints.iter().any(|c| {
+            c.required
+                && [&c.left, &c.right]
+                    .iter()
+                    .any(|a| matches!(a, Anchor::Point(SyncPoint::Local { behaviour, .. }) if *behaviour == item.beh.id))
+        })
+}
+
+/// Resolves constraints to terms. Returns the first behaviour that cannot be scheduled because a
+/// constraint names a sync it lacks or an external time that is unknown.
+fn resolve(
+    block: &Block,
+    items: &[Item],
+    constraints: &[Constraint],
+    external: &dyn ExternalTimes,
+) -> (Vec<Link>, Option<(usize, KnownWarning, String)>) {
+    let index: HashMap<&str, usize> = items
+        .iter()
+        .enumerate()
+        .map(|(i, it)| (it.beh.id.as_str(), i))
+        .collect();
+    let mut links = Vec::new();
+    for c in constraints {
+        let mut owner = None;
+        let mut term = |a: &Anchor| -> Result<Option<Term>, (KnownWarning, String)> {
+            let (behaviour, sync) = match a {
+                Anchor::BlockStart => return Ok(Some(Term::Fixed(0.0))),
+                Anchor::Point(SyncPoint::Local { behaviour, sync }) => (behaviour, sync),
+                Anchor::Point(SyncPoint::External {
+                    block: b,
+                    behaviour,
+                    sync,
+                }) if *b == block.id => (behaviour, sync),
+                Anchor::Point(p) => {
+                    return external.time(p).map(|t| Some(Term::Fixed(t))).ok_or((
+                        KnownWarning::NoSuchTarget,
+                        format!("the time of {p} is not known"),
+                    ));
+                }
+            };
+            let Some(&i) = index.get(behaviour.as_str()) else {
+                return Ok(None); // behaviour dropped or unsupported: the constraint lapses
+            };
+            owner.get_or_insert(i);
+            match items[i].model.key(sync) {
+                Some(k) if k < items[i].len => Ok(Some(Term::Key(i, k))),
+                Some(_) => Ok(None), // a persistent end
+                None => Err((
+                    KnownWarning::CannotSatisfyConstraints,
+                    format!(
+                        "<{}> '{behaviour}' has no sync point '{sync}' in its timing model",
+                        items[i].beh.kind.element_name()
+                    ),
+                )),
+            }
+        };
+        let left = term(&c.left);
+        let right = term(&c.right);
+        match (left, right) {
+            (Ok(Some(left)), Ok(Some(right))) => links.push(Link {
+                relation: c.relation,
+                left,
+                right,
+                offset: c.offset,
+                text: c.to_string(),
+            }),
+            (Err((w, why)), _) | (_, Err((w, why))) => {
+                let reason = format!("constraint '{c}': {why}");
+                if let Some(i) = owner {
+                    return (links, Some((i, w, reason)));
+                }
+            }
+            _ => {}
+        }
+    }
+    (links, None)
+}
+
+/// The behaviours and constraint texts of a conflict.
+struct Involved {
+    items: Vec<usize>,
+    texts: Vec<String>,
+    /// For each conflicting explicit constraint, the item on its left side.
+    owners: Vec<usize>,
+}
+
+impl Involved {
+    /// How many of the conflicting constraints item `i` stands on the left side of.
+    fn owned(&self, i: usize) -> usize {
+        self.owners.iter().filter(|&&o| o == i).count()
+    }
+}
+
+/// Adds the hard constraints of every item (rigid timing, order, durations, not before block start)
+/// and every link to a difference system over all keys; variable 0 is the block start.
+fn hard_system(items: &[Item], links: &[Link]) -> (DiffSystem, Vec<usize>) {
+    let mut s = DiffSystem::new();
+    let block = s.var(0.0);
+    let mut base = Vec::with_capacity(items.len());
+    for (i, it) in items.iter().enumerate() {
+        base.push(s.len());
+        let tag = links.len() + i;
+        let first = s.len();
+        for _ in 0..it.len {
+            let v = s.var(f64::MIN / 4.0);
+            s.at_least(v, block, 0.0, tag); // S4
+        }
+        let keys = &it.model.keys;
+        for (k, key) in keys.iter().enumerate().take(it.len).skip(1) {
+            match it.model.flexibility {
+                Flexibility::Rigid => s.equal(first + k, first, key.at, tag),
+                Flexibility::Stretchable { .. } => s.at_least(first + k, first + k - 1, 0.0, tag), // S6
+            }
+        }
+        if let (
+            Flexibility::Stretchable {
+                min_duration,
+                max_duration,
+            },
+            true,
+        ) = (it.model.flexibility, it.len == keys.len())
+        {
+            let end = first + it.len - 1;
+            s.at_least(end, first, min_duration, tag); // S5
+            if max_duration.is_finite() {
+                s.at_most(end, first, max_duration, tag);
+            }
+        }
+    }
+    let var = |t: Term| -> (usize, f64) {
+        match t {
+            Term::Key(i, k) => (base[i] + k, 0.0),
+            Term::Fixed(t) => (block, t),
+        }
+    };
+    for (tag, l) in links.iter().enumerate() {
+        let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
+        let offset = l.offset + bo - ao; // a REL b + offset
+        match l.relation {
+            Relation::At => s.equal(a, b, offset, tag),
+            Relation::Before => s.at_most(a, b, offset, tag),
+            Relation::After => s.at_least(a, b, offset, tag),
+        }
+    }
+    (s, base)
+}
+
+fn feasible(items: &[Item], links: &[Link]) -> Result<(), Involved> {
+    let (s, _) = hard_system(items, links);
+    match s.solve() {
+        Ok(_) => Ok(()),
+        Err(conflict) => {
+            let mut involved = Involved {
+                items: Vec::new(),
+                texts: Vec::new(),
+                owners: Vec::new(),
+            };
+            for &tag in &conflict.tags {
+                if tag < links.len() {
+                    let l = &links[tag];
+                    if !involved.texts.contains(&l.text) {
+                        involved.texts.push(l.text.clone());
+                        if let Term::Key(i, _) = l.left {
+                            involved.owners.push(i);
+                        }
+                    }
+                    for t in [l.left, l.right] {
+                        if let Term::Key(i, _) = t {
+                            involved.items.push(i);
+                        }
+                    }
+                } else {
+                    let i = tag - links.len();
+                    involved
+                        .texts
+                        .push(format!("the timing of '{}'", items[i].beh.id));
+                    involved.items.push(i);
+                }
+            }
+            involved.items.sort_unstable();
+            involved.items.dedup();
+            Err(involved)
+        }
+    }
+}
+
+/// Every behaviour at its preferred timing: one variable per behaviour start. `None` if the
+/// constraints need some behaviour to stretch.
+fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
+    let mut s = DiffSystem::new();
+    let block = s.var(0.0);
+    let starts: Vec<usize> = items.iter().map(|_| s.var(f64::MIN / 4.0)).collect();
+    for (i, &v) in starts.iter().enumerate() {
+        s.at_least(v, block, 0.0, links.len() + i);
+    }
+    let var = |t: Term| -> (usize, f64) {
+        match t {
+            Term::Key(i, k) => (starts[i], items[i].model.keys[k].at),
+            Term::Fixed(t) => (block, t),
+        }
+    };
+    for (tag, l) in links.iter().enumerate() {
+        let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
+        let offset = l.offset + bo - ao;
+        match l.relation {
+            Relation::At => s.equal(a, b, offset, tag),
+            Relation::Before => s.at_most(a, b, offset, tag),
+            Relation::After => s.at_least(a, b, offset, tag),
+        }
+    }
+    let x = s.solve().ok()?;
+    if x[block] > EPSILON {
+        return None;
+    }
+    Some(
+        items
+            .iter()
+            .zip(&starts)
+            .map(|(it, &v)| {
+                it.model.keys[..it.len]
+                    .iter()
+                    .map(|k| x[v] + k.at)
+                    .collect()
+            })
+            .collect(),
+    )
+}
+
+/// The two-stage linear program for blocks where some behaviour must stretch.
+fn optimise(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
+    let build = |deviation_bound: Option<f64>| {
+        let mut vars = ProblemVariables::new();
+        let t: Vec<Vec<Variable>> = items
+            .iter()
+            .map(|it| (0..it.len).map(|_| vars.add(variable().min(0.0))).collect())
+            .collect();
+        let mut constraints = Vec::new();
+        let mut deviation = Expression::from(0.0);
+        for (i, it) in items.iter().enumerate() {
+            let keys = &it.model.keys;
+            match it.model.flexibility {
+                Flexibility::Rigid => {
+                    for k in 1..it.len {
+                        constraints.push(constraint!(t[i][k] - t[i][0] == keys[k].at));
+                    }
+                }
+                Flexibility::Stretchable {
+                    min_duration,
+                    max_duration,
+                } => {
+                    for k in 1..it.len {
+                        constraints.push(constraint!(t[i][k] - t[i][k - 1] >= 0.0));
+                    }
+                    if it.len == keys.len() {
+                        let end = it.len - 1;
+                        constraints.push(constraint!(t[i][end] - t[i][0] >= min_duration));
+                        if max_duration.is_finite() {
+                            constraints.push(constraint!(t[i][end] - t[i][0] <= max_duration));
+                        }
+                    }
+                    let sigma = vars.add(variable().min(0.0));
+                    let stretch = vars.add(variable().min(0.0));
+                    let duration = it.model.preferred_duration().max(EPSILON);
+                    constraints.push(constraint!(stretch >= (sigma - 1.0) * duration));
+                    constraints.push(constraint!(stretch >= (1.0 - sigma) * duration));
+                    deviation += stretch;
+                    for k in 1..it.len {
+                        let p = keys[k].at - keys[k - 1].at;
+                        let d = vars.add(variable().min(0.0));
+                        constraints.push(constraint!(d >= t[i][k] - t[i][k - 1] - sigma * p));
+                        constraints.push(constraint!(d >= sigma * p - (t[i][k] - t[i][k - 1])));
+                        deviation += NON_UNIFORM_WEIGHT * d;
+                    }
+                }
+            }
+        }
+        let term = |x: Term| -> Expression {
+            match x {
+                Term::Key(i, k) => t[i][k].into(),
+                Term::Fixed(v) => Expression::from(v),
+            }
+        };
+        for l in links {
+            let (a, b) = (term(l.left), term(l.right) + l.offset);
+            constraints.push(match l.relation {
+                Relation::At => constraint!(a == b),
+                Relation::Before => constraint!(a <= b),
+                Relation::After => constraint!(a >= b),
+            });
+        }
+        let objective: Expression = match deviation_bound {
+            None => deviation.clone(),
+            Some(bound) => {
+                constraints.push(constraint!(deviation.clone() <= bound));
+                t.iter().flatten().map(|&v| Expression::from(v)).sum()
+            }
+        };
+        let mut problem = vars.minimise(objective.clone()).using(microlp);
+        for c in constraints {
+            problem = problem.with(c);
+        }
+        let solution = problem.solve().ok()?;
+        let value = solution.eval(&objective);
+        let times = t
+            .iter()
+            .map(|row| row.iter().map(|&v| solution.value(v)).collect())
+            .collect();
+        Some((value, times))
+    };
+    // the hard system is feasible, so both stages have solutions; fall back to the earliest
+    // feasible times if the LP solver gives up numerically
+    let Some((least_deviation, _)) = build(None) else {
+        return earliest(items, links);
+    };
+    match build(Some(least_deviation + 1e-7 * (1.0 + least_deviation))) {
+        Some((_, times)) => times,
+        None => earliest(items, links),
+    }
+}
+
+/// The least solution of the hard system (every key as early as possible).
+fn earliest(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
+    let (s, base) = hard_system(items, links);
+    let x = s.solve().unwrap_or_default();
+    items
+        .iter()
+        .zip(&base)
+        .map(|(it, &b)| {
+            (0..it.len)
+                .map(|k| x.get(b + k).copied().unwrap_or(0.0))
+                .collect()
+        })
+        .collect()
+}
