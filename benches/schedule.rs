@@ -6,7 +6,10 @@
 
 use std::hint::black_box;
 
+use bml_realizer::bml;
+use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::schedule::diff::DiffSystem;
+use bml_realizer::schedule::optimal::{NoExternal, Optimal};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 
 fn chain(n: usize) -> DiffSystem {
@@ -36,5 +39,44 @@ fn solve(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, solve);
+fn optimal(c: &mut Criterion) {
+    let mut g = c.benchmark_group("schedule/optimal");
+    let models = DefaultTimingModels::default();
+    for (name, text) in [
+        // needs stretching: the LP path
+        (
+            "testspeechgestures",
+            include_str!("../fixtures/realizertester/bml-1/core/testspeechgestures.xml"),
+        ),
+        // preferred timing fits: the fast path
+        (
+            "testspeechandnod_synctimed",
+            include_str!("../fixtures/realizertester/bml-1/core/testspeechandnod_synctimed.xml"),
+        ),
+        (
+            "testnodlong",
+            include_str!("../fixtures/realizertester/bml-1/core/testnodlong.xml"),
+        ),
+    ] {
+        let block = bml::load(text).unwrap().block;
+        g.bench_function(format!("{name}/schedule"), |b| {
+            b.iter(|| {
+                black_box(
+                    Optimal
+                        .schedule(black_box(&block), &models, &NoExternal)
+                        .unwrap(),
+                )
+            })
+        });
+        g.bench_function(format!("{name}/parse+schedule"), |b| {
+            b.iter(|| {
+                let block = bml::load(black_box(text)).unwrap().block;
+                black_box(Optimal.schedule(&block, &models, &NoExternal).unwrap())
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, solve, optimal);
 criterion_main!(benches);

@@ -10,7 +10,11 @@
 //! 2. Fast path: with every behaviour at its preferred timing (one variable per behaviour), the least
 //!    solution of the difference system, if there is one, has zero deviation and the earliest starts.
 //!    No LP is needed.
-//! 3. Otherwise a linear program (good_lp + microlp) first minimises the total deviation from
+//! 3. Second fast path: if every behaviour constrained at two or more keys has those keys fixed
+//!    relative to each other by `at` constraints (through other behaviours), it stretches
+//!    uniformly between them (Elckerlyc's linear stretch, S49) and everything else keeps its
+//!    preferred timing; the least solution again gives the earliest starts.
+//! 4. Otherwise a linear program (good_lp + microlp) first minimises the total deviation from
 //!    preferred timing, measured as stretch `|σ − 1| · duration` plus non-uniformity
 //!    `2 · Σ |phase − σ · preferred phase|`. It then minimises the sum of all sync times with the deviation
 //!    kept at that minimum. The program is built in a canonical order (behaviours sorted by id), so the
@@ -182,8 +186,9 @@ impl Optimal {
             }
             match feasible(&items, &links) {
                 Ok(()) => {
-                    let times =
-                        preferred(&items, &links).unwrap_or_else(|| optimise(&items, &links));
+                    let times = preferred(&items, &links)
+                        .or_else(|| uniform(&items, &links))
+                        .unwrap_or_else(|| optimise(&items, &links));
                     let mut behaviours: Vec<ScheduledBehaviour> = items
                         .iter()
                         .zip(times)
@@ -475,6 +480,186 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
     )
 }
 
+/// Weighted union-find: `value(node) = value(root) + offset(node)`.
+struct Offsets {
+    parent: Vec<usize>,
+    offset: Vec<f64>,
+}
+
+impl Offsets {
+    fn new(n: usize) -> Self {
+        Offsets {
+            parent: (0..n).collect(),
+            offset: vec![0.0; n],
+        }
+    }
+
+    fn find(&mut self, v: usize) -> (usize, f64) {
+        let p = self.parent[v];
+        if p == v {
+            return (v, 0.0);
+        }
+        let (root, off) = self.find(p);
+        self.parent[v] = root;
+        self.offset[v] += off;
+        (root, self.offset[v])
+    }
+
+    /// Records `value(a) = value(b) + d`.
+    fn join(&mut self, a: usize, b: usize, d: f64) {
+        let (ra, oa) = self.find(a);
+        let (rb, ob) = self.find(b);
+        if ra != rb {
+            // value(ra) = value(a) - oa = value(b) + d - oa = value(rb) + ob + d - oa
+            self.parent[ra] = rb;
+            self.offset[ra] = ob + d - oa;
+        }
+    }
+}
+
+/// Every behaviour constrained at two or more keys stretches uniformly between keys whose
+/// distances `at` constraints already fix; all others keep their preferred timing. `None` if some
+/// behaviour's constrained keys are not fixed relative to each other (the LP decides then).
+fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
+    // anchored keys per item, in key order
+    let mut anchors: Vec<Vec<usize>> = vec![Vec::new(); items.len()];
+    for l in links {
+        for t in [l.left, l.right] {
+            if let Term::Key(i, k) = t {
+                if !anchors[i].contains(&k) {
+                    anchors[i].push(k);
+                }
+            }
+        }
+    }
+    for a in &mut anchors {
+        a.sort_unstable();
+    }
+    let multi = |i: usize| {
+        matches!(items[i].model.flexibility, Flexibility::Stretchable { .. })
+            && anchors[i].len() >= 2
+    };
+    // nodes: 0 = block; one per anchor of a multi-anchor item, one (its start) for any other item
+    let mut node_of: Vec<Vec<usize>> = Vec::with_capacity(items.len());
+    let mut n = 1;
+    for (i, a) in anchors.iter().enumerate() {
+        let count = if multi(i) { a.len() } else { 1 };
+        node_of.push((n..n + count).collect());
+        n += count;
+    }
+    let node = |i: usize, k: usize| -> (usize, f64) {
+        if multi(i) {
+            let j = anchors[i].iter().position(|&a| a == k).unwrap_or(0);
+            (node_of[i][j], 0.0)
+        } else {
+            (node_of[i][0], items[i].model.keys[k].at)
+        }
+    };
+    let term = |t: Term| match t {
+        Term::Key(i, k) => node(i, k),
+        Term::Fixed(v) => (0, v),
+    };
+    let mut offsets = Offsets::new(n);
+    for l in links.iter().filter(|l| l.relation == Relation::At) {
+        // left = right + offset  =>  value(a) + oa = value(b) + ob + offset
+        let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
+        offsets.join(a, b, ob + l.offset - oa);
+    }
+    // the uniform scale of each multi-anchor item, from its fixed anchor distances
+    let mut scale = vec![1.0; items.len()];
+    for i in (0..items.len()).filter(|&i| multi(i)) {
+        let keys = &items[i].model.keys;
+        let (first, last) = (anchors[i][0], anchors[i][anchors[i].len() - 1]);
+        let (r0, o0) = offsets.find(node_of[i][0]);
+        for &v in &node_of[i][1..] {
+            if offsets.find(v).0 != r0 {
+                return None;
+            }
+        }
+        let (_, o1) = offsets.find(node_of[i][node_of[i].len() - 1]);
+        let span = keys[last].at - keys[first].at;
+        if span <= 0.0 {
+            return None;
+        }
+        scale[i] = (o1 - o0) / span;
+        let duration = scale[i] * items[i].model.preferred_duration();
+        if let Flexibility::Stretchable {
+            min_duration,
+            max_duration,
+        } = items[i].model.flexibility
+        {
+            if scale[i] < 0.0
+                || duration < min_duration - EPSILON
+                || duration > max_duration + EPSILON
+            {
+                return None;
+            }
+        }
+    }
+    // least solution over the nodes
+    let mut s = DiffSystem::new();
+    for v in 0..n {
+        s.var(if v == 0 { 0.0 } else { f64::MIN / 4.0 });
+    }
+    for (tag, l) in links.iter().enumerate() {
+        let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
+        let offset = l.offset + ob - oa;
+        match l.relation {
+            Relation::At => s.equal(a, b, offset, tag),
+            Relation::Before => s.at_most(a, b, offset, tag),
+            Relation::After => s.at_least(a, b, offset, tag),
+        }
+    }
+    for i in 0..items.len() {
+        let tag = links.len() + i;
+        // nothing before the block: for a stretched item, its extrapolated start
+        let lead = if multi(i) {
+            scale[i] * items[i].model.keys[anchors[i][0]].at
+        } else {
+            0.0
+        };
+        s.at_least(node_of[i][0], 0, lead, tag);
+    }
+    let x = s.solve().ok()?;
+    if x[0] > EPSILON {
+        return None;
+    }
+    let times = items
+        .iter()
+        .enumerate()
+        .map(|(i, it)| {
+            let keys = &it.model.keys[..it.len];
+            if !multi(i) {
+                let start = x[node_of[i][0]];
+                return keys.iter().map(|k| start + k.at).collect();
+            }
+            let a = &anchors[i];
+            let (last, at) = (a.len() - 1, |j: usize| x[node_of[i][j]]);
+            let p = |j: usize| it.model.keys[a[j]].at;
+            keys.iter()
+                .enumerate()
+                .map(|(k, key)| {
+                    if k <= a[0] {
+                        at(0) - scale[i] * (p(0) - key.at)
+                    } else if k >= a[last] {
+                        at(last) + scale[i] * (key.at - p(last))
+                    } else {
+                        // linear between the surrounding anchors (S49)
+                        let j = a.iter().rposition(|&x| x <= k).unwrap_or(0);
+                        let (p0, p1) = (p(j), p(j + 1));
+                        if p1 > p0 {
+                            at(j) + (key.at - p0) / (p1 - p0) * (at(j + 1) - at(j))
+                        } else {
+                            at(j)
+                        }
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    Some(times)
+}
+
 /// The two-stage linear program for blocks where some behaviour must stretch.
 fn optimise(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
     let build = |deviation_bound: Option<f64>| {
@@ -580,4 +765,44 @@ fn earliest(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
                 .collect()
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bml;
+    use crate::engine::timing::DefaultTimingModels;
+
+    fn prepared(src: &str) -> (Vec<TimingModel>, Block) {
+        let block = bml::load(src).unwrap().block;
+        let models = block
+            .behaviours
+            .iter()
+            .map(|b| DefaultTimingModels::default().model(b).unwrap())
+            .collect();
+        (models, block)
+    }
+
+    /// Where both apply, the uniform-stretch fast path and the LP agree.
+    #[test]
+    fn uniform_fast_path_matches_the_linear_program() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/realizertester/bml-1/core/");
+        for file in ["testspeechgestures.xml", "testnodlong.xml", "testspeech_nodtimedtosync.xml", "testshortbeh.xml"] {
+            let (models, block) = prepared(&std::fs::read_to_string(format!("{dir}{file}")).unwrap());
+            let items: Vec<Item> = block
+                .behaviours
+                .iter()
+                .zip(models)
+                .map(|(beh, model)| Item { beh, len: model.keys.len(), model })
+                .collect();
+            let (links, unusable) = resolve(&block, &items, &extract(&block), &NoExternal);
+            assert!(unusable.is_none());
+            assert!(preferred(&items, &links).is_none(), "{file} needs stretching");
+            let fast = uniform(&items, &links).unwrap_or_else(|| panic!("{file}: no fast path"));
+            let lp = optimise(&items, &links);
+            for (a, b) in fast.iter().flatten().zip(lp.iter().flatten()) {
+                assert!((a - b).abs() < 1e-6, "{file}: {fast:?} vs {lp:?}");
+            }
+        }
+    }
 }
