@@ -786,18 +786,34 @@ mod tests {
     /// Where both apply, the uniform-stretch fast path and the LP agree.
     #[test]
     fn uniform_fast_path_matches_the_linear_program() {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/realizertester/bml-1/core/");
-        for file in ["testspeechgestures.xml", "testnodlong.xml", "testspeech_nodtimedtosync.xml", "testshortbeh.xml"] {
-            let (models, block) = prepared(&std::fs::read_to_string(format!("{dir}{file}")).unwrap());
+        let dir = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/fixtures/realizertester/bml-1/core/"
+        );
+        for file in [
+            "testspeechgestures.xml",
+            "testnodlong.xml",
+            "testspeech_nodtimedtosync.xml",
+            "testshortbeh.xml",
+        ] {
+            let (models, block) =
+                prepared(&std::fs::read_to_string(format!("{dir}{file}")).unwrap());
             let items: Vec<Item> = block
                 .behaviours
                 .iter()
                 .zip(models)
-                .map(|(beh, model)| Item { beh, len: model.keys.len(), model })
+                .map(|(beh, model)| Item {
+                    beh,
+                    len: model.keys.len(),
+                    model,
+                })
                 .collect();
             let (links, unusable) = resolve(&block, &items, &extract(&block), &NoExternal);
             assert!(unusable.is_none());
-            assert!(preferred(&items, &links).is_none(), "{file} needs stretching");
+            assert!(
+                preferred(&items, &links).is_none(),
+                "{file} needs stretching"
+            );
             let fast = uniform(&items, &links).unwrap_or_else(|| panic!("{file}: no fast path"));
             let lp = optimise(&items, &links);
             for (a, b) in fast.iter().flatten().zip(lp.iter().flatten()) {
