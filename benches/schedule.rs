@@ -9,7 +9,7 @@ use std::hint::black_box;
 use bml_realizer::bml;
 use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::schedule::diff::DiffSystem;
-use bml_realizer::schedule::optimal::{NoExternal, Optimal};
+use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 
 fn chain(n: usize) -> DiffSystem {

@@ -4,7 +4,7 @@
 use bml_realizer::bml;
 use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::feedback::KnownWarning;
-use bml_realizer::schedule::optimal::{BlockSchedule, NoExternal, Optimal};
+use bml_realizer::schedule::{BlockSchedule, NoExternal, Optimal, SchedulingStrategy};
 
 fn fixture(path: &str) -> String {
     std::fs::read_to_string(format!("{}/fixtures/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()

@@ -5,7 +5,7 @@
 
 use bml_realizer::bml::{self, Anchor, Relation, SyncPoint};
 use bml_realizer::engine::timing::{DefaultTimingModels, Flexibility, TimingModels};
-use bml_realizer::schedule::optimal::{BlockSchedule, NoExternal, Optimal};
+use bml_realizer::schedule::{BlockSchedule, NoExternal, Optimal, SchedulingStrategy};
 use proptest::prelude::*;
 
 const KINDS: &[&str] = &[

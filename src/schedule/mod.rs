@@ -1,7 +1,16 @@
 //! Scheduling: turns a parsed block and the engines' timing models into sync-point times.
 //!
-//! Today this holds the difference-constraint solver the strategies build on ([`diff`]); the peg
-//! plan, timing models and strategies of issue #3 come next.
+//! - [`strategy`]: the `SchedulingStrategy` trait and the schedule it produces;
+//! - [`optimal`]: the default, order-invariant strategy;
+//! - [`diff`]: the difference-constraint solver under it.
 
 pub mod diff;
+mod links;
 pub mod optimal;
+pub mod strategy;
+
+pub use optimal::Optimal;
+pub use strategy::{
+    BlockSchedule, Dropped, ExternalTimes, NoExternal, ScheduleError, ScheduledBehaviour,
+    SchedulingStrategy,
+};

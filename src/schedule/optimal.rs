@@ -27,8 +27,12 @@ use good_lp::{
 };
 
 use super::diff::{DiffSystem, EPSILON};
-use crate::bml::{extract, Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
-use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
+use super::links::{is_required, items, resolve, Item, Link, Term};
+use super::strategy::{
+    BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
+};
+use crate::bml::{extract, Block, Relation};
+use crate::engine::timing::{Flexibility, TimingModels};
 use crate::feedback::KnownWarning;
 
 /// Cost of one second of non-uniform phase change relative to one second of uniform stretch: above
@@ -36,139 +40,23 @@ use crate::feedback::KnownWarning;
 /// linear stretch does) instead of putting the change into one phase.
 pub const NON_UNIFORM_WEIGHT: f64 = 2.0;
 
-/// Times of references that leave the block (other blocks' syncs, anticipators), block-local.
-pub trait ExternalTimes {
-    /// The block-local time of `point`, or `None` if it is unknown.
-    fn time(&self, point: &SyncPoint) -> Option<f64>;
-}
-
-/// No external references are known.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct NoExternal;
-
-impl ExternalTimes for NoExternal {
-    fn time(&self, _: &SyncPoint) -> Option<f64> {
-        None
-    }
-}
-
-/// One behaviour's scheduled sync times (block-local seconds; a persistent end is infinite).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ScheduledBehaviour {
-    /// Behaviour id.
-    pub id: String,
-    /// (sync id, time) in sync order.
-    pub syncs: Vec<(String, f64)>,
-}
-
-impl ScheduledBehaviour {
-    /// Time of sync `name`.
-    pub fn time(&self, name: &str) -> Option<f64> {
-        self.syncs.iter().find(|(s, _)| s == name).map(|(_, t)| *t)
-    }
-}
-
-/// A behaviour left out of the schedule, with the warning to send.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Dropped {
-    /// Behaviour id.
-    pub behaviour: String,
-    /// Warning type.
-    pub warning: KnownWarning,
-    /// Explanation, naming the constraints involved.
-    pub reason: String,
-}
-
-/// The schedule of one block.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct BlockSchedule {
-    /// Scheduled behaviours in document order.
-    pub behaviours: Vec<ScheduledBehaviour>,
-    /// Behaviours that could not be scheduled.
-    pub dropped: Vec<Dropped>,
-}
-
-impl BlockSchedule {
-    /// The scheduled behaviour `id`.
-    pub fn behaviour(&self, id: &str) -> Option<&ScheduledBehaviour> {
-        self.behaviours.iter().find(|b| b.id == id)
-    }
-
-    /// Time of `behaviour:sync`.
-    pub fn time(&self, behaviour: &str, sync: &str) -> Option<f64> {
-        self.behaviour(behaviour).and_then(|b| b.time(sync))
-    }
-}
-
-/// The whole block fails (a required behaviour or constraint cannot hold).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("block cannot be scheduled: {reason}")]
-pub struct ScheduleError {
-    /// Why, naming the constraints involved.
-    pub reason: String,
-}
-
 /// The optimal strategy (see the module documentation).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Optimal;
 
-/// A behaviour being scheduled.
-struct Item<'b> {
-    beh: &'b Behaviour,
-    model: TimingModel,
-    /// Number of keys that get times (a persistent end is left out).
-    len: usize,
-}
+impl SchedulingStrategy for Optimal {
+    fn name(&self) -> &'static str {
+        "optimal"
+    }
 
-/// One side of a constraint, resolved.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Term {
-    /// Key `k` of item `i`.
-    Key(usize, usize),
-    /// Block start (0) plus a known time.
-    Fixed(f64),
-}
-
-/// A constraint over resolved terms: `left REL right + offset`.
-struct Link {
-    relation: Relation,
-    left: Term,
-    right: Term,
-    offset: f64,
-    text: String,
-}
-
-impl Optimal {
-    /// Schedules `block` with the engines' timing `models`; times of references outside the block
-    /// come from `external`.
-    pub fn schedule(
+    fn schedule(
         &self,
         block: &Block,
         models: &dyn TimingModels,
         external: &dyn ExternalTimes,
     ) -> Result<BlockSchedule, ScheduleError> {
         let mut dropped = Vec::new();
-        // canonical order: by id
-        let mut order: Vec<&Behaviour> = block.behaviours.iter().collect();
-        order.sort_by(|a, b| a.id.cmp(&b.id));
-        let mut items: Vec<Item> = Vec::new();
-        for beh in order {
-            match models.model(beh) {
-                Some(model) => {
-                    let len = if model.persistent && !beh.syncs.iter().any(|s| s.sync == "end") {
-                        model.keys.len() - 1
-                    } else {
-                        model.keys.len()
-                    };
-                    items.push(Item { beh, model, len });
-                }
-                None => dropped.push(Dropped {
-                    behaviour: beh.id.clone(),
-                    warning: KnownWarning::BehaviorTypeNotSupported,
-                    reason: format!("no engine realizes <{}>", beh.kind.element_name()),
-                }),
-            }
-        }
+        let mut items = items(block, models, &mut dropped);
         let constraints = extract(block);
         loop {
             let (links, unusable) = resolve(block, &items, &constraints, external);
@@ -247,87 +135,6 @@ impl Optimal {
             }
         }
     }
-}
-
-/// A behaviour is required if it sits in `<required>` or a required constraint names it.
-fn is_required(item: &Item, constraints: &[Constraint]) -> bool {
-    item.beh.required
-        || constraints.iter().any(|c| {
-            c.required
-                && [&c.left, &c.right]
-                    .iter()
-                    .any(|a| matches!(a, Anchor::Point(SyncPoint::Local { behaviour, .. }) if *behaviour == item.beh.id))
-        })
-}
-
-/// Resolves constraints to terms. Returns the first behaviour that cannot be scheduled because a
-/// constraint names a sync it lacks or an external time that is unknown.
-fn resolve(
-    block: &Block,
-    items: &[Item],
-    constraints: &[Constraint],
-    external: &dyn ExternalTimes,
-) -> (Vec<Link>, Option<(usize, KnownWarning, String)>) {
-    let index: HashMap<&str, usize> = items
-        .iter()
-        .enumerate()
-        .map(|(i, it)| (it.beh.id.as_str(), i))
-        .collect();
-    let mut links = Vec::new();
-    for c in constraints {
-        let mut owner = None;
-        let mut term = |a: &Anchor| -> Result<Option<Term>, (KnownWarning, String)> {
-            let (behaviour, sync) = match a {
-                Anchor::BlockStart => return Ok(Some(Term::Fixed(0.0))),
-                Anchor::Point(SyncPoint::Local { behaviour, sync }) => (behaviour, sync),
-                Anchor::Point(SyncPoint::External {
-                    block: b,
-                    behaviour,
-                    sync,
-                }) if *b == block.id => (behaviour, sync),
-                Anchor::Point(p) => {
-                    return external.time(p).map(|t| Some(Term::Fixed(t))).ok_or((
-                        KnownWarning::NoSuchTarget,
-                        format!("the time of {p} is not known"),
-                    ));
-                }
-            };
-            let Some(&i) = index.get(behaviour.as_str()) else {
-                return Ok(None); // behaviour dropped or unsupported: the constraint lapses
-            };
-            owner.get_or_insert(i);
-            match items[i].model.key(sync) {
-                Some(k) if k < items[i].len => Ok(Some(Term::Key(i, k))),
-                Some(_) => Ok(None), // a persistent end
-                None => Err((
-                    KnownWarning::CannotSatisfyConstraints,
-                    format!(
-                        "<{}> '{behaviour}' has no sync point '{sync}' in its timing model",
-                        items[i].beh.kind.element_name()
-                    ),
-                )),
-            }
-        };
-        let left = term(&c.left);
-        let right = term(&c.right);
-        match (left, right) {
-            (Ok(Some(left)), Ok(Some(right))) => links.push(Link {
-                relation: c.relation,
-                left,
-                right,
-                offset: c.offset,
-                text: c.to_string(),
-            }),
-            (Err((w, why)), _) | (_, Err((w, why))) => {
-                let reason = format!("constraint '{c}': {why}");
-                if let Some(i) = owner {
-                    return (links, Some((i, w, reason)));
-                }
-            }
-            _ => {}
-        }
-    }
-    (links, None)
 }
 
 /// The behaviours and constraint texts of a conflict.
@@ -771,7 +578,8 @@ fn earliest(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
 mod tests {
     use super::*;
     use crate::bml;
-    use crate::engine::timing::DefaultTimingModels;
+    use crate::engine::timing::{DefaultTimingModels, TimingModel};
+    use crate::schedule::strategy::NoExternal;
 
     fn prepared(src: &str) -> (Vec<TimingModel>, Block) {
         let block = bml::load(src).unwrap().block;

@@ -1,0 +1,146 @@
+//! Behaviours and constraints prepared for a strategy: each behaviour with its timing model, and
+//! each normalised constraint resolved to sync keys of those behaviours or to known times.
+
+use std::collections::HashMap;
+
+use super::strategy::{Dropped, ExternalTimes};
+use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
+use crate::engine::timing::{TimingModel, TimingModels};
+use crate::feedback::KnownWarning;
+
+/// A behaviour being scheduled.
+pub(crate) struct Item<'b> {
+    pub(crate) beh: &'b Behaviour,
+    pub(crate) model: TimingModel,
+    /// Number of keys that get times (a persistent end is left out).
+    pub(crate) len: usize,
+}
+
+/// One side of a constraint, resolved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Term {
+    /// Key `k` of item `i`.
+    Key(usize, usize),
+    /// Block start (0) plus a known time.
+    Fixed(f64),
+}
+
+/// A constraint over resolved terms: `left REL right + offset`.
+pub(crate) struct Link {
+    pub(crate) relation: Relation,
+    pub(crate) left: Term,
+    pub(crate) right: Term,
+    pub(crate) offset: f64,
+    pub(crate) text: String,
+}
+
+/// The behaviours of `block` that some engine models, in canonical order (by id); the others are
+/// reported as dropped.
+pub(crate) fn items<'b>(
+    block: &'b Block,
+    models: &dyn TimingModels,
+    dropped: &mut Vec<Dropped>,
+) -> Vec<Item<'b>> {
+    let mut order: Vec<&Behaviour> = block.behaviours.iter().collect();
+    order.sort_by(|a, b| a.id.cmp(&b.id));
+    let mut items = Vec::new();
+    for beh in order {
+        match models.model(beh) {
+            Some(model) => {
+                let len = if model.persistent && !beh.syncs.iter().any(|s| s.sync == "end") {
+                    model.keys.len() - 1
+                } else {
+                    model.keys.len()
+                };
+                items.push(Item { beh, model, len });
+            }
+            None => dropped.push(Dropped {
+                behaviour: beh.id.clone(),
+                warning: KnownWarning::BehaviorTypeNotSupported,
+                reason: format!("no engine realizes <{}>", beh.kind.element_name()),
+            }),
+        }
+    }
+    items
+}
+
+/// A behaviour is required if it sits in `<required>` or a required constraint names it.
+pub(crate) fn is_required(item: &Item, constraints: &[Constraint]) -> bool {
+    item.beh.required
+        || constraints.iter().any(|c| {
+            c.required
+                && [&c.left, &c.right]
+                    .iter()
+                    .any(|a| matches!(a, Anchor::Point(SyncPoint::Local { behaviour, .. }) if *behaviour == item.beh.id))
+        })
+}
+
+/// Resolves constraints to terms. Returns the first behaviour that cannot be scheduled because a
+/// constraint names a sync it lacks or an external time that is unknown.
+pub(crate) fn resolve(
+    block: &Block,
+    items: &[Item],
+    constraints: &[Constraint],
+    external: &dyn ExternalTimes,
+) -> (Vec<Link>, Option<(usize, KnownWarning, String)>) {
+    let index: HashMap<&str, usize> = items
+        .iter()
+        .enumerate()
+        .map(|(i, it)| (it.beh.id.as_str(), i))
+        .collect();
+    let mut links = Vec::new();
+    for c in constraints {
+        let mut owner = None;
+        let mut term = |a: &Anchor| -> Result<Option<Term>, (KnownWarning, String)> {
+            let (behaviour, sync) = match a {
+                Anchor::BlockStart => return Ok(Some(Term::Fixed(0.0))),
+                Anchor::Point(SyncPoint::Local { behaviour, sync }) => (behaviour, sync),
+                Anchor::Point(SyncPoint::External {
+                    block: b,
+                    behaviour,
+                    sync,
+                }) if *b == block.id => (behaviour, sync),
+                Anchor::Point(p) => {
+                    return external.time(p).map(|t| Some(Term::Fixed(t))).ok_or((
+                        KnownWarning::NoSuchTarget,
+                        format!("the time of {p} is not known"),
+                    ));
+                }
+            };
+            let Some(&i) = index.get(behaviour.as_str()) else {
+                return Ok(None); // behaviour dropped or unsupported: the constraint lapses
+            };
+            owner.get_or_insert(i);
+            match items[i].model.key(sync) {
+                Some(k) if k < items[i].len => Ok(Some(Term::Key(i, k))),
+                Some(_) => Ok(None), // a persistent end
+                None => Err((
+                    KnownWarning::CannotSatisfyConstraints,
+                    format!(
+                        "<{}> '{behaviour}' has no sync point '{sync}' in its timing model",
+                        items[i].beh.kind.element_name()
+                    ),
+                )),
+            }
+        };
+        let left = term(&c.left);
+        let right = term(&c.right);
+        match (left, right) {
+            (Ok(Some(left)), Ok(Some(right))) => links.push(Link {
+                relation: c.relation,
+                left,
+                right,
+                offset: c.offset,
+                text: c.to_string(),
+            }),
+            (Err((w, why)), _) | (_, Err((w, why))) => {
+                let reason = format!("constraint '{c}': {why}");
+                if let Some(i) = owner {
+                    return (links, Some((i, w, reason)));
+                }
+            }
+            _ => {}
+        }
+    }
+    (links, None)
+}

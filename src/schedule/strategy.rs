@@ -1,0 +1,94 @@
+//! What every scheduling strategy shares: the `SchedulingStrategy` trait (S40), the schedule it
+//! produces, the reasons it drops behaviours or fails a block, and the source of times for references
+//! that leave the block.
+
+use crate::bml::{Block, SyncPoint};
+use crate::engine::timing::TimingModels;
+use crate::feedback::KnownWarning;
+
+/// A way of turning a block into sync times; strategies plug in from outside the core (S40).
+pub trait SchedulingStrategy {
+    /// A short name for logs and benches.
+    fn name(&self) -> &'static str;
+
+    /// Schedules `block` with the engines' timing `models`; times of references outside the block
+    /// come from `external`.
+    fn schedule(
+        &self,
+        block: &Block,
+        models: &dyn TimingModels,
+        external: &dyn ExternalTimes,
+    ) -> Result<BlockSchedule, ScheduleError>;
+}
+
+/// Times of references that leave the block (other blocks' syncs, anticipators), block-local.
+pub trait ExternalTimes {
+    /// The block-local time of `point`, or `None` if it is unknown.
+    fn time(&self, point: &SyncPoint) -> Option<f64>;
+}
+
+/// No external references are known.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoExternal;
+
+impl ExternalTimes for NoExternal {
+    fn time(&self, _: &SyncPoint) -> Option<f64> {
+        None
+    }
+}
+
+/// One behaviour's scheduled sync times (block-local seconds; a persistent end is infinite).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScheduledBehaviour {
+    /// Behaviour id.
+    pub id: String,
+    /// (sync id, time) in sync order.
+    pub syncs: Vec<(String, f64)>,
+}
+
+impl ScheduledBehaviour {
+    /// Time of sync `name`.
+    pub fn time(&self, name: &str) -> Option<f64> {
+        self.syncs.iter().find(|(s, _)| s == name).map(|(_, t)| *t)
+    }
+}
+
+/// A behaviour left out of the schedule, with the warning to send.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dropped {
+    /// Behaviour id.
+    pub behaviour: String,
+    /// Warning type.
+    pub warning: KnownWarning,
+    /// Explanation, naming the constraints involved.
+    pub reason: String,
+}
+
+/// The schedule of one block.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BlockSchedule {
+    /// Scheduled behaviours in document order.
+    pub behaviours: Vec<ScheduledBehaviour>,
+    /// Behaviours that could not be scheduled.
+    pub dropped: Vec<Dropped>,
+}
+
+impl BlockSchedule {
+    /// The scheduled behaviour `id`.
+    pub fn behaviour(&self, id: &str) -> Option<&ScheduledBehaviour> {
+        self.behaviours.iter().find(|b| b.id == id)
+    }
+
+    /// Time of `behaviour:sync`.
+    pub fn time(&self, behaviour: &str, sync: &str) -> Option<f64> {
+        self.behaviour(behaviour).and_then(|b| b.time(sync))
+    }
+}
+
+/// The whole block fails (a required behaviour or constraint cannot hold).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("block cannot be scheduled: {reason}")]
+pub struct ScheduleError {
+    /// Why, naming the constraints involved.
+    pub reason: String,
+}
