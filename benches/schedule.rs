@@ -9,7 +9,7 @@ use std::hint::black_box;
 use bml_realizer::bml;
 use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::schedule::diff::DiffSystem;
-use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy, SortedGreedy};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 
 fn chain(n: usize) -> DiffSystem {
@@ -63,6 +63,15 @@ fn optimal(c: &mut Criterion) {
             b.iter(|| {
                 black_box(
                     Optimal
+                        .schedule(black_box(&block), &models, &NoExternal)
+                        .unwrap(),
+                )
+            })
+        });
+        g.bench_function(format!("{name}/schedule-sorted-greedy"), |b| {
+            b.iter(|| {
+                black_box(
+                    SortedGreedy
                         .schedule(black_box(&block), &models, &NoExternal)
                         .unwrap(),
                 )

@@ -158,27 +158,28 @@ impl Default for SpeechTiming {
 /// Syllables of a word, estimated as groups of vowels (a silent final `e` does not count); at least
 /// one for any word with a letter or digit, none for punctuation.
 pub fn syllables(word: &str) -> usize {
-    if !word.chars().any(char::is_alphanumeric) {
-        return 0;
-    }
-    let letters: Vec<char> = word
-        .chars()
-        .filter(|c| c.is_alphabetic())
-        .map(|c| c.to_ascii_lowercase())
-        .collect();
-    let vowel = |c: char| matches!(c, 'a' | 'e' | 'i' | 'o' | 'u' | 'y');
-    let mut groups = 0;
-    let mut prev = false;
-    for &c in &letters {
+    let vowel = |c: char| matches!(c.to_ascii_lowercase(), 'a' | 'e' | 'i' | 'o' | 'u' | 'y');
+    let (mut groups, mut letters, mut any) = (0usize, 0usize, false);
+    let (mut prev_vowel, mut last, mut before_last) = (false, ' ', ' ');
+    for c in word.chars() {
+        any |= c.is_alphanumeric();
+        if !c.is_alphabetic() {
+            continue;
+        }
+        letters += 1;
         let v = vowel(c);
-        if v && !prev {
+        if v && !prev_vowel {
             groups += 1;
         }
-        prev = v;
+        prev_vowel = v;
+        before_last = last;
+        last = c.to_ascii_lowercase();
     }
-    let silent_e =
-        letters.len() > 2 && letters.ends_with(&['e']) && !vowel(letters[letters.len() - 2]);
-    if silent_e && groups > 1 {
+    if !any {
+        return 0;
+    }
+    // a silent final e ("make") does not count
+    if letters > 2 && last == 'e' && !vowel(before_last) && groups > 1 {
         groups -= 1;
     }
     groups.max(1)

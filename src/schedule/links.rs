@@ -31,7 +31,8 @@ pub(crate) struct Link {
     pub(crate) left: Term,
     pub(crate) right: Term,
     pub(crate) offset: f64,
-    pub(crate) text: String,
+    /// Index of the constraint (in `extract`'s list) this link comes from.
+    pub(crate) constraint: usize,
 }
 
 /// The behaviours of `block` that some engine models, in canonical order (by id); the others are
@@ -89,7 +90,7 @@ pub(crate) fn resolve(
         .map(|(i, it)| (it.beh.id.as_str(), i))
         .collect();
     let mut links = Vec::new();
-    for c in constraints {
+    for (ci, c) in constraints.iter().enumerate() {
         let mut owner = None;
         let mut term = |a: &Anchor| -> Result<Option<Term>, (KnownWarning, String)> {
             let (behaviour, sync) = match a {
@@ -131,7 +132,7 @@ pub(crate) fn resolve(
                 left,
                 right,
                 offset: c.offset,
-                text: c.to_string(),
+                constraint: ci,
             }),
             (Err((w, why)), _) | (_, Err((w, why))) => {
                 let reason = format!("constraint '{c}': {why}");

@@ -2,13 +2,16 @@
 //!
 //! - [`strategy`]: the `SchedulingStrategy` trait and the schedule it produces;
 //! - [`optimal`]: the default, order-invariant strategy;
+//! - [`greedy`]: Elckerlyc's sorted greedy algorithm, the baseline;
 //! - [`diff`]: the difference-constraint solver under it.
 
 pub mod diff;
+pub mod greedy;
 mod links;
 pub mod optimal;
 pub mod strategy;
 
+pub use greedy::SortedGreedy;
 pub use optimal::Optimal;
 pub use strategy::{
     BlockSchedule, Dropped, ExternalTimes, NoExternal, ScheduleError, ScheduledBehaviour,

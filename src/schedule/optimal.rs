@@ -31,7 +31,7 @@ use super::links::{is_required, items, resolve, Item, Link, Term};
 use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
 };
-use crate::bml::{extract, Block, Relation};
+use crate::bml::{extract, Block, Constraint, Relation};
 use crate::engine::timing::{Flexibility, TimingModels};
 use crate::feedback::KnownWarning;
 
@@ -72,7 +72,7 @@ impl SchedulingStrategy for Optimal {
                 items.remove(i);
                 continue;
             }
-            match feasible(&items, &links) {
+            match feasible(&items, &links, &constraints) {
                 Ok(()) => {
                     let times = preferred(&items, &links)
                         .or_else(|| uniform(&items, &links))
@@ -206,7 +206,7 @@ fn hard_system(items: &[Item], links: &[Link]) -> (DiffSystem, Vec<usize>) {
     (s, base)
 }
 
-fn feasible(items: &[Item], links: &[Link]) -> Result<(), Involved> {
+fn feasible(items: &[Item], links: &[Link], constraints: &[Constraint]) -> Result<(), Involved> {
     let (s, _) = hard_system(items, links);
     match s.solve() {
         Ok(_) => Ok(()),
@@ -219,8 +219,9 @@ fn feasible(items: &[Item], links: &[Link]) -> Result<(), Involved> {
             for &tag in &conflict.tags {
                 if tag < links.len() {
                     let l = &links[tag];
-                    if !involved.texts.contains(&l.text) {
-                        involved.texts.push(l.text.clone());
+                    let text = constraints[l.constraint].to_string();
+                    if !involved.texts.contains(&text) {
+                        involved.texts.push(text);
                         if let Term::Key(i, _) = l.left {
                             involved.owners.push(i);
                         }
