@@ -288,3 +288,22 @@ mod order_invariance {
         }
     }
 }
+
+#[test]
+fn persistent_controller_has_no_end_unless_a_constraint_names_it() {
+    let s = schedule(&block(
+        r#"<bmlt:controller xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="c" class="Balance" start="1"/>"#,
+    ));
+    assert!(close(at(&s, "c", "start"), 1.0));
+    assert_eq!(at(&s, "c", "end"), f64::INFINITY);
+    let s = schedule(&block(
+        r#"<bmlt:controller xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="c" class="Balance" start="1" end="4"/>"#,
+    ));
+    assert!(close(at(&s, "c", "end"), 4.0));
+    // naming the end from another behaviour gives the controller an end to synchronise to
+    let s = schedule(&block(
+        r#"<bmlt:controller xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="c" class="Balance" start="1"/><gesture id="g" lexeme="BEAT" start="c:end"/>"#,
+    ));
+    assert!(s.dropped.is_empty());
+    assert!(close(at(&s, "g", "start"), at(&s, "c", "end")) && at(&s, "c", "end").is_finite());
+}

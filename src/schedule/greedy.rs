@@ -50,7 +50,7 @@ impl SchedulingStrategy for SortedGreedy {
             });
         }
         let mut dropped = Vec::new();
-        let mut items = items(block, models, &mut dropped);
+        let mut items = items(block, models, &constraints, &mut dropped);
         let links = loop {
             let (links, unusable) = resolve(block, &items, &constraints, external);
             let Some((i, warning, reason)) = unusable else {

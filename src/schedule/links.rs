@@ -36,10 +36,12 @@ pub(crate) struct Link {
 }
 
 /// The behaviours of `block` that some engine models, in canonical order (by id); the others are
-/// reported as dropped.
+/// reported as dropped. A persistent behaviour's `end` is left out (infinite) unless a constraint
+/// names it.
 pub(crate) fn items<'b>(
     block: &'b Block,
     models: &dyn TimingModels,
+    constraints: &[Constraint],
     dropped: &mut Vec<Dropped>,
 ) -> Vec<Item<'b>> {
     let mut order: Vec<&Behaviour> = block.behaviours.iter().collect();
@@ -48,7 +50,13 @@ pub(crate) fn items<'b>(
     for beh in order {
         match models.model(beh) {
             Some(model) => {
-                let len = if model.persistent && !beh.syncs.iter().any(|s| s.sync == "end") {
+                // a persistent behaviour has no end unless a constraint names it
+                let end_named = constraints.iter().any(|c| {
+                    [&c.left, &c.right].iter().any(|a| {
+                        matches!(a, Anchor::Point(SyncPoint::Local { behaviour, sync }) if *behaviour == beh.id && sync == "end")
+                    })
+                });
+                let len = if model.persistent && !end_named {
                     model.keys.len() - 1
                 } else {
                     model.keys.len()
@@ -114,7 +122,10 @@ pub(crate) fn resolve(
             owner.get_or_insert(i);
             match items[i].model.key(sync) {
                 Some(k) if k < items[i].len => Ok(Some(Term::Key(i, k))),
-                Some(_) => Ok(None), // a persistent end
+                Some(_) => Err((
+                    KnownWarning::CannotSatisfyConstraints,
+                    format!("'{behaviour}:{sync}' is not scheduled (the behaviour persists)"),
+                )),
                 None => Err((
                     KnownWarning::CannotSatisfyConstraints,
                     format!(

@@ -56,8 +56,8 @@ impl SchedulingStrategy for Optimal {
         external: &dyn ExternalTimes,
     ) -> Result<BlockSchedule, ScheduleError> {
         let mut dropped = Vec::new();
-        let mut items = items(block, models, &mut dropped);
         let constraints = extract(block);
+        let mut items = items(block, models, &constraints, &mut dropped);
         loop {
             let (links, unusable) = resolve(block, &items, &constraints, external);
             if let Some((i, warning, reason)) = unusable {
