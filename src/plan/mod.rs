@@ -1,4 +1,4 @@
-//! The flexible multimodal plan. So far: the peg board ([`pegs`]); anticipators and plan validity
-//! come with the scheduler (issue #3).
+//! The flexible multimodal plan: the peg board ([`pegs`]). Schedules are put on it by
+//! `schedule::to_pegs`.
 
 pub mod pegs;

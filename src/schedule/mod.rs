@@ -3,13 +3,15 @@
 //! - [`strategy`]: the `SchedulingStrategy` trait and the schedule it produces;
 //! - [`optimal`]: the default, order-invariant strategy;
 //! - [`greedy`]: Elckerlyc's sorted greedy algorithm, the baseline;
-//! - [`diff`]: the difference-constraint solver under it.
+//! - [`diff`]: the difference-constraint solver under it;
+//! - [`to_pegs`]: a schedule put on the peg board, and validity after run-time changes.
 
 pub mod diff;
 pub mod greedy;
 mod links;
 pub mod optimal;
 pub mod strategy;
+pub mod to_pegs;
 
 pub use greedy::SortedGreedy;
 pub use optimal::Optimal;

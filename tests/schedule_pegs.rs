@@ -1,0 +1,154 @@
+//! Schedules on the peg board: shared pegs for `at`-linked syncs (S11), offset pegs (S12), unnamed
+//! syncs following their behaviour (S19, S20), anticipator moves without rescheduling and the
+//! validity check after them (S56–S58), and before/after as pushing order links.
+
+use bml_realizer::bml;
+use bml_realizer::engine::timing::DefaultTimingModels;
+use bml_realizer::plan::pegs::{PegBoard, SyncAddr};
+use bml_realizer::schedule::to_pegs::{
+    invalid, plan_block, Anticipators, BoardTimes, PlannedBlock,
+};
+use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy};
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() < 1e-9
+}
+
+fn addr(beh: &str, sync: &str) -> SyncAddr {
+    SyncAddr::new("bml1", beh, sync)
+}
+
+fn planned(
+    src: &str,
+    board: &mut PegBoard,
+    anticipators: &mut Anticipators,
+    start: f64,
+) -> PlannedBlock {
+    let block = bml::load(src).unwrap().block;
+    let schedule = {
+        let times = BoardTimes {
+            board,
+            anticipators,
+            block_start: start,
+        };
+        Optimal
+            .schedule(&block, &DefaultTimingModels::default(), &times)
+            .unwrap()
+    };
+    assert!(schedule.dropped.is_empty(), "{:?}", schedule.dropped);
+    let p = plan_block(board, anticipators, &block, &schedule, start);
+    // the plan reproduces the schedule
+    for b in &schedule.behaviours {
+        for (sync, t) in b.syncs.iter().filter(|(_, t)| t.is_finite()) {
+            let on_board = p.time(board, &b.id, sync).unwrap();
+            assert!(
+                close(on_board, start + t),
+                "{}:{sync} board {on_board} schedule {}",
+                b.id,
+                start + t
+            );
+        }
+    }
+    p
+}
+
+#[test]
+fn s11_s12_s19_thesis_example_30_on_pegs() {
+    let src = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/fixtures/thesis/ex30.xml"
+    ))
+    .unwrap();
+    let (mut board, mut ants) = (PegBoard::new(), Anticipators::default());
+    planned(&src, &mut board, &mut ants, 10.0);
+    let peg = |b: &str, s: &str| board.peg_of(&addr(b, s)).unwrap();
+    // S11: speech1:s1 = nod1:stroke share a peg; point1:start = walk1:end share another
+    assert_eq!(peg("speech1", "s1"), peg("nod1", "stroke"));
+    assert_eq!(peg("point1", "start"), peg("walk1", "end"));
+    // S12: point1:stroke = speech1:s1 + 0.5 is an offset peg
+    assert_ne!(peg("point1", "stroke"), peg("speech1", "s1"));
+    let s1 = board.time_of(&addr("speech1", "s1")).unwrap();
+    // S14, S19: moving the s1 peg moves everything linked to it and the unnamed syncs of its behaviours
+    let speech_start = board.time_of(&addr("speech1", "start")).unwrap();
+    let nod_end = board.time_of(&addr("nod1", "end")).unwrap();
+    board.move_to(peg("speech1", "s1"), s1 + 1.0).unwrap();
+    assert!(close(
+        board.time_of(&addr("nod1", "stroke")).unwrap(),
+        s1 + 1.0
+    ));
+    assert!(close(
+        board.time_of(&addr("point1", "stroke")).unwrap(),
+        s1 + 1.5
+    ));
+    assert!(close(
+        board.time_of(&addr("speech1", "start")).unwrap(),
+        speech_start + 1.0
+    ));
+    assert!(close(
+        board.time_of(&addr("nod1", "end")).unwrap(),
+        nod_end + 1.0
+    ));
+}
+
+#[test]
+fn s20_a_behaviour_no_constraint_names_gets_its_own_peg() {
+    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1"><head id="nod1" lexeme="NOD"/><gesture id="g1" lexeme="BEAT"/></bml>"#;
+    let (mut board, mut ants) = (PegBoard::new(), Anticipators::default());
+    planned(src, &mut board, &mut ants, 0.0);
+    let (n, g) = (
+        board.peg_of(&addr("nod1", "start")).unwrap(),
+        board.peg_of(&addr("g1", "start")).unwrap(),
+    );
+    assert_ne!(n, g);
+    board.move_to(n, 1.0).unwrap();
+    assert!(
+        close(board.time_of(&addr("nod1", "end")).unwrap(), 1.6),
+        "the nod moves as a whole"
+    );
+    assert!(
+        close(board.time_of(&addr("g1", "start")).unwrap(), 0.0),
+        "the gesture stays"
+    );
+}
+
+#[test]
+fn s56_s57_s58_anticipator_moves_retime_without_rescheduling_and_invalidate() {
+    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1">
+        <head id="nod1" lexeme="NOD" start="anticipators:beat:b1"/>
+        <gesture id="g1" lexeme="BEAT" start="nod1:end"/></bml>"#;
+    let (mut board, mut ants) = (PegBoard::new(), Anticipators::default());
+    let beat = ants.peg(&mut board, "beat", "b1", 2.0);
+    let plan = planned(src, &mut board, &mut ants, 0.0);
+    assert!(close(board.time_of(&addr("nod1", "start")).unwrap(), 2.0));
+    assert!(close(board.time_of(&addr("g1", "start")).unwrap(), 2.6));
+    // a small update: the nod's start follows the prediction, nothing else is rescheduled
+    board.move_to(beat, 2.2).unwrap();
+    assert!(close(board.time_of(&addr("nod1", "start")).unwrap(), 2.2));
+    assert!(close(board.time_of(&addr("g1", "start")).unwrap(), 2.6));
+    assert!(invalid(&board, &plan).is_empty());
+    // a large one puts the nod's start after its end: the behaviour is reported invalid
+    board.move_to(beat, 3.0).unwrap();
+    assert_eq!(invalid(&board, &plan), ["nod1"]);
+}
+
+#[test]
+fn after_constraints_become_order_links_that_push() {
+    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1">
+        <gesture id="g1" lexeme="BEAT" start="1"/><speech id="s1"><text>Hi there</text></speech>
+        <constraint><after ref="g1:end"><sync ref="s1:start"/></after></constraint></bml>"#;
+    let (mut board, mut ants) = (PegBoard::new(), Anticipators::default());
+    let plan = planned(src, &mut board, &mut ants, 0.0);
+    let g_end = board.peg_of(&addr("g1", "end")).unwrap();
+    let s_end = board.time_of(&addr("s1", "end")).unwrap();
+    board.move_to(g_end, 2.5).unwrap();
+    assert!(
+        close(board.time_of(&addr("s1", "start")).unwrap(), 2.5),
+        "pushed by the after link"
+    );
+    assert!(
+        close(board.time_of(&addr("s1", "end")).unwrap(), s_end + 0.5),
+        "the speech moves whole"
+    );
+    assert!(invalid(&board, &plan).is_empty());
+    let _ = NoExternal;
+}
