@@ -87,5 +87,36 @@ fn optimal(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, solve, optimal);
+fn anticipator_move(c: &mut Criterion) {
+    use bml_realizer::plan::pegs::PegBoard;
+    use bml_realizer::schedule::to_pegs::{invalid, plan_block, Anticipators, BoardTimes};
+    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1">
+        <head id="nod1" lexeme="NOD" start="anticipators:beat:b1"/>
+        <gesture id="g1" lexeme="BEAT" stroke="anticipators:beat:b1+0.5"/>
+        <speech id="s1" start="nod1:end"><text>Right on the beat.</text></speech></bml>"#;
+    let block = bml::load(src).unwrap().block;
+    let (mut board, mut ants) = (PegBoard::new(), Anticipators::default());
+    let beat = ants.peg(&mut board, "beat", "b1", 2.0);
+    let schedule = {
+        let times = BoardTimes {
+            board: &board,
+            anticipators: &ants,
+            block_start: 0.0,
+        };
+        Optimal
+            .schedule(&block, &DefaultTimingModels::default(), &times)
+            .unwrap()
+    };
+    let plan = plan_block(&mut board, &mut ants, &block, &schedule, 0.0);
+    let mut t = 2.0;
+    c.bench_function("schedule/anticipator-move+revalidate", |b| {
+        b.iter(|| {
+            t = if t > 2.05 { 2.0 } else { t + 0.001 };
+            board.move_to(beat, t).unwrap();
+            black_box(invalid(&board, &plan))
+        })
+    });
+}
+
+criterion_group!(benches, solve, optimal, anticipator_move);
 criterion_main!(benches);
