@@ -72,7 +72,7 @@ fn build(spec: &Spec) -> (String, Vec<Vec<(String, f64)>>) {
             model
                 .keys
                 .iter()
-                .map(|k| (k.name.clone(), start + scale * k.at))
+                .map(|k| (k.name.to_string(), start + scale * k.at))
                 .collect::<Vec<_>>(),
         );
         body.push_str(&xml);

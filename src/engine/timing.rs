@@ -4,6 +4,8 @@
 //! kind, so that the scheduler works before the animation engines exist, and a deterministic
 //! headless speech timing model (syllables at a configurable rate, inline syncs at word boundaries).
 
+use std::borrow::Cow;
+
 use crate::bml::{Behaviour, BehaviourKind, Speech, TextPart};
 
 /// Duration of behaviours that act once and end (interrupt, activate, parametervaluechange): the
@@ -31,7 +33,7 @@ pub enum Flexibility {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SyncKey {
     /// Sync point name (`start`, `stroke`, an inline speech sync, ...).
-    pub name: String,
+    pub name: Cow<'static, str>,
     /// Preferred offset from `start`, seconds.
     pub at: f64,
 }
@@ -48,12 +50,12 @@ pub struct TimingModel {
 }
 
 impl TimingModel {
-    fn new(keys: &[(&str, f64)], flexibility: Flexibility) -> Self {
+    fn new(keys: &[(&'static str, f64)], flexibility: Flexibility) -> Self {
         TimingModel {
             keys: keys
                 .iter()
                 .map(|(name, at)| SyncKey {
-                    name: name.to_string(),
+                    name: Cow::Borrowed(name),
                     at: *at,
                 })
                 .collect(),
@@ -63,7 +65,7 @@ impl TimingModel {
     }
 
     /// A stretchable model with the default bounds.
-    fn stretchable(keys: &[(&str, f64)]) -> Self {
+    fn stretchable(keys: &[(&'static str, f64)]) -> Self {
         Self::new(
             keys,
             Flexibility::Stretchable {
@@ -158,6 +160,9 @@ impl Default for SpeechTiming {
 /// Syllables of a word, estimated as groups of vowels (a silent final `e` does not count); at least
 /// one for any word with a letter or digit, none for punctuation.
 pub fn syllables(word: &str) -> usize {
+    if word.is_ascii() {
+        return syllables_ascii(word.as_bytes());
+    }
     let vowel = |c: char| matches!(c.to_ascii_lowercase(), 'a' | 'e' | 'i' | 'o' | 'u' | 'y');
     let (mut groups, mut letters, mut any) = (0usize, 0usize, false);
     let (mut prev_vowel, mut last, mut before_last) = (false, ' ', ' ');
@@ -185,6 +190,34 @@ pub fn syllables(word: &str) -> usize {
     groups.max(1)
 }
 
+/// [`syllables`] for ASCII words, on bytes.
+fn syllables_ascii(word: &[u8]) -> usize {
+    let vowel = |c: u8| matches!(c | 0x20, b'a' | b'e' | b'i' | b'o' | b'u' | b'y');
+    let (mut groups, mut letters, mut any) = (0usize, 0usize, false);
+    let (mut prev_vowel, mut last, mut before_last) = (false, b' ', b' ');
+    for &c in word {
+        any |= c.is_ascii_alphanumeric();
+        if !c.is_ascii_alphabetic() {
+            continue;
+        }
+        letters += 1;
+        let v = vowel(c);
+        if v && !prev_vowel {
+            groups += 1;
+        }
+        prev_vowel = v;
+        before_last = last;
+        last = c | 0x20;
+    }
+    if !any {
+        return 0;
+    }
+    if letters > 2 && last == b'e' && !vowel(before_last) && groups > 1 {
+        groups -= 1;
+    }
+    groups.max(1)
+}
+
 impl SpeechTiming {
     /// Time of one word including the pause its trailing punctuation asks for.
     fn word(&self, w: &str) -> f64 {
@@ -200,7 +233,7 @@ impl SpeechTiming {
     /// `end` after the last word. An empty text lasts one syllable.
     pub fn model(&self, speech: &Speech) -> TimingModel {
         let mut keys = vec![SyncKey {
-            name: "start".into(),
+            name: Cow::Borrowed("start"),
             at: 0.0,
         }];
         let mut t = 0.0;
@@ -210,13 +243,13 @@ impl SpeechTiming {
                     t += text.split_whitespace().map(|w| self.word(w)).sum::<f64>()
                 }
                 TextPart::Sync(id) => keys.push(SyncKey {
-                    name: id.clone(),
+                    name: Cow::Owned(id.clone()),
                     at: t,
                 }),
             }
         }
         keys.push(SyncKey {
-            name: "end".into(),
+            name: Cow::Borrowed("end"),
             at: if t > 0.0 { t } else { self.syllable_seconds },
         });
         TimingModel {
@@ -342,7 +375,7 @@ mod tests {
     fn keys(m: &TimingModel) -> Vec<(&str, f64)> {
         m.keys
             .iter()
-            .map(|k| (k.name.as_str(), (k.at * 1e9).round() / 1e9))
+            .map(|k| (k.name.as_ref(), (k.at * 1e9).round() / 1e9))
             .collect()
     }
 
@@ -440,7 +473,7 @@ mod tests {
                 .model(b)
                 .unwrap_or_else(|| panic!("no model for {}", b.id));
             m.check().unwrap_or_else(|e| panic!("{}: {e}", b.id));
-            let names: Vec<&str> = m.keys.iter().map(|k| k.name.as_str()).collect();
+            let names: Vec<&str> = m.keys.iter().map(|k| k.name.as_ref()).collect();
             assert_eq!(names, b.sync_points(), "{}", b.id);
         }
         let wait = models.model(&all[14]).unwrap();
@@ -459,7 +492,8 @@ mod tests {
 
     #[test]
     fn check_rejects_broken_models() {
-        let bad = |keys: &[(&str, f64)]| TimingModel::stretchable(keys).check().unwrap_err();
+        let bad =
+            |keys: &[(&'static str, f64)]| TimingModel::stretchable(keys).check().unwrap_err();
         assert!(bad(&[]).contains("at least"));
         assert!(bad(&[("ready", 0.0), ("end", 1.0)]).contains("first key"));
         assert!(bad(&[("start", 0.0), ("end", 0.0)]).contains("last key"));

@@ -120,7 +120,7 @@ impl SchedulingStrategy for SortedGreedy {
                             .enumerate()
                             .map(|(k, key)| {
                                 (
-                                    key.name.clone(),
+                                    key.name.to_string(),
                                     t.get(k).map_or(f64::INFINITY, |v| v - earliest),
                                 )
                             })

@@ -88,7 +88,10 @@ impl SchedulingStrategy for Optimal {
                                 .iter()
                                 .enumerate()
                                 .map(|(k, key)| {
-                                    (key.name.clone(), t.get(k).copied().unwrap_or(f64::INFINITY))
+                                    (
+                                        key.name.to_string(),
+                                        t.get(k).copied().unwrap_or(f64::INFINITY),
+                                    )
                                 })
                                 .collect(),
                         })
