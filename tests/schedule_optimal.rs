@@ -307,3 +307,30 @@ fn persistent_controller_has_no_end_unless_a_constraint_names_it() {
     assert!(s.dropped.is_empty());
     assert!(close(at(&s, "g", "start"), at(&s, "c", "end")) && at(&s, "c", "end").is_finite());
 }
+
+#[test]
+fn an_invalid_engine_timing_model_drops_the_behaviour_instead_of_panicking() {
+    use bml_realizer::engine::timing::{TimingModel, TimingModels};
+    struct Broken;
+    impl TimingModels for Broken {
+        fn model(&self, b: &bml::Behaviour) -> Option<TimingModel> {
+            let mut m = DefaultTimingModels::default().model(b)?;
+            if b.id == "g1" {
+                m.keys.clear();
+            }
+            Some(m)
+        }
+    }
+    let b = bml::load(&block(
+        r#"<gesture id="g1" lexeme="BEAT"/><head id="h1" lexeme="NOD"/>"#,
+    ))
+    .unwrap()
+    .block;
+    let s = Optimal.schedule(&b, &Broken, &NoExternal).unwrap();
+    assert_eq!(s.dropped.len(), 1);
+    assert_eq!(
+        (s.dropped[0].behaviour.as_str(), s.dropped[0].warning),
+        ("g1", KnownWarning::InvalidTiming)
+    );
+    assert!(s.time("h1", "end").is_some());
+}

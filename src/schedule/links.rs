@@ -49,6 +49,15 @@ pub(crate) fn items<'b>(
     let mut items = Vec::new();
     for beh in order {
         match models.model(beh) {
+            Some(model) if model.check().is_err() => dropped.push(Dropped {
+                behaviour: beh.id.clone(),
+                warning: KnownWarning::InvalidTiming,
+                reason: format!(
+                    "the engine's timing model for '{}' is invalid: {}",
+                    beh.id,
+                    model.check().err().unwrap_or_default()
+                ),
+            }),
             Some(model) => {
                 // a persistent behaviour has no end unless a constraint names it
                 let end_named = constraints.iter().any(|c| {
