@@ -16,3 +16,8 @@ pub mod feedback;
 pub mod plan;
 pub mod schedule;
 mod xmlname;
+
+/// The README's code runs as a doc test, so that it stays true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
