@@ -113,6 +113,7 @@ impl SchedulingStrategy for SortedGreedy {
                     doc(it.beh),
                     ScheduledBehaviour {
                         id: it.beh.id.clone(),
+                        rigid: it.model.flexibility == Flexibility::Rigid,
                         syncs: it
                             .model
                             .keys

@@ -82,6 +82,7 @@ impl SchedulingStrategy for Optimal {
                         .zip(times)
                         .map(|(it, t)| ScheduledBehaviour {
                             id: it.beh.id.clone(),
+                            rigid: it.model.flexibility == Flexibility::Rigid,
                             syncs: it
                                 .model
                                 .keys

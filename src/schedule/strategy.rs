@@ -44,6 +44,8 @@ pub struct ScheduledBehaviour {
     pub id: String,
     /// (sync id, time) in sync order.
     pub syncs: Vec<(String, f64)>,
+    /// Whether the behaviour's internal timing is fixed (TTS speech, audio): its syncs move together.
+    pub rigid: bool,
 }
 
 impl ScheduledBehaviour {

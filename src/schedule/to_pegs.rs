@@ -1,8 +1,8 @@
 //! From a schedule to pegs (thesis §7.3.3; S11, S12, S19–S21) and back to validity after run-time
 //! changes (S56–S58).
 //!
-//! - Sync points joined by `at` constraints share one time peg; a fixed nonzero offset becomes an
-//!   offset peg.
+//! - Sync points joined by `at` constraints share one time peg, and so do the named syncs of a rigid
+//!   behaviour; a fixed nonzero offset becomes an offset peg.
 //! - A sync `at`-linked to an anticipator hangs on the anticipator's peg on the global block peg.
 //! - A sync that no constraint names and that lies between two named syncs of its behaviour is not
 //!   a peg. It is placed proportionally between them, the way an engine stretches a motion between
@@ -202,6 +202,18 @@ pub fn plan_block(
                 orders.push((c.relation, a, b, c.offset))
             }
             _ => {}
+        }
+    }
+    // a rigid behaviour's named syncs keep their distances: one cluster
+    for b in schedule.behaviours.iter().filter(|b| b.rigid) {
+        let ids: Vec<usize> = b
+            .syncs
+            .iter()
+            .filter_map(|(s, _)| node.get(&(b.id.as_str(), s.as_str())).copied())
+            .filter(|&v| named[v])
+            .collect();
+        for w in ids.windows(2) {
+            joined.join(w[1], w[0], times[w[1]] - times[w[0]]);
         }
     }
     // one time peg per cluster of named syncs (S11), offset pegs for the others in it (S12)
