@@ -9,6 +9,7 @@
 pub mod diff;
 pub mod greedy;
 mod links;
+mod offsets;
 pub mod optimal;
 pub mod strategy;
 pub mod to_pegs;

@@ -28,6 +28,7 @@ use good_lp::{
 
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{is_required, items, resolve, Item, Link, Term};
+use super::offsets::Offsets;
 use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
 };
@@ -290,43 +291,6 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
             })
             .collect(),
     )
-}
-
-/// Weighted union-find: `value(node) = value(root) + offset(node)`.
-struct Offsets {
-    parent: Vec<usize>,
-    offset: Vec<f64>,
-}
-
-impl Offsets {
-    fn new(n: usize) -> Self {
-        Offsets {
-            parent: (0..n).collect(),
-            offset: vec![0.0; n],
-        }
-    }
-
-    fn find(&mut self, v: usize) -> (usize, f64) {
-        let p = self.parent[v];
-        if p == v {
-            return (v, 0.0);
-        }
-        let (root, off) = self.find(p);
-        self.parent[v] = root;
-        self.offset[v] += off;
-        (root, self.offset[v])
-    }
-
-    /// Records `value(a) = value(b) + d`.
-    fn join(&mut self, a: usize, b: usize, d: f64) {
-        let (ra, oa) = self.find(a);
-        let (rb, ob) = self.find(b);
-        if ra != rb {
-            // value(ra) = value(a) - oa = value(b) + d - oa = value(rb) + ob + d - oa
-            self.parent[ra] = rb;
-            self.offset[ra] = ob + d - oa;
-        }
-    }
 }
 
 /// Every behaviour constrained at two or more keys stretches uniformly between keys whose

@@ -16,6 +16,7 @@
 
 use std::collections::HashMap;
 
+use super::offsets::Offsets;
 use super::{BlockSchedule, ExternalTimes};
 use crate::bml::{extract, Anchor, Block, Relation, SyncPoint};
 use crate::plan::pegs::{BlockPegId, PegBoard, PegId, SyncAddr};
@@ -118,34 +119,6 @@ impl ExternalTimes for BoardTimes<'_> {
     }
 }
 
-/// Weighted union-find over sync points: `time(x) = time(root) + offset(x)`.
-struct Joined {
-    parent: Vec<usize>,
-    offset: Vec<f64>,
-}
-
-impl Joined {
-    fn find(&mut self, v: usize) -> (usize, f64) {
-        let p = self.parent[v];
-        if p == v {
-            return (v, 0.0);
-        }
-        let (root, off) = self.find(p);
-        self.parent[v] = root;
-        self.offset[v] += off;
-        (root, self.offset[v])
-    }
-
-    /// `time(a) = time(b) + d`.
-    fn join(&mut self, a: usize, b: usize, d: f64) {
-        let ((ra, oa), (rb, ob)) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.parent[ra] = rb;
-            self.offset[ra] = ob + d - oa;
-        }
-    }
-}
-
 fn local(a: &Anchor) -> Option<(&str, &str)> {
     match a {
         Anchor::Point(SyncPoint::Local { behaviour, sync }) => {
@@ -174,10 +147,7 @@ pub fn plan_block(
         }
     }
     let n = times.len();
-    let mut joined = Joined {
-        parent: (0..n).collect(),
-        offset: vec![0.0; n],
-    };
+    let mut joined = Offsets::new(n);
     let mut named = vec![false; n];
     let mut on_anticipator: Vec<Option<(String, String, f64)>> = vec![None; n];
     let mut orders = Vec::new();
