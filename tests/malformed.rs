@@ -208,6 +208,25 @@ fn xml_lang_survives_a_write_parse_round_trip() {
 }
 
 #[test]
+fn r55_a_sync_may_follow_only_one_anticipator_sync() {
+    let src = block(
+        "  <head id=\"h\" lexeme=\"NOD\" start=\"anticipators:a:x\"/>\n  <constraint><synchronize ref=\"anticipators:b:y\"><sync ref=\"h:start\"/></synchronize></constraint>",
+    );
+    let e = bml::load(&src).unwrap_err();
+    assert_eq!(e.first().code, Code::InvalidConstraint);
+    assert!(
+        e.first().message.contains("only one anticipator"),
+        "{}",
+        e.first().message
+    );
+    // the same anticipator sync twice, or two different syncs of the behaviour, are fine
+    let ok = block(
+        "  <head id=\"h\" lexeme=\"NOD\" start=\"anticipators:a:x\" end=\"anticipators:b:y\"/>",
+    );
+    assert!(bml::load(&ok).is_ok());
+}
+
+#[test]
 fn every_error_is_reported_not_just_the_first() {
     let src = block("  <gesture id=\"g1\"/>\n  <head id=\"h\" lexeme=\"NOD\" start=\"x:start+abc\" mode=\"?\"/>");
     let codes: Vec<Code> = errors(&src).into_iter().map(|e| e.0).collect();

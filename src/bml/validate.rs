@@ -3,7 +3,7 @@
 
 use super::constraints::{extract_elements, Anchor, Relation};
 use super::diagnostic::{Code, Diagnostic, Pos};
-use super::model::{BehaviourKind, Block, TextPart, FACE_LEXEMES, HEAD_LEXEMES};
+use super::model::{BehaviourKind, Block, ConstraintItem, TextPart, FACE_LEXEMES, HEAD_LEXEMES};
 use super::syncref::{SyncPoint, SyncRef};
 
 /// Checks a block's cross-references; returns errors and warnings in source order.
@@ -86,6 +86,66 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
                     ),
                 ));
             }
+        }
+    }
+    // R55 / S10: a sync point may be at-linked to at most one anticipator sync (checked only when
+    // the block names an anticipator, to keep validation allocation-free otherwise)
+    let anticipator = |r: &SyncRef| {
+        matches!(
+            r,
+            SyncRef::Point {
+                point: SyncPoint::Anticipator { .. },
+                ..
+            }
+        )
+    };
+    let names_anticipator = block
+        .behaviours
+        .iter()
+        .any(|b| b.syncs.iter().any(|s| anticipator(&s.value)))
+        || block
+            .constraints
+            .iter()
+            .flat_map(|c| &c.items)
+            .any(|item| match item {
+                ConstraintItem::Synchronize {
+                    reference, syncs, ..
+                } => {
+                    reference.as_ref().is_some_and(anticipator)
+                        || syncs.iter().any(|s| anticipator(&s.reference))
+                }
+                ConstraintItem::Before {
+                    reference, syncs, ..
+                }
+                | ConstraintItem::After {
+                    reference, syncs, ..
+                } => anticipator(reference) || syncs.iter().any(|s| anticipator(&s.reference)),
+            });
+    let all = if names_anticipator {
+        super::constraints::extract(block)
+    } else {
+        Vec::new()
+    };
+    for (i, c) in all.iter().enumerate() {
+        let (
+            Anchor::Point(l @ SyncPoint::Local { .. }),
+            Anchor::Point(a @ SyncPoint::Anticipator { .. }),
+            Relation::At,
+        ) = (&c.left, &c.right, c.relation)
+        else {
+            continue;
+        };
+        let earlier = all[..i].iter().find(|d| {
+            d.relation == Relation::At
+                && d.left == c.left
+                && matches!(&d.right, Anchor::Point(b @ SyncPoint::Anticipator { .. }) if b != a)
+        });
+        if let Some(d) = earlier {
+            diags.push(Diagnostic::error(
+                Code::InvalidConstraint,
+                c.pos,
+                format!("{l} is already synchronised to {} at {}; a sync point may follow only one anticipator sync", d.right, d.pos),
+            ));
         }
     }
     // <constraint> elements: checked on their normalised form.
