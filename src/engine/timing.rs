@@ -160,9 +160,6 @@ impl Default for SpeechTiming {
 /// Syllables of a word, estimated as groups of vowels (a silent final `e` does not count); at least
 /// one for any word with a letter or digit, none for punctuation.
 pub fn syllables(word: &str) -> usize {
-    if word.is_ascii() {
-        return syllables_ascii(word.as_bytes());
-    }
     let vowel = |c: char| matches!(c.to_ascii_lowercase(), 'a' | 'e' | 'i' | 'o' | 'u' | 'y');
     let (mut groups, mut letters, mut any) = (0usize, 0usize, false);
     let (mut prev_vowel, mut last, mut before_last) = (false, ' ', ' ');
@@ -185,34 +182,6 @@ pub fn syllables(word: &str) -> usize {
     }
     // a silent final e ("make") does not count
     if letters > 2 && last == 'e' && !vowel(before_last) && groups > 1 {
-        groups -= 1;
-    }
-    groups.max(1)
-}
-
-/// [`syllables`] for ASCII words, on bytes.
-fn syllables_ascii(word: &[u8]) -> usize {
-    let vowel = |c: u8| matches!(c | 0x20, b'a' | b'e' | b'i' | b'o' | b'u' | b'y');
-    let (mut groups, mut letters, mut any) = (0usize, 0usize, false);
-    let (mut prev_vowel, mut last, mut before_last) = (false, b' ', b' ');
-    for &c in word {
-        any |= c.is_ascii_alphanumeric();
-        if !c.is_ascii_alphabetic() {
-            continue;
-        }
-        letters += 1;
-        let v = vowel(c);
-        if v && !prev_vowel {
-            groups += 1;
-        }
-        prev_vowel = v;
-        before_last = last;
-        last = c | 0x20;
-    }
-    if !any {
-        return 0;
-    }
-    if letters > 2 && last == b'e' && !vowel(before_last) && groups > 1 {
         groups -= 1;
     }
     groups.max(1)

@@ -14,6 +14,8 @@
 
 use std::collections::VecDeque;
 
+use crate::bml::Relation;
+
 /// Improvements smaller than this (seconds) are not propagated: constraints hold within it, and
 /// cycles whose total weight is below it (float rounding of offsets) are not conflicts.
 pub const EPSILON: f64 = 1e-9;
@@ -101,6 +103,15 @@ impl DiffSystem {
     pub fn equal(&mut self, a: usize, b: usize, offset: f64, tag: usize) {
         self.at_least(a, b, offset, tag);
         self.at_most(a, b, offset, tag);
+    }
+
+    /// `x[a] REL x[b] + offset` for a BML relation (`=`, `<=`, `>=`).
+    pub fn relate(&mut self, a: usize, relation: Relation, b: usize, offset: f64, tag: usize) {
+        match relation {
+            Relation::At => self.equal(a, b, offset, tag),
+            Relation::Before => self.at_most(a, b, offset, tag),
+            Relation::After => self.at_least(a, b, offset, tag),
+        }
     }
 
     /// The least solution with every variable at or above its lower bound, or a conflicting cycle.

@@ -18,7 +18,7 @@
 //! reference the `Optimal` strategy is measured and tested against.
 
 use super::diff::EPSILON;
-use super::links::{is_required, items, resolve, Item, Link, Term};
+use super::links::{is_required, items, resolve, scheduled, Item, Link, Term};
 use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
 };
@@ -109,25 +109,7 @@ impl SchedulingStrategy for SortedGreedy {
             .zip(times)
             .filter_map(|(it, t)| {
                 let t = t?;
-                Some((
-                    doc(it.beh),
-                    ScheduledBehaviour {
-                        id: it.beh.id.clone(),
-                        rigid: it.model.flexibility == Flexibility::Rigid,
-                        syncs: it
-                            .model
-                            .keys
-                            .iter()
-                            .enumerate()
-                            .map(|(k, key)| {
-                                (
-                                    key.name.to_string(),
-                                    t.get(k).map_or(f64::INFINITY, |v| v - earliest),
-                                )
-                            })
-                            .collect(),
-                    },
-                ))
+                Some((doc(it.beh), scheduled(it, &t, earliest)))
             })
             .collect();
         behaviours.sort_by_key(|(d, _)| *d);

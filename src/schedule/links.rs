@@ -3,9 +3,9 @@
 
 use std::collections::HashMap;
 
-use super::strategy::{Dropped, ExternalTimes};
+use super::strategy::{Dropped, ExternalTimes, ScheduledBehaviour};
 use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
-use crate::engine::timing::{TimingModel, TimingModels};
+use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
 use crate::feedback::KnownWarning;
 
 /// A behaviour being scheduled.
@@ -164,4 +164,25 @@ pub(crate) fn resolve(
         }
     }
     (links, None)
+}
+
+/// The result for one item: its keys' times (block-local, minus `shift`); keys without a time (a
+/// persistent end) are infinite.
+pub(crate) fn scheduled(item: &Item, times: &[f64], shift: f64) -> ScheduledBehaviour {
+    ScheduledBehaviour {
+        id: item.beh.id.clone(),
+        rigid: item.model.flexibility == Flexibility::Rigid,
+        syncs: item
+            .model
+            .keys
+            .iter()
+            .enumerate()
+            .map(|(k, key)| {
+                (
+                    key.name.to_string(),
+                    times.get(k).map_or(f64::INFINITY, |v| v - shift),
+                )
+            })
+            .collect(),
+    }
 }

@@ -27,7 +27,7 @@ use good_lp::{
 };
 
 use super::diff::{DiffSystem, EPSILON};
-use super::links::{is_required, items, resolve, Item, Link, Term};
+use super::links::{is_required, items, resolve, scheduled, Item, Link, Term};
 use super::offsets::Offsets;
 use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
@@ -81,22 +81,7 @@ impl SchedulingStrategy for Optimal {
                     let mut behaviours: Vec<ScheduledBehaviour> = items
                         .iter()
                         .zip(times)
-                        .map(|(it, t)| ScheduledBehaviour {
-                            id: it.beh.id.clone(),
-                            rigid: it.model.flexibility == Flexibility::Rigid,
-                            syncs: it
-                                .model
-                                .keys
-                                .iter()
-                                .enumerate()
-                                .map(|(k, key)| {
-                                    (
-                                        key.name.to_string(),
-                                        t.get(k).copied().unwrap_or(f64::INFINITY),
-                                    )
-                                })
-                                .collect(),
-                        })
+                        .map(|(it, t)| scheduled(it, &t, 0.0))
                         .collect();
                     // document order
                     let pos: HashMap<&str, usize> = block
@@ -202,11 +187,7 @@ fn hard_system(items: &[Item], links: &[Link]) -> (DiffSystem, Vec<usize>) {
     for (tag, l) in links.iter().enumerate() {
         let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
         let offset = l.offset + bo - ao; // a REL b + offset
-        match l.relation {
-            Relation::At => s.equal(a, b, offset, tag),
-            Relation::Before => s.at_most(a, b, offset, tag),
-            Relation::After => s.at_least(a, b, offset, tag),
-        }
+        s.relate(a, l.relation, b, offset, tag);
     }
     (s, base)
 }
@@ -269,11 +250,7 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
     for (tag, l) in links.iter().enumerate() {
         let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
         let offset = l.offset + bo - ao;
-        match l.relation {
-            Relation::At => s.equal(a, b, offset, tag),
-            Relation::Before => s.at_most(a, b, offset, tag),
-            Relation::After => s.at_least(a, b, offset, tag),
-        }
+        s.relate(a, l.relation, b, offset, tag);
     }
     let x = s.solve().ok()?;
     if x[block] > EPSILON {
@@ -380,11 +357,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
     for (tag, l) in links.iter().enumerate() {
         let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
         let offset = l.offset + ob - oa;
-        match l.relation {
-            Relation::At => s.equal(a, b, offset, tag),
-            Relation::Before => s.at_most(a, b, offset, tag),
-            Relation::After => s.at_least(a, b, offset, tag),
-        }
+        s.relate(a, l.relation, b, offset, tag);
     }
     for i in 0..items.len() {
         let tag = links.len() + i;
