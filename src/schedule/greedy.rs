@@ -18,7 +18,7 @@
 //! reference the `Optimal` strategy is measured and tested against.
 
 use super::diff::EPSILON;
-use super::links::{is_required, items, resolve, scheduled, Item, Link, Term};
+use super::links::{is_required, items, resolve_all, scheduled, Item, Link, Term};
 use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
 };
@@ -51,21 +51,7 @@ impl SchedulingStrategy for SortedGreedy {
         }
         let mut dropped = Vec::new();
         let mut items = items(block, models, &constraints, &mut dropped);
-        let links = loop {
-            let (links, unusable) = resolve(block, &items, &constraints, external);
-            let Some((i, warning, reason)) = unusable else {
-                break links;
-            };
-            if is_required(&items[i], &constraints) {
-                return Err(ScheduleError { reason });
-            }
-            dropped.push(Dropped {
-                behaviour: items[i].beh.id.clone(),
-                warning,
-                reason,
-            });
-            items.remove(i);
-        };
+        let links = resolve_all(block, &mut items, &constraints, external, &mut dropped)?;
         let doc = |beh: &Behaviour| {
             block
                 .behaviours

@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use super::strategy::{Dropped, ExternalTimes, ScheduledBehaviour};
+use super::strategy::{Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour};
 use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
 use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
 use crate::feedback::KnownWarning;
@@ -184,5 +184,31 @@ pub(crate) fn scheduled(item: &Item, times: &[f64], shift: f64) -> ScheduledBeha
                 )
             })
             .collect(),
+    }
+}
+
+/// Resolves the constraints, dropping each behaviour that names a sync it lacks or an unknown
+/// external time (the block fails if that behaviour is required).
+pub(crate) fn resolve_all(
+    block: &Block,
+    items: &mut Vec<Item>,
+    constraints: &[Constraint],
+    external: &dyn ExternalTimes,
+    dropped: &mut Vec<Dropped>,
+) -> Result<Vec<Link>, ScheduleError> {
+    loop {
+        let (links, unusable) = resolve(block, items, constraints, external);
+        let Some((i, warning, reason)) = unusable else {
+            return Ok(links);
+        };
+        if is_required(&items[i], constraints) {
+            return Err(ScheduleError { reason });
+        }
+        dropped.push(Dropped {
+            behaviour: items[i].beh.id.clone(),
+            warning,
+            reason,
+        });
+        items.remove(i);
     }
 }

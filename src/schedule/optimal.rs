@@ -27,7 +27,7 @@ use good_lp::{
 };
 
 use super::diff::{DiffSystem, EPSILON};
-use super::links::{is_required, items, resolve, scheduled, Item, Link, Term};
+use super::links::{is_required, items, resolve_all, scheduled, Item, Link, Term};
 use super::offsets::Offsets;
 use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
@@ -60,19 +60,7 @@ impl SchedulingStrategy for Optimal {
         let constraints = extract(block);
         let mut items = items(block, models, &constraints, &mut dropped);
         loop {
-            let (links, unusable) = resolve(block, &items, &constraints, external);
-            if let Some((i, warning, reason)) = unusable {
-                if is_required(&items[i], &constraints) {
-                    return Err(ScheduleError { reason });
-                }
-                dropped.push(Dropped {
-                    behaviour: items[i].beh.id.clone(),
-                    warning,
-                    reason,
-                });
-                items.remove(i);
-                continue;
-            }
+            let links = resolve_all(block, &mut items, &constraints, external, &mut dropped)?;
             match feasible(&items, &links, &constraints) {
                 Ok(()) => {
                     let times = preferred(&items, &links)
@@ -521,6 +509,7 @@ mod tests {
     use super::*;
     use crate::bml;
     use crate::engine::timing::{DefaultTimingModels, TimingModel};
+    use crate::schedule::links::resolve;
     use crate::schedule::strategy::NoExternal;
 
     fn prepared(src: &str) -> (Vec<TimingModel>, Block) {
