@@ -8,7 +8,7 @@ use bml_realizer::plan::pegs::{PegBoard, SyncAddr};
 use bml_realizer::schedule::to_pegs::{
     invalid, plan_block, Anticipators, BoardTimes, PlannedBlock,
 };
-use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::schedule::{Optimal, SchedulingStrategy};
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9
@@ -150,7 +150,6 @@ fn after_constraints_become_order_links_that_push() {
         "the speech moves whole"
     );
     assert!(invalid(&board, &plan).is_empty());
-    let _ = NoExternal;
 }
 
 #[test]

@@ -40,16 +40,19 @@ pub struct DiffSystem {
     edges: Vec<Edge>,
 }
 
-/// The constraints that cannot hold together: the tags of a positive cycle, in cycle order.
+/// The constraints that cannot hold together: a positive cycle of edges.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Conflict {
-    /// Tags of the cycle's edges.
-    pub tags: Vec<usize>,
-    /// The cycle's edges (`to` of each is `from` of the next).
+    /// The cycle's edges in cycle order (`to` of each is `from` of the next).
     pub edges: Vec<Edge>,
 }
 
 impl Conflict {
+    /// The caller's tags of the cycle's edges, in cycle order.
+    pub fn tags(&self) -> impl Iterator<Item = usize> + '_ {
+        self.edges.iter().map(|e| e.tag)
+    }
+
     /// Total weight of the cycle: positive (beyond [`EPSILON`]) for a real conflict.
     pub fn weight(&self) -> f64 {
         self.edges.iter().map(|e| e.weight).sum()
@@ -182,10 +185,7 @@ impl DiffSystem {
             }
         }
         let Some(mut u) = last else {
-            return Conflict {
-                tags: Vec::new(),
-                edges: Vec::new(),
-            };
+            return Conflict { edges: Vec::new() };
         };
         for _ in 0..n {
             if let Some(ei) = pred[u] {
@@ -202,10 +202,7 @@ impl DiffSystem {
             }
         }
         edges.reverse();
-        Conflict {
-            tags: edges.iter().map(|e| e.tag).collect(),
-            edges,
-        }
+        Conflict { edges }
     }
 }
 
@@ -243,7 +240,7 @@ mod tests {
         s.equal(b, c, 1.0, 11);
         s.at_least(c, a, 0.0, 12);
         let conflict = s.solve().unwrap_err();
-        let mut tags = conflict.tags.clone();
+        let mut tags: Vec<usize> = conflict.tags().collect();
         tags.sort();
         assert_eq!(tags, vec![10, 11, 12]);
         assert!((conflict.weight() - 2.0).abs() < 1e-12);

@@ -190,7 +190,7 @@ fn feasible(items: &[Item], links: &[Link], constraints: &[Constraint]) -> Resul
                 texts: Vec::new(),
                 owners: Vec::new(),
             };
-            for &tag in &conflict.tags {
+            for tag in conflict.tags() {
                 if tag < links.len() {
                     let l = &links[tag];
                     let text = constraints[l.constraint].to_string();
