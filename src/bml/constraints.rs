@@ -106,17 +106,15 @@ pub struct Constraint {
 }
 
 impl Constraint {
-    /// Builds `a REL b` from two sync references, normalised so that the more local side is left.
+    /// Builds `a REL b` from two anchored times, normalised so that the more local side is left.
     fn between(
-        a: &SyncRef,
+        (la, lo): (Anchor, f64),
         relation: Relation,
-        b: &SyncRef,
+        (ra, ro): (Anchor, f64),
         required: bool,
         source: Source,
         pos: Pos,
     ) -> Constraint {
-        let (la, lo) = anchor(a);
-        let (ra, ro) = anchor(b);
         // la + lo REL ra + ro  <=>  la REL ra + (ro - lo)
         let c = Constraint {
             relation,
@@ -175,14 +173,11 @@ pub fn extract(block: &Block) -> Vec<Constraint> {
     let mut out = Vec::with_capacity(attributes + block.constraints.len());
     for (index, b) in block.behaviours.iter().enumerate() {
         for s in &b.syncs {
-            let own = SyncRef::Point {
-                point: SyncPoint::local(&b.id, s.sync),
-                offset: 0.0,
-            };
+            let own = Anchor::Point(SyncPoint::local(&b.id, s.sync));
             out.push(Constraint::between(
-                &own,
+                (own, 0.0),
                 Relation::At,
-                &s.value,
+                anchor(&s.value),
                 b.required,
                 Source::Attribute {
                     behaviour: index,
@@ -231,9 +226,9 @@ fn extract_elements_into(block: &Block, out: &mut Vec<Constraint>) {
             };
             for s in rest {
                 out.push(Constraint::between(
-                    &s.reference,
+                    anchor(&s.reference),
                     relation,
-                    reference,
+                    anchor(reference),
                     c.required,
                     source(),
                     s.pos,

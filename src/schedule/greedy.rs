@@ -91,7 +91,7 @@ impl SchedulingStrategy for SortedGreedy {
             .copied()
             .fold(0.0_f64, f64::min);
         let mut behaviours: Vec<(usize, ScheduledBehaviour)> = items
-            .iter()
+            .into_iter()
             .zip(times)
             .filter_map(|(it, t)| {
                 let t = t?;

@@ -168,21 +168,16 @@ pub(crate) fn resolve(
 
 /// The result for one item: its keys' times (block-local, minus `shift`); keys without a time (a
 /// persistent end) are infinite.
-pub(crate) fn scheduled(item: &Item, times: &[f64], shift: f64) -> ScheduledBehaviour {
+pub(crate) fn scheduled(item: Item, times: &[f64], shift: f64) -> ScheduledBehaviour {
     ScheduledBehaviour {
         id: item.beh.id.clone(),
         rigid: item.model.flexibility == Flexibility::Rigid,
         syncs: item
             .model
             .keys
-            .iter()
+            .into_iter()
             .enumerate()
-            .map(|(k, key)| {
-                (
-                    key.name.to_string(),
-                    times.get(k).map_or(f64::INFINITY, |v| v - shift),
-                )
-            })
+            .map(|(k, key)| (key.name, times.get(k).map_or(f64::INFINITY, |v| v - shift)))
             .collect(),
     }
 }

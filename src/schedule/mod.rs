@@ -18,5 +18,5 @@ pub use greedy::SortedGreedy;
 pub use optimal::Optimal;
 pub use strategy::{
     BlockSchedule, Dropped, ExternalTimes, NoExternal, ScheduleError, ScheduledBehaviour,
-    SchedulingStrategy,
+    SchedulingStrategy, SyncName,
 };

@@ -61,58 +61,71 @@ impl SchedulingStrategy for Optimal {
         let mut items = items(block, models, &constraints, &mut dropped);
         loop {
             let links = resolve_all(block, &mut items, &constraints, external, &mut dropped)?;
-            match feasible(&items, &links, &constraints) {
-                Ok(()) => {
-                    let times = preferred(&items, &links)
-                        .or_else(|| uniform(&items, &links))
-                        .unwrap_or_else(|| optimise(&items, &links));
-                    let mut behaviours: Vec<ScheduledBehaviour> = items
-                        .iter()
-                        .zip(times)
-                        .map(|(it, t)| scheduled(it, &t, 0.0))
-                        .collect();
-                    // document order
-                    let pos: HashMap<&str, usize> = block
-                        .behaviours
-                        .iter()
-                        .enumerate()
-                        .map(|(i, b)| (b.id.as_str(), i))
-                        .collect();
-                    behaviours
-                        .sort_by_key(|b| pos.get(b.id.as_str()).copied().unwrap_or(usize::MAX));
-                    return Ok(BlockSchedule {
-                        behaviours,
-                        dropped,
-                    });
-                }
-                Err(involved) => {
-                    let text = involved.texts.join("; ");
-                    // drop the behaviour that brought the most conflicting constraints (a
-                    // behaviour's own sync is the left side of its attributes); ties by id
-                    let candidate = involved
-                        .items
-                        .iter()
-                        .copied()
-                        .filter(|&i| !is_required(&items[i], &constraints))
-                        .max_by_key(|&i| (involved.owned(i), &items[i].beh.id));
-                    let Some(i) = candidate else {
-                        return Err(ScheduleError {
-                            reason: format!("required behaviours cannot satisfy: {text}"),
-                        });
-                    };
-                    dropped.push(Dropped {
-                        behaviour: items[i].beh.id.clone(),
-                        warning: KnownWarning::CannotSatisfyConstraints,
-                        reason: format!(
-                            "'{}' dropped: these constraints contradict each other: {text}",
-                            items[i].beh.id
-                        ),
-                    });
-                    items.remove(i);
-                }
-            }
+            // a fast-path answer satisfies every hard constraint, so feasibility is only checked
+            // (and conflicts only resolved) when neither fast path applies
+            let fast = preferred(&items, &links).or_else(|| uniform(&items, &links));
+            let times = match fast {
+                Some(times) => times,
+                None => match feasible(&items, &links, &constraints) {
+                    Ok(()) => optimise(&items, &links),
+                    Err(involved) => {
+                        drop_one(&mut items, &involved, &constraints, &mut dropped)?;
+                        continue;
+                    }
+                },
+            };
+            let mut behaviours: Vec<ScheduledBehaviour> = items
+                .into_iter()
+                .zip(times)
+                .map(|(it, t)| scheduled(it, &t, 0.0))
+                .collect();
+            // document order
+            let pos: HashMap<&str, usize> = block
+                .behaviours
+                .iter()
+                .enumerate()
+                .map(|(i, b)| (b.id.as_str(), i))
+                .collect();
+            behaviours.sort_by_key(|b| pos.get(b.id.as_str()).copied().unwrap_or(usize::MAX));
+            return Ok(BlockSchedule {
+                behaviours,
+                dropped,
+            });
         }
     }
+}
+
+/// Drops the non-required behaviour that brought the most conflicting constraints (a behaviour's
+/// own sync is the left side of its attributes; ties by id), or fails the block if only required
+/// behaviours are involved.
+fn drop_one(
+    items: &mut Vec<Item>,
+    involved: &Involved,
+    constraints: &[Constraint],
+    dropped: &mut Vec<Dropped>,
+) -> Result<(), ScheduleError> {
+    let text = involved.texts.join("; ");
+    let candidate = involved
+        .items
+        .iter()
+        .copied()
+        .filter(|&i| !is_required(&items[i], constraints))
+        .max_by_key(|&i| (involved.owned(i), &items[i].beh.id));
+    let Some(i) = candidate else {
+        return Err(ScheduleError {
+            reason: format!("required behaviours cannot satisfy: {text}"),
+        });
+    };
+    dropped.push(Dropped {
+        behaviour: items[i].beh.id.clone(),
+        warning: KnownWarning::CannotSatisfyConstraints,
+        reason: format!(
+            "'{}' dropped: these constraints contradict each other: {text}",
+            items[i].beh.id
+        ),
+    });
+    items.remove(i);
+    Ok(())
 }
 
 /// The behaviours and constraint texts of a conflict.
@@ -316,6 +329,15 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
             if offsets.find(v).0 != r0 {
                 return None;
             }
+        }
+        // anchors fixed out of order cannot be a uniform stretch (nor any valid timing)
+        let mut prev = o0;
+        for &v in &node_of[i][1..] {
+            let o = offsets.find(v).1;
+            if o < prev - EPSILON {
+                return None;
+            }
+            prev = o;
         }
         let (_, o1) = offsets.find(node_of[i][node_of[i].len() - 1]);
         let span = keys[last].at - keys[first].at;

@@ -2,6 +2,8 @@
 //! produces, the reasons it drops behaviours or fails a block, and the source of times for references
 //! that leave the block.
 
+use std::borrow::Cow;
+
 use crate::bml::{Block, SyncPoint};
 use crate::engine::timing::TimingModels;
 use crate::feedback::KnownWarning;
@@ -37,13 +39,17 @@ impl ExternalTimes for NoExternal {
     }
 }
 
+/// A sync point's name: static for the standard names, owned for a speech's inline syncs.
+pub type SyncName = Cow<'static, str>;
+
 /// One behaviour's scheduled sync times (block-local seconds; a persistent end is infinite).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ScheduledBehaviour {
     /// Behaviour id.
     pub id: String,
-    /// (sync id, time) in sync order.
-    pub syncs: Vec<(String, f64)>,
+    /// (sync id, time) in sync order. Standard sync names are static; a speech's inline syncs
+    /// are owned.
+    pub syncs: Vec<(SyncName, f64)>,
     /// Whether the behaviour's internal timing is fixed (TTS speech, audio): its syncs move together.
     pub rigid: bool,
 }

@@ -17,7 +17,7 @@
 use std::collections::HashMap;
 
 use super::offsets::Offsets;
-use super::{BlockSchedule, ExternalTimes};
+use super::{BlockSchedule, ExternalTimes, SyncName};
 use crate::bml::{extract, Anchor, Block, Relation, SyncPoint};
 use crate::plan::pegs::{BlockPegId, PegBoard, PegId, SyncAddr};
 
@@ -43,7 +43,7 @@ pub struct PlannedBlock {
     /// The block's peg.
     pub block: BlockPegId,
     /// Behaviours in schedule order: (id, [(sync, placement)]).
-    pub behaviours: Vec<(String, Vec<(String, Placement)>)>,
+    pub behaviours: Vec<(String, Vec<(SyncName, Placement)>)>,
 }
 
 impl PlannedBlock {
@@ -142,7 +142,7 @@ pub fn plan_block(
     let mut times = Vec::new();
     for b in &schedule.behaviours {
         for (sync, t) in b.syncs.iter().filter(|(_, t)| t.is_finite()) {
-            node.insert((b.id.as_str(), sync.as_str()), times.len());
+            node.insert((b.id.as_str(), sync.as_ref()), times.len());
             times.push(*t);
         }
     }
@@ -179,7 +179,7 @@ pub fn plan_block(
         let ids: Vec<usize> = b
             .syncs
             .iter()
-            .filter_map(|(s, _)| node.get(&(b.id.as_str(), s.as_str())).copied())
+            .filter_map(|(s, _)| node.get(&(b.id.as_str(), s.as_ref())).copied())
             .filter(|&v| named[v])
             .collect();
         for w in ids.windows(2) {
@@ -216,11 +216,11 @@ pub fn plan_block(
     // unnamed syncs: between named ones proportionally, outside them as offset pegs (S19, S20)
     let mut behaviours = Vec::new();
     for b in &schedule.behaviours {
-        let ids: Vec<(String, usize)> = b
+        let ids: Vec<(SyncName, usize)> = b
             .syncs
             .iter()
             .filter_map(|(s, _)| {
-                node.get(&(b.id.as_str(), s.as_str()))
+                node.get(&(b.id.as_str(), s.as_ref()))
                     .map(|&v| (s.clone(), v))
             })
             .collect();
