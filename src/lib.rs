@@ -4,16 +4,23 @@
 //! Layers (see `docs/architecture.md`):
 //! - [`bml`]: the language — typed model, parser, validation, constraint extraction, writer;
 //! - [`feedback`]: BML 1.0 feedback messages and their XML and JSON-lines codecs;
-//! - [`engine`]: what engines tell the scheduler (so far timing models and their defaults);
-//! - [`plan`]: the flexible plan (so far the peg board);
-//! - [`schedule`]: the scheduler (so far its difference-constraint solver).
+//! - [`realizer`]: the facade a host embeds (submit BML, `tick`, frames and feedback);
+//! - [`blocks`]: blocks at run time — lifecycle, composition, the event loop;
+//! - [`schedule`]: the scheduler — constraints to sync times, order-invariant;
+//! - [`plan`]: the flexible plan of pegs;
+//! - [`engine`]: the engine interface, registry and timing models; [`engines`]: built-in engines;
+//! - [`clock`]: virtual and wall clocks.
 
 #![warn(missing_docs)]
 
+pub mod blocks;
 pub mod bml;
+pub mod clock;
 pub mod engine;
+pub mod engines;
 pub mod feedback;
 pub mod plan;
+pub mod realizer;
 pub mod schedule;
 mod xmlname;
 

@@ -16,6 +16,7 @@ mod diagnostic;
 mod kinds;
 mod model;
 mod parser;
+mod stream;
 mod syncref;
 mod validate;
 mod writer;
@@ -28,6 +29,7 @@ pub use kinds::{
 };
 pub use model::*;
 pub use parser::{parse, parse_with_diagnostics, Parsed};
+pub use stream::{BlockStream, StreamItem};
 pub use syncref::{SyncPoint, SyncRef, SyncRefError, ANTICIPATORS};
 pub use validate::validate;
 pub use writer::write;

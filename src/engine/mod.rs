@@ -1,4 +1,290 @@
-//! The engine side the scheduler sees. So far: timing models ([`timing`]) — the `Engine` and
-//! `PlanUnit` traits and the registry come with the runtime (issue #4).
+//! The engine layer: what an engine is to the realizer (the `Engine` trait, S75), the registry that
+//! maps behaviour kinds to engines (S76), and what engines produce (actions for the runtime, frame
+//! output). Timing models, the scheduler's view of an engine, are in [`timing`].
 
+mod registry;
 pub mod timing;
+
+use std::fmt;
+
+pub use registry::{KindKey, Registry};
+
+use crate::bml::{Behaviour, TrajectoryType};
+use crate::feedback::Feedback;
+use crate::schedule::SyncName;
+use timing::TimingModel;
+
+/// One behaviour of one block: how the runtime and the engines name a plan unit.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct UnitKey {
+    /// Block id.
+    pub block: String,
+    /// Behaviour id.
+    pub behaviour: String,
+}
+
+impl UnitKey {
+    /// The key of `block:behaviour`.
+    pub fn new(block: &str, behaviour: &str) -> Self {
+        UnitKey {
+            block: block.to_string(),
+            behaviour: behaviour.to_string(),
+        }
+    }
+}
+
+impl fmt::Display for UnitKey {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}", self.block, self.behaviour)
+    }
+}
+
+/// A scheduled behaviour handed to its engine: the behaviour and its sync points' global times
+/// (in sync order; a persistent end is infinite).
+#[derive(Debug, Clone, Copy)]
+pub struct Unit<'a> {
+    /// Which unit.
+    pub key: &'a UnitKey,
+    /// The behaviour as written.
+    pub behaviour: &'a Behaviour,
+    /// (sync name, global time) in sync order.
+    pub syncs: &'a [(SyncName, f64)],
+}
+
+/// A change of a parameter of a running behaviour over time (BMLA `parametervaluechange`, S63–S65).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParameterChange {
+    /// The behaviour whose parameter changes.
+    pub target: UnitKey,
+    /// Parameter name, e.g. `volume`.
+    pub param: String,
+    /// Start value; `None` reads the target's value when the change starts (S64).
+    pub initial: Option<f64>,
+    /// Value reached at `end` and held afterwards (S65).
+    pub target_value: f64,
+    /// Linear or instant.
+    pub kind: TrajectoryType,
+    /// Global time the change starts.
+    pub start: f64,
+    /// Global time the target value is reached.
+    pub end: f64,
+    /// The behaviour that asked for the change (for warnings).
+    pub by: UnitKey,
+}
+
+impl ParameterChange {
+    /// The value at global time `t` starting from `from` (S63): linear or instant, held after `end`.
+    pub fn value_at(&self, from: f64, t: f64) -> f64 {
+        match self.kind {
+            TrajectoryType::Instant => self.target_value,
+            TrajectoryType::Linear => {
+                let span = self.end - self.start;
+                let alpha = if span > 0.0 {
+                    ((t - self.start) / span).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                from + alpha * (self.target_value - from)
+            }
+        }
+    }
+}
+
+/// What an engine asks the runtime to do (control behaviours act on blocks and other engines).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Interrupt behaviours of block `target`: those in `include` (all if empty) except `exclude`.
+    Interrupt {
+        /// The behaviour asking (for warnings).
+        by: UnitKey,
+        /// Block to interrupt.
+        target: String,
+        /// Behaviours to interrupt (empty: all).
+        include: Vec<String>,
+        /// Behaviours to spare.
+        exclude: Vec<String>,
+    },
+    /// Activate the pre-planned block `target`.
+    Activate {
+        /// The behaviour asking (for warnings).
+        by: UnitKey,
+        /// Block to activate.
+        target: String,
+    },
+    /// Change a parameter of another behaviour over time.
+    ChangeParameter(ParameterChange),
+}
+
+/// What one engine shows of one running unit in a frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Output {
+    /// The unit.
+    pub key: UnitKey,
+    /// The engine's name.
+    pub engine: &'static str,
+    /// Progress through the unit, 0 at start and 1 at end.
+    pub progress: f64,
+    /// Current parameter values (e.g. `volume` of a speech).
+    pub params: Vec<(String, f64)>,
+}
+
+/// Everything the realizer produced for one moment: engine output and the feedback sent since the
+/// previous frame.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Frame {
+    /// Global time of the frame.
+    pub time: f64,
+    /// One entry per running unit that shows something.
+    pub outputs: Vec<Output>,
+    /// Feedback sent since the previous frame, in order.
+    pub feedback: Vec<Feedback>,
+}
+
+/// Why an engine refused a unit or a parameter.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct EngineError(pub String);
+
+/// An engine realizes the behaviour kinds it is registered for (S75). The runtime tells it which
+/// units to play and when their sync points pass; it answers with timing models, interruption
+/// timing, parameters, frame output and actions.
+pub trait Engine {
+    /// A short name (frame output, logs).
+    fn name(&self) -> &'static str;
+
+    /// The timing model of `behaviour`, or `None` if this engine cannot realize it.
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel>;
+
+    /// Behaviours of the same exclusive group cannot run at once (R33: gaze, posture).
+    fn exclusive_group(&self, _behaviour: &Behaviour) -> Option<&'static str> {
+        None
+    }
+
+    /// Takes a scheduled unit into the engine's plan.
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError>;
+
+    /// Forgets a unit (it ended, was interrupted before starting, or its block was removed).
+    fn remove(&mut self, key: &UnitKey);
+
+    /// The sync point `sync` of `key` passed at global time `time`. Control engines act here.
+    fn sync_passed(&mut self, _key: &UnitKey, _sync: &str, _time: f64, _actions: &mut Vec<Action>) {
+    }
+
+    /// Interrupts a running unit at global time `now`: the new global times of its syncs (same
+    /// length as `syncs`; passed syncs keep theirs). The default ends motion gracefully: syncs up
+    /// to `relax` move to `now` and the retraction after it keeps its length; a unit already past
+    /// `relax`, or without one, ends at once.
+    fn interrupt(&mut self, _key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+        relax_now(now, syncs)
+    }
+
+    /// Number of units the engine holds (bounded-memory checks).
+    fn len(&self) -> usize;
+
+    /// Whether the engine holds no unit.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Plays every unit at global time `now` into `frame`.
+    fn play(&mut self, _now: f64, _frame: &mut Frame) {}
+
+    /// Current value of parameter `name` of unit `key`.
+    fn parameter(&self, _key: &UnitKey, _name: &str) -> Option<f64> {
+        None
+    }
+
+    /// Sets parameter `name` of a running unit at global time `now`. A parameter that changes
+    /// timing (a speech's `rate`) returns the unit's new sync times (as for
+    /// [`interrupt`](Engine::interrupt)); others return `None`.
+    fn set_parameter(
+        &mut self,
+        key: &UnitKey,
+        name: &str,
+        _value: f64,
+        _now: f64,
+    ) -> Result<Option<Vec<f64>>, EngineError> {
+        Err(EngineError(format!(
+            "{key} has no parameter '{name}' that can change while it runs"
+        )))
+    }
+}
+
+/// Graceful interruption timing (see [`Engine::interrupt`]).
+pub fn relax_now(now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+    let relax = syncs
+        .iter()
+        .position(|(s, _)| s == "relax")
+        .filter(|&r| syncs[r].1 > now);
+    match relax {
+        Some(r) => {
+            let shift = syncs[r].1 - now;
+            syncs
+                .iter()
+                .enumerate()
+                .map(|(i, &(_, t))| {
+                    if t <= now {
+                        t
+                    } else if i <= r {
+                        now
+                    } else {
+                        (t - shift).max(now)
+                    }
+                })
+                .collect()
+        }
+        None => stop_now(now, syncs),
+    }
+}
+
+/// Immediate interruption timing: every sync still ahead moves to `now` (speech, audio).
+pub fn stop_now(now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+    syncs.iter().map(|&(_, t)| t.min(now)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::borrow::Cow;
+
+    fn syncs(v: &[(&'static str, f64)]) -> Vec<(SyncName, f64)> {
+        v.iter().map(|&(s, t)| (Cow::Borrowed(s), t)).collect()
+    }
+
+    #[test]
+    fn graceful_interrupt_goes_to_relax_now_and_keeps_the_retraction() {
+        let s = syncs(&[
+            ("start", 0.0),
+            ("ready", 1.0),
+            ("stroke", 2.0),
+            ("relax", 3.0),
+            ("end", 4.5),
+        ]);
+        assert_eq!(relax_now(1.5, &s), [0.0, 1.0, 1.5, 1.5, 3.0]);
+        // past relax: ends at once
+        assert_eq!(relax_now(3.5, &s), [0.0, 1.0, 2.0, 3.0, 3.5]);
+        // no relax sync: stops
+        let se = syncs(&[("start", 0.0), ("end", 4.0)]);
+        assert_eq!(relax_now(1.0, &se), [0.0, 1.0]);
+        assert_eq!(stop_now(1.0, &s), [0.0, 1.0, 1.0, 1.0, 1.0]);
+    }
+
+    #[test]
+    fn parameter_trajectories_follow_s63_to_s65() {
+        let mut c = ParameterChange {
+            target: UnitKey::new("b", "s"),
+            param: "volume".into(),
+            initial: Some(0.0),
+            target_value: 100.0,
+            kind: TrajectoryType::Linear,
+            start: 1.0,
+            end: 3.0,
+            by: UnitKey::new("b", "p"),
+        };
+        assert_eq!(c.value_at(0.0, 1.0), 0.0);
+        assert_eq!(c.value_at(0.0, 2.5), 75.0);
+        assert_eq!(c.value_at(0.0, 9.0), 100.0); // held after the end
+        c.kind = TrajectoryType::Instant;
+        assert_eq!(c.value_at(0.0, 1.0), 100.0);
+    }
+}

@@ -360,11 +360,11 @@ impl TimingModels for DefaultTimingModels {
             BehaviourKind::PostureShift(_) => se(2.0),
             BehaviourKind::Locomotion(_) => se(3.0),
             BehaviourKind::Wait(w) => se(w.max_wait.filter(|d| *d > 0.0).unwrap_or(1.0)),
-            BehaviourKind::Interrupt(_)
-            | BehaviourKind::Activate(_)
-            | BehaviourKind::ParameterValueChange(_) => {
+            BehaviourKind::Interrupt(_) | BehaviourKind::Activate(_) => {
                 TimingModel::new(&[("start", 0.0), ("end", INSTANT)], Flexibility::Rigid)
             }
+            // instant unless its end is constrained: then the change spans start to end (S63)
+            BehaviourKind::ParameterValueChange(_) => se(INSTANT),
             BehaviourKind::AudioFile { .. } => {
                 // the file's length decides; until the audio engine reads it, one second
                 TimingModel::new(&[("start", 0.0), ("end", 1.0)], Flexibility::Rigid)

@@ -1,5 +1,7 @@
 //! `bmlr`: the command-line front end of the BML realizer (DESIGN §5).
 
+mod run;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -20,6 +22,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Realize BML: send files in order on a virtual clock (default) and print the feedback.
+    Run(run::RunArgs),
+    /// Schedule BML files without executing them; print every sync point's time.
+    Plan(run::PlanArgs),
     /// Parse and check BML files; print file:line:col diagnostics. Exit 1 if any file is invalid.
     Validate {
         /// BML files (one <bml> block each).
@@ -35,6 +41,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Validate { files, quiet } => validate(&files, quiet),
+        Command::Run(args) => run::run(args),
+        Command::Plan(args) => run::plan(args),
     }
 }
 

@@ -1,0 +1,389 @@
+//! `bmlr run` and `bmlr plan`: feed BML files and streams to a realizer on a virtual clock (or in
+//! real time) and print its feedback, or print the planned sync times without executing.
+
+use std::io::{BufRead, Read, Write};
+use std::path::Path;
+use std::process::ExitCode;
+use std::sync::mpsc;
+use std::time::Duration;
+
+use bml_realizer::bml::{BlockStream, StreamItem};
+use bml_realizer::clock::{Clock, WallClock};
+use bml_realizer::feedback::{BlockStatus, Feedback, Format};
+use bml_realizer::realizer::Realizer;
+use clap::{Args, ValueEnum};
+
+/// Feedback line format.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum FormatArg {
+    /// BML 1.0 feedback XML, one element per line.
+    Xml,
+    /// JSON lines.
+    Jsonl,
+}
+
+impl From<FormatArg> for Format {
+    fn from(f: FormatArg) -> Format {
+        match f {
+            FormatArg::Xml => Format::Xml,
+            FormatArg::Jsonl => Format::Jsonl,
+        }
+    }
+}
+
+/// Arguments of `bmlr run`.
+#[derive(Args)]
+pub struct RunArgs {
+    /// Feedback format.
+    #[arg(long, value_enum, default_value = "xml")]
+    format: FormatArg,
+    /// Run against the wall clock instead of the virtual clock.
+    #[arg(long)]
+    realtime: bool,
+    /// Stop the clock at this global time (seconds).
+    #[arg(long, value_name = "SECS")]
+    until: Option<f64>,
+    /// Frames per second of the engine loop (real time; on the virtual clock, frames are
+    /// computed at this rate when a frame consumer needs them).
+    #[arg(long, value_name = "HZ", default_value_t = 60.0)]
+    fps: f64,
+    /// Character for blocks without a characterId.
+    #[arg(long, value_name = "ID")]
+    character: Option<String>,
+    /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
+    /// clock before the next item.
+    #[arg(required = true, value_name = "ITEM", allow_hyphen_values = true)]
+    items: Vec<String>,
+}
+
+/// Arguments of `bmlr plan`.
+#[derive(Args)]
+pub struct PlanArgs {
+    /// Character for blocks without a characterId.
+    #[arg(long, value_name = "ID")]
+    character: Option<String>,
+    /// BML files, planned in order as if sent at once.
+    #[arg(required = true, value_name = "FILE")]
+    files: Vec<String>,
+}
+
+/// An item of the command line, read before anything runs.
+enum Item {
+    Text(String),
+    Advance(f64),
+    Stdin,
+}
+
+fn read_items(items: &[String]) -> Result<Vec<Item>, String> {
+    items
+        .iter()
+        .map(|a| {
+            if a == "-" {
+                Ok(Item::Stdin)
+            } else if let Some(secs) = a.strip_prefix('+') {
+                match secs.parse::<f64>() {
+                    Ok(s) if s.is_finite() && s >= 0.0 => Ok(Item::Advance(s)),
+                    _ => Err(format!(
+                        "'{a}' is not a clock advance: expected +SECS with SECS a number >= 0"
+                    )),
+                }
+            } else {
+                std::fs::read_to_string(Path::new(a))
+                    .map(Item::Text)
+                    .map_err(|e| format!("{a}: cannot read: {e}"))
+            }
+        })
+        .collect()
+}
+
+/// Prints every feedback message of a frame; false if stdout is gone.
+fn print(out: &mut impl Write, format: Format, feedback: &[Feedback]) -> bool {
+    for fb in feedback {
+        if writeln!(out, "{}", format.encode(fb)).is_err() {
+            return false;
+        }
+    }
+    out.flush().is_ok()
+}
+
+/// A realizer on the virtual clock that prints its feedback as it goes.
+struct VirtualRun {
+    realizer: Realizer,
+    format: Format,
+    until: f64,
+    out: std::io::StdoutLock<'static>,
+    open: bool,
+}
+
+impl VirtualRun {
+    /// Moves the clock to `t` (capped at `--until`), event by event.
+    fn advance_to(&mut self, t: f64) {
+        let t = t.min(self.until);
+        let frame = self.realizer.tick(t);
+        self.open &= print(&mut self.out, self.format, &frame.feedback);
+    }
+
+    fn perform(&mut self, text: &str) {
+        if self.realizer.now() >= self.until {
+            return;
+        }
+        let _ = self.realizer.perform_bml(text);
+        let frame = self.realizer.tick(self.realizer.now());
+        self.open &= print(&mut self.out, self.format, &frame.feedback);
+    }
+
+    fn stream(&mut self, item: StreamItem) {
+        match item {
+            StreamItem::Block(text) | StreamItem::Garbage(text) => self.perform(&text),
+            StreamItem::Advance(s) => self.advance_to(self.realizer.now() + s),
+        }
+    }
+}
+
+/// `bmlr run`.
+pub fn run(args: RunArgs) -> ExitCode {
+    let items = match read_items(&args.items) {
+        Ok(i) => i,
+        Err(e) => {
+            eprintln!("bmlr run: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    if let Some(u) = args.until {
+        if !(u.is_finite() && u >= 0.0) {
+            eprintln!("bmlr run: --until must be a number of seconds >= 0");
+            return ExitCode::from(2);
+        }
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        eprintln!("bmlr run: --fps must be a positive number");
+        return ExitCode::from(2);
+    }
+    let realizer = Realizer::new()
+        .with_default_character(args.character.clone())
+        .with_posix_time(args.realtime);
+    if args.realtime {
+        return run_realtime(realizer, items, &args);
+    }
+    let mut run = VirtualRun {
+        realizer,
+        format: args.format.into(),
+        until: args.until.unwrap_or(f64::INFINITY),
+        out: std::io::stdout().lock(),
+        open: true,
+    };
+    for item in items {
+        match item {
+            Item::Text(text) => run.perform(&text),
+            Item::Advance(s) => run.advance_to(run.realizer.now() + s),
+            Item::Stdin => {
+                let mut text = String::new();
+                if let Err(e) = std::io::stdin().read_to_string(&mut text) {
+                    eprintln!("bmlr run: cannot read stdin: {e}");
+                    return ExitCode::from(2);
+                }
+                let mut stream = BlockStream::new();
+                stream.push(&text);
+                while let Some(item) = stream.next_item(true) {
+                    run.stream(item);
+                }
+            }
+        }
+    }
+    // run until nothing more will happen
+    while let Some(t) = run.realizer.next_event() {
+        if t > run.until || !run.open {
+            break;
+        }
+        run.advance_to(t);
+    }
+    if run.until.is_finite() {
+        run.advance_to(run.until);
+    }
+    report_unfinished(&run.realizer);
+    ExitCode::SUCCESS
+}
+
+/// Tells stderr which blocks did not finish (waiting for activation, persistent behaviour, or
+/// the clock stopped).
+fn report_unfinished(realizer: &Realizer) {
+    for (character, m) in realizer.characters() {
+        for (id, status) in m.live_blocks() {
+            let why = match status {
+                BlockStatus::Pending => "pre-planned, never activated",
+                BlockStatus::Lurking => "still waiting for the blocks it is appended to",
+                _ => "still running",
+            };
+            let who = if character.is_empty() {
+                String::new()
+            } else {
+                format!(" (character {character})")
+            };
+            eprintln!(
+                "bmlr run: block '{id}'{who} did not finish at {:.3} s: {status}, {why}",
+                realizer.now()
+            );
+        }
+    }
+}
+
+/// `bmlr run --realtime`: the wall clock drives the realizer at `--fps`; `+SECS` waits.
+fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> ExitCode {
+    let clock = WallClock::new();
+    let format: Format = args.format.into();
+    let until = args.until.unwrap_or(f64::INFINITY);
+    let period = 1.0 / args.fps;
+    let mut out = std::io::stdout().lock();
+    let wait_until = |realizer: &mut Realizer, t: f64, out: &mut std::io::StdoutLock| loop {
+        let now = clock.now().min(until);
+        let frame = realizer.tick(now);
+        if !print(out, format, &frame.feedback) {
+            return false;
+        }
+        if now >= t || now >= until {
+            return true;
+        }
+        std::thread::sleep(Duration::from_secs_f64(period.min((t - now).max(0.0))));
+    };
+    for item in items {
+        match item {
+            Item::Text(text) => {
+                realizer.tick(clock.now().min(until));
+                let _ = realizer.perform_bml(&text);
+            }
+            Item::Advance(s) => {
+                let t = clock.now() + s;
+                if !wait_until(&mut realizer, t, &mut out) {
+                    return ExitCode::SUCCESS;
+                }
+            }
+            Item::Stdin => {
+                // a reader thread hands over lines; blocks run as soon as they are complete
+                let (tx, rx) = mpsc::channel::<Option<String>>();
+                std::thread::spawn(move || {
+                    for line in std::io::stdin().lock().lines() {
+                        match line {
+                            Ok(l) => {
+                                if tx.send(Some(l + "\n")).is_err() {
+                                    return;
+                                }
+                            }
+                            Err(_) => break,
+                        }
+                    }
+                    let _ = tx.send(None);
+                });
+                let mut stream = BlockStream::new();
+                let mut finished = false;
+                while !finished {
+                    match rx.recv_timeout(Duration::from_secs_f64(period)) {
+                        Ok(Some(text)) => stream.push(&text),
+                        Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => finished = true,
+                        Err(mpsc::RecvTimeoutError::Timeout) => {}
+                    }
+                    while let Some(item) = stream.next_item(finished) {
+                        match item {
+                            StreamItem::Block(t) | StreamItem::Garbage(t) => {
+                                realizer.tick(clock.now().min(until));
+                                let _ = realizer.perform_bml(&t);
+                            }
+                            StreamItem::Advance(s) => {
+                                let t = clock.now() + s;
+                                if !wait_until(&mut realizer, t, &mut out) {
+                                    return ExitCode::SUCCESS;
+                                }
+                            }
+                        }
+                    }
+                    let frame = realizer.tick(clock.now().min(until));
+                    if !print(&mut out, format, &frame.feedback) {
+                        return ExitCode::SUCCESS;
+                    }
+                }
+            }
+        }
+    }
+    // until nothing more will happen
+    while let Some(t) = realizer.next_event() {
+        if t > until || !wait_until(&mut realizer, t, &mut out) {
+            break;
+        }
+    }
+    if until.is_finite() {
+        wait_until(&mut realizer, until, &mut out);
+    }
+    report_unfinished(&realizer);
+    ExitCode::SUCCESS
+}
+
+/// `bmlr plan`: submits the files at time 0 without running the clock and prints each block's
+/// predicted sync times (block-relative, and global in parentheses) and every warning.
+pub fn plan(args: PlanArgs) -> ExitCode {
+    let items = match read_items(&args.files) {
+        Ok(i) => i,
+        Err(e) => {
+            eprintln!("bmlr plan: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let mut realizer = Realizer::new().with_default_character(args.character);
+    let mut feedback = Vec::new();
+    for item in items {
+        match item {
+            Item::Text(text) => {
+                let _ = realizer.perform_bml(&text);
+                feedback.extend(realizer.tick(0.0).feedback);
+            }
+            Item::Advance(_) | Item::Stdin => {
+                eprintln!("bmlr plan: only files can be planned");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    let mut out = std::io::stdout().lock();
+    for line in plan_lines(&feedback) {
+        if writeln!(out, "{line}").is_err() {
+            break;
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// The plan report: for each block's last full prediction, a header and one line per sync;
+/// warnings as they came.
+fn plan_lines(feedback: &[Feedback]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for fb in feedback {
+        match fb {
+            Feedback::Prediction(p) if !p.behaviours.is_empty() => {
+                for b in &p.blocks {
+                    let start = b.global_start.unwrap_or(0.0);
+                    lines.push(format!(
+                        "{} start {:.3} end {}",
+                        b.id,
+                        start,
+                        b.global_end
+                            .map_or_else(|| "unknown".to_string(), |e| format!("{e:.3}"))
+                    ));
+                    for x in p.behaviours.iter().filter(|x| x.block == b.id) {
+                        for (sync, t) in &x.syncs {
+                            lines.push(format!(
+                                "  {}:{}:{} {:.3} ({:.3})",
+                                x.block,
+                                x.behaviour,
+                                sync,
+                                t,
+                                start + t
+                            ));
+                        }
+                    }
+                }
+            }
+            Feedback::Warning(w) => {
+                lines.push(format!("warning {} {}: {}", w.id, w.kind.as_str(), w.text))
+            }
+            _ => {}
+        }
+    }
+    lines
+}

@@ -1,0 +1,210 @@
+//! One block in the running plan and its behaviours: block-local sync times from the schedule,
+//! how far each behaviour has got, and the derived block predictions (end, subsiding time).
+
+use crate::bml;
+use crate::engine::Registry;
+use crate::feedback::BlockStatus;
+use crate::schedule::{BlockSchedule, SyncName};
+
+/// Where a behaviour is in its life.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Phase {
+    /// Scheduled; its block has not started.
+    Planned,
+    /// Handed to its engine; no sync passed yet.
+    Added,
+    /// At least one sync passed.
+    Running,
+    /// Its end passed.
+    Ended,
+    /// Left the plan before it started (dropped, interrupted, refused by its engine).
+    Removed,
+}
+
+/// A scheduled behaviour at run time.
+#[derive(Debug, Clone)]
+pub(crate) struct LiveBehaviour {
+    pub(crate) id: String,
+    /// Index in the block's `behaviours` (document order).
+    pub(crate) index: usize,
+    /// Registry index of its engine.
+    pub(crate) engine: usize,
+    /// (sync, block-local time) in sync order.
+    pub(crate) syncs: Vec<(SyncName, f64)>,
+    /// The next sync to pass.
+    pub(crate) next: usize,
+    pub(crate) phase: Phase,
+}
+
+impl LiveBehaviour {
+    /// Block-local time of `sync`.
+    pub(crate) fn time(&self, sync: &str) -> Option<f64> {
+        self.syncs.iter().find(|(n, _)| n == sync).map(|s| s.1)
+    }
+
+    /// New global `times` from the engine (interrupt or a timing parameter): syncs not yet passed
+    /// take them, never earlier than `now` nor than the sync before.
+    pub(crate) fn retime(&mut self, times: &[f64], start: f64, now: f64) {
+        let mut floor = now - start;
+        for (k, s) in self.syncs.iter_mut().enumerate() {
+            if k < self.next {
+                continue;
+            }
+            if let Some(&t) = times.get(k) {
+                let local = (t - start).max(floor);
+                s.1 = local;
+                floor = local;
+            }
+        }
+    }
+
+    fn passed_relax(&self) -> bool {
+        match self.syncs.iter().position(|(n, _)| n == "relax") {
+            Some(r) => self.next > r,
+            None => self.phase == Phase::Ended,
+        }
+    }
+}
+
+/// A block in the plan.
+#[derive(Debug, Clone)]
+pub(crate) struct LiveBlock {
+    pub(crate) id: String,
+    /// Arrival number: ties between blocks go to the earlier one.
+    pub(crate) seq: u64,
+    pub(crate) status: BlockStatus,
+    /// Global start: predicted until the block starts, then fixed.
+    pub(crate) start: f64,
+    /// The block as written.
+    pub(crate) source: bml::Block,
+    pub(crate) behaviours: Vec<LiveBehaviour>,
+    /// Blocks that must end before this one starts.
+    pub(crate) waits_for: Vec<String>,
+    /// Blocks that must be subsiding before this one starts.
+    pub(crate) chunk_after: Vec<String>,
+    /// Waiting for an activation.
+    pub(crate) preplan: bool,
+}
+
+impl LiveBlock {
+    pub(crate) fn new(
+        source: bml::Block,
+        seq: u64,
+        start: f64,
+        waits_for: Vec<String>,
+        chunk_after: Vec<String>,
+    ) -> Self {
+        LiveBlock {
+            id: source.id.clone(),
+            seq,
+            status: BlockStatus::InPrep,
+            start,
+            source,
+            behaviours: Vec::new(),
+            waits_for,
+            chunk_after,
+            preplan: false,
+        }
+    }
+
+    /// Takes the scheduled behaviours (in document order) and their engines.
+    pub(crate) fn set_schedule(&mut self, schedule: BlockSchedule, registry: &Registry) {
+        for s in schedule.behaviours {
+            let Some(index) = self.source.behaviours.iter().position(|b| b.id == s.id) else {
+                continue;
+            };
+            let Some(engine) = registry.engine_for(&self.source.behaviours[index]) else {
+                continue;
+            };
+            self.behaviours.push(LiveBehaviour {
+                id: s.id,
+                index,
+                engine,
+                syncs: s.syncs,
+                next: 0,
+                phase: Phase::Planned,
+            });
+        }
+    }
+
+    /// R33: behaviours of one exclusive group (gaze, posture) with the same start and end cannot
+    /// both run; all but the first in document order leave the plan. Returns (id, reason) of each.
+    pub(crate) fn resolve_exclusive_ties(&mut self, registry: &Registry) -> Vec<(String, String)> {
+        let mut dropped = Vec::new();
+        for i in 0..self.behaviours.len() {
+            let a = &self.behaviours[i];
+            let b = &self.source.behaviours[a.index];
+            let Some(group) = registry.engine(a.engine).exclusive_group(b) else {
+                continue;
+            };
+            let span =
+                |x: &LiveBehaviour| (x.syncs.first().map(|s| s.1), x.syncs.last().map(|s| s.1));
+            let tie = self.behaviours[..i].iter().find(|p| {
+                p.phase != Phase::Removed
+                    && registry
+                        .engine(p.engine)
+                        .exclusive_group(&self.source.behaviours[p.index])
+                        == Some(group)
+                    && span(p) == span(a)
+            });
+            if let Some(p) = tie {
+                dropped.push((
+                    a.id.clone(),
+                    format!(
+                        "'{}' and '{}' are both {group} behaviours with the same start and end; only '{}' runs",
+                        p.id, a.id, p.id
+                    ),
+                ));
+                self.behaviours[i].phase = Phase::Removed;
+            }
+        }
+        dropped
+    }
+
+    pub(crate) fn behaviour(&self, id: &str) -> Option<&LiveBehaviour> {
+        self.behaviours.iter().find(|b| b.id == id)
+    }
+
+    /// Whether the block has started (IN_EXEC or SUBSIDING).
+    pub(crate) fn started(&self) -> bool {
+        matches!(self.status, BlockStatus::InExec | BlockStatus::Subsiding)
+    }
+
+    fn live(&self) -> impl Iterator<Item = &LiveBehaviour> {
+        self.behaviours.iter().filter(|b| b.phase != Phase::Removed)
+    }
+
+    /// Predicted global end: the latest end of its behaviours (infinite with a persistent one).
+    pub(crate) fn predicted_end(&self) -> Option<f64> {
+        let end = self
+            .live()
+            .filter_map(|b| b.syncs.last().map(|s| s.1))
+            .fold(0.0_f64, f64::max);
+        Some(self.start + end)
+    }
+
+    /// Predicted global time at which every behaviour has passed `relax` (or `end`).
+    pub(crate) fn predicted_subsiding(&self) -> Option<f64> {
+        let t = self
+            .live()
+            .filter_map(|b| b.time("relax").or_else(|| b.syncs.last().map(|s| s.1)))
+            .fold(0.0_f64, f64::max);
+        Some(self.start + t)
+    }
+
+    /// Every behaviour still in the plan has ended (S31).
+    pub(crate) fn all_ended(&self) -> bool {
+        self.behaviours
+            .iter()
+            .all(|b| matches!(b.phase, Phase::Ended | Phase::Removed))
+    }
+
+    /// IN_EXEC → SUBSIDING once every behaviour passed `relax` (or `end`); true if it changed.
+    pub(crate) fn update_subsiding(&mut self) -> bool {
+        if self.status == BlockStatus::InExec && self.live().all(LiveBehaviour::passed_relax) {
+            self.status = BlockStatus::Subsiding;
+            return true;
+        }
+        false
+    }
+}

@@ -1,0 +1,834 @@
+//! Blocks at run time for one character: the lifecycle state machine (IN_PREP → PENDING | LURKING →
+//! IN_EXEC → SUBSIDING → DONE, ending INTERRUPTED or REVOKED; S23–S39), composition (MERGE, APPEND,
+//! REPLACE, APPEND-AFTER) and the BMLA block attributes (interrupt, onStart, preplan, appendAfter,
+//! chunkAfter, chunkBefore, prependBefore), the event loop that passes sync points at their exact
+//! times, the control actions of engines, and the feedback of DESIGN §4.
+//!
+//! Time is the host's: [`BlockManager::submit`] happens at the manager's current time and
+//! [`BlockManager::advance`] moves it forward, processing every event up to the new time in time
+//! order (ties: earlier block first, then document order, then sync order). Feedback carries the
+//! exact scheduled times, so a run is deterministic whatever the frame rate.
+
+mod live;
+
+use std::collections::{HashSet, VecDeque};
+
+use crate::bml::{self, Diagnostic, SyncPoint};
+use crate::engine::{Action, Frame, ParameterChange, Registry, Unit, UnitKey};
+use crate::feedback::{
+    BehaviourPrediction, BlockPrediction, BlockProgress, BlockStatus, Feedback, KnownWarning,
+    PredictionFeedback, SyncPointProgress, WarningFeedback,
+};
+use crate::schedule::{ExternalTimes, SchedulingStrategy};
+use live::{LiveBlock, Phase};
+
+/// How many ids of finished blocks are remembered (so that late references to them are quiet
+/// no-ops rather than NO_SUCH_TARGET warnings).
+pub const FINISHED_HISTORY: usize = 4096;
+
+/// Counts of what the manager holds (bounded-memory checks).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sizes {
+    /// Blocks not yet finished.
+    pub blocks: usize,
+    /// Units held by all engines.
+    pub engine_units: usize,
+    /// Running parameter changes.
+    pub parameter_changes: usize,
+    /// Remembered ids of finished blocks.
+    pub finished_ids: usize,
+}
+
+/// The blocks of one character and the engines that realize them.
+pub struct BlockManager {
+    registry: Registry,
+    strategy: Box<dyn SchedulingStrategy>,
+    character: Option<String>,
+    blocks: Vec<LiveBlock>,
+    finished: VecDeque<String>,
+    finished_set: HashSet<String>,
+    changes: Vec<ParameterChange>,
+    now: f64,
+    seq: u64,
+    out: Vec<Feedback>,
+}
+
+/// Times of other blocks' syncs relative to the start of a block being scheduled.
+struct OtherBlocks<'a> {
+    blocks: &'a [LiveBlock],
+    start: f64,
+}
+
+impl ExternalTimes for OtherBlocks<'_> {
+    fn time(&self, point: &SyncPoint) -> Option<f64> {
+        let SyncPoint::External {
+            block,
+            behaviour,
+            sync,
+        } = point
+        else {
+            return None; // anticipators are not registered with the runtime yet
+        };
+        let b = self.blocks.iter().find(|b| &b.id == block)?;
+        let local = b.behaviour(behaviour)?.time(sync)?;
+        Some(b.start + local - self.start)
+    }
+}
+
+impl BlockManager {
+    /// A manager for `character` (None: the default character) with these engines and strategy.
+    pub fn new(
+        registry: Registry,
+        strategy: Box<dyn SchedulingStrategy>,
+        character: Option<String>,
+    ) -> Self {
+        BlockManager {
+            registry,
+            strategy,
+            character,
+            blocks: Vec::new(),
+            finished: VecDeque::new(),
+            finished_set: HashSet::new(),
+            changes: Vec::new(),
+            now: 0.0,
+            seq: 0,
+            out: Vec::new(),
+        }
+    }
+
+    /// The current time (the last time advanced to).
+    pub fn now(&self) -> f64 {
+        self.now
+    }
+
+    /// The engines.
+    pub fn registry(&self) -> &Registry {
+        &self.registry
+    }
+
+    /// Takes the feedback produced so far.
+    pub fn take_feedback(&mut self) -> Vec<Feedback> {
+        std::mem::take(&mut self.out)
+    }
+
+    /// What the manager holds.
+    pub fn sizes(&self) -> Sizes {
+        Sizes {
+            blocks: self.blocks.len(),
+            engine_units: self.registry.engines().map(|e| e.len()).sum(),
+            parameter_changes: self.changes.len(),
+            finished_ids: self.finished.len(),
+        }
+    }
+
+    /// Status of block `id`: its live status, DONE if it finished recently, `None` if unknown.
+    pub fn status(&self, id: &str) -> Option<BlockStatus> {
+        match self.blocks.iter().find(|b| b.id == id) {
+            Some(b) => Some(b.status),
+            None => self.finished_set.contains(id).then_some(BlockStatus::Done),
+        }
+    }
+
+    /// Ids and statuses of the blocks not yet finished, in arrival order.
+    pub fn live_blocks(&self) -> Vec<(String, BlockStatus)> {
+        self.blocks
+            .iter()
+            .map(|b| (b.id.clone(), b.status))
+            .collect()
+    }
+
+    /// The time of the next event (a sync point of a running block), if any. `None` when nothing
+    /// will happen without outside input (all done, only persistent behaviour, or blocks waiting
+    /// for an activation).
+    pub fn next_event(&self) -> Option<f64> {
+        self.next_sync()
+            .map(|(t, _, _)| t)
+            .filter(|t| t.is_finite())
+    }
+
+    // ---------------------------------------------------------------------------------------
+    // feedback helpers
+
+    fn emit(&mut self, fb: Feedback) {
+        self.out.push(fb);
+    }
+
+    fn warn(&mut self, id: String, kind: KnownWarning, text: String) {
+        let character_id = self.character.clone();
+        self.emit(Feedback::Warning(WarningFeedback {
+            id,
+            kind: kind.into(),
+            character_id,
+            text,
+        }));
+    }
+
+    fn predict(&mut self, i: usize, with_behaviours: bool) {
+        let fb = self.prediction(&self.blocks[i], with_behaviours);
+        self.emit(fb);
+    }
+
+    fn prediction(&self, b: &LiveBlock, with_behaviours: bool) -> Feedback {
+        let end = b.predicted_end();
+        let behaviours = if with_behaviours {
+            b.behaviours
+                .iter()
+                .filter(|x| x.phase != Phase::Removed)
+                .map(|x| BehaviourPrediction {
+                    kind: b.source.behaviours[x.index].kind.element_name().to_string(),
+                    block: b.id.clone(),
+                    behaviour: x.id.clone(),
+                    syncs: x
+                        .syncs
+                        .iter()
+                        .filter(|s| s.1.is_finite())
+                        .map(|(n, t)| (n.to_string(), *t))
+                        .collect(),
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let fb = PredictionFeedback {
+            character_id: self.character.clone(),
+            blocks: vec![BlockPrediction {
+                id: b.id.clone(),
+                global_start: Some(b.start),
+                // unknown while scheduling (the harness waits for a known end)
+                global_end: end.filter(|e| e.is_finite() && b.status != BlockStatus::InPrep),
+                status: Some(b.status),
+            }],
+            behaviours,
+        };
+        Feedback::Prediction(fb)
+    }
+
+    fn progress(&mut self, block: &str, sync: &str, t: f64, status: BlockStatus) {
+        let character_id = self.character.clone();
+        self.emit(Feedback::BlockProgress(BlockProgress {
+            block: block.to_string(),
+            sync: sync.to_string(),
+            global_time: t,
+            character_id,
+            status: Some(status),
+            posix_time: None,
+        }));
+    }
+
+    // ---------------------------------------------------------------------------------------
+    // submitting a block (S23–S27, S34–S38)
+
+    /// Reports the parser's warnings for an accepted block: unsupported extension attributes and
+    /// ignored extension content. Unknown behaviour kinds are reported when scheduling finds no
+    /// engine for them; lexemes when an engine cannot realize them.
+    fn parse_warnings(&mut self, block: &bml::Block, warnings: &[Diagnostic]) {
+        for d in warnings {
+            let kind = match d.code {
+                bml::Code::UnsupportedAttribute => KnownWarning::CustomAttributeNotSupported,
+                bml::Code::UnsupportedExtension
+                    if !block
+                        .behaviours
+                        .iter()
+                        .any(|b| (b.pos.line, b.pos.col) == (d.pos.line, d.pos.col)) =>
+                {
+                    KnownWarning::BehaviorTypeNotSupported
+                }
+                _ => continue,
+            };
+            self.warn(
+                block.id.clone(),
+                kind,
+                format!("{}:{}: {}", d.pos.line, d.pos.col, d.message),
+            );
+        }
+    }
+
+    /// Plans `block` at the current time: interrupts, composition, scheduling, and its start if
+    /// nothing holds it back. Every problem becomes a warning; the block is rejected only if its
+    /// id is in use or its required behaviours cannot be scheduled.
+    pub fn submit(&mut self, block: bml::Block, warnings: &[Diagnostic]) {
+        let now = self.now;
+        if let Some(b) = self.blocks.iter().find(|b| b.id == block.id) {
+            let status = b.status;
+            self.warn(
+                block.id.clone(),
+                KnownWarning::ImpossibleToSchedule,
+                format!(
+                    "block id '{}' is still in use (status {status}); the new block is ignored",
+                    block.id
+                ),
+            );
+            return;
+        }
+        self.parse_warnings(&block, warnings);
+        // S25: blocks named in bmla:interrupt leave the plan first
+        for target in &block.ext.interrupt {
+            self.interrupt_block_by_id(target, now, &block.id);
+        }
+        // S35: REPLACE removes everything
+        if block.composition == bml::Composition::Replace {
+            let ids: Vec<String> = self.blocks.iter().map(|b| b.id.clone()).collect();
+            for id in ids {
+                self.interrupt_block_by_id(&id, now, &block.id);
+            }
+        }
+        // S36, S37: blocks this one waits for
+        let mut waits_for: Vec<String> = match &block.composition {
+            bml::Composition::Append => self
+                .blocks
+                .iter()
+                .filter(|b| b.status != BlockStatus::Pending)
+                .map(|b| b.id.clone())
+                .collect(),
+            bml::Composition::AppendAfter(ids) => self.existing(ids, &block.id),
+            _ => Vec::new(),
+        };
+        for id in self.existing(&block.ext.append_after, &block.id) {
+            if !waits_for.contains(&id) {
+                waits_for.push(id);
+            }
+        }
+        let chunk_after = self.existing(&block.ext.chunk_after, &block.id);
+        let start = self.predicted_start(now, &waits_for, &chunk_after);
+
+        // S24: scheduling starts
+        self.seq += 1;
+        let mut live = LiveBlock::new(block, self.seq, start, waits_for, chunk_after);
+        let fb = self.prediction(&live, false);
+        self.emit(fb);
+
+        let schedule = {
+            let external = OtherBlocks {
+                blocks: &self.blocks,
+                start,
+            };
+            self.strategy
+                .schedule(&live.source, &self.registry, &external)
+        };
+        let schedule = match schedule {
+            Ok(s) => s,
+            Err(e) => {
+                let id = live.id.clone();
+                self.warn(id, KnownWarning::CannotSatisfyConstraints, e.to_string());
+                return;
+            }
+        };
+        for d in &schedule.dropped {
+            self.warn(
+                format!("{}:{}", live.id, d.behaviour),
+                d.warning,
+                d.reason.clone(),
+            );
+        }
+        live.set_schedule(schedule, &self.registry);
+        for (beh, reason) in live.resolve_exclusive_ties(&self.registry) {
+            self.warn(
+                format!("{}:{beh}", live.id),
+                KnownWarning::ImpossibleToSchedule,
+                reason,
+            );
+        }
+        // chunkBefore / prependBefore: make other blocks wait for this one
+        let id = live.id.clone();
+        let ext = live.source.ext.clone();
+        for (targets, chunk) in [(&ext.chunk_before, true), (&ext.prepend_before, false)] {
+            for t in targets {
+                match self.blocks.iter_mut().find(|b| &b.id == t) {
+                    Some(b) if !b.started() => {
+                        let list = if chunk {
+                            &mut b.chunk_after
+                        } else {
+                            &mut b.waits_for
+                        };
+                        list.push(id.clone());
+                    }
+                    Some(_) => self.warn(
+                        id.clone(),
+                        KnownWarning::ImpossibleToSchedule,
+                        format!("block '{t}' has already started; '{id}' cannot go before it"),
+                    ),
+                    None => self.warn(
+                        id.clone(),
+                        KnownWarning::NoSuchTarget,
+                        format!("no block '{t}' to go before"),
+                    ),
+                }
+            }
+        }
+        // S26, S27
+        live.status = BlockStatus::Pending;
+        live.preplan = ext.preplan;
+        self.blocks.push(live);
+        let i = self.blocks.len() - 1;
+        self.predict(i, true);
+        if !ext.preplan {
+            self.release(i, now);
+        }
+        self.start_ready(now);
+    }
+
+    /// The ids of `ids` that name live blocks. Unknown ids that never existed get a warning.
+    fn existing(&mut self, ids: &[String], by: &str) -> Vec<String> {
+        let mut v = Vec::new();
+        for id in ids {
+            if self.blocks.iter().any(|b| &b.id == id) {
+                v.push(id.clone());
+            } else if !self.finished_set.contains(id) {
+                self.warn(
+                    by.to_string(),
+                    KnownWarning::NoSuchTarget,
+                    format!("block '{by}' refers to block '{id}', which does not exist"),
+                );
+            }
+        }
+        v
+    }
+
+    fn predicted_start(&self, now: f64, waits_for: &[String], chunk_after: &[String]) -> f64 {
+        let mut start = now;
+        for b in &self.blocks {
+            if waits_for.contains(&b.id) {
+                start = start.max(b.predicted_end().unwrap_or(now));
+            }
+            if chunk_after.contains(&b.id) {
+                start = start.max(b.predicted_subsiding().unwrap_or(now));
+            }
+        }
+        if start.is_finite() {
+            start
+        } else {
+            now
+        }
+    }
+
+    /// A PENDING block that may run: LURKING (with its prediction) until what it waits for is
+    /// done; [`start_ready`](Self::start_ready) starts it.
+    fn release(&mut self, i: usize, now: f64) {
+        self.blocks[i].preplan = false;
+        if self.ready(i) {
+            self.blocks[i].status = BlockStatus::Lurking;
+        } else {
+            let (w, c) = (
+                self.blocks[i].waits_for.clone(),
+                self.blocks[i].chunk_after.clone(),
+            );
+            self.blocks[i].start = self.predicted_start(now, &w, &c);
+            self.blocks[i].status = BlockStatus::Lurking;
+            self.predict(i, false);
+        }
+    }
+
+    /// S29: every append target is done and every chunk target subsiding or done.
+    fn ready(&self, i: usize) -> bool {
+        let b = &self.blocks[i];
+        let live = |id: &String| self.blocks.iter().find(|x| &x.id == id);
+        b.waits_for.iter().all(|id| live(id).is_none())
+            && b.chunk_after.iter().all(|id| {
+                live(id)
+                    .is_none_or(|x| matches!(x.status, BlockStatus::Subsiding | BlockStatus::Done))
+            })
+    }
+
+    /// Starts every LURKING block that is ready, at `t`, until none is left (a start can end a
+    /// block at once, which can make others ready).
+    fn start_ready(&mut self, t: f64) {
+        loop {
+            let next = (0..self.blocks.len())
+                .find(|&i| self.blocks[i].status == BlockStatus::Lurking && self.ready(i));
+            match next {
+                Some(i) => self.start_block(i, t),
+                None => return,
+            }
+        }
+    }
+
+    /// S30: the block peg moves to `t`, start feedback, onStart activations, units to engines.
+    fn start_block(&mut self, i: usize, t: f64) {
+        let b = &mut self.blocks[i];
+        b.start = t;
+        b.status = BlockStatus::InExec;
+        let id = b.id.clone();
+        self.progress(&id, "start", t, BlockStatus::InExec);
+        // hand every unit to its engine
+        let mut failed = Vec::new();
+        {
+            let b = &mut self.blocks[i];
+            for x in b
+                .behaviours
+                .iter_mut()
+                .filter(|x| x.phase == Phase::Planned)
+            {
+                let key = UnitKey::new(&b.id, &x.id);
+                let global: Vec<_> = x.syncs.iter().map(|(n, l)| (n.clone(), t + l)).collect();
+                let unit = Unit {
+                    key: &key,
+                    behaviour: &b.source.behaviours[x.index],
+                    syncs: &global,
+                };
+                match self.registry.engine_mut(x.engine).add(unit) {
+                    Ok(()) => x.phase = Phase::Added,
+                    Err(e) => {
+                        x.phase = Phase::Removed;
+                        failed.push((x.id.clone(), e.to_string()));
+                    }
+                }
+            }
+        }
+        for (beh, reason) in failed {
+            self.warn(
+                format!("{id}:{beh}"),
+                KnownWarning::ExecutionFailure,
+                reason,
+            );
+        }
+        if self.finish_if_done(i, t) {
+            return;
+        }
+        self.predict(i, false);
+        let on_start = self.blocks[i].source.ext.on_start.clone();
+        for target in on_start {
+            self.activate(&target, t, &id);
+        }
+    }
+
+    /// Activates pre-planned block `target` (by `activate` or onStart, S28).
+    fn activate(&mut self, target: &str, t: f64, by: &str) {
+        match self.blocks.iter().position(|b| b.id == target) {
+            Some(j) if self.blocks[j].status == BlockStatus::Pending => {
+                self.release(j, t);
+                self.start_ready(t);
+            }
+            Some(_) => {} // already on its way: activating twice is a no-op
+            None if self.finished_set.contains(target) => {}
+            None => self.warn(
+                by.to_string(),
+                KnownWarning::NoSuchTarget,
+                format!("cannot activate block '{target}': no such block"),
+            ),
+        }
+    }
+
+    /// Ends block `i` with DONE if every behaviour still in its plan has ended (S31).
+    fn finish_if_done(&mut self, i: usize, t: f64) -> bool {
+        if !self.blocks[i].all_ended() {
+            return false;
+        }
+        self.end_block(i, t, BlockStatus::Done);
+        true
+    }
+
+    /// Removes block `i` from the plan with end feedback of `status`, then starts what waited.
+    fn end_block(&mut self, i: usize, t: f64, status: BlockStatus) {
+        let b = self.blocks.remove(i);
+        for x in &b.behaviours {
+            if matches!(x.phase, Phase::Added | Phase::Running | Phase::Ended) {
+                self.registry
+                    .engine_mut(x.engine)
+                    .remove(&UnitKey::new(&b.id, &x.id));
+            }
+        }
+        self.changes.retain(|c| c.target.block != b.id);
+        self.progress(&b.id, "end", t, status);
+        self.remember(b.id);
+        self.start_ready(t);
+    }
+
+    fn remember(&mut self, id: String) {
+        if self.finished_set.insert(id.clone()) {
+            self.finished.push_back(id);
+            if self.finished.len() > FINISHED_HISTORY {
+                if let Some(old) = self.finished.pop_front() {
+                    self.finished_set.remove(&old);
+                }
+            }
+        }
+    }
+
+    // ---------------------------------------------------------------------------------------
+    // interruption (S32, S33)
+
+    /// Interrupts a whole block: before its start it is revoked; while running, every behaviour
+    /// that started reports its remaining syncs now, the others are dropped, and it ends
+    /// INTERRUPTED.
+    fn interrupt_block_by_id(&mut self, target: &str, t: f64, by: &str) {
+        let Some(i) = self.blocks.iter().position(|b| b.id == target) else {
+            if !self.finished_set.contains(target) {
+                self.warn(
+                    by.to_string(),
+                    KnownWarning::NoSuchTarget,
+                    format!("cannot interrupt block '{target}': no such block"),
+                );
+            }
+            return;
+        };
+        if !self.blocks[i].started() {
+            self.end_block(i, t, BlockStatus::Revoked);
+            return;
+        }
+        let id = self.blocks[i].id.clone();
+        let start = self.blocks[i].start;
+        let mut reports = Vec::new();
+        for x in &mut self.blocks[i].behaviours {
+            if x.phase == Phase::Running {
+                for (name, _) in &x.syncs[x.next..] {
+                    reports.push((x.id.clone(), name.to_string()));
+                }
+                x.next = x.syncs.len();
+                x.phase = Phase::Ended;
+            }
+        }
+        for (beh, sync) in reports {
+            self.sync_feedback(&id, &beh, &sync, t - start, t);
+        }
+        self.end_block(i, t, BlockStatus::Interrupted);
+    }
+
+    /// Interrupts behaviours of block `target` at `t` (a BMLA interrupt behaviour): a behaviour
+    /// not yet started leaves the plan; a running one ends the way its engine says (speech stops,
+    /// motion retracts from now).
+    fn interrupt_behaviours(
+        &mut self,
+        by: &UnitKey,
+        target: &str,
+        include: &[String],
+        exclude: &[String],
+        t: f64,
+    ) {
+        let Some(i) = self.blocks.iter().position(|b| b.id == target) else {
+            if !self.finished_set.contains(target) {
+                self.warn(
+                    by.to_string(),
+                    KnownWarning::NoSuchTarget,
+                    format!("cannot interrupt block '{target}': no such block"),
+                );
+            }
+            return;
+        };
+        for id in include.iter().chain(exclude) {
+            if self.blocks[i].behaviour(id).is_none() {
+                self.warn(
+                    by.to_string(),
+                    KnownWarning::NoSuchTarget,
+                    format!("block '{target}' has no behaviour '{id}'"),
+                );
+            }
+        }
+        let b = &mut self.blocks[i];
+        let start = b.start;
+        for x in &mut b.behaviours {
+            let selected =
+                (include.is_empty() || include.contains(&x.id)) && !exclude.contains(&x.id);
+            if !selected {
+                continue;
+            }
+            let key = UnitKey::new(&b.id, &x.id);
+            match x.phase {
+                Phase::Planned => x.phase = Phase::Removed,
+                Phase::Added => {
+                    self.registry.engine_mut(x.engine).remove(&key);
+                    x.phase = Phase::Removed;
+                }
+                Phase::Running => {
+                    let global: Vec<_> = x
+                        .syncs
+                        .iter()
+                        .map(|(n, l)| (n.clone(), start + l))
+                        .collect();
+                    let times = self
+                        .registry
+                        .engine_mut(x.engine)
+                        .interrupt(&key, t, &global);
+                    x.retime(&times, start, t);
+                }
+                Phase::Ended | Phase::Removed => {}
+            }
+        }
+        if self.blocks[i].started() {
+            self.finish_if_done(i, t);
+        }
+    }
+
+    // ---------------------------------------------------------------------------------------
+    // the event loop
+
+    /// The earliest unreported sync of a running block: (global time, block index, behaviour
+    /// index). Ties go to the earlier block, then document order.
+    fn next_sync(&self) -> Option<(f64, usize, usize)> {
+        let mut best: Option<((f64, u64, usize), usize, usize)> = None;
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if !b.started() {
+                continue;
+            }
+            for (xi, x) in b.behaviours.iter().enumerate() {
+                if !matches!(x.phase, Phase::Added | Phase::Running) || x.next >= x.syncs.len() {
+                    continue;
+                }
+                let order = (b.start + x.syncs[x.next].1, b.seq, x.index);
+                if best.is_none_or(|(o, _, _)| order < o) {
+                    best = Some((order, bi, xi));
+                }
+            }
+        }
+        best.map(|((t, _, _), bi, xi)| (t, bi, xi))
+    }
+
+    fn sync_feedback(&mut self, block: &str, behaviour: &str, sync: &str, local: f64, t: f64) {
+        let character_id = self.character.clone();
+        self.emit(Feedback::SyncPointProgress(SyncPointProgress {
+            block: block.to_string(),
+            behaviour: behaviour.to_string(),
+            sync: sync.to_string(),
+            time: local,
+            global_time: t,
+            character_id,
+            posix_time: None,
+        }));
+    }
+
+    /// Moves time to `to`: every sync point up to then passes in time order with its feedback and
+    /// consequences (control actions, block ends, blocks that were waiting), then parameter
+    /// changes apply and every engine plays into `frame`.
+    pub fn advance(&mut self, to: f64, frame: &mut Frame) {
+        let to = to.max(self.now);
+        while let Some((t, bi, xi)) = self.next_sync() {
+            if t > to {
+                break;
+            }
+            self.now = t;
+            self.pass_sync(bi, xi, t);
+        }
+        self.now = to;
+        self.apply_changes(to);
+        for e in self.registry.engines_mut() {
+            e.play(to, frame);
+        }
+    }
+
+    fn pass_sync(&mut self, bi: usize, xi: usize, t: f64) {
+        let (block_id, beh_id, sync, local, engine, last) = {
+            let b = &mut self.blocks[bi];
+            let x = &mut b.behaviours[xi];
+            let (name, local) = x.syncs[x.next].clone();
+            x.next += 1;
+            x.phase = Phase::Running;
+            (
+                b.id.clone(),
+                x.id.clone(),
+                name,
+                local,
+                x.engine,
+                x.next == x.syncs.len(),
+            )
+        };
+        self.sync_feedback(&block_id, &beh_id, &sync, local, t);
+        let key = UnitKey::new(&block_id, &beh_id);
+        let mut actions = Vec::new();
+        self.registry
+            .engine_mut(engine)
+            .sync_passed(&key, &sync, t, &mut actions);
+        if last {
+            self.blocks[bi].behaviours[xi].phase = Phase::Ended;
+            self.registry.engine_mut(engine).remove(&key);
+        }
+        if self.blocks[bi].update_subsiding() {
+            self.start_ready(t);
+        }
+        for a in actions {
+            self.act(a, t);
+        }
+        if let Some(bi) = self.blocks.iter().position(|b| b.id == block_id) {
+            self.finish_if_done(bi, t);
+        }
+    }
+
+    fn act(&mut self, action: Action, t: f64) {
+        match action {
+            Action::Interrupt {
+                by,
+                target,
+                include,
+                exclude,
+            } => self.interrupt_behaviours(&by, &target, &include, &exclude, t),
+            Action::Activate { by, target } => self.activate(&target, t, &by.to_string()),
+            Action::ChangeParameter(mut c) => {
+                let engine = self
+                    .blocks
+                    .iter()
+                    .find(|b| b.id == c.target.block)
+                    .and_then(|b| b.behaviour(&c.target.behaviour))
+                    .filter(|x| matches!(x.phase, Phase::Added | Phase::Running))
+                    .map(|x| x.engine);
+                let Some(engine) = engine else {
+                    self.warn(
+                        c.by.to_string(),
+                        KnownWarning::NoSuchTarget,
+                        format!(
+                            "cannot change '{}' of {}: it is not in the running plan",
+                            c.param, c.target
+                        ),
+                    );
+                    return;
+                };
+                if c.initial.is_none() {
+                    // S64: start from the target's current value
+                    c.initial = self.registry.engine(engine).parameter(&c.target, &c.param);
+                    if c.initial.is_none() {
+                        self.warn(
+                            c.by.to_string(),
+                            KnownWarning::ExecutionFailure,
+                            format!("{} has no parameter '{}'", c.target, c.param),
+                        );
+                        return;
+                    }
+                }
+                self.changes.push(c);
+                self.apply_changes(t);
+            }
+        }
+    }
+
+    /// Sets every running parameter change's value at `t`; changes past their end are done (the
+    /// value stays, S65).
+    fn apply_changes(&mut self, t: f64) {
+        let changes = std::mem::take(&mut self.changes);
+        for c in changes {
+            let found = self
+                .blocks
+                .iter()
+                .position(|b| b.id == c.target.block)
+                .and_then(|bi| {
+                    let xi = self.blocks[bi]
+                        .behaviours
+                        .iter()
+                        .position(|x| x.id == c.target.behaviour)?;
+                    Some((bi, xi))
+                });
+            let Some((bi, xi)) = found else { continue };
+            let x = &self.blocks[bi].behaviours[xi];
+            if !matches!(x.phase, Phase::Added | Phase::Running) {
+                continue; // the target ended: nothing to change any more
+            }
+            let value = c.value_at(c.initial.unwrap_or(c.target_value), t.max(c.start));
+            let engine = x.engine;
+            match self
+                .registry
+                .engine_mut(engine)
+                .set_parameter(&c.target, &c.param, value, t)
+            {
+                Ok(retimed) => {
+                    if let Some(times) = retimed {
+                        let start = self.blocks[bi].start;
+                        self.blocks[bi].behaviours[xi].retime(&times, start, t);
+                    }
+                    if t < c.end {
+                        self.changes.push(c);
+                    }
+                }
+                Err(e) => self.warn(c.by.to_string(), KnownWarning::ExecutionFailure, e.0),
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

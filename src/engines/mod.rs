@@ -1,0 +1,71 @@
+//! The built-in engines and the default registry that maps every BML 1.0, BMLA and BMLT behaviour
+//! kind to one of them:
+//!
+//! - [`control`]: `wait`, `interrupt`, `activate`, `parametervaluechange`;
+//! - [`speech`]: `speech` and `bmlt:text` with the headless speech timing model, `volume` settable
+//!   while speaking;
+//! - [`timing_only`]: every other kind, timing only until its animation engine lands: it plays the
+//!   scheduled pegs and reports every sync point, but moves no body.
+
+pub mod control;
+pub mod speech;
+pub mod timing_only;
+
+use crate::bml::{NS_BML, NS_BMLA, NS_BMLT, NS_CORE_EXT};
+use crate::engine::timing::DefaultTimingModels;
+use crate::engine::{KindKey, Registry};
+
+/// Kinds the timing-only motion engine realizes (namespace, element).
+pub const MOTION_KINDS: &[(&str, &str)] = &[
+    (NS_BML, "gesture"),
+    (NS_BML, "pointing"),
+    (NS_BML, "head"),
+    (NS_BML, "headDirectionShift"),
+    (NS_BML, "gaze"),
+    (NS_BML, "gazeShift"),
+    (NS_BML, "posture"),
+    (NS_BML, "postureShift"),
+    (NS_BML, "face"),
+    (NS_BML, "faceLexeme"),
+    (NS_BML, "faceShift"),
+    (NS_CORE_EXT, "faceFacs"),
+    (NS_BML, "locomotion"),
+    (NS_BMLT, "procanimation"),
+    (NS_BMLT, "procanimationgesture"),
+    (NS_BMLT, "keyframe"),
+    (NS_BMLT, "noise"),
+    (NS_BMLT, "transition"),
+    (NS_BMLT, "controller"),
+    (NS_BMLT, "facemorph"),
+];
+
+fn keys(kinds: &[(&str, &str)]) -> Vec<KindKey> {
+    kinds.iter().map(|(ns, n)| KindKey::new(ns, n)).collect()
+}
+
+/// A registry with every built-in engine, using `models` for timing.
+pub fn default_registry(models: DefaultTimingModels) -> Registry {
+    let mut r = Registry::new();
+    r.register(
+        Box::new(control::ControlEngine::default()),
+        &keys(&[
+            (NS_BML, "wait"),
+            (NS_BMLA, "interrupt"),
+            (NS_BMLA, "activate"),
+            (NS_BMLA, "parametervaluechange"),
+        ]),
+    );
+    r.register(
+        Box::new(speech::SpeechEngine::new(models.speech)),
+        &keys(&[(NS_BML, "speech"), (NS_BMLT, "text")]),
+    );
+    r.register(
+        Box::new(timing_only::TimingOnlyEngine::motion(models)),
+        &keys(MOTION_KINDS),
+    );
+    r.register(
+        Box::new(timing_only::TimingOnlyEngine::audio(models)),
+        &keys(&[(NS_BMLT, "audiofile")]),
+    );
+    r
+}

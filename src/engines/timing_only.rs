@@ -1,0 +1,125 @@
+//! The timing-only engine: realizes the BML kinds whose animation engine has not landed yet
+//! (gesture, pointing, head, gaze, posture, face, locomotion, BMLT animation kinds) and BMLT audio.
+//! It takes the default timing models, plays units exactly at their scheduled sync times and lets
+//! the runtime report every sync point; the frame shows each unit's progress. Motion interrupted
+//! goes to `relax` at once and keeps its retraction; audio stops at once. It moves no joints: the
+//! support table (`docs/bml-support.md`) marks these kinds "timing only".
+
+use std::collections::HashMap;
+
+use crate::bml::{Behaviour, BehaviourKind};
+use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::engine::{relax_now, stop_now, Engine, EngineError, Frame, Output, Unit, UnitKey};
+use crate::schedule::SyncName;
+
+/// The timing-only engine (see the module documentation).
+#[derive(Debug)]
+pub struct TimingOnlyEngine {
+    name: &'static str,
+    models: DefaultTimingModels,
+    stop_on_interrupt: bool,
+    units: HashMap<UnitKey, Vec<(SyncName, f64)>>,
+}
+
+impl TimingOnlyEngine {
+    /// The engine for motion kinds: interrupted units retract gracefully.
+    pub fn motion(models: DefaultTimingModels) -> Self {
+        TimingOnlyEngine {
+            name: "motion",
+            models,
+            stop_on_interrupt: false,
+            units: HashMap::new(),
+        }
+    }
+
+    /// The engine for audio: interrupted units stop at once.
+    pub fn audio(models: DefaultTimingModels) -> Self {
+        TimingOnlyEngine {
+            name: "audio",
+            models,
+            stop_on_interrupt: true,
+            units: HashMap::new(),
+        }
+    }
+}
+
+impl Engine for TimingOnlyEngine {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        match behaviour.kind {
+            BehaviourKind::Unknown(_)
+            | BehaviourKind::Speech(_)
+            | BehaviourKind::Text(_)
+            | BehaviourKind::Wait(_)
+            | BehaviourKind::Interrupt(_)
+            | BehaviourKind::Activate(_)
+            | BehaviourKind::ParameterValueChange(_) => None,
+            _ => self.models.model(behaviour),
+        }
+    }
+
+    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&'static str> {
+        match behaviour.kind {
+            BehaviourKind::Gaze(_) => Some("gaze"),
+            BehaviourKind::Posture(_) => Some("posture"),
+            _ => None,
+        }
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        self.units.insert(unit.key.clone(), unit.syncs.to_vec());
+        Ok(())
+    }
+
+    fn remove(&mut self, key: &UnitKey) {
+        self.units.remove(key);
+    }
+
+    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+        let times = if self.stop_on_interrupt {
+            stop_now(now, syncs)
+        } else {
+            relax_now(now, syncs)
+        };
+        if let Some(u) = self.units.get_mut(key) {
+            for (s, t) in u.iter_mut().zip(&times) {
+                s.1 = *t;
+            }
+        }
+        times
+    }
+
+    fn len(&self) -> usize {
+        self.units.len()
+    }
+
+    fn play(&mut self, now: f64, frame: &mut Frame) {
+        let mut running: Vec<(&UnitKey, f64)> = self
+            .units
+            .iter()
+            .filter_map(|(k, s)| {
+                let (start, end) = (s.first()?.1, s.last()?.1);
+                (start <= now && now < end).then(|| {
+                    let p = if end.is_finite() {
+                        (now - start) / (end - start)
+                    } else {
+                        0.0
+                    };
+                    (k, p.clamp(0.0, 1.0))
+                })
+            })
+            .collect();
+        running.sort_by(|a, b| a.0.cmp(b.0));
+        for (key, progress) in running {
+            frame.outputs.push(Output {
+                key: key.clone(),
+                engine: self.name,
+                progress,
+                params: Vec::new(),
+            });
+        }
+    }
+}

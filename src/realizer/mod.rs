@@ -1,0 +1,234 @@
+//! The realizer facade a host embeds: submit BML text, call [`Realizer::tick`] each frame, read
+//! frames and feedback. Blocks are routed to characters by `characterId`; each character has its
+//! own engines and [`BlockManager`]. Also the [`RealizerPort`] trait, the string-level port that
+//! the CLI and test harnesses drive.
+
+use std::collections::BTreeMap;
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use crate::blocks::BlockManager;
+use crate::bml::{self, BmlError, Diagnostic};
+use crate::engine::timing::DefaultTimingModels;
+use crate::engine::{Frame, Registry};
+use crate::engines::default_registry;
+use crate::feedback::{Feedback, FeedbackListener, KnownWarning, WarningFeedback};
+use crate::schedule::{Optimal, SchedulingStrategy};
+
+/// The id used in warnings about a block whose id could not be read.
+pub const NO_ID: &str = "<no id>";
+
+/// The string-level realizer port (BML in, feedback out), as in RealizerTester and AsapRealizer.
+pub trait RealizerPort {
+    /// Submits one `<bml>` block as text. Problems are reported as warning feedback.
+    fn perform_bml(&mut self, bml: &str);
+    /// Adds a listener that receives every feedback message from now on.
+    fn add_listener(&mut self, listener: Box<dyn FeedbackListener>);
+}
+
+type RegistryFactory = Box<dyn Fn() -> Registry>;
+type StrategyFactory = Box<dyn Fn() -> Box<dyn SchedulingStrategy>>;
+
+/// A BML realizer for one or more characters.
+pub struct Realizer {
+    characters: BTreeMap<String, BlockManager>,
+    default_character: Option<String>,
+    engines: RegistryFactory,
+    strategy: StrategyFactory,
+    listeners: Vec<Box<dyn FeedbackListener>>,
+    posix_time: bool,
+    now: f64,
+    unframed: Vec<Feedback>,
+}
+
+impl Default for Realizer {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Realizer {
+    /// A realizer with the built-in engines and the `Optimal` scheduler, at time 0.
+    pub fn new() -> Self {
+        Realizer {
+            characters: BTreeMap::new(),
+            default_character: None,
+            engines: Box::new(|| default_registry(DefaultTimingModels::default())),
+            strategy: Box::new(|| Box::new(Optimal)),
+            listeners: Vec::new(),
+            posix_time: false,
+            now: 0.0,
+            unframed: Vec::new(),
+        }
+    }
+
+    /// Uses `factory` to make the engines of each character (register extra kinds and engines
+    /// here, S76).
+    pub fn with_engines(mut self, factory: impl Fn() -> Registry + 'static) -> Self {
+        self.engines = Box::new(factory);
+        self
+    }
+
+    /// Uses another scheduling strategy (S40).
+    pub fn with_strategy(
+        mut self,
+        factory: impl Fn() -> Box<dyn SchedulingStrategy> + 'static,
+    ) -> Self {
+        self.strategy = Box::new(factory);
+        self
+    }
+
+    /// Blocks without a `characterId` go to character `id` (their feedback names it).
+    pub fn with_default_character(mut self, id: Option<String>) -> Self {
+        self.default_character = id;
+        self
+    }
+
+    /// Stamps block and sync progress with `bmla:posixTime` (for wall-clock runs; virtual-clock
+    /// runs leave it out so that logs are byte-identical).
+    pub fn with_posix_time(mut self, on: bool) -> Self {
+        self.posix_time = on;
+        self
+    }
+
+    /// The current time: the last `tick`.
+    pub fn now(&self) -> f64 {
+        self.now
+    }
+
+    /// The character ids with a block manager ("" is the default character).
+    pub fn characters(&self) -> impl Iterator<Item = (&str, &BlockManager)> {
+        self.characters.iter().map(|(k, v)| (k.as_str(), v))
+    }
+
+    /// The block manager of character `id` ("" for the default character), if it has one.
+    pub fn character(&self, id: &str) -> Option<&BlockManager> {
+        self.characters.get(id)
+    }
+
+    /// The time of the next scheduled event of any character, if any (see
+    /// [`BlockManager::next_event`]).
+    pub fn next_event(&self) -> Option<f64> {
+        self.characters
+            .values()
+            .filter_map(BlockManager::next_event)
+            .reduce(f64::min)
+    }
+
+    fn manager(&mut self, character: Option<String>) -> &mut BlockManager {
+        let character = character.or_else(|| self.default_character.clone());
+        let key = character.clone().unwrap_or_default();
+        let now = self.now;
+        let (engines, strategy) = (&self.engines, &self.strategy);
+        self.characters.entry(key).or_insert_with(|| {
+            let mut m = BlockManager::new(engines(), strategy(), character);
+            m.advance(now, &mut Frame::default());
+            m
+        })
+    }
+
+    /// Submits one `<bml>` block at the current time. Invalid BML yields a PARSING_FAILURE
+    /// warning (and the error, for callers that want it); the stream keeps working.
+    pub fn perform_bml(&mut self, text: &str) -> Result<(), BmlError> {
+        let (block, diagnostics) = bml::check(text);
+        let errors: Vec<&Diagnostic> = diagnostics.iter().filter(|d| d.is_error()).collect();
+        match block {
+            Some(block) if errors.is_empty() => {
+                let m = self.manager(block.character_id.clone());
+                m.submit(block, &diagnostics);
+                let fb = m.take_feedback();
+                self.deliver(fb);
+                Ok(())
+            }
+            block => {
+                let id = block
+                    .as_ref()
+                    .map(|b| b.id.as_str())
+                    .filter(|id| !id.is_empty())
+                    .unwrap_or(NO_ID)
+                    .to_string();
+                let character_id = block
+                    .and_then(|b| b.character_id)
+                    .or_else(|| self.default_character.clone());
+                let text = errors
+                    .iter()
+                    .map(|d| format!("{}:{}: {}", d.pos.line, d.pos.col, d.message))
+                    .collect::<Vec<_>>()
+                    .join("; ");
+                self.deliver(vec![Feedback::Warning(WarningFeedback {
+                    id,
+                    kind: KnownWarning::ParsingFailure.into(),
+                    character_id,
+                    text: if text.is_empty() {
+                        "the block could not be read".into()
+                    } else {
+                        text
+                    },
+                })]);
+                let mut diagnostics = diagnostics;
+                diagnostics.retain(Diagnostic::is_error);
+                Err(BmlError(diagnostics))
+            }
+        }
+    }
+
+    /// Adds a listener that receives every feedback message from now on, in order.
+    pub fn add_listener(&mut self, listener: Box<dyn FeedbackListener>) {
+        self.listeners.push(listener);
+    }
+
+    fn deliver(&mut self, mut feedback: Vec<Feedback>) {
+        if self.posix_time {
+            let ms = SystemTime::now()
+                .duration_since(UNIX_EPOCH)
+                .map_or(0, |d| d.as_millis() as u64);
+            for fb in &mut feedback {
+                match fb {
+                    Feedback::BlockProgress(p) => p.posix_time = Some(ms),
+                    Feedback::SyncPointProgress(p) => p.posix_time = Some(ms),
+                    _ => {}
+                }
+            }
+        }
+        for fb in &feedback {
+            for l in &mut self.listeners {
+                l.feedback(fb);
+            }
+        }
+        self.unframed.extend(feedback);
+    }
+
+    /// Moves time to `now` (never backwards): every character passes the sync points up to then
+    /// (characters in id order), engines play, and the frame holds their output and the feedback
+    /// sent since the previous frame.
+    pub fn tick(&mut self, now: f64) -> Frame {
+        let now = if now.is_finite() {
+            now.max(self.now)
+        } else {
+            self.now
+        };
+        self.now = now;
+        let mut frame = Frame {
+            time: now,
+            ..Frame::default()
+        };
+        let mut feedback = Vec::new();
+        for m in self.characters.values_mut() {
+            m.advance(now, &mut frame);
+            feedback.extend(m.take_feedback());
+        }
+        self.deliver(feedback);
+        frame.feedback = std::mem::take(&mut self.unframed);
+        frame
+    }
+}
+
+impl RealizerPort for Realizer {
+    fn perform_bml(&mut self, bml: &str) {
+        // the error is also reported as warning feedback
+        let _ = Realizer::perform_bml(self, bml);
+    }
+
+    fn add_listener(&mut self, listener: Box<dyn FeedbackListener>) {
+        Realizer::add_listener(self, listener);
+    }
+}
