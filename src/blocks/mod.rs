@@ -481,13 +481,16 @@ impl BlockManager {
                 reason,
             );
         }
-        if self.finish_if_done(i, t) {
-            return;
+        if !self.blocks[i].all_ended() {
+            self.predict(i, false);
         }
-        self.predict(i, false);
+        // activations may start (and end) other blocks: find this one again by id afterwards
         let on_start = self.blocks[i].source.ext.on_start.clone();
         for target in on_start {
             self.activate(&target, t, &id);
+        }
+        if let Some(i) = self.blocks.iter().position(|b| b.id == id) {
+            self.finish_if_done(i, t);
         }
     }
 

@@ -50,7 +50,8 @@ pub struct TimingModel {
 }
 
 impl TimingModel {
-    fn new(keys: &[(&'static str, f64)], flexibility: Flexibility) -> Self {
+    /// A model with static key names at preferred times (seconds from `start`).
+    pub fn new(keys: &[(&'static str, f64)], flexibility: Flexibility) -> Self {
         TimingModel {
             keys: keys
                 .iter()
@@ -64,8 +65,8 @@ impl TimingModel {
         }
     }
 
-    /// A stretchable model with the default bounds.
-    fn stretchable(keys: &[(&'static str, f64)]) -> Self {
+    /// A stretchable model with the default bounds (any duration above [`MIN_DURATION`]).
+    pub fn stretchable(keys: &[(&'static str, f64)]) -> Self {
         Self::new(
             keys,
             Flexibility::Stretchable {
