@@ -1,13 +1,29 @@
-//! The `bmlr` command line: exit codes and output of `bmlr validate` (DESIGN §5).
+//! The `bmlr` command line: exit codes and output of `validate`, `run` and `plan` (DESIGN §5).
 
 use std::process::Command;
 
 fn bmlr(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+    bmlr_stdin(args, "")
+}
+
+fn bmlr_stdin(args: &[&str], input: &str) -> (i32, String, String) {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
         .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(input.as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -60,4 +76,93 @@ fn validate_missing_file_exits_2() {
 fn usage_error_exits_2() {
     let (code, _, _) = bmlr(&["validate"]);
     assert_eq!(code, 2);
+}
+
+#[test]
+fn plan_prints_block_relative_and_global_times() {
+    let (code, out, err) = bmlr(&[
+        "plan",
+        "fixtures/examples/welcome.xml",
+        &format!("{RT}/core/testspeechappend.xml"),
+    ]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "greet start 0.000 end 2.900");
+    assert_eq!(lines[2], "  greet:hello:stress 0.600 (0.600)");
+    assert!(lines.contains(&"  greet:beat:stroke 0.600 (0.600)"));
+    // the appended block is planned after the greeting
+    assert_eq!(
+        &lines[lines.len() - 3..],
+        [
+            "bml2 start 2.900 end 4.600",
+            "  bml2:speech1:start 0.000 (2.900)",
+            "  bml2:speech1:end 1.700 (4.600)",
+        ]
+    );
+}
+
+#[test]
+fn run_reads_a_stream_of_blocks_with_clock_advances_from_stdin() {
+    let input = format!(
+        "{}\n+1\nnot bml at all\n<bml xmlns=\"http://www.bml-initiative.org/bml/bml-1.0\" id=\"b\">\n<head id=\"h\" lexeme=\"NOD\"/>\n</bml>\n",
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><speech id="s"><text>Hi</text></speech></bml>"#
+    );
+    let (code, out, err) = bmlr_stdin(&["run", "--format", "jsonl", "-"], &input);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let has = |needle: &str| out.lines().any(|l| l.contains(needle));
+    assert!(has(r#""id":"a:end","globalTime":0.2"#), "{out}");
+    assert!(has(r#""type":"PARSING_FAILURE""#), "{out}");
+    // the block after the garbage runs, one second later
+    assert!(has(r#""id":"b:start","globalTime":1.0"#), "{out}");
+    assert!(has(r#""id":"b:end","globalTime":1.6"#), "{out}");
+}
+
+#[test]
+fn run_until_stops_the_clock_and_says_what_did_not_finish() {
+    let (code, out, err) = bmlr(&["run", "--until", "1", "fixtures/examples/long-speech.xml"]);
+    assert_eq!(code, 0);
+    assert!(!out.contains("talk:end"));
+    assert!(out.contains(r#"id="talk:nod1:start""#));
+    assert!(!out.contains(r#"id="talk:nod1:ready""#)); // at 1.083
+    assert_eq!(
+        err,
+        "bmlr run: block 'talk' did not finish at 1.000 s: IN_EXEC, still running\n"
+    );
+}
+
+#[test]
+fn run_usage_and_io_errors_exit_2() {
+    let (code, _, err) = bmlr(&["run", "no/such/file.xml"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.starts_with("bmlr run: no/such/file.xml: cannot read"),
+        "{err}"
+    );
+    let (code, _, err) = bmlr(&["run", "+soon", "fixtures/examples/welcome.xml"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("'+soon' is not a clock advance"), "{err}");
+    let (code, _, _) = bmlr(&["run", "--until", "-1", "fixtures/examples/welcome.xml"]);
+    assert_eq!(code, 2);
+}
+
+#[test]
+fn run_gives_byte_identical_logs_and_both_formats_carry_the_same_messages() {
+    let args = [
+        "run",
+        "fixtures/examples/long-speech.xml",
+        "+1.5",
+        "fixtures/examples/interrupt-speech.xml",
+    ];
+    let (_, a, _) = bmlr(&args);
+    let (_, b, _) = bmlr(&args);
+    assert_eq!(a, b);
+    let mut jsonl = vec!["run", "--format", "jsonl"];
+    jsonl.extend_from_slice(&args[1..]);
+    let (_, j, _) = bmlr(&jsonl);
+    let decode = |text: &str| -> Vec<bml_realizer::feedback::Feedback> {
+        text.lines()
+            .map(|l| bml_realizer::feedback::from_line(l).unwrap())
+            .collect()
+    };
+    assert_eq!(decode(&a), decode(&j));
 }

@@ -149,7 +149,7 @@ fn scenario4_keeping_the_turn_by_speaking_louder() {
         frame
             .outputs
             .iter()
-            .find(|o| o.key == key)
+            .find(|o| *o.key == key)
             .and_then(|o| o.params.iter().find(|p| p.0 == "volume").map(|p| p.1))
             .unwrap()
     };

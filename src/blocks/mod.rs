@@ -11,7 +11,7 @@
 
 mod live;
 
-use std::collections::{HashSet, VecDeque};
+use std::collections::{HashMap, HashSet, VecDeque};
 
 use crate::bml::{self, Diagnostic, SyncPoint};
 use crate::engine::{Action, Frame, ParameterChange, Registry, Unit, UnitKey};
@@ -44,7 +44,12 @@ pub struct BlockManager {
     registry: Registry,
     strategy: Box<dyn SchedulingStrategy>,
     character: Option<String>,
+    /// Live blocks in arrival order (so sorted by `seq`).
     blocks: Vec<LiveBlock>,
+    /// Block id → seq, to find a block without scanning.
+    index: HashMap<String, u64>,
+    /// How many blocks are LURKING (nothing to check when none is).
+    lurking: usize,
     finished: VecDeque<String>,
     finished_set: HashSet<String>,
     changes: Vec<ParameterChange>,
@@ -56,7 +61,14 @@ pub struct BlockManager {
 /// Times of other blocks' syncs relative to the start of a block being scheduled.
 struct OtherBlocks<'a> {
     blocks: &'a [LiveBlock],
+    index: &'a HashMap<String, u64>,
     start: f64,
+}
+
+/// Where block `id` is in `blocks` (sorted by seq).
+fn position(blocks: &[LiveBlock], index: &HashMap<String, u64>, id: &str) -> Option<usize> {
+    let seq = *index.get(id)?;
+    blocks.binary_search_by_key(&seq, |b| b.seq).ok()
 }
 
 impl ExternalTimes for OtherBlocks<'_> {
@@ -69,7 +81,7 @@ impl ExternalTimes for OtherBlocks<'_> {
         else {
             return None; // anticipators are not registered with the runtime yet
         };
-        let b = self.blocks.iter().find(|b| &b.id == block)?;
+        let b = &self.blocks[position(self.blocks, self.index, block)?];
         let local = b.behaviour(behaviour)?.time(sync)?;
         Some(b.start + local - self.start)
     }
@@ -87,6 +99,8 @@ impl BlockManager {
             strategy,
             character,
             blocks: Vec::new(),
+            index: HashMap::new(),
+            lurking: 0,
             finished: VecDeque::new(),
             finished_set: HashSet::new(),
             changes: Vec::new(),
@@ -123,8 +137,8 @@ impl BlockManager {
 
     /// Status of block `id`: its live status, DONE if it finished recently, `None` if unknown.
     pub fn status(&self, id: &str) -> Option<BlockStatus> {
-        match self.blocks.iter().find(|b| b.id == id) {
-            Some(b) => Some(b.status),
+        match self.pos(id) {
+            Some(i) => Some(self.blocks[i].status),
             None => self.finished_set.contains(id).then_some(BlockStatus::Done),
         }
     }
@@ -248,8 +262,8 @@ impl BlockManager {
     /// id is in use or its required behaviours cannot be scheduled.
     pub fn submit(&mut self, block: bml::Block, warnings: &[Diagnostic]) {
         let now = self.now;
-        if let Some(b) = self.blocks.iter().find(|b| b.id == block.id) {
-            let status = b.status;
+        if let Some(i) = self.pos(&block.id) {
+            let status = self.blocks[i].status;
             self.warn(
                 block.id.clone(),
                 KnownWarning::ImpossibleToSchedule,
@@ -300,6 +314,7 @@ impl BlockManager {
         let schedule = {
             let external = OtherBlocks {
                 blocks: &self.blocks,
+                index: &self.index,
                 start,
             };
             self.strategy
@@ -333,7 +348,7 @@ impl BlockManager {
         let ext = live.source.ext.clone();
         for (targets, chunk) in [(&ext.chunk_before, true), (&ext.prepend_before, false)] {
             for t in targets {
-                match self.blocks.iter_mut().find(|b| &b.id == t) {
+                match self.pos(t).map(|i| &mut self.blocks[i]) {
                     Some(b) if !b.started() => {
                         let list = if chunk {
                             &mut b.chunk_after
@@ -358,6 +373,7 @@ impl BlockManager {
         // S26, S27
         live.status = BlockStatus::Pending;
         live.preplan = ext.preplan;
+        self.index.insert(live.id.clone(), live.seq);
         self.blocks.push(live);
         let i = self.blocks.len() - 1;
         self.predict(i, true);
@@ -371,7 +387,7 @@ impl BlockManager {
     fn existing(&mut self, ids: &[String], by: &str) -> Vec<String> {
         let mut v = Vec::new();
         for id in ids {
-            if self.blocks.iter().any(|b| &b.id == id) {
+            if self.pos(id).is_some() {
                 v.push(id.clone());
             } else if !self.finished_set.contains(id) {
                 self.warn(
@@ -386,12 +402,18 @@ impl BlockManager {
 
     fn predicted_start(&self, now: f64, waits_for: &[String], chunk_after: &[String]) -> f64 {
         let mut start = now;
-        for b in &self.blocks {
-            if waits_for.contains(&b.id) {
-                start = start.max(b.predicted_end().unwrap_or(now));
-            }
-            if chunk_after.contains(&b.id) {
-                start = start.max(b.predicted_subsiding().unwrap_or(now));
+        for (ids, subsiding) in [(waits_for, false), (chunk_after, true)] {
+            for b in ids
+                .iter()
+                .filter_map(|id| self.pos(id))
+                .map(|i| &self.blocks[i])
+            {
+                let t = if subsiding {
+                    b.predicted_subsiding()
+                } else {
+                    b.predicted_end()
+                };
+                start = start.max(t.unwrap_or(now));
             }
         }
         if start.is_finite() {
@@ -401,10 +423,18 @@ impl BlockManager {
         }
     }
 
+    /// Where block `id` is in `self.blocks`.
+    fn pos(&self, id: &str) -> Option<usize> {
+        position(&self.blocks, &self.index, id)
+    }
+
     /// A PENDING block that may run: LURKING (with its prediction) until what it waits for is
     /// done; [`start_ready`](Self::start_ready) starts it.
     fn release(&mut self, i: usize, now: f64) {
         self.blocks[i].preplan = false;
+        if self.blocks[i].status != BlockStatus::Lurking {
+            self.lurking += 1;
+        }
         if self.ready(i) {
             self.blocks[i].status = BlockStatus::Lurking;
         } else {
@@ -421,7 +451,7 @@ impl BlockManager {
     /// S29: every append target is done and every chunk target subsiding or done.
     fn ready(&self, i: usize) -> bool {
         let b = &self.blocks[i];
-        let live = |id: &String| self.blocks.iter().find(|x| &x.id == id);
+        let live = |id: &String| self.pos(id).map(|i| &self.blocks[i]);
         b.waits_for.iter().all(|id| live(id).is_none())
             && b.chunk_after.iter().all(|id| {
                 live(id)
@@ -432,7 +462,7 @@ impl BlockManager {
     /// Starts every LURKING block that is ready, at `t`, until none is left (a start can end a
     /// block at once, which can make others ready).
     fn start_ready(&mut self, t: f64) {
-        loop {
+        while self.lurking > 0 {
             let next = (0..self.blocks.len())
                 .find(|&i| self.blocks[i].status == BlockStatus::Lurking && self.ready(i));
             match next {
@@ -444,6 +474,9 @@ impl BlockManager {
 
     /// S30: the block peg moves to `t`, start feedback, onStart activations, units to engines.
     fn start_block(&mut self, i: usize, t: f64) {
+        if self.blocks[i].status == BlockStatus::Lurking {
+            self.lurking -= 1;
+        }
         let b = &mut self.blocks[i];
         b.start = t;
         b.status = BlockStatus::InExec;
@@ -489,14 +522,14 @@ impl BlockManager {
         for target in on_start {
             self.activate(&target, t, &id);
         }
-        if let Some(i) = self.blocks.iter().position(|b| b.id == id) {
+        if let Some(i) = self.pos(&id) {
             self.finish_if_done(i, t);
         }
     }
 
     /// Activates pre-planned block `target` (by `activate` or onStart, S28).
     fn activate(&mut self, target: &str, t: f64, by: &str) {
-        match self.blocks.iter().position(|b| b.id == target) {
+        match self.pos(target) {
             Some(j) if self.blocks[j].status == BlockStatus::Pending => {
                 self.release(j, t);
                 self.start_ready(t);
@@ -523,6 +556,10 @@ impl BlockManager {
     /// Removes block `i` from the plan with end feedback of `status`, then starts what waited.
     fn end_block(&mut self, i: usize, t: f64, status: BlockStatus) {
         let b = self.blocks.remove(i);
+        self.index.remove(&b.id);
+        if b.status == BlockStatus::Lurking {
+            self.lurking -= 1;
+        }
         for x in &b.behaviours {
             if matches!(x.phase, Phase::Added | Phase::Running | Phase::Ended) {
                 self.registry
@@ -554,7 +591,7 @@ impl BlockManager {
     /// that started reports its remaining syncs now, the others are dropped, and it ends
     /// INTERRUPTED.
     fn interrupt_block_by_id(&mut self, target: &str, t: f64, by: &str) {
-        let Some(i) = self.blocks.iter().position(|b| b.id == target) else {
+        let Some(i) = self.pos(target) else {
             if !self.finished_set.contains(target) {
                 self.warn(
                     by.to_string(),
@@ -597,7 +634,7 @@ impl BlockManager {
         exclude: &[String],
         t: f64,
     ) {
-        let Some(i) = self.blocks.iter().position(|b| b.id == target) else {
+        let Some(i) = self.pos(target) else {
             if !self.finished_set.contains(target) {
                 self.warn(
                     by.to_string(),
@@ -657,7 +694,8 @@ impl BlockManager {
     /// The earliest unreported sync of a running block: (global time, block index, behaviour
     /// index). Ties go to the earlier block, then document order.
     fn next_sync(&self) -> Option<(f64, usize, usize)> {
-        let mut best: Option<((f64, u64, usize), usize, usize)> = None;
+        // times equal within a nanosecond (float noise of the solver) count as ties
+        let mut best: Option<((i64, u64, usize), usize, usize)> = None;
         for (bi, b) in self.blocks.iter().enumerate() {
             if !b.started() {
                 continue;
@@ -666,13 +704,17 @@ impl BlockManager {
                 if !matches!(x.phase, Phase::Added | Phase::Running) || x.next >= x.syncs.len() {
                     continue;
                 }
-                let order = (b.start + x.syncs[x.next].1, b.seq, x.index);
+                let t = b.start + x.syncs[x.next].1;
+                let order = ((t * 1e9).round() as i64, b.seq, x.index);
                 if best.is_none_or(|(o, _, _)| order < o) {
                     best = Some((order, bi, xi));
                 }
             }
         }
-        best.map(|((t, _, _), bi, xi)| (t, bi, xi))
+        best.map(|(_, bi, xi)| {
+            let (b, x) = (&self.blocks[bi], &self.blocks[bi].behaviours[xi]);
+            (b.start + x.syncs[x.next].1, bi, xi)
+        })
     }
 
     fn sync_feedback(&mut self, block: &str, behaviour: &str, sync: &str, local: f64, t: f64) {
@@ -739,7 +781,7 @@ impl BlockManager {
         for a in actions {
             self.act(a, t);
         }
-        if let Some(bi) = self.blocks.iter().position(|b| b.id == block_id) {
+        if let Some(bi) = self.pos(&block_id) {
             self.finish_if_done(bi, t);
         }
     }
@@ -755,10 +797,8 @@ impl BlockManager {
             Action::Activate { by, target } => self.activate(&target, t, &by.to_string()),
             Action::ChangeParameter(mut c) => {
                 let engine = self
-                    .blocks
-                    .iter()
-                    .find(|b| b.id == c.target.block)
-                    .and_then(|b| b.behaviour(&c.target.behaviour))
+                    .pos(&c.target.block)
+                    .and_then(|i| self.blocks[i].behaviour(&c.target.behaviour))
                     .filter(|x| matches!(x.phase, Phase::Added | Phase::Running))
                     .map(|x| x.engine);
                 let Some(engine) = engine else {
@@ -795,17 +835,13 @@ impl BlockManager {
     fn apply_changes(&mut self, t: f64) {
         let changes = std::mem::take(&mut self.changes);
         for c in changes {
-            let found = self
-                .blocks
-                .iter()
-                .position(|b| b.id == c.target.block)
-                .and_then(|bi| {
-                    let xi = self.blocks[bi]
-                        .behaviours
-                        .iter()
-                        .position(|x| x.id == c.target.behaviour)?;
-                    Some((bi, xi))
-                });
+            let found = self.pos(&c.target.block).and_then(|bi| {
+                let xi = self.blocks[bi]
+                    .behaviours
+                    .iter()
+                    .position(|x| x.id == c.target.behaviour)?;
+                Some((bi, xi))
+            });
             let Some((bi, xi)) = found else { continue };
             let x = &self.blocks[bi].behaviours[xi];
             if !matches!(x.phase, Phase::Added | Phase::Running) {

@@ -6,6 +6,7 @@ mod registry;
 pub mod timing;
 
 use std::fmt;
+use std::sync::Arc;
 
 pub use registry::{KindKey, Registry};
 
@@ -118,14 +119,14 @@ pub enum Action {
 /// What one engine shows of one running unit in a frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Output {
-    /// The unit.
-    pub key: UnitKey,
+    /// The unit (shared with the engine: no copy per frame).
+    pub key: Arc<UnitKey>,
     /// The engine's name.
     pub engine: &'static str,
     /// Progress through the unit, 0 at start and 1 at end.
     pub progress: f64,
     /// Current parameter values (e.g. `volume` of a speech).
-    pub params: Vec<(String, f64)>,
+    pub params: Vec<(&'static str, f64)>,
 }
 
 /// Everything the realizer produced for one moment: engine output and the feedback sent since the

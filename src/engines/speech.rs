@@ -4,7 +4,7 @@
 //! retimes the words still to come. Interrupting a speech stops it at once. No audio is produced
 //! (headless); the frame shows each running speech's progress, volume and rate.
 
-use std::collections::HashMap;
+use std::sync::Arc;
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::engine::timing::{SpeechTiming, TimingModel, TimingModels};
@@ -16,6 +16,7 @@ pub const DEFAULT_VOLUME: f64 = 100.0;
 
 #[derive(Debug, Clone)]
 struct Speaking {
+    key: Arc<UnitKey>,
     syncs: Vec<(SyncName, f64)>,
     volume: f64,
     rate: f64,
@@ -25,7 +26,8 @@ struct Speaking {
 #[derive(Debug)]
 pub struct SpeechEngine {
     timing: SpeechTiming,
-    units: HashMap<UnitKey, Speaking>,
+    /// Units in the order they were added.
+    units: Vec<Speaking>,
 }
 
 impl SpeechEngine {
@@ -33,8 +35,14 @@ impl SpeechEngine {
     pub fn new(timing: SpeechTiming) -> Self {
         SpeechEngine {
             timing,
-            units: HashMap::new(),
+            units: Vec::new(),
         }
+    }
+}
+
+impl SpeechEngine {
+    fn unit_mut(&mut self, key: &UnitKey) -> Option<&mut Speaking> {
+        self.units.iter_mut().find(|u| *u.key == *key)
     }
 }
 
@@ -56,24 +64,23 @@ impl Engine for SpeechEngine {
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        self.units.insert(
-            unit.key.clone(),
-            Speaking {
-                syncs: unit.syncs.to_vec(),
-                volume: DEFAULT_VOLUME,
-                rate: 1.0,
-            },
-        );
+        self.remove(unit.key);
+        self.units.push(Speaking {
+            key: Arc::new(unit.key.clone()),
+            syncs: unit.syncs.to_vec(),
+            volume: DEFAULT_VOLUME,
+            rate: 1.0,
+        });
         Ok(())
     }
 
     fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
+        self.units.retain(|u| *u.key != *key);
     }
 
     fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
         let times = stop_now(now, syncs);
-        if let Some(u) = self.units.get_mut(key) {
+        if let Some(u) = self.unit_mut(key) {
             for (s, t) in u.syncs.iter_mut().zip(&times) {
                 s.1 = *t;
             }
@@ -86,28 +93,21 @@ impl Engine for SpeechEngine {
     }
 
     fn play(&mut self, now: f64, frame: &mut Frame) {
-        let mut running: Vec<(&UnitKey, &Speaking)> = self
-            .units
-            .iter()
-            .filter(|(_, u)| {
-                let (start, end) = span(&u.syncs);
-                start <= now && now < end
-            })
-            .collect();
-        running.sort_by(|a, b| a.0.cmp(b.0)); // deterministic frames
-        for (key, u) in running {
+        for u in &self.units {
             let (start, end) = span(&u.syncs);
-            frame.outputs.push(Output {
-                key: key.clone(),
-                engine: "speech",
-                progress: ((now - start) / (end - start)).clamp(0.0, 1.0),
-                params: vec![("volume".into(), u.volume), ("rate".into(), u.rate)],
-            });
+            if start <= now && now < end {
+                frame.outputs.push(Output {
+                    key: u.key.clone(),
+                    engine: "speech",
+                    progress: ((now - start) / (end - start)).clamp(0.0, 1.0),
+                    params: vec![("volume", u.volume), ("rate", u.rate)],
+                });
+            }
         }
     }
 
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
-        let u = self.units.get(key)?;
+        let u = self.units.iter().find(|u| *u.key == *key)?;
         match name {
             "volume" => Some(u.volume),
             "rate" => Some(u.rate),
@@ -123,8 +123,7 @@ impl Engine for SpeechEngine {
         now: f64,
     ) -> Result<Option<Vec<f64>>, EngineError> {
         let u = self
-            .units
-            .get_mut(key)
+            .unit_mut(key)
             .ok_or_else(|| EngineError(format!("{key} is not speaking")))?;
         match name {
             "volume" if value.is_finite() => {

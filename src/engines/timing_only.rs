@@ -5,7 +5,7 @@
 //! goes to `relax` at once and keeps its retraction; audio stops at once. It moves no joints: the
 //! support table (`docs/bml-support.md`) marks these kinds "timing only".
 
-use std::collections::HashMap;
+use std::sync::Arc;
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
@@ -18,7 +18,8 @@ pub struct TimingOnlyEngine {
     name: &'static str,
     models: DefaultTimingModels,
     stop_on_interrupt: bool,
-    units: HashMap<UnitKey, Vec<(SyncName, f64)>>,
+    /// Units in the order they were added (deterministic frames without sorting).
+    units: Vec<(Arc<UnitKey>, Vec<(SyncName, f64)>)>,
 }
 
 impl TimingOnlyEngine {
@@ -28,7 +29,7 @@ impl TimingOnlyEngine {
             name: "motion",
             models,
             stop_on_interrupt: false,
-            units: HashMap::new(),
+            units: Vec::new(),
         }
     }
 
@@ -38,7 +39,7 @@ impl TimingOnlyEngine {
             name: "audio",
             models,
             stop_on_interrupt: true,
-            units: HashMap::new(),
+            units: Vec::new(),
         }
     }
 }
@@ -70,12 +71,14 @@ impl Engine for TimingOnlyEngine {
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        self.units.insert(unit.key.clone(), unit.syncs.to_vec());
+        self.remove(unit.key);
+        self.units
+            .push((Arc::new(unit.key.clone()), unit.syncs.to_vec()));
         Ok(())
     }
 
     fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
+        self.units.retain(|(k, _)| **k != *key);
     }
 
     fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
@@ -84,7 +87,7 @@ impl Engine for TimingOnlyEngine {
         } else {
             relax_now(now, syncs)
         };
-        if let Some(u) = self.units.get_mut(key) {
+        if let Some((_, u)) = self.units.iter_mut().find(|(k, _)| **k == *key) {
             for (s, t) in u.iter_mut().zip(&times) {
                 s.1 = *t;
             }
@@ -97,27 +100,23 @@ impl Engine for TimingOnlyEngine {
     }
 
     fn play(&mut self, now: f64, frame: &mut Frame) {
-        let mut running: Vec<(&UnitKey, f64)> = self
-            .units
-            .iter()
-            .filter_map(|(k, s)| {
-                let (start, end) = (s.first()?.1, s.last()?.1);
-                (start <= now && now < end).then(|| {
-                    let p = if end.is_finite() {
-                        (now - start) / (end - start)
-                    } else {
-                        0.0
-                    };
-                    (k, p.clamp(0.0, 1.0))
-                })
-            })
-            .collect();
-        running.sort_by(|a, b| a.0.cmp(b.0));
-        for (key, progress) in running {
+        for (key, s) in &self.units {
+            let (Some(first), Some(last)) = (s.first(), s.last()) else {
+                continue;
+            };
+            let (start, end) = (first.1, last.1);
+            if !(start <= now && now < end) {
+                continue;
+            }
+            let progress = if end.is_finite() {
+                (now - start) / (end - start)
+            } else {
+                0.0
+            };
             frame.outputs.push(Output {
                 key: key.clone(),
                 engine: self.name,
-                progress,
+                progress: progress.clamp(0.0, 1.0),
                 params: Vec::new(),
             });
         }

@@ -1,0 +1,116 @@
+//! The documented examples (`fixtures/examples/README.md`) run through `bmlr run`, and their
+//! feedback is what the README says.
+
+use std::process::Command;
+
+use bml_realizer::feedback::{self, BlockStatus, Feedback};
+
+const README: &str = include_str!("../fixtures/examples/README.md");
+
+/// Runs the example command line `cmd` (as written in the README) and returns its feedback.
+fn run(cmd: &str) -> Vec<Feedback> {
+    assert!(
+        README.contains(&format!("bmlr {cmd}\n")),
+        "README shows `bmlr {cmd}`"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(cmd.split_whitespace())
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| feedback::from_line(l).unwrap())
+        .collect()
+}
+
+fn sync(fb: &[Feedback], id: &str) -> f64 {
+    fb.iter()
+        .find_map(|f| match f {
+            Feedback::SyncPointProgress(s)
+                if format!("{}:{}:{}", s.block, s.behaviour, s.sync) == id =>
+            {
+                Some(s.global_time)
+            }
+            _ => None,
+        })
+        .unwrap_or_else(|| panic!("no {id}"))
+}
+
+fn block(fb: &[Feedback], id: &str, which: &str) -> (f64, Option<BlockStatus>) {
+    fb.iter()
+        .find_map(|f| match f {
+            Feedback::BlockProgress(p) if p.block == id && p.sync == which => {
+                Some((feedback::round_ms(p.global_time), p.status))
+            }
+            _ => None,
+        })
+        .unwrap_or_else(|| panic!("no {id}:{which}"))
+}
+
+fn ms(t: f64) -> f64 {
+    feedback::round_ms(t)
+}
+
+fn no_warnings(fb: &[Feedback]) {
+    assert!(!fb.iter().any(|f| matches!(f, Feedback::Warning(_))));
+}
+
+#[test]
+fn welcome() {
+    let fb = run("run fixtures/examples/welcome.xml");
+    no_warnings(&fb);
+    assert_eq!(ms(sync(&fb, "greet:hello:stress")), 0.6);
+    assert_eq!(ms(sync(&fb, "greet:beat:stroke")), 0.6);
+    assert_eq!(ms(sync(&fb, "greet:beat:start")), 0.1);
+    assert_eq!(ms(sync(&fb, "greet:hello:end")), 2.3);
+    assert_eq!(ms(sync(&fb, "greet:nod:start")), 2.3);
+    assert_eq!(block(&fb, "greet", "end"), (2.9, Some(BlockStatus::Done)));
+}
+
+#[test]
+fn gaze_then_point() {
+    let fb = run("run fixtures/examples/gaze-then-point.xml");
+    no_warnings(&fb);
+    assert_eq!(ms(sync(&fb, "look:gaze1:ready")), 0.8);
+    assert_eq!(ms(sync(&fb, "look:point1:start")), 0.8);
+    assert_eq!(ms(sync(&fb, "look:point1:end")), 4.0);
+    assert_eq!(block(&fb, "look", "end").0, 4.0);
+}
+
+#[test]
+fn interrupted_speech() {
+    let fb =
+        run("run fixtures/examples/long-speech.xml +1.5 fixtures/examples/interrupt-speech.xml");
+    no_warnings(&fb);
+    assert_eq!(sync(&fb, "talk:speech1:end"), 1.5);
+    assert_eq!(sync(&fb, "talk:nod1:relax"), 1.5);
+    assert_eq!(ms(sync(&fb, "talk:nod1:end")), 2.083);
+    assert_eq!(block(&fb, "talk", "end"), (2.083, Some(BlockStatus::Done)));
+}
+
+#[test]
+fn preplanned_reply() {
+    let fb = run("run fixtures/examples/reply.xml +2 fixtures/examples/listen.xml");
+    no_warnings(&fb);
+    // scheduled at once: the PENDING prediction comes before anything starts
+    let pending = fb.iter().position(|f| {
+        matches!(f, Feedback::Prediction(p) if p.blocks[0].id == "reply" && p.blocks[0].status == Some(BlockStatus::Pending))
+    });
+    let first_start = fb
+        .iter()
+        .position(|f| matches!(f, Feedback::BlockProgress(_)))
+        .unwrap();
+    assert!(pending.unwrap() < first_start);
+    assert_eq!(block(&fb, "turn", "start").0, 2.0);
+    assert_eq!(block(&fb, "reply", "start").0, 2.0);
+    assert_eq!(sync(&fb, "reply:answer:start"), 2.0);
+    assert_eq!(block(&fb, "reply", "end").1, Some(BlockStatus::Done));
+}
