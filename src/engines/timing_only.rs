@@ -12,6 +12,9 @@ use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{relax_now, stop_now, Engine, EngineError, Frame, Output, Unit, UnitKey};
 use crate::schedule::SyncName;
 
+/// A unit's (sync, global time) list.
+type Syncs = Vec<(SyncName, f64)>;
+
 /// The timing-only engine (see the module documentation).
 #[derive(Debug)]
 pub struct TimingOnlyEngine {
@@ -19,7 +22,7 @@ pub struct TimingOnlyEngine {
     models: DefaultTimingModels,
     stop_on_interrupt: bool,
     /// Units in the order they were added (deterministic frames without sorting).
-    units: Vec<(Arc<UnitKey>, Vec<(SyncName, f64)>)>,
+    units: Vec<(Arc<UnitKey>, Syncs)>,
 }
 
 impl TimingOnlyEngine {
