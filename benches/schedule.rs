@@ -118,5 +118,38 @@ fn anticipator_move(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, solve, optimal, anticipator_move);
+/// N blocks sent at once, each tied to the one before by an external reference (its speech
+/// starts when the previous block's speech ends, a beat gesture on its end): parse + schedule +
+/// plan of every block through the runtime, the shape of AsapRealizer's chained-block bench.
+fn chained_blocks(c: &mut Criterion) {
+    use bml_realizer::realizer::Realizer;
+    let mut g = c.benchmark_group("schedule/chained-blocks");
+    g.sample_size(10);
+    for n in [10usize, 100, 1000, 10_000] {
+        let blocks: Vec<String> = (0..n)
+            .map(|i| {
+                let start = if i == 0 {
+                    String::new()
+                } else {
+                    format!(r#" start="b{}:s:end""#, i - 1)
+                };
+                format!(
+                    r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b{i}"><speech id="s"{start}><text>One two three.</text></speech><gesture id="g" lexeme="BEAT" stroke="s:end"/></bml>"#
+                )
+            })
+            .collect();
+        g.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| {
+                let mut r = Realizer::new();
+                for text in &blocks {
+                    r.perform_bml(text).unwrap();
+                }
+                black_box(r)
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, solve, optimal, anticipator_move, chained_blocks);
 criterion_main!(benches);

@@ -428,24 +428,26 @@ impl BlockManager {
         position(&self.blocks, &self.index, id)
     }
 
-    /// A PENDING block that may run: LURKING (with its prediction) until what it waits for is
-    /// done; [`start_ready`](Self::start_ready) starts it.
+    /// A PENDING block that may run: it starts now if nothing holds it back, else it is LURKING
+    /// (with its prediction) until [`start_ready`](Self::start_ready) starts it. Block indices may
+    /// change (a block that starts can end at once).
     fn release(&mut self, i: usize, now: f64) {
         self.blocks[i].preplan = false;
-        if self.blocks[i].status != BlockStatus::Lurking {
-            self.lurking += 1;
+        if self.blocks[i].status == BlockStatus::Lurking {
+            return;
         }
         if self.ready(i) {
-            self.blocks[i].status = BlockStatus::Lurking;
-        } else {
-            let (w, c) = (
-                self.blocks[i].waits_for.clone(),
-                self.blocks[i].chunk_after.clone(),
-            );
-            self.blocks[i].start = self.predicted_start(now, &w, &c);
-            self.blocks[i].status = BlockStatus::Lurking;
-            self.predict(i, false);
+            self.start_block(i, now);
+            return;
         }
+        let (w, c) = (
+            self.blocks[i].waits_for.clone(),
+            self.blocks[i].chunk_after.clone(),
+        );
+        self.blocks[i].start = self.predicted_start(now, &w, &c);
+        self.blocks[i].status = BlockStatus::Lurking;
+        self.lurking += 1;
+        self.predict(i, false);
     }
 
     /// S29: every append target is done and every chunk target subsiding or done.

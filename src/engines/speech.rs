@@ -64,7 +64,7 @@ impl Engine for SpeechEngine {
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        self.remove(unit.key);
+        // keys are unique: the runtime never adds a unit twice
         self.units.push(Speaking {
             key: Arc::new(unit.key.clone()),
             syncs: unit.syncs.to_vec(),

@@ -74,7 +74,7 @@ impl Engine for TimingOnlyEngine {
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        self.remove(unit.key);
+        // keys are unique: the runtime never adds a unit twice
         self.units
             .push((Arc::new(unit.key.clone()), unit.syncs.to_vec()));
         Ok(())
