@@ -815,3 +815,146 @@ fn a_new_kind_and_engine_register_from_outside_the_core() {
     assert!(s.warnings().is_empty(), "{:?}", s.warnings());
     assert!(close(s.at("b:k:end"), 1.15));
 }
+
+// ---- anticipators (S56, S57; thesis scenarios 1–3) ---------------------------------------
+
+use bml_realizer::plan::anticipator::{Metronome, Scripted};
+
+#[test]
+fn scenario3_speech_starts_one_second_after_the_last_predicted_end_of_the_users_turn() {
+    let mut s = Session::new();
+    // predicted end of the user's speech: 5 s; revised at 2 s to 6 s; revised again at 8 s (after
+    // the speech started: no effect)
+    s.r.add_anticipator(
+        None,
+        Box::new(Scripted::new(
+            "speechStopAnticipator",
+            &[("stop", 5.0)],
+            &[(2.0, "stop", 6.0), (8.0, "stop", 9.0)],
+        )),
+    );
+    s.send(
+        0.0,
+        &block(
+            "bml1",
+            "",
+            &speech(
+                "speech1",
+                5,
+                None,
+                r#"start="anticipators:speechStopAnticipator:stop+1""#,
+            ),
+        ),
+    );
+    s.finish();
+    assert_eq!(
+        s.block_time("bml1", "start"),
+        Some(0.0),
+        "the block starts on arrival"
+    );
+    assert!(close(s.at("bml1:speech1:start"), 7.0));
+    assert!(
+        close(s.at("bml1:speech1:end"), 8.0),
+        "rigid speech keeps its length"
+    );
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
+    // no new scheduling feedback after the revision: one IN_PREP and one PENDING prediction
+    let predictions = s
+        .fb()
+        .iter()
+        .filter(|f| matches!(f, Feedback::Prediction(_)))
+        .count();
+    assert_eq!(predictions, 3); // IN_PREP, PENDING, IN_EXEC
+}
+
+#[test]
+fn scenario2_a_tempo_change_retimes_the_ticks_still_to_come() {
+    let metronome = Metronome::new("metronome1", 1.0, 60.0); // tick k at k s
+    let mut s = Session::new();
+    s.r.add_anticipator(None, Box::new(metronome.clone()));
+    s.send(
+        0.0,
+        &block(
+            "conduct",
+            "",
+            r#"<head id="b1" lexeme="NOD" stroke="anticipators:metronome1:tick1"/>
+               <head id="b2" lexeme="NOD" stroke="anticipators:metronome1:tick2"/>
+               <head id="b3" lexeme="NOD" stroke="anticipators:metronome1:tick3"/>"#,
+        ),
+    );
+    s.r.tick(1.1);
+    // from now on a tick every 0.5 s: at 1.1 the metronome is at tick 1.1, so tick2 comes at
+    // 1.1 + 0.9 × 0.5 = 1.55 and tick3 at 2.05
+    metronome.set_tempo(120.0, 1.1);
+    s.finish();
+    assert!(close(s.at("conduct:b1:stroke"), 1.0));
+    assert!(close(s.at("conduct:b2:stroke"), 1.55));
+    assert!(close(s.at("conduct:b3:stroke"), 2.05));
+    // each nod keeps its shape around the moved stroke
+    assert!(close(s.at("conduct:b3:start"), 1.75));
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
+}
+
+/// A gesture's stroke on a beat, and a nod from 1.5 to 2 s that must end before the beat
+/// (predicted at 3 s, revised at 0.5 s to `revised`).
+fn beat_block(revised: f64) -> Session {
+    let mut s = Session::new();
+    s.r.add_anticipator(
+        None,
+        Box::new(Scripted::new(
+            "beat",
+            &[("b1", 3.0)],
+            &[(0.5, "b1", revised)],
+        )),
+    );
+    s.send(
+        0.0,
+        &block(
+            "b",
+            "",
+            r#"<gesture id="g1" lexeme="BEAT" stroke="anticipators:beat:b1"/>
+               <head id="n1" lexeme="NOD" start="1.5" end="2"/>
+               <constraint><before ref="anticipators:beat:b1"><sync ref="n1:end"/></before></constraint>"#,
+        ),
+    );
+    s.finish();
+    s
+}
+
+#[test]
+fn a_moved_prediction_drags_what_must_stay_before_it() {
+    let s = beat_block(1.8);
+    assert!(close(s.at("b:g1:stroke"), 1.8));
+    // n1:end <= beat still holds: the nod's end was dragged from 2 to 1.8, its start stays
+    assert!(close(s.at("b:n1:start"), 1.5));
+    assert!(close(s.at("b:n1:end"), 1.8));
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
+}
+
+#[test]
+fn a_prediction_that_breaks_a_behaviours_timing_drops_it_with_invalid_timing() {
+    let s = beat_block(1.4);
+    // the stroke followed the beat
+    assert!(close(s.at("b:g1:stroke"), 1.4));
+    // the nod would have to end (1.4) before it starts (1.5): dropped before it started (S57)
+    assert!(!s.has_sync("b", "n1"));
+    assert_eq!(s.warnings(), [("b:n1".into(), "INVALID_TIMING".into())]);
+    assert!(close(s.block_time("b", "end").unwrap(), s.at("b:g1:end")));
+}
+
+#[test]
+fn an_unknown_anticipator_drops_the_behaviour_that_names_it() {
+    let mut s = Session::new();
+    s.send(
+        0.0,
+        &block(
+            "b",
+            "",
+            &(speech("s", 1, None, r#"start="anticipators:nobody:stop""#)
+                + r#"<head id="h" lexeme="NOD"/>"#),
+        ),
+    );
+    s.finish();
+    assert_eq!(s.warnings(), [("b:s".into(), "NO_SUCH_TARGET".into())]);
+    assert!(s.has_sync("b", "h"));
+}

@@ -1,9 +1,11 @@
 //! One block in the running plan and its behaviours: block-local sync times from the schedule,
 //! how far each behaviour has got, and the derived block predictions (end, subsiding time).
 
-use crate::bml;
+use crate::bml::{self, ConstraintItem, SyncPoint, SyncRef};
 use crate::engine::Registry;
 use crate::feedback::BlockStatus;
+use crate::plan::pegs::PegBoard;
+use crate::schedule::to_pegs::{Anticipators, PlannedBlock};
 use crate::schedule::{BlockSchedule, SyncName};
 
 /// Where a behaviour is in its life.
@@ -34,6 +36,8 @@ pub(crate) struct LiveBehaviour {
     /// The next sync to pass.
     pub(crate) next: usize,
     pub(crate) phase: Phase,
+    /// Internal timing fixed (speech): once started, it no longer follows its pegs.
+    pub(crate) rigid: bool,
 }
 
 impl LiveBehaviour {
@@ -84,6 +88,56 @@ pub(crate) struct LiveBlock {
     pub(crate) chunk_after: Vec<String>,
     /// Waiting for an activation.
     pub(crate) preplan: bool,
+    /// The block's own peg board, for blocks tied to anticipators: moving an anticipator's peg
+    /// retimes what hangs on it (S56).
+    pub(crate) pegs: Option<BlockPegs>,
+}
+
+/// A block on its own peg board (only blocks that refer to anticipators have one).
+#[derive(Debug, Clone)]
+pub(crate) struct BlockPegs {
+    pub(crate) board: PegBoard,
+    pub(crate) anticipators: Anticipators,
+    pub(crate) plan: PlannedBlock,
+}
+
+/// The anticipator syncs (anticipator, sync) that sync references of `block` name.
+pub(crate) fn anticipator_refs(block: &bml::Block) -> Vec<(&str, &str)> {
+    let mut out = Vec::new();
+    let refs = block
+        .behaviours
+        .iter()
+        .flat_map(|b| b.syncs.iter().map(|s| &s.value))
+        .chain(block.constraints.iter().flat_map(|c| {
+            c.items.iter().flat_map(|item| {
+                let (reference, syncs) = match item {
+                    ConstraintItem::Synchronize {
+                        reference, syncs, ..
+                    } => (reference.as_ref(), syncs),
+                    ConstraintItem::Before {
+                        reference, syncs, ..
+                    }
+                    | ConstraintItem::After {
+                        reference, syncs, ..
+                    } => (Some(reference), syncs),
+                };
+                reference
+                    .into_iter()
+                    .chain(syncs.iter().map(|s| &s.reference))
+            })
+        }));
+    for r in refs {
+        if let SyncRef::Point {
+            point: SyncPoint::Anticipator { anticipator, sync },
+            ..
+        } = r
+        {
+            if !out.contains(&(anticipator.as_str(), sync.as_str())) {
+                out.push((anticipator.as_str(), sync.as_str()));
+            }
+        }
+    }
+    out
 }
 
 impl LiveBlock {
@@ -104,6 +158,7 @@ impl LiveBlock {
             waits_for,
             chunk_after,
             preplan: false,
+            pegs: None,
         }
     }
 
@@ -123,6 +178,7 @@ impl LiveBlock {
                 syncs: s.syncs,
                 next: 0,
                 phase: Phase::Planned,
+                rigid: s.rigid,
             });
         }
     }

@@ -9,6 +9,7 @@
 //! order (ties: earlier block first, then document order, then sync order). Feedback carries the
 //! exact scheduled times, so a run is deterministic whatever the frame rate.
 
+mod anticipation;
 mod live;
 
 use std::collections::{HashMap, HashSet, VecDeque};
@@ -19,8 +20,11 @@ use crate::feedback::{
     BehaviourPrediction, BlockPrediction, BlockProgress, BlockStatus, Feedback, KnownWarning,
     PredictionFeedback, SyncPointProgress, WarningFeedback,
 };
+use crate::plan::anticipator::Anticipator;
+use crate::plan::pegs::PegBoard;
+use crate::schedule::to_pegs::{self, Anticipators};
 use crate::schedule::{ExternalTimes, SchedulingStrategy};
-use live::{LiveBlock, Phase};
+use live::{anticipator_refs, BlockPegs, LiveBlock, Phase};
 
 /// How many ids of finished blocks are remembered (so that late references to them are quiet
 /// no-ops rather than NO_SUCH_TARGET warnings).
@@ -53,6 +57,7 @@ pub struct BlockManager {
     finished: VecDeque<String>,
     finished_set: HashSet<String>,
     changes: Vec<ParameterChange>,
+    anticipators: Vec<Box<dyn Anticipator>>,
     now: f64,
     seq: u64,
     out: Vec<Feedback>,
@@ -62,6 +67,7 @@ pub struct BlockManager {
 struct OtherBlocks<'a> {
     blocks: &'a [LiveBlock],
     index: &'a HashMap<String, u64>,
+    anticipators: &'a [Box<dyn Anticipator>],
     start: f64,
 }
 
@@ -73,17 +79,22 @@ fn position(blocks: &[LiveBlock], index: &HashMap<String, u64>, id: &str) -> Opt
 
 impl ExternalTimes for OtherBlocks<'_> {
     fn time(&self, point: &SyncPoint) -> Option<f64> {
-        let SyncPoint::External {
-            block,
-            behaviour,
-            sync,
-        } = point
-        else {
-            return None; // anticipators are not registered with the runtime yet
-        };
-        let b = &self.blocks[position(self.blocks, self.index, block)?];
-        let local = b.behaviour(behaviour)?.time(sync)?;
-        Some(b.start + local - self.start)
+        match point {
+            SyncPoint::External {
+                block,
+                behaviour,
+                sync,
+            } => {
+                let b = &self.blocks[position(self.blocks, self.index, block)?];
+                let local = b.behaviour(behaviour)?.time(sync)?;
+                Some(b.start + local - self.start)
+            }
+            SyncPoint::Anticipator { anticipator, sync } => {
+                let a = self.anticipators.iter().find(|a| a.id() == anticipator)?;
+                Some(a.predict(sync)? - self.start)
+            }
+            SyncPoint::Local { .. } => None,
+        }
     }
 }
 
@@ -104,6 +115,7 @@ impl BlockManager {
             finished: VecDeque::new(),
             finished_set: HashSet::new(),
             changes: Vec::new(),
+            anticipators: Vec::new(),
             now: 0.0,
             seq: 0,
             out: Vec::new(),
@@ -155,9 +167,14 @@ impl BlockManager {
     /// will happen without outside input (all done, only persistent behaviour, or blocks waiting
     /// for an activation).
     pub fn next_event(&self) -> Option<f64> {
-        self.next_sync()
+        let sync = self
+            .next_sync()
             .map(|(t, _, _)| t)
-            .filter(|t| t.is_finite())
+            .filter(|t| t.is_finite());
+        match (sync, self.next_prediction_change()) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
     }
 
     // ---------------------------------------------------------------------------------------
@@ -315,6 +332,7 @@ impl BlockManager {
             let external = OtherBlocks {
                 blocks: &self.blocks,
                 index: &self.index,
+                anticipators: &self.anticipators,
                 start,
             };
             self.strategy
@@ -334,6 +352,33 @@ impl BlockManager {
                 d.warning,
                 d.reason.clone(),
             );
+        }
+        let refs = anticipator_refs(&live.source);
+        if !refs.is_empty() {
+            // its own peg board: anticipator moves retime it without rescheduling (S56)
+            let (mut board, mut anticipators) = (PegBoard::new(), Anticipators::default());
+            for (a, sync) in refs {
+                let predicted = self
+                    .anticipators
+                    .iter()
+                    .find(|x| x.id() == a)
+                    .and_then(|x| x.predict(sync));
+                if let Some(t) = predicted.filter(|t| t.is_finite()) {
+                    anticipators.peg(&mut board, a, sync, t);
+                }
+            }
+            let plan = to_pegs::plan_block(
+                &mut board,
+                &mut anticipators,
+                &live.source,
+                &schedule,
+                start,
+            );
+            live.pegs = Some(BlockPegs {
+                board,
+                anticipators,
+                plan,
+            });
         }
         live.set_schedule(schedule, &self.registry);
         for (beh, reason) in live.resolve_exclusive_ties(&self.registry) {
@@ -478,6 +523,16 @@ impl BlockManager {
     fn start_block(&mut self, i: usize, t: f64) {
         if self.blocks[i].status == BlockStatus::Lurking {
             self.lurking -= 1;
+        }
+        let moved = self.blocks[i].start != t;
+        if let Some(p) = self.blocks[i].pegs.as_mut() {
+            // the block peg moves to now; syncs hanging on anticipators stay where they are
+            let block = p.plan.block;
+            let _ = p.board.set_block_start(block, t);
+        }
+        self.blocks[i].start = t;
+        if moved && self.blocks[i].pegs.is_some() {
+            self.follow_pegs(i, t);
         }
         let b = &mut self.blocks[i];
         b.start = t;
@@ -737,14 +792,37 @@ impl BlockManager {
     /// changes apply and every engine plays into `frame`.
     pub fn advance(&mut self, to: f64, frame: &mut Frame) {
         let to = to.max(self.now);
-        while let Some((t, bi, xi)) = self.next_sync() {
-            if t > to {
-                break;
+        // changes made from outside since the last frame (e.g. a new tempo)
+        self.update_anticipators(self.now);
+        let mut last_change = f64::NEG_INFINITY;
+        loop {
+            let sync = self.next_sync().filter(|s| s.0 <= to);
+            // an anticipator that keeps announcing the same change is not asked again
+            let change = self
+                .next_prediction_change()
+                .filter(|&c| c <= to && c > last_change);
+            if let Some(c) = change {
+                last_change = c;
             }
-            self.now = t;
-            self.pass_sync(bi, xi, t);
+            match (sync, change) {
+                // a prediction changing at the same moment as a sync applies first
+                (Some((ts, _, _)), Some(tc)) if tc <= ts => {
+                    self.now = self.now.max(tc);
+                    self.update_anticipators(tc);
+                }
+                (None, Some(tc)) => {
+                    self.now = self.now.max(tc);
+                    self.update_anticipators(tc);
+                }
+                (Some((t, bi, xi)), _) => {
+                    self.now = t;
+                    self.pass_sync(bi, xi, t);
+                }
+                (None, None) => break,
+            }
         }
         self.now = to;
+        self.update_anticipators(to);
         self.apply_changes(to);
         for e in self.registry.engines_mut() {
             e.play(to, frame);

@@ -179,6 +179,10 @@ pub trait Engine {
         relax_now(now, syncs)
     }
 
+    /// The unit's sync times moved (an anticipator's prediction changed, S56): new global times,
+    /// in sync order. Passed syncs keep theirs.
+    fn retime(&mut self, _key: &UnitKey, _syncs: &[(SyncName, f64)]) {}
+
     /// Number of units the engine holds (bounded-memory checks).
     fn len(&self) -> usize;
 

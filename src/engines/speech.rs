@@ -88,6 +88,12 @@ impl Engine for SpeechEngine {
         times
     }
 
+    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
+        if let Some(u) = self.unit_mut(key) {
+            u.syncs = syncs.to_vec();
+        }
+    }
+
     fn len(&self) -> usize {
         self.units.len()
     }

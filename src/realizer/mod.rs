@@ -12,6 +12,7 @@ use crate::engine::timing::DefaultTimingModels;
 use crate::engine::{Frame, Registry};
 use crate::engines::default_registry;
 use crate::feedback::{Feedback, FeedbackListener, KnownWarning, WarningFeedback};
+use crate::plan::anticipator::Anticipator;
 use crate::schedule::{Optimal, SchedulingStrategy};
 
 /// The id used in warnings about a block whose id could not be read.
@@ -124,6 +125,14 @@ impl Realizer {
             m.advance(now, &mut Frame::default());
             m
         })
+    }
+
+    /// Registers an anticipator for `character` (None: blocks without a characterId). Blocks
+    /// can then refer to its predictions as `anticipators:ID:SYNC`; when they change, what hangs
+    /// on them moves without rescheduling.
+    pub fn add_anticipator(&mut self, character: Option<&str>, anticipator: Box<dyn Anticipator>) {
+        self.manager(character.map(str::to_string))
+            .add_anticipator(anticipator);
     }
 
     /// Submits one `<bml>` block at the current time. Invalid BML yields a PARSING_FAILURE

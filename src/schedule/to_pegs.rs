@@ -88,6 +88,13 @@ impl Anticipators {
             .or_insert_with(|| board.time_peg(BlockPegId::GLOBAL, t))
     }
 
+    /// Every anticipator peg: (anticipator, sync, peg).
+    pub fn iter(&self) -> impl Iterator<Item = (&str, &str, PegId)> {
+        self.pegs
+            .iter()
+            .map(|((a, s), p)| (a.as_str(), s.as_str(), *p))
+    }
+
     /// The peg of `anticipator:sync`, if it exists.
     pub fn get(&self, anticipator: &str, sync: &str) -> Option<PegId> {
         self.pegs
@@ -128,7 +135,9 @@ fn local(a: &Anchor) -> Option<(&str, &str)> {
     }
 }
 
-/// Puts a scheduled block on the board, starting at global time `start`.
+/// Puts a scheduled block on the board, starting at global time `start`. `before`/`after`
+/// constraints against an anticipator become order links only if that anticipator's peg is already
+/// on the board (create it with [`Anticipators::peg`] at its prediction first).
 pub fn plan_block(
     board: &mut PegBoard,
     anticipators: &mut Anticipators,
@@ -151,6 +160,7 @@ pub fn plan_block(
     let mut named = vec![false; n];
     let mut on_anticipator: Vec<Option<(String, String, f64)>> = vec![None; n];
     let mut orders = Vec::new();
+    let mut ant_orders = Vec::new();
     let constraints = extract(block);
     for c in &constraints {
         let l = local(&c.left).and_then(|k| node.get(&k).copied());
@@ -171,6 +181,12 @@ pub fn plan_block(
             (Relation::Before | Relation::After, Some(a), Some(b), _) => {
                 orders.push((c.relation, a, b, c.offset))
             }
+            (
+                Relation::Before | Relation::After,
+                Some(a),
+                None,
+                Anchor::Point(SyncPoint::Anticipator { anticipator, sync }),
+            ) => ant_orders.push((c.relation, a, anticipator, sync, c.offset)),
             _ => {}
         }
     }
@@ -290,6 +306,15 @@ pub fn plan_block(
                 Relation::Before => board.order(pa, pb, -offset),
                 // a >= b + offset
                 _ => board.order(pb, pa, offset),
+            }
+        }
+    }
+    // before/after an anticipator's prediction: order links with its peg, if it is on the board
+    for (relation, a, anticipator, sync, offset) in ant_orders {
+        if let (Some(pa), Some(ap)) = (peg[a], anticipators.get(anticipator, sync)) {
+            match relation {
+                Relation::Before => board.order(pa, ap, -offset),
+                _ => board.order(ap, pa, offset),
             }
         }
     }

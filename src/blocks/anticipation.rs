@@ -1,0 +1,176 @@
+//! Anticipators at run time: registering them, polling their predictions, and blocks that hang on
+//! them following their pegs without rescheduling (S56), losing behaviours whose timing broke
+//! (S57).
+
+use super::live::Phase;
+use super::BlockManager;
+use crate::engine::UnitKey;
+use crate::feedback::KnownWarning;
+use crate::plan::anticipator::Anticipator;
+use crate::plan::pegs::PegId;
+use crate::schedule::to_pegs;
+
+impl BlockManager {
+    /// Registers an anticipator (replacing one with the same id). Blocks scheduled from now on
+    /// can refer to its syncs as `anticipators:ID:SYNC`.
+    pub fn add_anticipator(&mut self, anticipator: Box<dyn Anticipator>) {
+        self.anticipators.retain(|a| a.id() != anticipator.id());
+        self.anticipators.push(anticipator);
+    }
+
+    /// When a scripted prediction next changes, if a live block hangs on an anticipator.
+    pub(super) fn next_prediction_change(&self) -> Option<f64> {
+        if !self.blocks.iter().any(|b| b.pegs.is_some()) {
+            return None;
+        }
+        self.anticipators
+            .iter()
+            .filter_map(|a| a.next_change())
+            .filter(|t| t.is_finite())
+            .reduce(f64::min)
+    }
+
+    /// Polls every anticipator at `t`; blocks hanging on one whose predictions changed follow
+    /// their pegs.
+    pub(super) fn update_anticipators(&mut self, t: f64) {
+        let changed: Vec<String> = self
+            .anticipators
+            .iter_mut()
+            .filter_map(|a| a.update(t).then(|| a.id().to_string()))
+            .collect();
+        if changed.is_empty() {
+            return;
+        }
+        let ids: Vec<String> = self
+            .blocks
+            .iter()
+            .filter(|b| b.pegs.is_some())
+            .map(|b| b.id.clone())
+            .collect();
+        for id in ids {
+            let Some(i) = self.pos(&id) else { continue };
+            let (mut moved, mut refused) = (false, None);
+            if let Some(p) = self.blocks[i].pegs.as_mut() {
+                let pegs: Vec<(String, String, PegId)> = p
+                    .anticipators
+                    .iter()
+                    .filter(|(a, _, _)| changed.iter().any(|c| c == a))
+                    .map(|(a, s, peg)| (a.to_string(), s.to_string(), peg))
+                    .collect();
+                for (a, sync, peg) in pegs {
+                    let prediction = self
+                        .anticipators
+                        .iter()
+                        .find(|x| x.id() == a)
+                        .and_then(|x| x.predict(&sync));
+                    let Some(prediction) = prediction.filter(|p| p.is_finite()) else {
+                        continue;
+                    };
+                    if (p.board.global(peg) - prediction).abs() > 1e-12 {
+                        match p.board.move_to(peg, prediction) {
+                            Ok(_) => moved = true,
+                            Err(e) => refused = Some(format!("anticipators:{a}:{sync}: {e}")),
+                        }
+                    }
+                }
+            }
+            if let Some(reason) = refused {
+                self.warn(id.clone(), KnownWarning::InvalidTiming, reason);
+            }
+            if moved {
+                self.follow_pegs(i, t);
+            }
+        }
+    }
+
+    /// Block `i` takes its behaviours' times from its peg board at time `t`. Passed syncs stay,
+    /// and so does a rigid behaviour that started (a speech already speaking). A behaviour whose
+    /// timing broke (order, block start, a future sync moved into the past) leaves the plan with
+    /// an INVALID_TIMING warning; if it was running, it ends now as its engine ends interrupted
+    /// units.
+    pub(super) fn follow_pegs(&mut self, i: usize, t: f64) {
+        let block_id = self.blocks[i].id.clone();
+        let Some(p) = self.blocks[i].pegs.as_ref() else {
+            return;
+        };
+        let invalid = to_pegs::invalid(&p.board, &p.plan);
+        let start = self.blocks[i].start;
+        let started = self.blocks[i].started();
+        let (mut dropped, mut updates) = (Vec::new(), Vec::new());
+        for (xi, x) in self.blocks[i].behaviours.iter().enumerate() {
+            if !matches!(x.phase, Phase::Planned | Phase::Added | Phase::Running)
+                || (x.rigid && x.phase == Phase::Running)
+            {
+                continue;
+            }
+            let Some(global) = p.plan.times(&p.board, &x.id) else {
+                continue;
+            };
+            let into_past = started
+                && global
+                    .iter()
+                    .enumerate()
+                    .any(|(k, g)| k >= x.next && *g < t - 1e-9);
+            if invalid.contains(&x.id) || into_past {
+                dropped.push(xi);
+            } else {
+                updates.push((xi, global));
+            }
+        }
+        for (xi, global) in updates {
+            let x = &mut self.blocks[i].behaviours[xi];
+            for (k, s) in x.syncs.iter_mut().enumerate().skip(x.next) {
+                if let Some(g) = global.get(k) {
+                    s.1 = g - start;
+                }
+            }
+            if matches!(x.phase, Phase::Added | Phase::Running) {
+                let key = UnitKey::new(&block_id, &x.id);
+                let syncs: Vec<_> = x
+                    .syncs
+                    .iter()
+                    .map(|(n, l)| (n.clone(), start + l))
+                    .collect();
+                self.registry.engine_mut(x.engine).retime(&key, &syncs);
+            }
+        }
+        for xi in dropped {
+            let x = &mut self.blocks[i].behaviours[xi];
+            let key = UnitKey::new(&block_id, &x.id);
+            let behaviour = x.id.clone();
+            let running = x.phase == Phase::Running;
+            if running {
+                let global: Vec<_> = x
+                    .syncs
+                    .iter()
+                    .map(|(n, l)| (n.clone(), start + l))
+                    .collect();
+                let times = self
+                    .registry
+                    .engine_mut(x.engine)
+                    .interrupt(&key, t, &global);
+                x.retime(&times, start, t);
+            } else {
+                if x.phase == Phase::Added {
+                    self.registry.engine_mut(x.engine).remove(&key);
+                }
+                x.phase = Phase::Removed;
+            }
+            self.warn(
+                format!("{block_id}:{behaviour}"),
+                KnownWarning::InvalidTiming,
+                format!(
+                    "'{behaviour}' no longer fits its constraints after an anticipator moved; {}",
+                    if running {
+                        "it stops now"
+                    } else {
+                        "it is dropped"
+                    }
+                ),
+            );
+        }
+        if self.blocks[i].started() {
+            self.finish_if_done(i, t);
+        }
+    }
+}
