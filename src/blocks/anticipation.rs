@@ -111,7 +111,19 @@ impl BlockManager {
                     .iter()
                     .enumerate()
                     .any(|(k, g)| k >= x.next && *g < t - 1e-9);
-            if invalid.contains(&x.id) || into_past {
+            let named: Vec<_> = x
+                .syncs
+                .iter()
+                .zip(&global)
+                .map(|((n, _), g)| (n.clone(), *g))
+                .collect();
+            let behaviour = &self.blocks[i].source.behaviours[x.index];
+            let engine_refuses = self
+                .registry
+                .engine(x.engine)
+                .check_timing(behaviour, &named)
+                .is_err();
+            if invalid.contains(&x.id) || into_past || engine_refuses {
                 dropped.push(xi);
             } else {
                 updates.push((xi, global));

@@ -179,6 +179,16 @@ pub trait Engine {
         relax_now(now, syncs)
     }
 
+    /// Whether `behaviour` can be realized with these sync times (S58, S59): the default checks
+    /// them against the engine's timing model — sync order, a duration within the model's bounds,
+    /// a rigid behaviour's internal distances. Called when pegs move without rescheduling.
+    fn check_timing(&self, behaviour: &Behaviour, syncs: &[(SyncName, f64)]) -> Result<(), String> {
+        match self.timing(behaviour) {
+            Some(model) => model.admits(syncs),
+            None => Ok(()),
+        }
+    }
+
     /// The unit's sync times moved (an anticipator's prediction changed, S56): new global times,
     /// in sync order. Passed syncs keep theirs.
     fn retime(&mut self, _key: &UnitKey, _syncs: &[(SyncName, f64)]) {}

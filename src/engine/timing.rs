@@ -50,6 +50,44 @@ pub struct TimingModel {
 }
 
 impl TimingModel {
+    /// Whether sync times (in key order; a persistent end may be infinite) realize this model:
+    /// non-decreasing, a duration within the bounds of a stretchable model, the internal distances
+    /// of a rigid one (within 1 µs).
+    pub fn admits(&self, syncs: &[(Cow<'static, str>, f64)]) -> Result<(), String> {
+        const TOLERANCE: f64 = 1e-6;
+        if let Some(w) = syncs.windows(2).find(|w| w[1].1 < w[0].1 - 1e-9) {
+            return Err(format!("'{}' comes before '{}'", w[1].0, w[0].0));
+        }
+        let (Some(first), Some(last)) = (syncs.first(), syncs.last()) else {
+            return Ok(());
+        };
+        let duration = last.1 - first.1;
+        match self.flexibility {
+            Flexibility::Stretchable {
+                min_duration,
+                max_duration,
+            } if duration.is_finite() => {
+                if duration < min_duration - TOLERANCE || duration > max_duration + TOLERANCE {
+                    return Err(format!(
+                        "a duration of {duration:.3} s is outside the engine's bounds [{min_duration}, {max_duration}] s"
+                    ));
+                }
+            }
+            Flexibility::Rigid => {
+                for (k, (name, t)) in syncs.iter().enumerate() {
+                    let Some(key) = self.keys.get(k) else { break };
+                    if t.is_finite() && ((t - first.1) - key.at).abs() > TOLERANCE {
+                        return Err(format!(
+                            "'{name}' moved within a behaviour whose timing is fixed"
+                        ));
+                    }
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
     /// A model with static key names at preferred times (seconds from `start`).
     pub fn new(keys: &[(&'static str, f64)], flexibility: Flexibility) -> Self {
         TimingModel {
@@ -419,6 +457,39 @@ mod tests {
         ] {
             assert_eq!(syllables(w), n, "{w}");
         }
+    }
+
+    #[test]
+    fn s58_s59_timing_models_admit_only_ordered_times_within_their_bounds() {
+        let syncs = |v: &[(&'static str, f64)]| -> Vec<(Cow<'static, str>, f64)> {
+            v.iter().map(|&(n, t)| (Cow::Borrowed(n), t)).collect()
+        };
+        let mut m = TimingModel::stretchable(&[("start", 0.0), ("stroke", 0.5), ("end", 1.0)]);
+        assert!(m
+            .admits(&syncs(&[("start", 1.0), ("stroke", 1.2), ("end", 3.0)]))
+            .is_ok());
+        let err = m.admits(&syncs(&[("start", 1.0), ("stroke", 0.9), ("end", 3.0)]));
+        assert_eq!(err.unwrap_err(), "'stroke' comes before 'start'");
+        m.flexibility = Flexibility::Stretchable {
+            min_duration: 0.5,
+            max_duration: 2.0,
+        };
+        assert!(m
+            .admits(&syncs(&[("start", 0.0), ("stroke", 0.1), ("end", 0.4)]))
+            .is_err());
+        assert!(m
+            .admits(&syncs(&[("start", 0.0), ("stroke", 0.1), ("end", 2.5)]))
+            .is_err());
+        assert!(m
+            .admits(&syncs(&[("start", 0.0), ("stroke", 0.1), ("end", 2.0)]))
+            .is_ok());
+        let rigid = TimingModel::new(&[("start", 0.0), ("end", 1.0)], Flexibility::Rigid);
+        assert!(rigid
+            .admits(&syncs(&[("start", 3.0), ("end", 4.0)]))
+            .is_ok());
+        assert!(rigid
+            .admits(&syncs(&[("start", 3.0), ("end", 4.5)]))
+            .is_err());
     }
 
     #[test]
