@@ -66,12 +66,12 @@ impl TimingModel {
             Flexibility::Stretchable {
                 min_duration,
                 max_duration,
-            } if duration.is_finite() => {
-                if duration < min_duration - TOLERANCE || duration > max_duration + TOLERANCE {
-                    return Err(format!(
-                        "a duration of {duration:.3} s is outside the engine's bounds [{min_duration}, {max_duration}] s"
-                    ));
-                }
+            } if duration.is_finite()
+                && (duration < min_duration - TOLERANCE || duration > max_duration + TOLERANCE) =>
+            {
+                return Err(format!(
+                    "a duration of {duration:.3} s is outside the engine's bounds [{min_duration}, {max_duration}] s"
+                ));
             }
             Flexibility::Rigid => {
                 for (k, (name, t)) in syncs.iter().enumerate() {
