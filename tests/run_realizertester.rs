@@ -650,3 +650,14 @@ fn bmlt_audio() {
     log.no_dup();
     log.order("bml1:audio1", SE);
 }
+
+#[test]
+fn chunk_starts_when_the_previous_block_subsides() {
+    let log = run(&["asap/chunking/firstchunk.xml", "asap/chunking/secondchunk.xml"]);
+    log.no_warnings();
+    log.blocks(&["bml1", "bml2"]);
+    log.no_dup();
+    log.order("bml1:g1", GESTURE7);
+    log.order("bml2:g1", GESTURE7);
+    log.link("bml1:g1:relax", 0.0, "bml2:g1:start", 0.0);
+}
