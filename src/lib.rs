@@ -9,13 +9,15 @@
 //! - [`schedule`]: the scheduler — constraints to sync times, order-invariant;
 //! - [`plan`]: the flexible plan of pegs;
 //! - [`engine`]: the engine interface, registry and timing models; [`engines`]: built-in engines;
-//! - [`clock`]: virtual and wall clocks.
+//! - [`clock`]: virtual and wall clocks;
+//! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`).
 
 #![warn(missing_docs)]
 
 pub mod blocks;
 pub mod bml;
 pub mod clock;
+pub mod conformance;
 pub mod engine;
 pub mod engines;
 pub mod feedback;

@@ -653,7 +653,10 @@ fn bmlt_audio() {
 
 #[test]
 fn chunk_starts_when_the_previous_block_subsides() {
-    let log = run(&["asap/chunking/firstchunk.xml", "asap/chunking/secondchunk.xml"]);
+    let log = run(&[
+        "asap/chunking/firstchunk.xml",
+        "asap/chunking/secondchunk.xml",
+    ]);
     log.no_warnings();
     log.blocks(&["bml1", "bml2"]);
     log.no_dup();

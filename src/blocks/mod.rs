@@ -249,28 +249,54 @@ impl BlockManager {
     // ---------------------------------------------------------------------------------------
     // submitting a block (S23–S27, S34–S38)
 
-    /// Reports the parser's warnings for an accepted block: unsupported extension attributes and
-    /// ignored extension content. Unknown behaviour kinds are reported when scheduling finds no
-    /// engine for them; lexemes when an engine cannot realize them.
+    /// Reports what of an accepted block will not be interpreted: extension attributes that no
+    /// engine reads (CUSTOM_ATTRIBUTE_NOT_SUPPORTED) and extension content the parser ignored.
+    /// Unknown behaviour kinds are reported when scheduling finds no engine for them; lexemes when
+    /// an engine cannot realize them.
     fn parse_warnings(&mut self, block: &bml::Block, warnings: &[Diagnostic]) {
-        for d in warnings {
-            let kind = match d.code {
-                bml::Code::UnsupportedAttribute => KnownWarning::CustomAttributeNotSupported,
-                bml::Code::UnsupportedExtension
-                    if !block
-                        .behaviours
-                        .iter()
-                        .any(|b| (b.pos.line, b.pos.col) == (d.pos.line, d.pos.col)) =>
-                {
-                    KnownWarning::BehaviorTypeNotSupported
-                }
-                _ => continue,
-            };
+        for a in &block.foreign_attrs {
             self.warn(
                 block.id.clone(),
-                kind,
-                format!("{}:{}: {}", d.pos.line, d.pos.col, d.message),
+                KnownWarning::CustomAttributeNotSupported,
+                format!(
+                    "attribute '{}' (namespace {}) on <bml id=\"{}\"> is not interpreted and is ignored",
+                    a.name, a.ns, block.id
+                ),
             );
+        }
+        for b in &block.behaviours {
+            let Some(engine) = self.registry.engine_for(b) else {
+                continue;
+            };
+            for a in &b.foreign_attrs {
+                if !self.registry.engine(engine).interprets(&a.ns, &a.name) {
+                    self.warn(
+                        format!("{}:{}", block.id, b.id),
+                        KnownWarning::CustomAttributeNotSupported,
+                        format!(
+                            "attribute '{}' (namespace {}) on <{} id=\"{}\"> is not interpreted and is ignored",
+                            a.name,
+                            a.ns,
+                            b.kind.element_name(),
+                            b.id
+                        ),
+                    );
+                }
+            }
+        }
+        for d in warnings {
+            let ignored_content = d.code == bml::Code::UnsupportedExtension
+                && !block
+                    .behaviours
+                    .iter()
+                    .any(|b| (b.pos.line, b.pos.col) == (d.pos.line, d.pos.col));
+            if ignored_content {
+                self.warn(
+                    block.id.clone(),
+                    KnownWarning::BehaviorTypeNotSupported,
+                    format!("{}:{}: {}", d.pos.line, d.pos.col, d.message),
+                );
+            }
         }
     }
 
@@ -571,6 +597,7 @@ impl BlockManager {
                 reason,
             );
         }
+        self.coarticulate(i, t);
         if !self.blocks[i].all_ended() {
             self.predict(i, false);
         }
@@ -581,6 +608,56 @@ impl BlockManager {
         }
         if let Some(i) = self.pos(&id) {
             self.finish_if_done(i, t);
+        }
+    }
+
+    /// A chunked block starting at `t` takes over from the blocks it is chunked after: their
+    /// behaviours that are retracting (past `relax`) on a body resource this block uses (a hand,
+    /// the voice) skip the rest of the retraction and end now.
+    fn coarticulate(&mut self, i: usize, t: f64) {
+        if self.blocks[i].chunk_after.is_empty() {
+            return;
+        }
+        let mut used: Vec<&'static str> = Vec::new();
+        for x in self.blocks[i]
+            .behaviours
+            .iter()
+            .filter(|x| x.phase != Phase::Removed)
+        {
+            let b = &self.blocks[i].source.behaviours[x.index];
+            used.extend(self.registry.engine(x.engine).resources(b));
+        }
+        if used.is_empty() {
+            return;
+        }
+        for target in self.blocks[i].chunk_after.clone() {
+            let Some(j) = self.pos(&target) else { continue };
+            let start = self.blocks[j].start;
+            let block_id = self.blocks[j].id.clone();
+            for xi in 0..self.blocks[j].behaviours.len() {
+                let x = &self.blocks[j].behaviours[xi];
+                let relax = x.syncs.iter().position(|(n, _)| n == "relax");
+                let retracting = x.phase == Phase::Running && relax.is_some_and(|r| x.next > r);
+                let b = &self.blocks[j].source.behaviours[x.index];
+                let shares = self
+                    .registry
+                    .engine(x.engine)
+                    .resources(b)
+                    .iter()
+                    .any(|r| used.contains(r));
+                if !(retracting && shares) {
+                    continue;
+                }
+                let key = UnitKey::new(&block_id, &x.id);
+                let global: Vec<_> = x
+                    .syncs
+                    .iter()
+                    .map(|(n, l)| (n.clone(), start + l))
+                    .collect();
+                let engine = x.engine;
+                let times = self.registry.engine_mut(engine).interrupt(&key, t, &global);
+                self.blocks[j].behaviours[xi].retime(&times, start, t);
+            }
         }
     }
 

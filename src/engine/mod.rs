@@ -161,6 +161,19 @@ pub trait Engine {
         None
     }
 
+    /// Body resources the behaviour occupies (e.g. `left_hand`, `voice`): a chunked block
+    /// co-articulates with the block before it where they share one (the earlier behaviour skips
+    /// the rest of its retraction).
+    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// Whether the engine interprets the extension attribute `{ns}name` on its behaviours (the
+    /// runtime warns CUSTOM_ATTRIBUTE_NOT_SUPPORTED for the others).
+    fn interprets(&self, _ns: &str, _name: &str) -> bool {
+        false
+    }
+
     /// Takes a scheduled unit into the engine's plan.
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError>;
 
@@ -222,6 +235,86 @@ pub trait Engine {
         Err(EngineError(format!(
             "{key} has no parameter '{name}' that can change while it runs"
         )))
+    }
+}
+
+/// The units an engine holds, in the order they were added (so frames are deterministic without
+/// sorting), each with its key (shared with frame outputs) and current global sync times.
+#[derive(Debug, Clone, Default)]
+pub struct Units<T> {
+    units: Vec<(Arc<UnitKey>, SyncTimes, T)>,
+}
+
+/// A unit's (sync, global time) list, in sync order.
+pub type SyncTimes = Vec<(SyncName, f64)>;
+
+impl<T> Units<T> {
+    /// No units.
+    pub fn new() -> Self {
+        Units { units: Vec::new() }
+    }
+
+    /// Adds a unit with the engine's own data `data`.
+    pub fn add(&mut self, unit: Unit<'_>, data: T) {
+        self.units
+            .push((Arc::new(unit.key.clone()), unit.syncs.to_vec(), data));
+    }
+
+    /// Forgets a unit.
+    pub fn remove(&mut self, key: &UnitKey) {
+        self.units.retain(|(k, _, _)| **k != *key);
+    }
+
+    /// New sync times for a unit.
+    pub fn retime(&mut self, key: &UnitKey, times: &[f64]) {
+        if let Some((_, syncs, _)) = self.units.iter_mut().find(|(k, _, _)| **k == *key) {
+            for (s, t) in syncs.iter_mut().zip(times) {
+                s.1 = *t;
+            }
+        }
+    }
+
+    /// A unit's data.
+    pub fn get(&self, key: &UnitKey) -> Option<&T> {
+        self.units
+            .iter()
+            .find(|(k, _, _)| **k == *key)
+            .map(|(_, _, d)| d)
+    }
+
+    /// A unit's sync times and data.
+    pub fn get_mut(&mut self, key: &UnitKey) -> Option<(&mut SyncTimes, &mut T)> {
+        self.units
+            .iter_mut()
+            .find(|(k, _, _)| **k == *key)
+            .map(|(_, s, d)| (s, d))
+    }
+
+    /// How many units.
+    pub fn len(&self) -> usize {
+        self.units.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.units.is_empty()
+    }
+
+    /// The units running at `now` (start ≤ now < end) with their progress (0 at start, 1 at end;
+    /// 0 for a unit without a finite end), in the order they were added.
+    pub fn running(&self, now: f64) -> impl Iterator<Item = (&Arc<UnitKey>, f64, &T)> + '_ {
+        self.units.iter().filter_map(move |(k, s, d)| {
+            let (start, end) = (s.first()?.1, s.last()?.1);
+            if !(start <= now && now < end) {
+                return None;
+            }
+            let p = if end.is_finite() {
+                (now - start) / (end - start)
+            } else {
+                0.0
+            };
+            Some((k, p.clamp(0.0, 1.0), d))
+        })
     }
 }
 

@@ -184,7 +184,14 @@ pub struct SpeechTiming {
     pub comma_pause: f64,
     /// Pause after `.`, `!` or `?` (default 0.3 s).
     pub sentence_pause: f64,
+    /// An incremental TTS that can change its speaking rate (AsapRealizer's incremental speech):
+    /// speech is stretchable between 1/[`RETIME_RANGE`] and [`RETIME_RANGE`] times its preferred
+    /// length instead of rigid. Off by default: a TTS decides its timing (DESIGN §3).
+    pub retimable: bool,
 }
+
+/// How far a retimable speech may stretch or compress (factor on its preferred duration).
+pub const RETIME_RANGE: f64 = 3.0;
 
 impl Default for SpeechTiming {
     fn default() -> Self {
@@ -192,6 +199,7 @@ impl Default for SpeechTiming {
             syllable_seconds: 0.2,
             comma_pause: 0.15,
             sentence_pause: 0.3,
+            retimable: false,
         }
     }
 }
@@ -310,13 +318,22 @@ impl SpeechTiming {
                 }),
             }
         }
+        let end = if t > 0.0 { t } else { self.syllable_seconds };
         keys.push(SyncKey {
             name: Cow::Borrowed("end"),
-            at: if t > 0.0 { t } else { self.syllable_seconds },
+            at: end,
         });
+        let flexibility = if self.retimable {
+            Flexibility::Stretchable {
+                min_duration: end / RETIME_RANGE,
+                max_duration: end * RETIME_RANGE,
+            }
+        } else {
+            Flexibility::Rigid
+        };
         TimingModel {
             keys,
-            flexibility: Flexibility::Rigid,
+            flexibility,
             persistent: false,
         }
     }

@@ -5,9 +5,11 @@
 //! - [`speech`]: `speech` and `bmlt:text` with the headless speech timing model, `volume` settable
 //!   while speaking;
 //! - [`timing_only`]: every other kind, timing only until its animation engine lands: it plays the
-//!   scheduled pegs and reports every sync point, but moves no body.
+//!   scheduled pegs and reports every sync point, but moves no body;
+//! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well).
 
 pub mod control;
+pub mod murml;
 pub mod speech;
 pub mod timing_only;
 
@@ -66,6 +68,13 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(timing_only::TimingOnlyEngine::audio(models)),
         &keys(&[(NS_BMLT, "audiofile")]),
+    );
+    r.register(
+        Box::new(murml::MurmlEngine::default()),
+        &keys(&[
+            (murml::NS_MURML, "murmlgesture"),
+            (murml::NS_MURML, "murmlface"),
+        ]),
     );
     r
 }

@@ -3,21 +3,36 @@
 //! speech runs, `volume` (0–100) and `rate` (1 = the model's rate) can change; a rate change
 //! retimes the words still to come. Interrupting a speech stops it at once. No audio is produced
 //! (headless); the frame shows each running speech's progress, volume and rate.
-
-use std::sync::Arc;
+//!
+//! Incremental speech (the `bmlis` extension of AsapRealizer's incremental TTS):
+//! `bmlis:generatefiller="true"` adds a hesitation filler after the text — the speech gets a
+//! `relax` sync where the text ends and its `end` after the filler; a chunked successor that
+//! speaks cuts the filler (co-articulation on the voice).
 
 use crate::bml::{Behaviour, BehaviourKind};
+use crate::engine::timing::SyncKey;
 use crate::engine::timing::{SpeechTiming, TimingModel, TimingModels};
-use crate::engine::{stop_now, Engine, EngineError, Frame, Output, Unit, UnitKey};
+use crate::engine::{stop_now, Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
 use crate::schedule::SyncName;
 
 /// Volume of a speech that no one changed.
 pub const DEFAULT_VOLUME: f64 = 100.0;
 
+/// The incremental-speech extension namespace (AsapRealizer's `bmlis`).
+pub const NS_BMLIS: &str = "http://www.asap-project.org/bmlis";
+
+/// Length of a hesitation filler ("uhm"), seconds.
+pub const FILLER_SECONDS: f64 = 0.5;
+
+/// Whether a speech asks for a hesitation filler after its text.
+fn wants_filler(b: &Behaviour) -> bool {
+    b.foreign_attrs
+        .iter()
+        .any(|a| a.ns == NS_BMLIS && a.name == "generatefiller" && a.value.trim() == "true")
+}
+
 #[derive(Debug, Clone)]
 struct Speaking {
-    key: Arc<UnitKey>,
-    syncs: Vec<(SyncName, f64)>,
     volume: f64,
     rate: f64,
 }
@@ -26,8 +41,7 @@ struct Speaking {
 #[derive(Debug)]
 pub struct SpeechEngine {
     timing: SpeechTiming,
-    /// Units in the order they were added.
-    units: Vec<Speaking>,
+    units: Units<Speaking>,
 }
 
 impl SpeechEngine {
@@ -35,14 +49,8 @@ impl SpeechEngine {
     pub fn new(timing: SpeechTiming) -> Self {
         SpeechEngine {
             timing,
-            units: Vec::new(),
+            units: Units::new(),
         }
-    }
-}
-
-impl SpeechEngine {
-    fn unit_mut(&mut self, key: &UnitKey) -> Option<&mut Speaking> {
-        self.units.iter_mut().find(|u| *u.key == *key)
     }
 }
 
@@ -52,46 +60,66 @@ impl Engine for SpeechEngine {
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        match behaviour.kind {
+        let mut model = match behaviour.kind {
             BehaviourKind::Speech(_) | BehaviourKind::Text(_) => {
                 crate::engine::timing::DefaultTimingModels {
                     speech: self.timing,
                 }
-                .model(behaviour)
+                .model(behaviour)?
             }
-            _ => None,
+            _ => return None,
+        };
+        if wants_filler(behaviour) {
+            // the text ends at `relax`; the filler runs from there to `end`
+            let end = model.keys.last().map_or(0.0, |k| k.at);
+            let at = model.keys.len() - 1;
+            model.keys.insert(
+                at,
+                SyncKey {
+                    name: "relax".into(),
+                    at: end,
+                },
+            );
+            if let Some(last) = model.keys.last_mut() {
+                last.at = end + FILLER_SECONDS;
+            }
         }
+        Some(model)
+    }
+
+    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
+        &["voice"]
+    }
+
+    fn interprets(&self, ns: &str, name: &str) -> bool {
+        ns == NS_BMLIS && name == "generatefiller"
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         // keys are unique: the runtime never adds a unit twice
-        self.units.push(Speaking {
-            key: Arc::new(unit.key.clone()),
-            syncs: unit.syncs.to_vec(),
-            volume: DEFAULT_VOLUME,
-            rate: 1.0,
-        });
+        self.units.add(
+            unit,
+            Speaking {
+                volume: DEFAULT_VOLUME,
+                rate: 1.0,
+            },
+        );
         Ok(())
     }
 
     fn remove(&mut self, key: &UnitKey) {
-        self.units.retain(|u| *u.key != *key);
+        self.units.remove(key);
     }
 
     fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
         let times = stop_now(now, syncs);
-        if let Some(u) = self.unit_mut(key) {
-            for (s, t) in u.syncs.iter_mut().zip(&times) {
-                s.1 = *t;
-            }
-        }
+        self.units.retime(key, &times);
         times
     }
 
     fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        if let Some(u) = self.unit_mut(key) {
-            u.syncs = syncs.to_vec();
-        }
+        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
+        self.units.retime(key, &times);
     }
 
     fn len(&self) -> usize {
@@ -99,21 +127,18 @@ impl Engine for SpeechEngine {
     }
 
     fn play(&mut self, now: f64, frame: &mut Frame) {
-        for u in &self.units {
-            let (start, end) = span(&u.syncs);
-            if start <= now && now < end {
-                frame.outputs.push(Output {
-                    key: u.key.clone(),
-                    engine: "speech",
-                    progress: ((now - start) / (end - start)).clamp(0.0, 1.0),
-                    params: vec![("volume", u.volume), ("rate", u.rate)],
-                });
-            }
+        for (key, progress, u) in self.units.running(now) {
+            frame.outputs.push(Output {
+                key: key.clone(),
+                engine: "speech",
+                progress,
+                params: vec![("volume", u.volume), ("rate", u.rate)],
+            });
         }
     }
 
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
-        let u = self.units.iter().find(|u| *u.key == *key)?;
+        let u = self.units.get(key)?;
         match name {
             "volume" => Some(u.volume),
             "rate" => Some(u.rate),
@@ -128,8 +153,9 @@ impl Engine for SpeechEngine {
         value: f64,
         now: f64,
     ) -> Result<Option<Vec<f64>>, EngineError> {
-        let u = self
-            .unit_mut(key)
+        let (syncs, u) = self
+            .units
+            .get_mut(key)
             .ok_or_else(|| EngineError(format!("{key} is not speaking")))?;
         match name {
             "volume" if value.is_finite() => {
@@ -140,12 +166,12 @@ impl Engine for SpeechEngine {
                 // the rest of the speech plays at the new rate
                 let factor = u.rate / value;
                 u.rate = value;
-                for s in &mut u.syncs {
+                for s in syncs.iter_mut() {
                     if s.1 > now {
                         s.1 = now + (s.1 - now) * factor;
                     }
                 }
-                Ok(Some(u.syncs.iter().map(|s| s.1).collect()))
+                Ok(Some(syncs.iter().map(|s| s.1).collect()))
             }
             "volume" | "rate" => Err(EngineError(format!(
                 "{value} is not a valid {name} for {key} (volume 0-100, rate > 0)"
@@ -155,11 +181,4 @@ impl Engine for SpeechEngine {
             ))),
         }
     }
-}
-
-fn span(syncs: &[(SyncName, f64)]) -> (f64, f64) {
-    (
-        syncs.first().map_or(0.0, |s| s.1),
-        syncs.last().map_or(0.0, |s| s.1),
-    )
 }

@@ -5,15 +5,12 @@
 //! goes to `relax` at once and keeps its retraction; audio stops at once. It moves no joints: the
 //! support table (`docs/bml-support.md`) marks these kinds "timing only".
 
-use std::sync::Arc;
-
-use crate::bml::{Behaviour, BehaviourKind};
+use crate::bml::{Behaviour, BehaviourKind, Mode};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{relax_now, stop_now, Engine, EngineError, Frame, Output, Unit, UnitKey};
+use crate::engine::{
+    relax_now, stop_now, Engine, EngineError, Frame, Output, Unit, UnitKey, Units,
+};
 use crate::schedule::SyncName;
-
-/// A unit's (sync, global time) list.
-type Syncs = Vec<(SyncName, f64)>;
 
 /// The timing-only engine (see the module documentation).
 #[derive(Debug)]
@@ -21,8 +18,7 @@ pub struct TimingOnlyEngine {
     name: &'static str,
     models: DefaultTimingModels,
     stop_on_interrupt: bool,
-    /// Units in the order they were added (deterministic frames without sorting).
-    units: Vec<(Arc<UnitKey>, Syncs)>,
+    units: Units<()>,
 }
 
 impl TimingOnlyEngine {
@@ -32,7 +28,7 @@ impl TimingOnlyEngine {
             name: "motion",
             models,
             stop_on_interrupt: false,
-            units: Vec::new(),
+            units: Units::new(),
         }
     }
 
@@ -42,7 +38,7 @@ impl TimingOnlyEngine {
             name: "audio",
             models,
             stop_on_interrupt: true,
-            units: Vec::new(),
+            units: Units::new(),
         }
     }
 }
@@ -73,15 +69,23 @@ impl Engine for TimingOnlyEngine {
         }
     }
 
+    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
+        let mode = match &behaviour.kind {
+            BehaviourKind::Gesture(g) => g.mode,
+            BehaviourKind::Pointing(p) => p.mode,
+            _ => return &[],
+        };
+        hands(mode)
+    }
+
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         // keys are unique: the runtime never adds a unit twice
-        self.units
-            .push((Arc::new(unit.key.clone()), unit.syncs.to_vec()));
+        self.units.add(unit, ());
         Ok(())
     }
 
     fn remove(&mut self, key: &UnitKey) {
-        self.units.retain(|(k, _)| **k != *key);
+        self.units.remove(key);
     }
 
     fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
@@ -90,18 +94,13 @@ impl Engine for TimingOnlyEngine {
         } else {
             relax_now(now, syncs)
         };
-        if let Some((_, u)) = self.units.iter_mut().find(|(k, _)| **k == *key) {
-            for (s, t) in u.iter_mut().zip(&times) {
-                s.1 = *t;
-            }
-        }
+        self.units.retime(key, &times);
         times
     }
 
     fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        if let Some((_, u)) = self.units.iter_mut().find(|(k, _)| **k == *key) {
-            *u = syncs.to_vec();
-        }
+        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
+        self.units.retime(key, &times);
     }
 
     fn len(&self) -> usize {
@@ -109,25 +108,22 @@ impl Engine for TimingOnlyEngine {
     }
 
     fn play(&mut self, now: f64, frame: &mut Frame) {
-        for (key, s) in &self.units {
-            let (Some(first), Some(last)) = (s.first(), s.last()) else {
-                continue;
-            };
-            let (start, end) = (first.1, last.1);
-            if !(start <= now && now < end) {
-                continue;
-            }
-            let progress = if end.is_finite() {
-                (now - start) / (end - start)
-            } else {
-                0.0
-            };
+        for (key, progress, _) in self.units.running(now) {
             frame.outputs.push(Output {
                 key: key.clone(),
                 engine: self.name,
-                progress: progress.clamp(0.0, 1.0),
+                progress,
                 params: Vec::new(),
             });
         }
+    }
+}
+
+/// The hands a gesture mode occupies (the right hand when none is given).
+pub fn hands(mode: Option<Mode>) -> &'static [&'static str] {
+    match mode {
+        Some(Mode::LeftHand) => &["left_hand"],
+        Some(Mode::BothHands) => &["left_hand", "right_hand"],
+        Some(Mode::RightHand) | None => &["right_hand"],
     }
 }

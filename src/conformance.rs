@@ -1,0 +1,100 @@
+//! This realizer as a RealizerTester port (`realizer_tests::TestPort`): in process on the virtual
+//! clock, so the conformance suite runs fast and deterministically inside `cargo test` and
+//! `bmlr conformance`. Feedback goes through the XML codec, as it would through a real port.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use realizer_tests::{Fixture, TestPort};
+
+use crate::engine::timing::{DefaultTimingModels, SpeechTiming};
+use crate::engines::default_registry;
+use crate::feedback::{Feedback, Format};
+use crate::realizer::Realizer;
+
+/// A fresh [`Realizer`] per test on a virtual clock; tests of the incremental-speech fixture get
+/// retimable speech.
+pub struct InProcess {
+    realizer: Realizer,
+    lines: Rc<RefCell<Vec<String>>>,
+    end_delay: f64,
+}
+
+impl Default for InProcess {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl InProcess {
+    /// A port to a new realizer.
+    pub fn new() -> Self {
+        let lines = Rc::new(RefCell::new(Vec::new()));
+        InProcess {
+            realizer: Self::realizer(&lines, 0.0, Fixture::Standard),
+            lines,
+            end_delay: 0.0,
+        }
+    }
+
+    /// A deliberately broken realizer that reports every block end `secs` seconds late (to show
+    /// that the suite catches timing regressions).
+    pub fn with_late_block_ends(mut self, secs: f64) -> Self {
+        self.end_delay = secs;
+        self.realizer = Self::realizer(&self.lines, secs, Fixture::Standard);
+        self
+    }
+
+    fn realizer(lines: &Rc<RefCell<Vec<String>>>, end_delay: f64, fixture: Fixture) -> Realizer {
+        let sink = lines.clone();
+        let speech = SpeechTiming {
+            retimable: fixture == Fixture::IncrementalSpeech,
+            ..SpeechTiming::default()
+        };
+        let mut r =
+            Realizer::new().with_engines(move || default_registry(DefaultTimingModels { speech }));
+        r.add_listener(Box::new(move |fb: &Feedback| {
+            let mut fb = fb.clone();
+            if let Feedback::BlockProgress(p) = &mut fb {
+                if p.sync == "end" {
+                    p.global_time += end_delay;
+                }
+            }
+            sink.borrow_mut().push(Format::Xml.encode(&fb));
+        }));
+        r
+    }
+
+    fn take(&mut self) -> Vec<String> {
+        std::mem::take(&mut *self.lines.borrow_mut())
+    }
+}
+
+impl TestPort for InProcess {
+    fn perform_bml(&mut self, bml: &str) {
+        // problems are reported as warning feedback
+        let _ = self.realizer.perform_bml(bml);
+    }
+
+    fn sleep(&mut self, secs: f64) -> Vec<String> {
+        let now = self.realizer.now();
+        self.realizer.tick(now + secs.max(0.0));
+        self.take()
+    }
+
+    fn step(&mut self) -> Option<Vec<String>> {
+        let next = self.realizer.next_event()?;
+        self.realizer.tick(next);
+        Some(self.take())
+    }
+
+    fn real_time(&self) -> bool {
+        false
+    }
+
+    fn reset(&mut self, fixture: Fixture) -> Result<(), String> {
+        self.realizer = Self::realizer(&self.lines, self.end_delay, fixture);
+        self.lines.borrow_mut().clear();
+        Ok(())
+    }
+}
