@@ -166,3 +166,44 @@ fn run_gives_byte_identical_logs_and_both_formats_carry_the_same_messages() {
     };
     assert_eq!(decode(&a), decode(&j));
 }
+
+#[test]
+fn conformance_in_process_passes_all_41_tests() {
+    let (code, out, _) = bmlr(&["conformance"]);
+    assert_eq!(code, 0, "{out}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 42);
+    assert!(
+        lines[..41].iter().all(|l| l.starts_with("ok     test")),
+        "{out}"
+    );
+    assert_eq!(lines[41], "41 passed, 0 failed");
+    let (code, out, _) = bmlr(&["conformance", "--filter", "Gaze"]);
+    assert_eq!(code, 0);
+    assert_eq!(out.lines().last(), Some("4 passed, 0 failed"));
+}
+
+#[test]
+fn serve_stdio_answers_each_line_with_feedback_and_warns_on_garbage() {
+    let input = concat!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><speech id="s"><text>Hi</text></speech></bml>"#,
+        "\n",
+        "garbage\n",
+    );
+    let (code, out, err) = bmlr_stdin(&["serve", "--stdio"], input);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let fb: Vec<bml_realizer::feedback::Feedback> = out
+        .lines()
+        .map(|l| bml_realizer::feedback::from_line(l).unwrap())
+        .collect();
+    let has = |needle: &str| out.lines().any(|l| l.contains(needle));
+    assert!(
+        has(r#"id="a:speech:start""#) || has(r#"id="a:s:start""#),
+        "{out}"
+    );
+    assert!(has(r#"id="a:end""#), "{out}");
+    assert!(has(r#"type="PARSING_FAILURE""#), "{out}");
+    // wall clock: block and sync progress carry posix times
+    assert!(fb.iter().any(|f| matches!(f,
+        bml_realizer::feedback::Feedback::BlockProgress(p) if p.posix_time.is_some())));
+}

@@ -1,6 +1,7 @@
 //! `bmlr`: the command-line front end of the BML realizer (DESIGN §5).
 
 mod run;
+mod serve;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -26,6 +27,10 @@ enum Command {
     Run(run::RunArgs),
     /// Schedule BML files without executing them; print every sync point's time.
     Plan(run::PlanArgs),
+    /// Serve the realizer port: one <bml> block per input line, one feedback element per output line.
+    Serve(serve::ServeArgs),
+    /// Run the RealizerTester conformance suite; last line "N passed, M failed".
+    Conformance(serve::ConformanceArgs),
     /// Parse and check BML files; print file:line:col diagnostics. Exit 1 if any file is invalid.
     Validate {
         /// BML files (one <bml> block each).
@@ -43,6 +48,8 @@ fn main() -> ExitCode {
         Command::Validate { files, quiet } => validate(&files, quiet),
         Command::Run(args) => run::run(args),
         Command::Plan(args) => run::plan(args),
+        Command::Serve(args) => serve::serve(args),
+        Command::Conformance(args) => serve::conformance(args),
     }
 }
 

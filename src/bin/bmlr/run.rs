@@ -248,7 +248,10 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
     for item in items {
         match item {
             Item::Text(text) => {
-                realizer.tick(clock.now().min(until));
+                let frame = realizer.tick(clock.now().min(until));
+                if !print(&mut out, format, &frame.feedback) {
+                    return ExitCode::SUCCESS;
+                }
                 let _ = realizer.perform_bml(&text);
             }
             Item::Advance(s) => {
@@ -284,7 +287,10 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
                     while let Some(item) = stream.next_item(finished) {
                         match item {
                             StreamItem::Block(t) | StreamItem::Garbage(t) => {
-                                realizer.tick(clock.now().min(until));
+                                let frame = realizer.tick(clock.now().min(until));
+                                if !print(&mut out, format, &frame.feedback) {
+                                    return ExitCode::SUCCESS;
+                                }
                                 let _ = realizer.perform_bml(&t);
                             }
                             StreamItem::Advance(s) => {

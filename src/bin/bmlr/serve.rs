@@ -1,0 +1,157 @@
+//! `bmlr serve --stdio` (the realizer port over stdin/stdout on the wall clock: one `<bml>` block
+//! per input line, one feedback element per output line) and `bmlr conformance` (the RealizerTester
+//! suite, in process or against a realizer command).
+
+use std::io::{BufRead, Write};
+use std::process::ExitCode;
+use std::sync::mpsc;
+use std::time::Duration;
+
+use bml_realizer::bml::{BlockStream, StreamItem};
+use bml_realizer::clock::{Clock, WallClock};
+use bml_realizer::conformance::InProcess;
+use bml_realizer::engine::timing::{DefaultTimingModels, SpeechTiming};
+use bml_realizer::engines::default_registry;
+use bml_realizer::feedback::Format;
+use bml_realizer::realizer::Realizer;
+use clap::Args;
+use realizer_tests::{run, Outcome, ProcessPort, TestPort};
+
+/// Arguments of `bmlr serve`.
+#[derive(Args)]
+pub struct ServeArgs {
+    /// Serve on stdin/stdout.
+    #[arg(long, required = true)]
+    stdio: bool,
+    /// Frames per second of the engine loop.
+    #[arg(long, value_name = "HZ", default_value_t = 60.0)]
+    fps: f64,
+    /// Speech may change its rate to meet its constraints (an incremental TTS).
+    #[arg(long)]
+    retimable_speech: bool,
+}
+
+/// `bmlr serve --stdio`: runs until stdin closes and nothing more is scheduled.
+pub fn serve(args: ServeArgs) -> ExitCode {
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        eprintln!("bmlr serve: --fps must be a positive number");
+        return ExitCode::from(2);
+    }
+    let speech = SpeechTiming {
+        retimable: args.retimable_speech,
+        ..SpeechTiming::default()
+    };
+    let mut realizer = Realizer::new()
+        .with_engines(move || default_registry(DefaultTimingModels { speech }))
+        .with_posix_time(true);
+    let clock = WallClock::new();
+    let (tx, rx) = mpsc::channel::<Option<String>>();
+    std::thread::spawn(move || {
+        for line in std::io::stdin().lock().lines() {
+            let Ok(line) = line else { break };
+            if tx.send(Some(line + "\n")).is_err() {
+                return;
+            }
+        }
+        let _ = tx.send(None);
+    });
+    let period = Duration::from_secs_f64(1.0 / args.fps);
+    let mut out = std::io::stdout().lock();
+    let mut stream = BlockStream::new();
+    let mut open = true;
+    loop {
+        if open {
+            match rx.recv_timeout(period) {
+                Ok(Some(text)) => stream.push(&text),
+                Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => open = false,
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+            }
+        } else {
+            std::thread::sleep(period);
+        }
+        // bring the clock up to date before blocks arrive (they are planned at this time)
+        let mut feedback = realizer.tick(clock.now()).feedback;
+        while let Some(item) = stream.next_item(!open) {
+            match item {
+                StreamItem::Block(t) | StreamItem::Garbage(t) => {
+                    let _ = realizer.perform_bml(&t);
+                }
+                // a live port has no use for clock advances: time passes by itself
+                StreamItem::Advance(_) => {}
+            }
+        }
+        feedback.extend(realizer.tick(clock.now()).feedback);
+        for fb in &feedback {
+            if writeln!(out, "{}", Format::Xml.encode(fb)).is_err() {
+                return ExitCode::SUCCESS;
+            }
+        }
+        if out.flush().is_err() {
+            return ExitCode::SUCCESS;
+        }
+        if !open && realizer.next_event().is_none() {
+            return ExitCode::SUCCESS;
+        }
+    }
+}
+
+/// Arguments of `bmlr conformance`.
+#[derive(Args)]
+pub struct ConformanceArgs {
+    /// Test a realizer process speaking the line protocol (e.g. 'bmlr serve --stdio') in real
+    /// time, instead of this realizer in process on a virtual clock.
+    #[arg(long, value_name = "CMD")]
+    realizer: Option<String>,
+    /// The realizer command for the incremental-speech tests (a realizer with retimable speech);
+    /// defaults to --realizer.
+    #[arg(long, value_name = "CMD")]
+    incremental_realizer: Option<String>,
+    /// Run only the tests whose name contains PAT.
+    #[arg(long, value_name = "PAT", default_value = "")]
+    filter: String,
+}
+
+/// `bmlr conformance`.
+pub fn conformance(args: ConformanceArgs) -> ExitCode {
+    let mut port: Box<dyn TestPort> = match &args.realizer {
+        None => Box::new(InProcess::new()),
+        Some(cmd) => {
+            let incremental = args.incremental_realizer.as_deref().unwrap_or(cmd);
+            match ProcessPort::spawn_with(cmd, incremental) {
+                Ok(p) => Box::new(p),
+                Err(e) => {
+                    eprintln!("bmlr conformance: cannot start '{cmd}': {e}");
+                    return ExitCode::from(2);
+                }
+            }
+        }
+    };
+    let external = args.realizer.is_some();
+    let mut out = std::io::stdout().lock();
+    let outcomes = run(port.as_mut(), &args.filter, |i, n, o: &Outcome| {
+        let line = match &o.failure {
+            None => format!("ok     {}", o.name),
+            Some(f) => format!(
+                "FAILED {}: {}",
+                o.name,
+                f.lines().next().unwrap_or_default()
+            ),
+        };
+        let _ = writeln!(out, "{line}");
+        let _ = out.flush();
+        if let Some(f) = &o.failure {
+            // the whole story (the feedback seen) for people
+            eprintln!("--- {} ---\n{f}", o.name);
+        }
+        if external {
+            eprintln!("[{}/{n}] {}", i + 1, o.name);
+        }
+    });
+    let failed = outcomes.iter().filter(|o| o.failure.is_some()).count();
+    let _ = writeln!(out, "{} passed, {} failed", outcomes.len() - failed, failed);
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
