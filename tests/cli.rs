@@ -207,3 +207,21 @@ fn serve_stdio_answers_each_line_with_feedback_and_warns_on_garbage() {
     assert!(fb.iter().any(|f| matches!(f,
         bml_realizer::feedback::Feedback::BlockProgress(p) if p.posix_time.is_some())));
 }
+
+#[test]
+fn run_realtime_reports_on_the_wall_clock_with_posix_times() {
+    let input = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><speech id="s"><text>Hi</text></speech></bml>"#;
+    let (code, out, err) = bmlr_stdin(&["run", "--realtime", "--format", "jsonl", "-"], input);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let end = out
+        .lines()
+        .find(|l| l.contains(r#""id":"a:end""#))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(end.contains(r#""bmla:posixTime":"#), "{end}");
+    // the speech lasts 0.2 s on the wall clock (the block starts when it arrives)
+    let fb = bml_realizer::feedback::from_line(end).unwrap();
+    let bml_realizer::feedback::Feedback::BlockProgress(p) = fb else {
+        panic!("{end}")
+    };
+    assert!(p.global_time >= 0.2, "{}", p.global_time);
+}

@@ -103,7 +103,7 @@ pub struct ConformanceArgs {
     #[arg(long, value_name = "CMD")]
     realizer: Option<String>,
     /// The realizer command for the incremental-speech tests (a realizer with retimable speech);
-    /// defaults to --realizer.
+    /// defaults to --realizer (with --retimable-speech added if that is `bmlr serve`).
     #[arg(long, value_name = "CMD")]
     incremental_realizer: Option<String>,
     /// Run only the tests whose name contains PAT.
@@ -111,13 +111,34 @@ pub struct ConformanceArgs {
     filter: String,
 }
 
+/// The command for the incremental-speech tests: the one given, else `cmd` itself — with
+/// `--retimable-speech` added when `cmd` is this realizer's `serve --stdio`.
+fn incremental_command(cmd: &str, given: Option<&str>) -> String {
+    if let Some(g) = given {
+        return g.to_string();
+    }
+    let words: Vec<&str> = cmd.split_whitespace().collect();
+    let ours = words.len() >= 2
+        && words[0].rsplit('/').next() == Some("bmlr")
+        && words[1] == "serve"
+        && !words.contains(&"--retimable-speech");
+    if ours {
+        format!("{cmd} --retimable-speech")
+    } else {
+        cmd.to_string()
+    }
+}
+
 /// `bmlr conformance`.
 pub fn conformance(args: ConformanceArgs) -> ExitCode {
     let mut port: Box<dyn TestPort> = match &args.realizer {
         None => Box::new(InProcess::new()),
         Some(cmd) => {
-            let incremental = args.incremental_realizer.as_deref().unwrap_or(cmd);
-            match ProcessPort::spawn_with(cmd, incremental) {
+            let incremental = incremental_command(cmd, args.incremental_realizer.as_deref());
+            if incremental != *cmd {
+                eprintln!("bmlr conformance: incremental-speech tests run on '{incremental}'");
+            }
+            match ProcessPort::spawn_with(cmd, &incremental) {
                 Ok(p) => Box::new(p),
                 Err(e) => {
                     eprintln!("bmlr conformance: cannot start '{cmd}': {e}");
@@ -153,5 +174,24 @@ pub fn conformance(args: ConformanceArgs) -> ExitCode {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::incremental_command;
+
+    #[test]
+    fn our_serve_gets_retimable_speech_for_the_incremental_tests() {
+        assert_eq!(
+            incremental_command("bmlr serve --stdio", None),
+            "bmlr serve --stdio --retimable-speech"
+        );
+        assert_eq!(
+            incremental_command("./target/release/bmlr serve --stdio", None),
+            "./target/release/bmlr serve --stdio --retimable-speech"
+        );
+        assert_eq!(incremental_command("java -jar asap.jar", None), "java -jar asap.jar");
+        assert_eq!(incremental_command("bmlr serve --stdio", Some("x")), "x");
     }
 }
