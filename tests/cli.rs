@@ -225,3 +225,108 @@ fn run_realtime_reports_on_the_wall_clock_with_posix_times() {
     };
     assert!(p.global_time >= 0.2, "{}", p.global_time);
 }
+
+// ---- bmlr diff ---------------------------------------------------------------------------
+
+use bml_realizer::feedback::{Feedback, Format};
+
+/// The feedback of the greeting example, as messages.
+fn greeting() -> Vec<Feedback> {
+    let (_, out, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
+    out.lines()
+        .map(|l| bml_realizer::feedback::from_line(l).unwrap())
+        .collect()
+}
+
+fn write_log(name: &str, fb: &[Feedback], format: Format) -> String {
+    let path = std::env::temp_dir().join(format!("bmlr-diff-{}-{name}", std::process::id()));
+    let text: String = fb.iter().map(|f| format.encode(f) + "\n").collect();
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+fn diff_of(a: &str, b: &str) -> (i32, String) {
+    let (code, out, err) = bmlr(&["diff", a, b, "--tolerance", "0.1"]);
+    (code, out + &err)
+}
+
+#[test]
+fn diff_equal_logs_even_across_formats_clock_origins_jitter_and_posix_times() {
+    let base = greeting();
+    let a = write_log("a.log", &base, Format::Xml);
+    assert_eq!(diff_of(&a, &a).0, 0);
+    // the same run: JSON lines, another clock origin, ±0.05 s jitter, wall-clock posix times
+    let mut other = base.clone();
+    for (i, f) in other.iter_mut().enumerate() {
+        let jitter = if i % 2 == 0 { 0.05 } else { -0.05 };
+        match f {
+            Feedback::BlockProgress(p) => {
+                p.global_time += 100.0 + jitter;
+                p.posix_time = Some(1_700_000_000_000 + i as u64);
+            }
+            Feedback::SyncPointProgress(p) => {
+                p.time += jitter;
+                p.global_time += 100.0 + jitter;
+                p.posix_time = Some(1_700_000_000_000 + i as u64);
+            }
+            _ => {}
+        }
+    }
+    let b = write_log("b.jsonl", &other, Format::Jsonl);
+    let (code, out) = diff_of(&a, &b);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("equal: 22 messages"), "{out}");
+}
+
+#[test]
+fn diff_reports_a_missing_sync_and_swapped_syncs() {
+    let base = greeting();
+    let a = write_log("m-a.log", &base, Format::Xml);
+    let without: Vec<Feedback> = base
+        .iter()
+        .filter(|f| !matches!(f, Feedback::SyncPointProgress(p) if p.behaviour == "nod" && p.sync == "stroke"))
+        .cloned()
+        .collect();
+    let b = write_log("m-b.log", &without, Format::Xml);
+    let (code, out) = diff_of(&a, &b);
+    assert_eq!(code, 1);
+    assert!(
+        out.contains("missing in B: syncPointProgress greet:nod:stroke"),
+        "{out}"
+    );
+    // two syncs of the beat swapped (with their times)
+    let mut swapped = base.clone();
+    let i = swapped
+        .iter()
+        .position(|f| matches!(f, Feedback::SyncPointProgress(p) if p.behaviour == "beat" && p.sync == "ready"))
+        .unwrap();
+    swapped.swap(i, i + 1);
+    let c = write_log("m-c.log", &swapped, Format::Xml);
+    let (code, out) = diff_of(&a, &c);
+    assert_eq!(code, 1);
+    assert!(
+        out.contains("reordered: B has syncPointProgress greet:beat:strokeStart"),
+        "{out}"
+    );
+}
+
+#[test]
+fn diff_of_a_truncated_or_garbage_file_exits_2_with_the_line() {
+    let base = greeting();
+    let a = write_log("t-a.log", &base, Format::Xml);
+    let text = std::fs::read_to_string(&a).unwrap();
+    let cut = &text[..text.len() - 40];
+    let t = std::env::temp_dir().join(format!("bmlr-diff-{}-t.log", std::process::id()));
+    std::fs::write(&t, cut).unwrap();
+    let (code, out) = diff_of(&a, t.to_str().unwrap());
+    assert_eq!(code, 2);
+    assert!(
+        out.contains(&format!("{}:22: bad feedback", t.display())),
+        "{out}"
+    );
+    let g = std::env::temp_dir().join(format!("bmlr-diff-{}-g.log", std::process::id()));
+    std::fs::write(&g, "hello\n").unwrap();
+    let (code, out) = diff_of(g.to_str().unwrap(), &a);
+    assert_eq!(code, 2);
+    assert!(out.contains(":1: bad feedback"), "{out}");
+}

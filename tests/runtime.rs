@@ -958,3 +958,39 @@ fn an_unknown_anticipator_drops_the_behaviour_that_names_it() {
     assert_eq!(s.warnings(), [("b:s".into(), "NO_SUCH_TARGET".into())]);
     assert!(s.has_sync("b", "h"));
 }
+
+#[test]
+fn a_block_tied_to_a_sync_that_just_passed_starts_at_it() {
+    let mut s = Session::new();
+    s.send(0.0, &block("bml1", "", &speech("speech1", 10, None, "")));
+    // a frame later, a parameter change tied to the speech's start (already past)
+    s.send(
+        0.05,
+        &block(
+            "bml2",
+            "",
+            r#"<bmla:parametervaluechange id="pvc1" target="bml1:speech1" paramId="volume" start="bml1:speech1:start" end="bml1:speech1:end"><bmla:trajectory type="linear" initialValue="0" targetValue="100"/></bmla:parametervaluechange>"#,
+        ),
+    );
+    s.finish();
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
+    assert!(close(s.at("bml2:pvc1:start"), 0.0));
+    assert!(close(s.at("bml2:pvc1:end"), 2.0));
+    assert_eq!(s.block_time("bml2", "start"), Some(0.0));
+    // much later than LATE_START it cannot hold: the change is dropped with a warning
+    let mut s = Session::new();
+    s.send(0.0, &block("bml1", "", &speech("speech1", 10, None, "")));
+    s.send(
+        1.0,
+        &block(
+            "bml2",
+            "",
+            r#"<bmla:parametervaluechange id="pvc1" target="bml1:speech1" paramId="volume" start="bml1:speech1:start"><bmla:trajectory type="instant" targetValue="100"/></bmla:parametervaluechange>"#,
+        ),
+    );
+    s.finish();
+    assert_eq!(
+        s.warnings(),
+        [("bml2:pvc1".into(), "CANNOT_SATISFY_CONSTRAINTS".into())]
+    );
+}

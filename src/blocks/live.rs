@@ -101,9 +101,10 @@ pub(crate) struct BlockPegs {
     pub(crate) plan: PlannedBlock,
 }
 
-/// The anticipator syncs (anticipator, sync) that sync references of `block` name.
-pub(crate) fn anticipator_refs(block: &bml::Block) -> Vec<(&str, &str)> {
-    let mut out = Vec::new();
+/// Every sync point that a sync reference of `block` names (attributes and `<constraint>`s), each
+/// once, in document order.
+pub(crate) fn referenced_points(block: &bml::Block) -> Vec<&SyncPoint> {
+    let mut out: Vec<&SyncPoint> = Vec::new();
     let refs = block
         .behaviours
         .iter()
@@ -127,17 +128,26 @@ pub(crate) fn anticipator_refs(block: &bml::Block) -> Vec<(&str, &str)> {
             })
         }));
     for r in refs {
-        if let SyncRef::Point {
-            point: SyncPoint::Anticipator { anticipator, sync },
-            ..
-        } = r
-        {
-            if !out.contains(&(anticipator.as_str(), sync.as_str())) {
-                out.push((anticipator.as_str(), sync.as_str()));
+        if let SyncRef::Point { point, .. } = r {
+            if !out.contains(&point) {
+                out.push(point);
             }
         }
     }
     out
+}
+
+/// The anticipator syncs (anticipator, sync) that sync references of `block` name.
+pub(crate) fn anticipator_refs(block: &bml::Block) -> Vec<(&str, &str)> {
+    referenced_points(block)
+        .into_iter()
+        .filter_map(|p| match p {
+            SyncPoint::Anticipator { anticipator, sync } => {
+                Some((anticipator.as_str(), sync.as_str()))
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 impl LiveBlock {

@@ -24,7 +24,12 @@ use crate::plan::anticipator::Anticipator;
 use crate::plan::pegs::PegBoard;
 use crate::schedule::to_pegs::{self, Anticipators};
 use crate::schedule::{ExternalTimes, SchedulingStrategy};
-use live::{anticipator_refs, BlockPegs, LiveBlock, Phase};
+use live::{anticipator_refs, referenced_points, BlockPegs, LiveBlock, Phase};
+
+/// How late a block may start so that its references to other blocks' sync points that have just
+/// passed still hold exactly (a block sent a frame after the moment it refers to): it starts that
+/// much in the past instead of failing those constraints.
+pub const LATE_START: f64 = 0.25;
 
 /// How many ids of finished blocks are remembered (so that late references to them are quiet
 /// no-ops rather than NO_SUCH_TARGET warnings).
@@ -346,7 +351,24 @@ impl BlockManager {
             }
         }
         let chunk_after = self.existing(&block.ext.chunk_after, &block.id);
-        let start = self.predicted_start(now, &waits_for, &chunk_after);
+        let mut start = self.predicted_start(now, &waits_for, &chunk_after);
+        // a block tied to another block's sync point that passed a moment ago starts then
+        for p in referenced_points(&block) {
+            if let SyncPoint::External {
+                block: b,
+                behaviour,
+                sync,
+            } = p
+            {
+                let t = self.pos(b).and_then(|i| {
+                    let other = &self.blocks[i];
+                    Some(other.start + other.behaviour(behaviour)?.time(sync)?)
+                });
+                if let Some(t) = t.filter(|t| *t < start && start - *t <= LATE_START) {
+                    start = t;
+                }
+            }
+        }
 
         // S24: scheduling starts
         self.seq += 1;
@@ -449,7 +471,13 @@ impl BlockManager {
         let i = self.blocks.len() - 1;
         self.predict(i, true);
         if !ext.preplan {
-            self.release(i, now);
+            if self.ready(i) {
+                // at its planned start: now, or a moment ago (LATE_START)
+                let t = self.blocks[i].start.min(now);
+                self.start_block(i, t);
+            } else {
+                self.release(i, now);
+            }
         }
         self.start_ready(now);
     }

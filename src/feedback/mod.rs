@@ -2,6 +2,7 @@
 //! with the BMLA status and posix-time extensions), the listener trait, and the two line codecs of
 //! DESIGN §4 — XML (one element per line) and JSON lines.
 
+pub mod diff;
 mod json;
 mod xml;
 

@@ -1,5 +1,6 @@
 //! `bmlr`: the command-line front end of the BML realizer (DESIGN §5).
 
+mod diff;
 mod run;
 mod serve;
 
@@ -27,6 +28,8 @@ enum Command {
     Run(run::RunArgs),
     /// Schedule BML files without executing them; print every sync point's time.
     Plan(run::PlanArgs),
+    /// Compare two feedback logs (XML or JSON lines) modulo clock origin, posix times and jitter.
+    Diff(diff::DiffArgs),
     /// Serve the realizer port: one <bml> block per input line, one feedback element per output line.
     Serve(serve::ServeArgs),
     /// Run the RealizerTester conformance suite; last line "N passed, M failed".
@@ -48,6 +51,7 @@ fn main() -> ExitCode {
         Command::Validate { files, quiet } => validate(&files, quiet),
         Command::Run(args) => run::run(args),
         Command::Plan(args) => run::plan(args),
+        Command::Diff(args) => diff::run(args),
         Command::Serve(args) => serve::serve(args),
         Command::Conformance(args) => serve::conformance(args),
     }

@@ -191,7 +191,10 @@ mod tests {
             incremental_command("./target/release/bmlr serve --stdio", None),
             "./target/release/bmlr serve --stdio --retimable-speech"
         );
-        assert_eq!(incremental_command("java -jar asap.jar", None), "java -jar asap.jar");
+        assert_eq!(
+            incremental_command("java -jar asap.jar", None),
+            "java -jar asap.jar"
+        );
         assert_eq!(incremental_command("bmlr serve --stdio", Some("x")), "x");
     }
 }
