@@ -10,7 +10,8 @@
 //! - [`plan`]: the flexible plan of pegs;
 //! - [`engine`]: the engine interface, registry and timing models; [`engines`]: built-in engines;
 //! - [`clock`]: virtual and wall clocks;
-//! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`).
+//! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`);
+//! - [`timeline`]: timeline pictures (SVG) of plans and logs.
 
 #![warn(missing_docs)]
 
@@ -24,6 +25,7 @@ pub mod feedback;
 pub mod plan;
 pub mod realizer;
 pub mod schedule;
+pub mod timeline;
 mod xmlname;
 
 /// The README's code runs as a doc test, so that it stays true.

@@ -28,6 +28,8 @@ enum Command {
     Run(run::RunArgs),
     /// Schedule BML files without executing them; print every sync point's time.
     Plan(run::PlanArgs),
+    /// Draw a feedback log as a timeline picture (SVG).
+    Timeline(run::TimelineArgs),
     /// Compare two feedback logs (XML or JSON lines) modulo clock origin, posix times and jitter.
     Diff(diff::DiffArgs),
     /// Serve the realizer port: one <bml> block per input line, one feedback element per output line.
@@ -52,6 +54,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run::run(args),
         Command::Plan(args) => run::plan(args),
         Command::Diff(args) => diff::run(args),
+        Command::Timeline(args) => run::timeline(args),
         Command::Serve(args) => serve::serve(args),
         Command::Conformance(args) => serve::conformance(args),
     }

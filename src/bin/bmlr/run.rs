@@ -11,6 +11,7 @@ use bml_realizer::bml::{BlockStream, StreamItem};
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{BlockStatus, Feedback, Format};
 use bml_realizer::realizer::Realizer;
+use bml_realizer::timeline::Timeline;
 use clap::{Args, ValueEnum};
 
 /// Feedback line format.
@@ -62,6 +63,9 @@ pub struct PlanArgs {
     /// Character for blocks without a characterId.
     #[arg(long, value_name = "ID")]
     character: Option<String>,
+    /// Also draw the plan as a timeline picture (SVG) with the constraints as links.
+    #[arg(long, value_name = "OUT.svg")]
+    svg: Option<std::path::PathBuf>,
     /// BML files, planned in order as if sent at once.
     #[arg(required = true, value_name = "FILE")]
     files: Vec<String>,
@@ -334,16 +338,30 @@ pub fn plan(args: PlanArgs) -> ExitCode {
     };
     let mut realizer = Realizer::new().with_default_character(args.character);
     let mut feedback = Vec::new();
+    let mut blocks = Vec::new();
     for item in items {
         match item {
             Item::Text(text) => {
                 let _ = realizer.perform_bml(&text);
                 feedback.extend(realizer.tick(0.0).feedback);
+                if let Ok(parsed) = bml_realizer::bml::load(&text) {
+                    blocks.push(parsed.block);
+                }
             }
             Item::Advance(_) | Item::Stdin => {
                 eprintln!("bmlr plan: only files can be planned");
                 return ExitCode::from(2);
             }
+        }
+    }
+    if let Some(path) = &args.svg {
+        let mut timeline = Timeline::from_feedback(&feedback);
+        for b in &blocks {
+            timeline.add_constraints(b);
+        }
+        if let Err(e) = write_svg(path, &timeline) {
+            eprintln!("bmlr plan: {e}");
+            return ExitCode::from(2);
         }
     }
     let mut out = std::io::stdout().lock();
@@ -392,4 +410,60 @@ fn plan_lines(feedback: &[Feedback]) -> Vec<String> {
         }
     }
     lines
+}
+
+/// Writes a timeline picture and says so on stderr.
+pub fn write_svg(path: &Path, timeline: &Timeline) -> Result<(), String> {
+    std::fs::write(path, timeline.to_svg())
+        .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    let lanes: usize = timeline.blocks.iter().map(|b| b.lanes.len()).sum();
+    eprintln!(
+        "wrote {} ({} block{}, {lanes} behaviour{})",
+        path.display(),
+        timeline.blocks.len(),
+        if timeline.blocks.len() == 1 { "" } else { "s" },
+        if lanes == 1 { "" } else { "s" }
+    );
+    Ok(())
+}
+
+/// Arguments of `bmlr timeline`.
+#[derive(Args)]
+pub struct TimelineArgs {
+    /// A feedback log (XML or JSON lines).
+    log: std::path::PathBuf,
+    /// The picture to write.
+    #[arg(long, value_name = "OUT.svg", required = true)]
+    svg: std::path::PathBuf,
+}
+
+/// `bmlr timeline LOG --svg OUT.svg`: draws what a log reports.
+pub fn timeline(args: TimelineArgs) -> ExitCode {
+    let text = match std::fs::read_to_string(&args.log) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("bmlr timeline: {}: cannot read: {e}", args.log.display());
+            return ExitCode::from(2);
+        }
+    };
+    let log = match bml_realizer::feedback::diff::Log::parse(&text) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!(
+                "bmlr timeline: {}:{}: {}",
+                args.log.display(),
+                e.line,
+                e.error
+            );
+            return ExitCode::from(2);
+        }
+    };
+    let feedback: Vec<Feedback> = log.messages.into_iter().map(|(_, f)| f).collect();
+    match write_svg(&args.svg, &Timeline::from_feedback(&feedback)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("bmlr timeline: {e}");
+            ExitCode::from(2)
+        }
+    }
 }

@@ -1,0 +1,151 @@
+//! Timeline pictures: `bmlr plan --svg` and `bmlr timeline --svg` write well-formed SVG that a real
+//! renderer (`rsvg-convert`, Debian's librsvg2-bin, installed by `.ci/run`) turns into a PNG, also
+//! for a plan of 50 behaviours.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn tmp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("bmlr-timeline-{}-{name}", std::process::id()))
+}
+
+fn bmlr(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn well_formed(svg: &Path) -> String {
+    let text = std::fs::read_to_string(svg).unwrap();
+    let mut r = quick_xml::Reader::from_str(&text);
+    loop {
+        match r.read_event() {
+            Ok(quick_xml::events::Event::Eof) => break,
+            Ok(_) => {}
+            Err(e) => panic!("{}: not well-formed: {e}", svg.display()),
+        }
+    }
+    text
+}
+
+/// Renders with rsvg-convert; returns the PNG's (width, height).
+fn render(svg: &Path) -> (u32, u32) {
+    let png = svg.with_extension("png");
+    let status = Command::new("rsvg-convert")
+        .arg(svg)
+        .arg("-o")
+        .arg(&png)
+        .status()
+        .expect(
+            "rsvg-convert (Debian package librsvg2-bin) must be installed; .ci/run installs it",
+        );
+    assert!(status.success(), "rsvg-convert failed on {}", svg.display());
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    (be(16), be(20))
+}
+
+#[test]
+fn plan_svg_shows_lanes_syncs_and_constraint_links_and_renders() {
+    let svg = tmp("plan.svg");
+    let (code, _, err) = bmlr(&[
+        "plan",
+        "fixtures/realizertester/bml-1/core/testspeechgestures.xml",
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("(1 block, 4 behaviours)"), "{err}");
+    let text = well_formed(&svg);
+    for lane in [
+        "welkom (speech)",
+        "g1 (gesture)",
+        "relaxleft (gesture)",
+        "transleft (gesture)",
+    ] {
+        assert!(text.contains(lane), "{lane}");
+    }
+    // the six constraints of the block are drawn as links
+    assert_eq!(text.matches("stroke-dasharray").count(), 6);
+    assert!(text.contains("<title>bml1:g1:start = bml1:welkom:deicticheart1</title>"));
+    let (w, h) = render(&svg);
+    assert!(w > 1000 && h > 100, "{w}x{h}");
+}
+
+#[test]
+fn timeline_of_a_log_shows_what_happened_with_warnings() {
+    let log = tmp("gaze.log");
+    let (_, out, _) = bmlr(&[
+        "run",
+        "fixtures/realizertester/bml-1/core/testgazeoverlap.xml",
+    ]);
+    std::fs::write(&log, out).unwrap();
+    let svg = tmp("gaze.svg");
+    let (code, _, err) = bmlr(&[
+        "timeline",
+        log.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let text = well_formed(&svg);
+    assert!(text.contains("gaze1 (gaze)"));
+    assert!(text.contains("⚠ bml1:gaze2"), "the warning is shown");
+    render(&svg);
+    // an unreadable log is an error with its line
+    std::fs::write(&log, "garbage\n").unwrap();
+    let (code, _, err) = bmlr(&[
+        "timeline",
+        log.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains(":1: bad feedback"), "{err}");
+}
+
+#[test]
+fn fifty_behaviours_stay_readable() {
+    let mut body = String::new();
+    for i in 0..50 {
+        let kind = [
+            "gesture lexeme=\"BEAT\"",
+            "head lexeme=\"NOD\"",
+            "gaze target=\"x\"",
+        ][i % 3];
+        let start = if i == 0 {
+            String::from("0")
+        } else {
+            format!("b{}:end", i - 1)
+        };
+        body.push_str(&format!(r#"<{kind} id="b{i}" start="{start}"/>"#));
+    }
+    let bml = tmp("fifty.xml");
+    std::fs::write(
+        &bml,
+        format!(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="many">{body}</bml>"#),
+    )
+    .unwrap();
+    let svg = tmp("fifty.svg");
+    let (code, _, err) = bmlr(&[
+        "plan",
+        bml.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("(1 block, 50 behaviours)"), "{err}");
+    well_formed(&svg);
+    let (w, h) = render(&svg);
+    // one 30 px lane per behaviour, a time axis that keeps 20 px per second at least
+    assert!((1500..1700).contains(&h), "{w}x{h}");
+    assert!(w >= 1200 && w < 6000, "{w}x{h}");
+}
