@@ -7,6 +7,9 @@ use std::fmt::Write as _;
 use crate::bml::{self, Anchor, SyncPoint};
 use crate::feedback::{BlockStatus, Feedback};
 
+/// A sync point: (block, behaviour, sync).
+pub type SyncId = (String, String, String);
+
 /// One behaviour's lane.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lane {
@@ -41,9 +44,9 @@ pub struct BlockRow {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Link {
     /// One end.
-    pub from: (String, String, String),
+    pub from: SyncId,
     /// The other end.
-    pub to: (String, String, String),
+    pub to: SyncId,
     /// `=`, `<=`, `>=` for constraints, `≈` for sync points that merely coincide.
     pub label: String,
 }
@@ -298,7 +301,7 @@ fn svg(t: &Timeline) -> String {
     }
     // rows
     let mut y = TOP + 20.0;
-    let mut positions: Vec<((String, String, String), (f64, f64))> = Vec::new();
+    let mut positions: Vec<(SyncId, (f64, f64))> = Vec::new();
     let mut character: Option<&String> = None;
     for b in &t.blocks {
         let who = if b.character != character.cloned() && b.character.is_some() {
@@ -386,7 +389,7 @@ fn svg(t: &Timeline) -> String {
     }
     // links
     for link in &t.links {
-        let at = |p: &(String, String, String)| positions.iter().find(|q| &q.0 == p).map(|q| q.1);
+        let at = |p: &SyncId| positions.iter().find(|q| &q.0 == p).map(|q| q.1);
         if let (Some((x1, y1)), Some((x2, y2))) = (at(&link.from), at(&link.to)) {
             let colour = if link.label == "≈" {
                 "#9aa"
