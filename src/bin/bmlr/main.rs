@@ -3,6 +3,7 @@
 mod diff;
 mod run;
 mod serve;
+mod tcp;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -21,8 +21,15 @@ use realizer_tests::{run, Outcome, ProcessPort, TestPort};
 #[derive(Args)]
 pub struct ServeArgs {
     /// Serve on stdin/stdout.
-    #[arg(long, required = true)]
+    #[arg(long, required_unless_present = "tcp", conflicts_with = "tcp")]
     stdio: bool,
+    /// Serve several clients on a TCP address (e.g. 127.0.0.1:7700; port 0 picks one, printed
+    /// on stderr).
+    #[arg(long, value_name = "ADDR")]
+    tcp: Option<String>,
+    /// With --tcp: send each client only the feedback about its own blocks.
+    #[arg(long, requires = "tcp")]
+    per_client: bool,
     /// Frames per second of the engine loop.
     #[arg(long, value_name = "HZ", default_value_t = 60.0)]
     fps: f64,
@@ -31,7 +38,7 @@ pub struct ServeArgs {
     retimable_speech: bool,
 }
 
-/// `bmlr serve --stdio`: runs until stdin closes and nothing more is scheduled.
+/// `bmlr serve --stdio` (runs until stdin closes and nothing more is scheduled) or `--tcp`.
 pub fn serve(args: ServeArgs) -> ExitCode {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         eprintln!("bmlr serve: --fps must be a positive number");
@@ -44,6 +51,9 @@ pub fn serve(args: ServeArgs) -> ExitCode {
     let mut realizer = Realizer::new()
         .with_engines(move || default_registry(DefaultTimingModels { speech }))
         .with_posix_time(true);
+    if let Some(addr) = &args.tcp {
+        return crate::tcp::serve(addr, args.per_client, args.fps, realizer);
+    }
     let clock = WallClock::new();
     let (tx, rx) = mpsc::channel::<Option<String>>();
     std::thread::spawn(move || {

@@ -1,0 +1,163 @@
+//! `bmlr serve --tcp`: many clients at once on loopback, per-client and broadcast feedback,
+//! garbage and disconnects.
+
+use std::io::{BufRead, BufReader, Write};
+use std::net::TcpStream;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+struct Server {
+    child: Child,
+    addr: String,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn server(extra: &[&str]) -> Server {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(["serve", "--tcp", "127.0.0.1:0"])
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let addr = line
+        .trim()
+        .strip_prefix("bmlr serve: listening on ")
+        .unwrap_or_else(|| panic!("{line}"))
+        .to_string();
+    Server { child, addr }
+}
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// Reads lines until `done` says so or the deadline passes.
+fn read_until(
+    reader: &mut BufReader<TcpStream>,
+    deadline: Instant,
+    mut done: impl FnMut(&str) -> bool,
+) -> Vec<String> {
+    let mut lines = Vec::new();
+    reader
+        .get_ref()
+        .set_read_timeout(Some(Duration::from_millis(200)))
+        .unwrap();
+    while Instant::now() < deadline {
+        let mut line = String::new();
+        match reader.read_line(&mut line) {
+            Ok(0) => break,
+            Ok(_) => {
+                let stop = done(&line);
+                lines.push(line);
+                if stop {
+                    break;
+                }
+            }
+            Err(_) => continue, // timeout: try again
+        }
+    }
+    lines
+}
+
+#[test]
+fn fifty_clients_times_200_blocks_lose_no_feedback() {
+    let s = server(&["--per-client"]);
+    let started = Instant::now();
+    let handles: Vec<_> = (0..50)
+        .map(|c| {
+            let addr = s.addr.clone();
+            std::thread::spawn(move || {
+                let stream = TcpStream::connect(&addr).unwrap();
+                let mut writer = stream.try_clone().unwrap();
+                let mut text = String::new();
+                for b in 0..200 {
+                    text.push_str(&format!(
+                        r#"<bml {NS} id="c{c}b{b}"><head id="h" lexeme="NOD" start="0" end="0.02"/></bml>"#
+                    ));
+                    text.push('\n');
+                }
+                writer.write_all(text.as_bytes()).unwrap();
+                let mut reader = BufReader::new(stream);
+                let mut ends = 0;
+                let lines = read_until(&mut reader, Instant::now() + Duration::from_secs(60), |l| {
+                    if l.contains(":end\" globalTime") && l.contains("blockProgress") {
+                        ends += 1;
+                    }
+                    ends == 200
+                });
+                (c, lines)
+            })
+        })
+        .collect();
+    for h in handles {
+        let (c, lines) = h.join().unwrap();
+        let count = |needle: &str| lines.iter().filter(|l| l.contains(needle)).count();
+        // per block: IN_PREP, PENDING and IN_EXEC predictions, start, 7 syncs, end
+        assert_eq!(count("<blockProgress"), 400, "client {c}");
+        assert_eq!(count("<syncPointProgress"), 1400, "client {c}");
+        assert_eq!(count("<predictionFeedback"), 600, "client {c}");
+        assert_eq!(lines.len(), 2400, "client {c}");
+        // only its own blocks
+        assert!(
+            lines.iter().all(|l| l.contains(&format!("id=\"c{c}b"))),
+            "client {c}"
+        );
+    }
+    assert!(started.elapsed() < Duration::from_secs(60));
+}
+
+#[test]
+fn garbage_gets_a_warning_for_its_sender_only_and_a_disconnect_disturbs_no_one() {
+    let s = server(&[]);
+    let good = TcpStream::connect(&s.addr).unwrap();
+    let mut bad = TcpStream::connect(&s.addr).unwrap();
+    let quitter = TcpStream::connect(&s.addr).unwrap();
+    std::thread::sleep(Duration::from_millis(100));
+    drop(quitter);
+    bad.write_all(b"this is not BML\n<bml id=\"x\"><oops></bml>\n")
+        .unwrap();
+    let mut good_w = good.try_clone().unwrap();
+    good_w
+        .write_all(
+            format!(r#"<bml {NS} id="g1"><head id="h" lexeme="NOD" start="0" end="0.1"/></bml>"#)
+                .as_bytes(),
+        )
+        .unwrap();
+    good_w.write_all(b"\n").unwrap();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let mut good_r = BufReader::new(good);
+    let good_lines = read_until(&mut good_r, deadline, |l| l.contains("id=\"g1:end\""));
+    assert!(
+        good_lines.iter().any(|l| l.contains("id=\"g1:end\"")),
+        "{good_lines:?}"
+    );
+    assert!(
+        !good_lines.iter().any(|l| l.contains("PARSING_FAILURE")),
+        "{good_lines:?}"
+    );
+    // the broadcast reaches the bad client too, with its own two warnings
+    let mut bad_r = BufReader::new(bad);
+    let mut warnings = 0;
+    let bad_lines = read_until(&mut bad_r, deadline, |l| {
+        warnings += usize::from(l.contains("PARSING_FAILURE"));
+        l.contains("id=\"g1:end\"")
+    });
+    assert_eq!(
+        bad_lines
+            .iter()
+            .filter(|l| l.contains("PARSING_FAILURE"))
+            .count(),
+        2,
+        "{bad_lines:?}"
+    );
+    assert!(bad_lines.iter().any(|l| l.contains("id=\"g1:end\"")));
+}
