@@ -9,6 +9,7 @@
 //! - [`schedule`]: the scheduler — constraints to sync times, order-invariant;
 //! - [`plan`]: the flexible plan of pegs;
 //! - [`engine`]: the engine interface, registry and timing models; [`engines`]: built-in engines;
+//! - [`body`]: the skeleton (H-Anim), poses and forward kinematics;
 //! - [`clock`]: virtual and wall clocks;
 //! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`);
 //! - [`timeline`]: timeline pictures (SVG) of plans and logs.
@@ -17,6 +18,7 @@
 
 pub mod blocks;
 pub mod bml;
+pub mod body;
 pub mod clock;
 pub mod conformance;
 pub mod engine;

@@ -1,0 +1,9 @@
+//! The body: an H-Anim skeleton ([`skeleton`]) and poses with forward kinematics ([`pose`]).
+//! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians
+//! (A1, A2).
+
+pub mod pose;
+pub mod skeleton;
+
+pub use pose::{Pose, WorldPose};
+pub use skeleton::{Joint, Skeleton, SkeletonError};

@@ -1,0 +1,184 @@
+//! Skeletons: joints with H-Anim names in a tree, each with its rest translation from its parent.
+//! The default adult is embedded (`fixtures/skeletons/adult.json`); others load from the same JSON
+//! format: `{"name": …, "joints": [{"name": …, "parent": … | null, "offset": [x, y, z]}, …]}`,
+//! parents before children.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+
+/// The embedded default adult.
+const ADULT: &str = include_str!("../../fixtures/skeletons/adult.json");
+
+/// One joint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// H-Anim name, e.g. `skullbase`.
+    pub name: String,
+    /// Index of the parent joint (`None` for the root).
+    pub parent: Option<usize>,
+    /// Rest translation from the parent joint (metres, parent frame).
+    pub offset: Vec3,
+}
+
+/// A joint tree; joints are stored parents first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Skeleton {
+    /// Its name.
+    pub name: String,
+    joints: Vec<Joint>,
+    index: HashMap<String, usize>,
+}
+
+/// Why a skeleton file was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("skeleton: {0}")]
+pub struct SkeletonError(pub String);
+
+impl Skeleton {
+    /// The default adult.
+    pub fn adult() -> Skeleton {
+        Skeleton::from_json(ADULT).expect("the embedded adult skeleton is valid")
+    }
+
+    /// Reads a skeleton from JSON (see the module documentation).
+    pub fn from_json(text: &str) -> Result<Skeleton, SkeletonError> {
+        let e = |m: String| SkeletonError(m);
+        let v: serde_json::Value =
+            serde_json::from_str(text).map_err(|x| e(format!("not JSON: {x}")))?;
+        let name = v["name"].as_str().unwrap_or("unnamed").to_string();
+        let list = v["joints"]
+            .as_array()
+            .ok_or_else(|| e("no \"joints\" list".into()))?;
+        let mut s = Skeleton {
+            name,
+            joints: Vec::new(),
+            index: HashMap::new(),
+        };
+        for (i, j) in list.iter().enumerate() {
+            let jname = j["name"]
+                .as_str()
+                .filter(|n| !n.is_empty())
+                .ok_or_else(|| e(format!("joint {i} has no name")))?;
+            let parent = match &j["parent"] {
+                serde_json::Value::Null => None,
+                p => {
+                    let p = p
+                        .as_str()
+                        .ok_or_else(|| e(format!("joint '{jname}': parent must be a name or null")))?;
+                    Some(*s.index.get(p).ok_or_else(|| {
+                        e(format!("joint '{jname}': parent '{p}' is not defined before it"))
+                    })?)
+                }
+            };
+            if parent.is_none() && !s.joints.is_empty() {
+                return Err(e(format!("joint '{jname}' is a second root")));
+            }
+            let o: Vec<f32> = j["offset"]
+                .as_array()
+                .map(|a| a.iter().filter_map(|x| x.as_f64()).map(|x| x as f32).collect())
+                .unwrap_or_default();
+            if o.len() != 3 || o.iter().any(|x| !x.is_finite()) {
+                return Err(e(format!("joint '{jname}': offset must be three numbers")));
+            }
+            if s.index.insert(jname.to_string(), s.joints.len()).is_some() {
+                return Err(e(format!("joint '{jname}' is defined twice")));
+            }
+            s.joints.push(Joint {
+                name: jname.to_string(),
+                parent,
+                offset: Vec3::new(o[0], o[1], o[2]),
+            });
+        }
+        if s.joints.is_empty() {
+            return Err(e("no joints".into()));
+        }
+        Ok(s)
+    }
+
+    /// The joints, parents before children.
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
+    }
+
+    /// Number of joints.
+    pub fn len(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Whether there are no joints (never true for a loaded skeleton).
+    pub fn is_empty(&self) -> bool {
+        self.joints.is_empty()
+    }
+
+    /// The index of joint `name`.
+    pub fn joint(&self, name: &str) -> Option<usize> {
+        self.index.get(name).copied()
+    }
+
+    /// The children of joint `i`.
+    pub fn children(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        self.joints
+            .iter()
+            .enumerate()
+            .filter(move |(_, j)| j.parent == Some(i))
+            .map(|(k, _)| k)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_adult_has_the_h_anim_joints_a_realizer_needs() {
+        let s = Skeleton::adult();
+        for name in [
+            "HumanoidRoot",
+            "sacroiliac",
+            "vl5",
+            "vt12",
+            "vt6",
+            "vc7",
+            "vc4",
+            "skullbase",
+            "l_eyeball_joint",
+            "r_eyeball_joint",
+            "l_shoulder",
+            "l_elbow",
+            "l_wrist",
+            "l_index1",
+            "l_index3",
+            "r_shoulder",
+            "r_wrist",
+            "r_index1",
+            "l_hip",
+            "l_knee",
+            "l_talocrural",
+            "r_talocrural",
+        ] {
+            assert!(s.joint(name).is_some(), "{name}");
+        }
+        assert_eq!(s.joints()[0].name, "HumanoidRoot");
+        let skull = s.joint("skullbase").unwrap();
+        assert_eq!(s.joints()[skull].parent, s.joint("vc4"));
+        assert_eq!(s.children(s.joint("vt6").unwrap()).count(), 3); // neck and both clavicles
+    }
+
+    #[test]
+    fn bad_skeleton_files_are_refused_with_a_reason() {
+        let bad = |t: &str| Skeleton::from_json(t).unwrap_err().0;
+        assert!(bad("{").starts_with("not JSON"));
+        assert_eq!(bad(r#"{"joints": []}"#), "no joints");
+        assert!(bad(r#"{"joints": [{"name": "a", "parent": "b", "offset": [0,0,0]}]}"#)
+            .contains("not defined before it"));
+        assert!(bad(r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0]}]}"#)
+            .contains("three numbers"));
+        assert!(bad(r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0,0]},
+                                    {"name": "a", "parent": "a", "offset": [0,0,0]}]}"#)
+            .contains("twice"));
+        assert!(bad(r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0,0]},
+                                    {"name": "b", "parent": null, "offset": [0,0,0]}]}"#)
+            .contains("second root"));
+    }
+}
