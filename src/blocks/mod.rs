@@ -15,7 +15,8 @@ mod live;
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use crate::bml::{self, Diagnostic, SyncPoint};
-use crate::engine::{Action, Frame, ParameterChange, Registry, Unit, UnitKey};
+use crate::body::{Pose, Skeleton};
+use crate::engine::{Action, CharacterPose, Frame, ParameterChange, Registry, Unit, UnitKey};
 use crate::feedback::{
     BehaviourPrediction, BlockPrediction, BlockProgress, BlockStatus, Feedback, KnownWarning,
     PredictionFeedback, SyncPointProgress, WarningFeedback,
@@ -63,6 +64,7 @@ pub struct BlockManager {
     finished_set: HashSet<String>,
     changes: Vec<ParameterChange>,
     anticipators: Vec<Box<dyn Anticipator>>,
+    skeleton: Skeleton,
     now: f64,
     seq: u64,
     out: Vec<Feedback>,
@@ -121,10 +123,21 @@ impl BlockManager {
             finished_set: HashSet::new(),
             changes: Vec::new(),
             anticipators: Vec::new(),
+            skeleton: Skeleton::adult(),
             now: 0.0,
             seq: 0,
             out: Vec::new(),
         }
+    }
+
+    /// Uses `skeleton` for this character's body (the default adult otherwise).
+    pub fn set_skeleton(&mut self, skeleton: Skeleton) {
+        self.skeleton = skeleton;
+    }
+
+    /// The character's skeleton.
+    pub fn skeleton(&self) -> &Skeleton {
+        &self.skeleton
     }
 
     /// The current time (the last time advanced to).
@@ -894,7 +907,8 @@ impl BlockManager {
 
     /// Moves time to `to`: every sync point up to then passes in time order with its feedback and
     /// consequences (control actions, block ends, blocks that were waiting), then parameter
-    /// changes apply and every engine plays into `frame`.
+    /// changes apply, every engine plays into `frame` and moves the body, whose pose joins the
+    /// frame.
     pub fn advance(&mut self, to: f64, frame: &mut Frame) {
         let to = to.max(self.now);
         // changes made from outside since the last frame (e.g. a new tempo)
@@ -929,9 +943,15 @@ impl BlockManager {
         self.now = to;
         self.update_anticipators(to);
         self.apply_changes(to);
+        let mut pose = Pose::rest(&self.skeleton);
         for e in self.registry.engines_mut() {
             e.play(to, frame);
+            e.animate(to, &self.skeleton, &mut pose);
         }
+        frame.poses.push(CharacterPose {
+            character: self.character.clone(),
+            pose,
+        });
     }
 
     fn pass_sync(&mut self, bi: usize, xi: usize, t: f64) {

@@ -87,9 +87,15 @@ mod tests {
         pose.rotate(el, Quat::from_rotation_y(FRAC_PI_2));
         let w2 = pose.world(&s);
         assert!((w2.positions[wr] - w2.positions[el] - Vec3::new(0.0, 0.0, -0.25)).length() < 1e-6);
-        assert_eq!(w2.positions[el], w.positions[el], "the elbow itself does not move");
+        assert_eq!(
+            w2.positions[el], w.positions[el],
+            "the elbow itself does not move"
+        );
         // a nod of the skull base moves the eyes but not the neck
-        let (skull, eye) = (s.joint("skullbase").unwrap(), s.joint("l_eyeball_joint").unwrap());
+        let (skull, eye) = (
+            s.joint("skullbase").unwrap(),
+            s.joint("l_eyeball_joint").unwrap(),
+        );
         let mut nod = Pose::rest(&s);
         nod.rotate(skull, Quat::from_rotation_x(0.3));
         let wn = nod.world(&s);

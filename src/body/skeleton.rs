@@ -63,11 +63,13 @@ impl Skeleton {
             let parent = match &j["parent"] {
                 serde_json::Value::Null => None,
                 p => {
-                    let p = p
-                        .as_str()
-                        .ok_or_else(|| e(format!("joint '{jname}': parent must be a name or null")))?;
+                    let p = p.as_str().ok_or_else(|| {
+                        e(format!("joint '{jname}': parent must be a name or null"))
+                    })?;
                     Some(*s.index.get(p).ok_or_else(|| {
-                        e(format!("joint '{jname}': parent '{p}' is not defined before it"))
+                        e(format!(
+                            "joint '{jname}': parent '{p}' is not defined before it"
+                        ))
                     })?)
                 }
             };
@@ -76,7 +78,12 @@ impl Skeleton {
             }
             let o: Vec<f32> = j["offset"]
                 .as_array()
-                .map(|a| a.iter().filter_map(|x| x.as_f64()).map(|x| x as f32).collect())
+                .map(|a| {
+                    a.iter()
+                        .filter_map(|x| x.as_f64())
+                        .map(|x| x as f32)
+                        .collect()
+                })
                 .unwrap_or_default();
             if o.len() != 3 || o.iter().any(|x| !x.is_finite()) {
                 return Err(e(format!("joint '{jname}': offset must be three numbers")));
@@ -170,15 +177,23 @@ mod tests {
         let bad = |t: &str| Skeleton::from_json(t).unwrap_err().0;
         assert!(bad("{").starts_with("not JSON"));
         assert_eq!(bad(r#"{"joints": []}"#), "no joints");
-        assert!(bad(r#"{"joints": [{"name": "a", "parent": "b", "offset": [0,0,0]}]}"#)
-            .contains("not defined before it"));
-        assert!(bad(r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0]}]}"#)
-            .contains("three numbers"));
-        assert!(bad(r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0,0]},
-                                    {"name": "a", "parent": "a", "offset": [0,0,0]}]}"#)
-            .contains("twice"));
-        assert!(bad(r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0,0]},
-                                    {"name": "b", "parent": null, "offset": [0,0,0]}]}"#)
-            .contains("second root"));
+        assert!(
+            bad(r#"{"joints": [{"name": "a", "parent": "b", "offset": [0,0,0]}]}"#)
+                .contains("not defined before it")
+        );
+        assert!(
+            bad(r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0]}]}"#)
+                .contains("three numbers")
+        );
+        assert!(bad(
+            r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0,0]},
+                                    {"name": "a", "parent": "a", "offset": [0,0,0]}]}"#
+        )
+        .contains("twice"));
+        assert!(bad(
+            r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0,0]},
+                                    {"name": "b", "parent": null, "offset": [0,0,0]}]}"#
+        )
+        .contains("second root"));
     }
 }

@@ -11,6 +11,7 @@ use std::sync::Arc;
 pub use registry::{KindKey, Registry};
 
 use crate::bml::{Behaviour, TrajectoryType};
+use crate::body::{Pose, Skeleton};
 use crate::feedback::Feedback;
 use crate::schedule::SyncName;
 use timing::TimingModel;
@@ -129,14 +130,25 @@ pub struct Output {
     pub params: Vec<(&'static str, f64)>,
 }
 
-/// Everything the realizer produced for one moment: engine output and the feedback sent since the
-/// previous frame.
+/// A character's body at a moment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CharacterPose {
+    /// The character (`None`: the default character).
+    pub character: Option<String>,
+    /// Its pose (joint order of the character's skeleton).
+    pub pose: Pose,
+}
+
+/// Everything the realizer produced for one moment: engine output, each character's pose, and the
+/// feedback sent since the previous frame.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Frame {
     /// Global time of the frame.
     pub time: f64,
     /// One entry per running unit that shows something.
     pub outputs: Vec<Output>,
+    /// The pose of every character, in character order.
+    pub poses: Vec<CharacterPose>,
     /// Feedback sent since the previous frame, in order.
     pub feedback: Vec<Feedback>,
 }
@@ -217,6 +229,10 @@ pub trait Engine {
     /// Plays every unit at global time `now` into `frame`.
     fn play(&mut self, _now: f64, _frame: &mut Frame) {}
 
+    /// Moves the body: applies the units running at `now` to `pose` (joint rotations on top of
+    /// what earlier engines set). Engines that move nothing keep the default.
+    fn animate(&mut self, _now: f64, _skeleton: &Skeleton, _pose: &mut Pose) {}
+
     /// Current value of parameter `name` of unit `key`.
     fn parameter(&self, _key: &UnitKey, _name: &str) -> Option<f64> {
         None
@@ -240,13 +256,19 @@ pub trait Engine {
 
 /// The units an engine holds, in the order they were added (so frames are deterministic without
 /// sorting), each with its key (shared with frame outputs) and current global sync times.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct Units<T> {
     units: Vec<(Arc<UnitKey>, SyncTimes, T)>,
 }
 
 /// A unit's (sync, global time) list, in sync order.
 pub type SyncTimes = Vec<(SyncName, f64)>;
+
+impl<T> Default for Units<T> {
+    fn default() -> Self {
+        Units { units: Vec::new() }
+    }
+}
 
 impl<T> Units<T> {
     /// No units.
@@ -298,6 +320,11 @@ impl<T> Units<T> {
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
         self.units.is_empty()
+    }
+
+    /// Every unit's sync times and data, in the order they were added.
+    pub fn all(&self) -> impl Iterator<Item = (&SyncTimes, &T)> + '_ {
+        self.units.iter().map(|(_, s, d)| (s, d))
     }
 
     /// The units running at `now` (start ≤ now < end) with their progress (0 at start, 1 at end;

@@ -6,9 +6,11 @@
 //!   while speaking;
 //! - [`timing_only`]: every other kind, timing only until its animation engine lands: it plays the
 //!   scheduled pegs and reports every sync point, but moves no body;
-//! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well).
+//! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well);
+//! - [`head`]: head nods, shakes and tilts as real motion of the neck and skull.
 
 pub mod control;
+pub mod head;
 pub mod murml;
 pub mod speech;
 pub mod timing_only;
@@ -21,7 +23,6 @@ use crate::engine::{KindKey, Registry};
 pub const MOTION_KINDS: &[(&str, &str)] = &[
     (NS_BML, "gesture"),
     (NS_BML, "pointing"),
-    (NS_BML, "head"),
     (NS_BML, "headDirectionShift"),
     (NS_BML, "gaze"),
     (NS_BML, "gazeShift"),
@@ -68,6 +69,10 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(timing_only::TimingOnlyEngine::audio(models)),
         &keys(&[(NS_BMLT, "audiofile")]),
+    );
+    r.register(
+        Box::new(head::HeadEngine::default()),
+        &keys(&[(NS_BML, "head")]),
     );
     r.register(
         Box::new(murml::MurmlEngine::default()),

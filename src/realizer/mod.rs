@@ -8,6 +8,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use crate::blocks::BlockManager;
 use crate::bml::{self, BmlError, Diagnostic};
+use crate::body::Skeleton;
 use crate::engine::timing::DefaultTimingModels;
 use crate::engine::{Frame, Registry};
 use crate::engines::default_registry;
@@ -37,6 +38,7 @@ pub struct Realizer {
     strategy: StrategyFactory,
     listeners: Vec<Box<dyn FeedbackListener>>,
     posix_time: bool,
+    skeleton: Skeleton,
     now: f64,
     unframed: Vec<Feedback>,
 }
@@ -57,6 +59,7 @@ impl Realizer {
             strategy: Box::new(|| Box::new(Optimal)),
             listeners: Vec::new(),
             posix_time: false,
+            skeleton: Skeleton::adult(),
             now: 0.0,
             unframed: Vec::new(),
         }
@@ -75,6 +78,12 @@ impl Realizer {
         factory: impl Fn() -> Box<dyn SchedulingStrategy> + 'static,
     ) -> Self {
         self.strategy = Box::new(factory);
+        self
+    }
+
+    /// Every character gets `skeleton` (the default adult otherwise).
+    pub fn with_skeleton(mut self, skeleton: Skeleton) -> Self {
+        self.skeleton = skeleton;
         self
     }
 
@@ -119,9 +128,10 @@ impl Realizer {
         let character = character.or_else(|| self.default_character.clone());
         let key = character.clone().unwrap_or_default();
         let now = self.now;
-        let (engines, strategy) = (&self.engines, &self.strategy);
+        let (engines, strategy, skeleton) = (&self.engines, &self.strategy, &self.skeleton);
         self.characters.entry(key).or_insert_with(|| {
             let mut m = BlockManager::new(engines(), strategy(), character);
+            m.set_skeleton(skeleton.clone());
             m.advance(now, &mut Frame::default());
             m
         })
