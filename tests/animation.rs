@@ -9,8 +9,11 @@ use glam::Vec3;
 
 const FPS: f64 = 60.0;
 
+/// (time, value) samples.
+type Series = Vec<(f64, f64)>;
+
 /// (time, head pitch in degrees) every frame, and the scheduled sync times.
-fn run(bml: &str, until: f64) -> (Vec<(f64, f64)>, Vec<(String, f64)>) {
+fn run(bml: &str, until: f64) -> (Series, Vec<(String, f64)>) {
     let skeleton = Skeleton::adult();
     let skull = skeleton.joint("skullbase").unwrap();
     let mut r = Realizer::new();
@@ -34,7 +37,7 @@ fn run(bml: &str, until: f64) -> (Vec<(f64, f64)>, Vec<(String, f64)>) {
     (pitches, syncs)
 }
 
-fn at<'a>(syncs: &'a [(String, f64)], name: &str) -> f64 {
+fn at(syncs: &[(String, f64)], name: &str) -> f64 {
     syncs.iter().find(|s| s.0 == name).map(|s| s.1).unwrap()
 }
 
