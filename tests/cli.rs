@@ -330,3 +330,33 @@ fn diff_of_a_truncated_or_garbage_file_exits_2_with_the_line() {
     assert_eq!(code, 2);
     assert!(out.contains(":1: bad feedback"), "{out}");
 }
+
+#[test]
+fn run_bvh_records_frames_without_changing_the_feedback() {
+    let bvh = std::env::temp_dir().join(format!("bmlr-{}-welcome.bvh", std::process::id()));
+    let (code, with, err) = bmlr(&[
+        "run",
+        "--fps",
+        "50",
+        "--bvh",
+        bvh.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (_, without, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
+    assert_eq!(with, without, "frames do not change the feedback");
+    // 0 .. 2.9 s at 50 fps: 146 frames
+    assert!(err.contains("(146 frames at 50 fps, 32 joints)"), "{err}");
+    let text = std::fs::read_to_string(&bvh).unwrap();
+    assert!(text.starts_with("HIERARCHY\nROOT HumanoidRoot\n"));
+    assert!(text.contains("MOTION\nFrames: 146\nFrame Time: 0.020000\n"));
+    let (code, _, err) = bmlr(&[
+        "run",
+        "--realtime",
+        "--bvh",
+        "x.bvh",
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("leave out --realtime"), "{err}");
+}

@@ -1,7 +1,9 @@
-//! The body: an H-Anim skeleton ([`skeleton`]) and poses with forward kinematics ([`pose`]).
+//! The body: an H-Anim skeleton ([`skeleton`]), poses with forward kinematics ([`pose`]) and BVH
+//! export ([`bvh`]).
 //! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians
 //! (A1, A2).
 
+pub mod bvh;
 pub mod pose;
 pub mod skeleton;
 

@@ -51,9 +51,13 @@ pub struct RunArgs {
     /// Character for blocks without a characterId.
     #[arg(long, value_name = "ID")]
     character: Option<String>,
+    /// Write the realized motion of the character (--character, else the default one) as BVH,
+    /// one frame every 1/--fps seconds (virtual clock only).
+    #[arg(long, value_name = "OUT.bvh")]
+    bvh: Option<std::path::PathBuf>,
     /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
     /// clock before the next item.
-    #[arg(required = true, value_name = "ITEM", allow_hyphen_values = true)]
+    #[arg(required = true, value_name = "ITEM")]
     items: Vec<String>,
 }
 
@@ -117,14 +121,45 @@ struct VirtualRun {
     until: f64,
     out: std::io::StdoutLock<'static>,
     open: bool,
+    /// BVH recording: the character, the frame period, the next frame's time and the poses.
+    motion: Option<Motion>,
+}
+
+struct Motion {
+    character: Option<String>,
+    period: f64,
+    next: f64,
+    poses: Vec<bml_realizer::body::Pose>,
 }
 
 impl VirtualRun {
-    /// Moves the clock to `t` (capped at `--until`), event by event.
+    /// Moves the clock to `t` (capped at `--until`), event by event; frames on the way are
+    /// recorded when a BVH is asked for (feedback does not depend on them).
     fn advance_to(&mut self, t: f64) {
         let t = t.min(self.until);
+        while let Some(m) = self.motion.as_mut().filter(|m| m.next <= t) {
+            let at = m.next;
+            m.next = (m.poses.len() + 1) as f64 * m.period;
+            let frame = self.realizer.tick(at);
+            self.open &= print(&mut self.out, self.format, &frame.feedback);
+            self.record(frame.poses);
+        }
         let frame = self.realizer.tick(t);
         self.open &= print(&mut self.out, self.format, &frame.feedback);
+    }
+
+    fn record(&mut self, poses: Vec<bml_realizer::engine::CharacterPose>) {
+        let Some(m) = self.motion.as_mut() else {
+            return;
+        };
+        let pose = poses
+            .into_iter()
+            .find(|p| p.character == m.character)
+            .map(|p| p.pose)
+            .unwrap_or_else(|| {
+                bml_realizer::body::Pose::rest(&bml_realizer::body::Skeleton::adult())
+            });
+        m.poses.push(pose);
     }
 
     fn perform(&mut self, text: &str) {
@@ -166,6 +201,10 @@ pub fn run(args: RunArgs) -> ExitCode {
     let realizer = Realizer::new()
         .with_default_character(args.character.clone())
         .with_posix_time(args.realtime);
+    if args.realtime && args.bvh.is_some() {
+        eprintln!("bmlr run: --bvh records on the virtual clock; leave out --realtime");
+        return ExitCode::from(2);
+    }
     if args.realtime {
         return run_realtime(realizer, items, &args);
     }
@@ -175,6 +214,12 @@ pub fn run(args: RunArgs) -> ExitCode {
         until: args.until.unwrap_or(f64::INFINITY),
         out: std::io::stdout().lock(),
         open: true,
+        motion: args.bvh.as_ref().map(|_| Motion {
+            character: args.character.clone(),
+            period: 1.0 / args.fps,
+            next: 0.0,
+            poses: Vec::new(),
+        }),
     };
     for item in items {
         match item {
@@ -205,6 +250,34 @@ pub fn run(args: RunArgs) -> ExitCode {
         run.advance_to(run.until);
     }
     report_unfinished(&run.realizer);
+    if let (Some(path), Some(m)) = (&args.bvh, run.motion.take()) {
+        // one last frame at the final time
+        let now = run.realizer.now();
+        let mut m = m;
+        if m.poses.is_empty() || m.next <= now + 1e-9 {
+            let frame = run.realizer.tick(now);
+            m.poses.extend(
+                frame
+                    .poses
+                    .into_iter()
+                    .find(|p| p.character == m.character)
+                    .map(|p| p.pose),
+            );
+        }
+        let skeleton = bml_realizer::body::Skeleton::adult();
+        let text = bml_realizer::body::bvh::write(&skeleton, &m.poses, args.fps);
+        if let Err(e) = std::fs::write(path, text) {
+            eprintln!("bmlr run: {}: cannot write: {e}", path.display());
+            return ExitCode::from(2);
+        }
+        eprintln!(
+            "wrote {} ({} frames at {} fps, {} joints)",
+            path.display(),
+            m.poses.len(),
+            args.fps,
+            skeleton.len()
+        );
+    }
     ExitCode::SUCCESS
 }
 
