@@ -12,7 +12,8 @@
 //! - [`body`]: the skeleton (H-Anim), poses and forward kinematics;
 //! - [`clock`]: virtual and wall clocks;
 //! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`);
-//! - [`timeline`]: timeline pictures (SVG) of plans and logs.
+//! - [`timeline`]: timeline pictures (SVG) of plans and logs;
+//! - [`world`]: named target points the host places.
 
 #![warn(missing_docs)]
 
@@ -28,6 +29,7 @@ pub mod plan;
 pub mod realizer;
 pub mod schedule;
 pub mod timeline;
+pub mod world;
 mod xmlname;
 
 /// The README's code runs as a doc test, so that it stays true.

@@ -93,3 +93,186 @@ fn a_louder_nod_goes_further_and_a_shake_turns_instead() {
         "a shake does not pitch"
     );
 }
+
+// ---- gaze ---------------------------------------------------------------------------------
+
+use bml_realizer::engines::gaze::{EYE_PITCH_LIMIT, EYE_YAW_LIMIT};
+use glam::Quat;
+
+/// Angle (degrees) between each eye's line of sight (+z of the eye joint) and the direction to
+/// `target`, the larger of the two eyes.
+fn eye_error(skeleton: &Skeleton, pose: &bml_realizer::body::Pose, target: Vec3) -> f64 {
+    let w = pose.world(skeleton);
+    ["l_eyeball_joint", "r_eyeball_joint"]
+        .iter()
+        .map(|e| {
+            let i = skeleton.joint(e).unwrap();
+            let sight = w.orientations[i] * Vec3::Z;
+            sight.angle_between(target - w.positions[i]).to_degrees() as f64
+        })
+        .fold(0.0, f64::max)
+}
+
+fn eye_angles(skeleton: &Skeleton, pose: &bml_realizer::body::Pose) -> Vec<(f32, f32)> {
+    ["l_eyeball_joint", "r_eyeball_joint"]
+        .iter()
+        .map(|e| {
+            let d = pose.rotations[skeleton.joint(e).unwrap()] * Vec3::Z;
+            (
+                d.x.atan2(d.z).to_degrees(),
+                (-d.y).atan2((d.x * d.x + d.z * d.z).sqrt()).to_degrees(),
+            )
+        })
+        .collect()
+}
+
+fn gaze_block(id: &str, target: &str, extra: &str) -> String {
+    format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="{id}"><gaze id="g" target="{target}" {extra}/></bml>"#
+    )
+}
+
+#[test]
+fn a_gaze_puts_the_eyes_on_a_static_target_within_their_limits() {
+    let skeleton = Skeleton::adult();
+    let target = Vec3::new(0.5, 1.3, 1.0);
+    let mut r = Realizer::new();
+    r.world_mut().set("cup", target);
+    r.perform_bml(&gaze_block(
+        "b",
+        "cup",
+        r#"start="0" ready="0.5" relax="2" end="2.5""#,
+    ))
+    .unwrap();
+    let skull = skeleton.joint("skullbase").unwrap();
+    let mut yaw_speed = Vec::new();
+    let mut last_yaw = 0.0f32;
+    for i in 0..=150 {
+        let t = f64::from(i) / FPS;
+        let frame = r.tick(t);
+        let pose = &frame.poses[0].pose;
+        if (0.5..2.0).contains(&t) {
+            let e = eye_error(&skeleton, pose, target);
+            assert!(e < 0.5, "eye-line error {e}° at {t}");
+        }
+        for (y, p) in eye_angles(&skeleton, pose) {
+            assert!(y.abs() <= EYE_YAW_LIMIT + 1e-3 && p.abs() <= EYE_PITCH_LIMIT + 1e-3);
+        }
+        let w = pose.world(&skeleton);
+        let face = w.orientations[skull] * Vec3::Z;
+        let yaw = face.x.atan2(face.z);
+        if t <= 0.5 {
+            yaw_speed.push(yaw - last_yaw);
+        }
+        last_yaw = yaw;
+        if t >= 2.5 {
+            assert!(yaw.abs().to_degrees() < 0.5, "back at rest: {yaw}");
+        }
+    }
+    // head velocity single-peaked while shifting to the target
+    let peak = yaw_speed
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .unwrap()
+        .0;
+    assert!(yaw_speed[..=peak].windows(2).all(|w| w[1] >= w[0] - 1e-7));
+    assert!(yaw_speed[peak..].windows(2).all(|w| w[1] <= w[0] + 1e-7));
+}
+
+#[test]
+fn donders_the_final_head_orientation_does_not_depend_on_where_the_head_was() {
+    let skeleton = Skeleton::adult();
+    let skull = skeleton.joint("skullbase").unwrap();
+    let head_at = |before: Option<&str>| -> Quat {
+        let mut r = Realizer::new();
+        r.world_mut().set("left", Vec3::new(1.0, 1.0, 0.8));
+        r.world_mut().set("cup", Vec3::new(-0.4, 1.2, 1.0));
+        if let Some(t) = before {
+            r.perform_bml(&format!(
+                r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><gazeShift id="s" target="{t}" start="0" end="1"/></bml>"#
+            ))
+            .unwrap();
+            r.tick(1.5);
+        }
+        let now = r.now();
+        // block-relative times: the gaze starts when the block does
+        r.perform_bml(&gaze_block("b", "cup", r#"start="0" ready="0.5" end="3""#))
+            .unwrap();
+        let frame = r.tick(now + 1.0);
+        frame.poses[0].pose.world(&skeleton).orientations[skull]
+    };
+    let straight = head_at(None);
+    let shifted = head_at(Some("left"));
+    let diff = straight.angle_between(shifted).to_degrees();
+    assert!(diff < 0.1, "{diff}°");
+}
+
+#[test]
+fn a_moving_target_is_tracked_after_ready() {
+    let skeleton = Skeleton::adult();
+    let mut r = Realizer::new();
+    let place = |t: f64| {
+        // 30°/s around the character, 1.2 m away, at eye height
+        let a = (30.0 * t).to_radians();
+        Vec3::new(1.2 * a.sin() as f32, 1.55, 1.2 * a.cos() as f32)
+    };
+    r.world_mut().set("bird", place(0.0));
+    // up to 60° to the side by relax: within reach of the neck and the eyes
+    r.perform_bml(&gaze_block(
+        "b",
+        "bird",
+        r#"start="0" ready="0.4" relax="2" end="2.4""#,
+    ))
+    .unwrap();
+    for i in 0..=150 {
+        let t = f64::from(i) / FPS;
+        r.world_mut().set("bird", place(t));
+        let frame = r.tick(t);
+        if (0.4..2.0).contains(&t) {
+            let e = eye_error(&skeleton, &frame.poses[0].pose, place(t));
+            assert!(e < 2.0, "tracking error {e}° at {t}");
+        }
+    }
+}
+
+#[test]
+fn a_gaze_at_a_target_the_world_lacks_is_refused_with_a_warning() {
+    let mut r = Realizer::new();
+    let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let sink = log.clone();
+    r.add_listener(Box::new(move |f: &Feedback| {
+        sink.borrow_mut().push(f.clone())
+    }));
+    r.perform_bml(&gaze_block("b", "nowhere", "")).unwrap();
+    let warnings: Vec<String> = log
+        .borrow()
+        .iter()
+        .filter_map(|f| match f {
+            Feedback::Warning(w) => Some(format!("{} {} {}", w.id, w.kind.as_str(), w.text)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].starts_with("b:g EXECUTION_FAILURE b:g: there is no target 'nowhere'"));
+}
+
+#[test]
+fn a_gaze_shift_keeps_looking_at_its_target_after_it_ends() {
+    let skeleton = Skeleton::adult();
+    let target = Vec3::new(1.0, 1.0, 0.8);
+    let mut r = Realizer::new();
+    r.world_mut().set("left", target);
+    r.perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><gazeShift id="s" target="left" start="0" end="1"/></bml>"#)
+        .unwrap();
+    let frame = r.tick(5.0);
+    assert_eq!(r.next_event(), None, "the shift has ended");
+    let pose = &frame.poses[0].pose;
+    assert!(eye_error(&skeleton, pose, target) < 0.5);
+    let skull = skeleton.joint("skullbase").unwrap();
+    let face = pose.world(&skeleton).orientations[skull] * Vec3::Z;
+    assert!(
+        face.x.atan2(face.z).to_degrees() > 20.0,
+        "the head stays turned left"
+    );
+}

@@ -119,7 +119,7 @@ fn fifty_behaviours_stay_readable() {
         let kind = [
             "gesture lexeme=\"BEAT\"",
             "head lexeme=\"NOD\"",
-            "gaze target=\"x\"",
+            "gaze target=\"user\"",
         ][i % 3];
         let start = if i == 0 {
             String::from("0")

@@ -25,6 +25,7 @@ use crate::plan::anticipator::Anticipator;
 use crate::plan::pegs::PegBoard;
 use crate::schedule::to_pegs::{self, Anticipators};
 use crate::schedule::{ExternalTimes, SchedulingStrategy};
+use crate::world::World;
 use live::{anticipator_refs, referenced_points, BlockPegs, LiveBlock, Phase};
 
 /// How late a block may start so that its references to other blocks' sync points that have just
@@ -65,6 +66,8 @@ pub struct BlockManager {
     changes: Vec<ParameterChange>,
     anticipators: Vec<Box<dyn Anticipator>>,
     skeleton: Skeleton,
+    /// The world as of the last advance (shared with the realizer).
+    world: std::sync::Arc<World>,
     now: f64,
     seq: u64,
     out: Vec<Feedback>,
@@ -124,6 +127,7 @@ impl BlockManager {
             changes: Vec::new(),
             anticipators: Vec::new(),
             skeleton: Skeleton::adult(),
+            world: std::sync::Arc::new(World::default()),
             now: 0.0,
             seq: 0,
             out: Vec::new(),
@@ -133,6 +137,13 @@ impl BlockManager {
     /// Uses `skeleton` for this character's body (the default adult otherwise).
     pub fn set_skeleton(&mut self, skeleton: Skeleton) {
         self.skeleton = skeleton;
+    }
+
+    /// Uses `world` for targets from now on (the realizer shares its world this way).
+    pub fn set_world(&mut self, world: &std::sync::Arc<World>) {
+        if !std::sync::Arc::ptr_eq(&self.world, world) {
+            self.world = world.clone();
+        }
     }
 
     /// The character's skeleton.
@@ -621,6 +632,7 @@ impl BlockManager {
                     key: &key,
                     behaviour: &b.source.behaviours[x.index],
                     syncs: &global,
+                    world: &self.world,
                 };
                 match self.registry.engine_mut(x.engine).add(unit) {
                     Ok(()) => x.phase = Phase::Added,
@@ -909,7 +921,8 @@ impl BlockManager {
     /// consequences (control actions, block ends, blocks that were waiting), then parameter
     /// changes apply, every engine plays into `frame` and moves the body, whose pose joins the
     /// frame.
-    pub fn advance(&mut self, to: f64, frame: &mut Frame) {
+    pub fn advance(&mut self, to: f64, world: &std::sync::Arc<World>, frame: &mut Frame) {
+        self.set_world(world);
         let to = to.max(self.now);
         // changes made from outside since the last frame (e.g. a new tempo)
         self.update_anticipators(self.now);
@@ -946,7 +959,7 @@ impl BlockManager {
         let mut pose = Pose::rest(&self.skeleton);
         for e in self.registry.engines_mut() {
             e.play(to, frame);
-            e.animate(to, &self.skeleton, &mut pose);
+            e.animate(to, &self.skeleton, &self.world, &mut pose);
         }
         frame.poses.push(CharacterPose {
             character: self.character.clone(),

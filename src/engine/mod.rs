@@ -14,6 +14,7 @@ use crate::bml::{Behaviour, TrajectoryType};
 use crate::body::{Pose, Skeleton};
 use crate::feedback::Feedback;
 use crate::schedule::SyncName;
+use crate::world::World;
 use timing::TimingModel;
 
 /// One behaviour of one block: how the runtime and the engines name a plan unit.
@@ -51,6 +52,8 @@ pub struct Unit<'a> {
     pub behaviour: &'a Behaviour,
     /// (sync name, global time) in sync order.
     pub syncs: &'a [(SyncName, f64)],
+    /// The world as it is when the unit is added (targets).
+    pub world: &'a World,
 }
 
 /// A change of a parameter of a running behaviour over time (BMLA `parametervaluechange`, S63–S65).
@@ -230,8 +233,9 @@ pub trait Engine {
     fn play(&mut self, _now: f64, _frame: &mut Frame) {}
 
     /// Moves the body: applies the units running at `now` to `pose` (joint rotations on top of
-    /// what earlier engines set). Engines that move nothing keep the default.
-    fn animate(&mut self, _now: f64, _skeleton: &Skeleton, _pose: &mut Pose) {}
+    /// what earlier engines set), with targets from `world`. Engines that move nothing keep the
+    /// default.
+    fn animate(&mut self, _now: f64, _skeleton: &Skeleton, _world: &World, _pose: &mut Pose) {}
 
     /// Current value of parameter `name` of unit `key`.
     fn parameter(&self, _key: &UnitKey, _name: &str) -> Option<f64> {

@@ -13,6 +13,7 @@ use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
 use crate::schedule::SyncName;
+use crate::world::World;
 
 /// Full amplitude (amount 1) of a nod, degrees.
 pub const NOD_DEGREES: f64 = 30.0;
@@ -186,7 +187,7 @@ impl Engine for HeadEngine {
         }
     }
 
-    fn animate(&mut self, now: f64, skeleton: &Skeleton, pose: &mut Pose) {
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         let (Some(skull), Some(neck)) = (skeleton.joint("skullbase"), skeleton.joint("vc4")) else {
             return;
         };

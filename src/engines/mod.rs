@@ -7,9 +7,11 @@
 //! - [`timing_only`]: every other kind, timing only until its animation engine lands: it plays the
 //!   scheduled pegs and reports every sync point, but moves no body;
 //! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well);
-//! - [`head`]: head nods, shakes and tilts as real motion of the neck and skull.
+//! - [`head`]: head nods, shakes and tilts as real motion of the neck and skull;
+//! - [`gaze`]: gaze and gaze shifts as real motion of eyes, neck and trunk toward world targets.
 
 pub mod control;
+pub mod gaze;
 pub mod head;
 pub mod murml;
 pub mod speech;
@@ -24,8 +26,6 @@ pub const MOTION_KINDS: &[(&str, &str)] = &[
     (NS_BML, "gesture"),
     (NS_BML, "pointing"),
     (NS_BML, "headDirectionShift"),
-    (NS_BML, "gaze"),
-    (NS_BML, "gazeShift"),
     (NS_BML, "posture"),
     (NS_BML, "postureShift"),
     (NS_BML, "face"),
@@ -80,6 +80,11 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
             (murml::NS_MURML, "murmlgesture"),
             (murml::NS_MURML, "murmlface"),
         ]),
+    );
+    // last: the eyes are aimed from the head where the other engines put it
+    r.register(
+        Box::new(gaze::GazeEngine::default()),
+        &keys(&[(NS_BML, "gaze"), (NS_BML, "gazeShift")]),
     );
     r
 }

@@ -15,6 +15,7 @@ use crate::engines::default_registry;
 use crate::feedback::{Feedback, FeedbackListener, KnownWarning, WarningFeedback};
 use crate::plan::anticipator::Anticipator;
 use crate::schedule::{Optimal, SchedulingStrategy};
+use crate::world::World;
 
 /// The id used in warnings about a block whose id could not be read.
 pub const NO_ID: &str = "<no id>";
@@ -39,6 +40,7 @@ pub struct Realizer {
     listeners: Vec<Box<dyn FeedbackListener>>,
     posix_time: bool,
     skeleton: Skeleton,
+    world: std::sync::Arc<World>,
     now: f64,
     unframed: Vec<Feedback>,
 }
@@ -60,6 +62,7 @@ impl Realizer {
             listeners: Vec::new(),
             posix_time: false,
             skeleton: Skeleton::adult(),
+            world: std::sync::Arc::new(World::default()),
             now: 0.0,
             unframed: Vec::new(),
         }
@@ -100,6 +103,17 @@ impl Realizer {
         self
     }
 
+    /// The world: named targets (the host moves them between ticks).
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The world, to place or move targets (takes effect at the next tick, or at once for blocks
+    /// submitted after the change).
+    pub fn world_mut(&mut self) -> &mut World {
+        std::sync::Arc::make_mut(&mut self.world)
+    }
+
     /// The current time: the last `tick`.
     pub fn now(&self) -> f64 {
         self.now
@@ -128,11 +142,12 @@ impl Realizer {
         let character = character.or_else(|| self.default_character.clone());
         let key = character.clone().unwrap_or_default();
         let now = self.now;
-        let (engines, strategy, skeleton) = (&self.engines, &self.strategy, &self.skeleton);
+        let (engines, strategy, skeleton, world) =
+            (&self.engines, &self.strategy, &self.skeleton, &self.world);
         self.characters.entry(key).or_insert_with(|| {
             let mut m = BlockManager::new(engines(), strategy(), character);
             m.set_skeleton(skeleton.clone());
-            m.advance(now, &mut Frame::default());
+            m.advance(now, world, &mut Frame::default());
             m
         })
     }
@@ -152,7 +167,9 @@ impl Realizer {
         let errors: Vec<&Diagnostic> = diagnostics.iter().filter(|d| d.is_error()).collect();
         match block {
             Some(block) if errors.is_empty() => {
+                let world = self.world.clone();
                 let m = self.manager(block.character_id.clone());
+                m.set_world(&world);
                 m.submit(block, &diagnostics);
                 let fb = m.take_feedback();
                 self.deliver(fb);
@@ -232,7 +249,7 @@ impl Realizer {
         };
         let mut feedback = Vec::new();
         for m in self.characters.values_mut() {
-            m.advance(now, &mut frame);
+            m.advance(now, &self.world, &mut frame);
             feedback.extend(m.take_feedback());
         }
         self.deliver(feedback);

@@ -1,0 +1,345 @@
+//! The gaze engine: `gaze` and `gazeShift` as real motion of eyes, neck and trunk toward a named
+//! point of the [`World`] (A44–A47).
+//!
+//! - The aim is a yaw (about +y, toward the character's left) and a pitch (about +x, down) from the
+//!   point between the eyes to the target, recomputed every frame, so moving targets are tracked.
+//! - `influence` distributes the aim over the body: EYES moves only the eyes; NECK and HEAD add
+//!   the neck (vc4) and skull base; SHOULDER the upper spine (vt6); WAIST the lower spine (vl5);
+//!   WHOLE the root. Each joint takes a fixed share of the aim as a yaw-then-pitch rotation (no
+//!   torsion: Donders' law), so the head's orientation depends on the aim only, not on where it
+//!   came from. The eyes then take what is left, aimed exactly from their real position
+//!   (vergence), within ±35° yaw and ±30° pitch.
+//! - Timing: from `start` to `ready` the aim moves from the rest aim to the target along a
+//!   minimum-jerk profile (single-peaked velocity; the eyes arrive in the first half), it holds
+//!   until `relax`, then returns to the rest aim by `end`. A `gazeShift` moves over its whole span
+//!   and makes its target the new rest aim, kept after it ends.
+//! - Of several gazes running at once the one that started last wins (R33).
+//! - A target the world does not have is refused when the behaviour starts (the runtime reports
+//!   EXECUTION_FAILURE).
+
+use glam::{Quat, Vec3};
+
+use crate::bml::{Behaviour, BehaviourKind, Influence};
+use crate::body::{Pose, Skeleton};
+use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::schedule::SyncName;
+use crate::world::World;
+
+/// Eye yaw limit (each side), degrees.
+pub const EYE_YAW_LIMIT: f32 = 35.0;
+/// Eye pitch limit (up and down), degrees.
+pub const EYE_PITCH_LIMIT: f32 = 30.0;
+
+/// Shares of the aim per joint for an influence: (joint, yaw share, pitch share).
+fn shares(influence: Influence) -> &'static [(&'static str, f32, f32)] {
+    match influence {
+        Influence::Eyes => &[],
+        Influence::Neck | Influence::Head => &[("vc4", 0.25, 0.25), ("skullbase", 0.35, 0.35)],
+        Influence::Shoulder => &[
+            ("vt6", 0.15, 0.1),
+            ("vc4", 0.2, 0.2),
+            ("skullbase", 0.3, 0.35),
+        ],
+        Influence::Waist => &[
+            ("vl5", 0.15, 0.05),
+            ("vt6", 0.1, 0.1),
+            ("vc4", 0.2, 0.2),
+            ("skullbase", 0.25, 0.35),
+        ],
+        Influence::Whole => &[
+            ("HumanoidRoot", 0.2, 0.0),
+            ("vl5", 0.1, 0.05),
+            ("vt6", 0.1, 0.1),
+            ("vc4", 0.2, 0.2),
+            ("skullbase", 0.2, 0.35),
+        ],
+    }
+}
+
+/// Minimum-jerk profile: 0 at 0, 1 at 1, zero velocity and acceleration at both ends.
+pub fn min_jerk(u: f64) -> f64 {
+    let u = u.clamp(0.0, 1.0);
+    u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+}
+
+/// A yaw-then-pitch rotation (no torsion).
+fn donders(yaw: f32, pitch: f32) -> Quat {
+    Quat::from_rotation_y(yaw) * Quat::from_rotation_x(pitch)
+}
+
+/// Yaw and pitch of direction `d` (in a frame facing +z, y up).
+fn yaw_pitch(d: Vec3) -> (f32, f32) {
+    let yaw = d.x.atan2(d.z);
+    let pitch = (-d.y).atan2((d.x * d.x + d.z * d.z).sqrt());
+    (yaw, pitch)
+}
+
+#[derive(Debug, Clone)]
+struct GazeUnit {
+    target: String,
+    influence: Influence,
+    shift: bool,
+}
+
+/// The gaze engine (see the module documentation).
+#[derive(Debug, Default)]
+pub struct GazeEngine {
+    models: DefaultTimingModels,
+    units: Units<GazeUnit>,
+    /// Where the character looks when no gaze runs (set by gaze shifts).
+    rest: Option<(String, Influence)>,
+}
+
+fn gaze(b: &Behaviour) -> Option<(&str, Influence, bool)> {
+    match &b.kind {
+        BehaviourKind::Gaze(g) => Some((&g.target, g.influence.unwrap_or(Influence::Neck), false)),
+        BehaviourKind::GazeShift(g) => {
+            Some((&g.target, g.influence.unwrap_or(Influence::Neck), true))
+        }
+        _ => None,
+    }
+}
+
+fn at(syncs: &[(SyncName, f64)], name: &str) -> Option<f64> {
+    syncs.iter().find(|s| s.0 == name).map(|s| s.1)
+}
+
+/// How far a unit has turned toward its target at `t` (0..1), for the body and for the eyes.
+fn weights(u: &GazeUnit, syncs: &[(SyncName, f64)], t: f64) -> Option<(f64, f64)> {
+    let start = at(syncs, "start")?;
+    let end = at(syncs, "end")?;
+    if t < start || t >= end {
+        return None;
+    }
+    let (ready, relax) = if u.shift {
+        (end, f64::INFINITY)
+    } else {
+        (at(syncs, "ready")?, at(syncs, "relax")?)
+    };
+    let rise = |span: f64, k: f64| {
+        if span > 0.0 {
+            min_jerk(((t - start) / span * k).min(1.0))
+        } else {
+            1.0
+        }
+    };
+    if t < ready {
+        // the eyes lead: they arrive half way through the shift
+        return Some((rise(ready - start, 1.0), rise(ready - start, 2.0)));
+    }
+    if t < relax {
+        return Some((1.0, 1.0));
+    }
+    let back = if end > relax {
+        1.0 - min_jerk((t - relax) / (end - relax))
+    } else {
+        0.0
+    };
+    Some((back, back))
+}
+
+impl GazeEngine {
+    /// The aim (yaw, pitch) from the point between the eyes at rest to `target`.
+    fn aim(skeleton: &Skeleton, rest: &[Vec3], target: Vec3) -> Option<(f32, f32)> {
+        let (l, r) = (
+            skeleton.joint("l_eyeball_joint")?,
+            skeleton.joint("r_eyeball_joint")?,
+        );
+        let eyes = (rest[l] + rest[r]) / 2.0;
+        Some(yaw_pitch(target - eyes))
+    }
+}
+
+impl Engine for GazeEngine {
+    fn name(&self) -> &'static str {
+        "gaze"
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        gaze(behaviour)?;
+        self.models.model(behaviour)
+    }
+
+    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&'static str> {
+        matches!(behaviour.kind, BehaviourKind::Gaze(_)).then_some("gaze")
+    }
+
+    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
+        &["eyes"]
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let (target, influence, shift) = gaze(unit.behaviour)
+            .ok_or_else(|| EngineError("the gaze engine realizes gaze and gazeShift".into()))?;
+        if unit.world.get(target).is_none() {
+            let known: Vec<&str> = unit.world.points().map(|p| p.0).collect();
+            return Err(EngineError(format!(
+                "{}: there is no target '{target}' in the world (it has {known:?})",
+                unit.key
+            )));
+        }
+        self.units.add(
+            unit,
+            GazeUnit {
+                target: target.to_string(),
+                influence,
+                shift,
+            },
+        );
+        Ok(())
+    }
+
+    fn remove(&mut self, key: &UnitKey) {
+        // a shift that ran leaves its target as the new rest aim
+        if let Some(u) = self.units.get(key) {
+            if u.shift {
+                self.rest = Some((u.target.clone(), u.influence));
+            }
+        }
+        self.units.remove(key);
+    }
+
+    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+        let times = crate::engine::relax_now(now, syncs);
+        self.units.retime(key, &times);
+        times
+    }
+
+    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
+        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
+        self.units.retime(key, &times);
+    }
+
+    fn len(&self) -> usize {
+        self.units.len()
+    }
+
+    fn play(&mut self, now: f64, frame: &mut Frame) {
+        for (key, progress, _) in self.units.running(now) {
+            frame.outputs.push(Output {
+                key: key.clone(),
+                engine: "gaze",
+                progress,
+                params: Vec::new(),
+            });
+        }
+    }
+
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
+        // the gaze that started last wins (R33); ties go to the one that ends first
+        let active = self
+            .units
+            .all()
+            .filter_map(|(syncs, u)| {
+                let w = weights(u, syncs, now)?;
+                Some((at(syncs, "start")?, at(syncs, "end")?, u, w))
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
+        let rest_aim = self
+            .rest
+            .as_ref()
+            .and_then(|(t, i)| Some((world.get(t)?, *i)));
+        let target = active.and_then(|(_, _, u, w)| Some((world.get(&u.target)?, u.influence, w)));
+        if target.is_none() && rest_aim.is_none() {
+            return;
+        }
+        let rest_positions = Pose::rest(skeleton).world(skeleton).positions;
+        let aim_of = |p: Vec3| Self::aim(skeleton, &rest_positions, p).unwrap_or((0.0, 0.0));
+        let (rest_yaw, rest_pitch, rest_influence) = match rest_aim {
+            Some((p, i)) => {
+                let (y, pi) = aim_of(p);
+                (y, pi, i)
+            }
+            None => (0.0, 0.0, Influence::Eyes),
+        };
+        // the body: blend of the rest aim's shares and the target's shares
+        let (wb, we) = target.map_or((0.0, 0.0), |t| (t.2 .0 as f32, t.2 .1 as f32));
+        let (t_yaw, t_pitch, t_influence) = match target {
+            Some((p, i, _)) => {
+                let (y, pi) = aim_of(p);
+                (y, pi, i)
+            }
+            None => (rest_yaw, rest_pitch, rest_influence),
+        };
+        let joints: Vec<&str> = shares(rest_influence)
+            .iter()
+            .chain(shares(t_influence))
+            .map(|s| s.0)
+            .fold(Vec::new(), |mut v, j| {
+                if !v.contains(&j) {
+                    v.push(j);
+                }
+                v
+            });
+        let share = |inf: Influence, j: &str| {
+            shares(inf)
+                .iter()
+                .find(|s| s.0 == j)
+                .map_or((0.0, 0.0), |s| (s.1, s.2))
+        };
+        for j in joints {
+            let Some(i) = skeleton.joint(j) else { continue };
+            let (ry, rp) = share(rest_influence, j);
+            let (ty, tp) = share(t_influence, j);
+            let yaw = (1.0 - wb) * ry * rest_yaw + wb * ty * t_yaw;
+            let pitch = (1.0 - wb) * rp * rest_pitch + wb * tp * t_pitch;
+            pose.rotate(i, donders(yaw, pitch));
+        }
+        // the eyes: aimed exactly from where they are now, blended from the rest aim
+        let now_world = pose.world(skeleton);
+        let rest_point = rest_aim.map(|r| r.0);
+        let target_point = target.map(|t| t.0);
+        for eye in ["l_eyeball_joint", "r_eyeball_joint"] {
+            let Some(e) = skeleton.joint(eye) else {
+                continue;
+            };
+            let parent = skeleton.joints()[e].parent.unwrap_or(0);
+            let inv = now_world.orientations[parent].inverse();
+            let eye_aim = |p: Option<Vec3>| {
+                p.map_or((0.0, 0.0), |p| {
+                    let (y, pi) = yaw_pitch(inv * (p - now_world.positions[e]));
+                    (
+                        y.clamp(-EYE_YAW_LIMIT.to_radians(), EYE_YAW_LIMIT.to_radians()),
+                        pi.clamp(-EYE_PITCH_LIMIT.to_radians(), EYE_PITCH_LIMIT.to_radians()),
+                    )
+                })
+            };
+            let (ry, rp) = eye_aim(rest_point);
+            let (ty, tp) = if target_point.is_some() {
+                eye_aim(target_point)
+            } else {
+                (ry, rp)
+            };
+            let yaw = ry + we * (ty - ry);
+            let pitch = rp + we * (tp - rp);
+            pose.rotate(e, donders(yaw, pitch));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn minimum_jerk_starts_and_ends_at_rest() {
+        assert_eq!(min_jerk(0.0), 0.0);
+        assert_eq!(min_jerk(1.0), 1.0);
+        assert!((min_jerk(0.5) - 0.5).abs() < 1e-12);
+        let v = |u: f64| (min_jerk(u + 1e-6) - min_jerk(u)) / 1e-6;
+        assert!(v(0.0) < 1e-4 && v(0.999_998) < 1e-3 && v(0.5) > 1.8);
+    }
+
+    #[test]
+    fn yaw_is_toward_the_left_and_pitch_down() {
+        let (y, p) = yaw_pitch(Vec3::new(1.0, 0.0, 1.0));
+        assert!((y - std::f32::consts::FRAC_PI_4).abs() < 1e-6 && p.abs() < 1e-6);
+        let (y, p) = yaw_pitch(Vec3::new(0.0, -1.0, 1.0));
+        assert!(y.abs() < 1e-6 && (p - std::f32::consts::FRAC_PI_4).abs() < 1e-6);
+        // the Donders rotation takes +z to that direction
+        let d = donders(0.3, 0.2) * Vec3::Z;
+        let (y, p) = yaw_pitch(d);
+        assert!((y - 0.3).abs() < 1e-5 && (p - 0.2).abs() < 1e-5);
+    }
+}
