@@ -134,7 +134,8 @@ impl BlockManager {
         }
     }
 
-    /// Uses `skeleton` for this character's body (the default adult otherwise).
+    /// Uses `skeleton` for this character's body (the default adult otherwise). Set it before the
+    /// character acts: engines may keep measurements of the skeleton.
     pub fn set_skeleton(&mut self, skeleton: Skeleton) {
         self.skeleton = skeleton;
     }

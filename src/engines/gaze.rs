@@ -89,6 +89,8 @@ pub struct GazeEngine {
     units: Units<GazeUnit>,
     /// Where the character looks when no gaze runs (set by gaze shifts).
     rest: Option<(String, Influence)>,
+    /// The point between the eyes in the rest pose (the skeleton does not change).
+    eyes_at_rest: Option<Vec3>,
 }
 
 fn gaze(b: &Behaviour) -> Option<(&str, Influence, bool)> {
@@ -140,14 +142,18 @@ fn weights(u: &GazeUnit, syncs: &[(SyncName, f64)], t: f64) -> Option<(f64, f64)
 }
 
 impl GazeEngine {
-    /// The aim (yaw, pitch) from the point between the eyes at rest to `target`.
-    fn aim(skeleton: &Skeleton, rest: &[Vec3], target: Vec3) -> Option<(f32, f32)> {
-        let (l, r) = (
-            skeleton.joint("l_eyeball_joint")?,
-            skeleton.joint("r_eyeball_joint")?,
-        );
-        let eyes = (rest[l] + rest[r]) / 2.0;
-        Some(yaw_pitch(target - eyes))
+    /// The point between the eyes in the rest pose.
+    fn eyes_at_rest(&mut self, skeleton: &Skeleton) -> Vec3 {
+        *self.eyes_at_rest.get_or_insert_with(|| {
+            let rest = Pose::rest(skeleton).world(skeleton).positions;
+            match (
+                skeleton.joint("l_eyeball_joint"),
+                skeleton.joint("r_eyeball_joint"),
+            ) {
+                (Some(l), Some(r)) => (rest[l] + rest[r]) / 2.0,
+                _ => rest[0],
+            }
+        })
     }
 }
 
@@ -244,8 +250,8 @@ impl Engine for GazeEngine {
         if target.is_none() && rest_aim.is_none() {
             return;
         }
-        let rest_positions = Pose::rest(skeleton).world(skeleton).positions;
-        let aim_of = |p: Vec3| Self::aim(skeleton, &rest_positions, p).unwrap_or((0.0, 0.0));
+        let eyes = self.eyes_at_rest(skeleton);
+        let aim_of = |p: Vec3| yaw_pitch(p - eyes);
         let (rest_yaw, rest_pitch, rest_influence) = match rest_aim {
             Some((p, i)) => {
                 let (y, pi) = aim_of(p);
