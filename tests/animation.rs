@@ -276,3 +276,62 @@ fn a_gaze_shift_keeps_looking_at_its_target_after_it_ends() {
         "the head stays turned left"
     );
 }
+
+// ---- pointing -----------------------------------------------------------------------------
+
+#[test]
+fn pointing_aims_the_index_finger_at_the_target_at_the_stroke_and_returns() {
+    let skeleton = Skeleton::adult();
+    for (mode, side, target) in [
+        ("RIGHT_HAND", "r", Vec3::new(-0.6, 1.3, 1.2)),
+        ("LEFT_HAND", "l", Vec3::new(0.8, 0.9, 0.7)),
+        ("RIGHT_HAND", "r", Vec3::new(0.1, 1.8, 1.0)),
+    ] {
+        let mut r = Realizer::new();
+        r.world_mut().set("thing", target);
+        let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let sink = log.clone();
+        r.add_listener(Box::new(move |f: &Feedback| {
+            sink.borrow_mut().push(f.clone())
+        }));
+        r.perform_bml(&format!(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><pointing id="p" target="thing" mode="{mode}" start="0.2" end="2.4"/></bml>"#
+        ))
+        .unwrap();
+        let mut stroke = None;
+        let (i1, i3) = (
+            skeleton.joint(&format!("{side}_index1")).unwrap(),
+            skeleton.joint(&format!("{side}_index3")).unwrap(),
+        );
+        for i in 0..=180 {
+            let t = f64::from(i) / FPS;
+            let frame = r.tick(t);
+            if stroke.is_none() {
+                stroke = log.borrow().iter().find_map(|f| match f {
+                    Feedback::SyncPointProgress(p) if p.sync == "stroke" => Some(p.global_time),
+                    _ => None,
+                });
+                if let Some(s) = stroke {
+                    // the frame of the stroke: the index finger points at the target
+                    let at_stroke = r.tick(s);
+                    let w = at_stroke.poses[0].pose.world(&skeleton);
+                    let finger = w.positions[i3] - w.positions[i1];
+                    let error = finger.angle_between(target - w.positions[i3]).to_degrees();
+                    assert!(error < 3.0, "{mode}: finger {error}° off the target");
+                }
+            }
+            if t >= 2.4 {
+                // back to the start pose
+                let pose = &frame.poses[0].pose;
+                for j in ["shoulder", "elbow", "wrist"] {
+                    let q = pose.rotations[skeleton.joint(&format!("{side}_{j}")).unwrap()];
+                    assert!(
+                        q.angle_between(Quat::IDENTITY).to_degrees() < 0.5,
+                        "{j} at {t}"
+                    );
+                }
+            }
+        }
+        assert!(stroke.is_some());
+    }
+}

@@ -1,9 +1,10 @@
 //! The body: an H-Anim skeleton ([`skeleton`]), poses with forward kinematics ([`pose`]) and BVH
-//! export ([`bvh`]).
+//! export ([`bvh`]), and two-link inverse kinematics ([`ik`]).
 //! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians
 //! (A1, A2).
 
 pub mod bvh;
+pub mod ik;
 pub mod pose;
 pub mod skeleton;
 

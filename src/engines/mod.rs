@@ -8,12 +8,14 @@
 //!   scheduled pegs and reports every sync point, but moves no body;
 //! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well);
 //! - [`head`]: head nods, shakes and tilts as real motion of the neck and skull;
-//! - [`gaze`]: gaze and gaze shifts as real motion of eyes, neck and trunk toward world targets.
+//! - [`gaze`]: gaze and gaze shifts as real motion of eyes, neck and trunk toward world targets;
+//! - [`pointing`]: pointing as real arm motion (two-link IK) toward world targets.
 
 pub mod control;
 pub mod gaze;
 pub mod head;
 pub mod murml;
+pub mod pointing;
 pub mod speech;
 pub mod timing_only;
 
@@ -24,7 +26,6 @@ use crate::engine::{KindKey, Registry};
 /// Kinds the timing-only motion engine realizes (namespace, element).
 pub const MOTION_KINDS: &[(&str, &str)] = &[
     (NS_BML, "gesture"),
-    (NS_BML, "pointing"),
     (NS_BML, "headDirectionShift"),
     (NS_BML, "posture"),
     (NS_BML, "postureShift"),
@@ -80,6 +81,10 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
             (murml::NS_MURML, "murmlgesture"),
             (murml::NS_MURML, "murmlface"),
         ]),
+    );
+    r.register(
+        Box::new(pointing::PointingEngine::default()),
+        &keys(&[(NS_BML, "pointing")]),
     );
     // last: the eyes are aimed from the head where the other engines put it
     r.register(

@@ -1,0 +1,53 @@
+//! Analytic two-link inverse kinematics (A40): where to put the middle joint (elbow, knee) so that
+//! the end of the second link (wrist, ankle) reaches a target, bending toward a pole direction.
+
+use glam::Vec3;
+
+/// The middle joint's position for links of lengths `upper` and `lower` from `root` to reach
+/// `target`, bending toward `pole`. A target out of reach is approached along the same line (the
+/// limb stretches out or folds as far as it can).
+pub fn two_link(root: Vec3, upper: f32, lower: f32, target: Vec3, pole: Vec3) -> Vec3 {
+    let to = target - root;
+    let n = to.normalize_or(Vec3::X);
+    let min = (upper - lower).abs() + 1e-4;
+    let max = upper + lower - 1e-4;
+    let d = to.length().clamp(min, max);
+    // law of cosines: the angle at the root between the target line and the upper link
+    let cos_a = ((upper * upper + d * d - lower * lower) / (2.0 * upper * d)).clamp(-1.0, 1.0);
+    let sin_a = (1.0 - cos_a * cos_a).sqrt();
+    let m = (pole - n * pole.dot(n)).normalize_or(n.any_orthonormal_vector());
+    root + upper * (cos_a * n + sin_a * m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reachable_targets_are_reached_within_a_millimetre() {
+        let (upper, lower) = (0.29f32, 0.25f32);
+        let root = Vec3::new(0.2, 1.4, 0.0);
+        let mut seed = 7u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for _ in 0..1000 {
+            let dir = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize_or(Vec3::X);
+            let dist = 0.06 + next() * (upper + lower - 0.07);
+            let target = root + dir * dist;
+            let elbow = two_link(root, upper, lower, target, Vec3::new(0.0, -1.0, -0.3));
+            assert!(((elbow - root).length() - upper).abs() < 1e-5);
+            let wrist = elbow + (target - elbow).normalize() * lower;
+            assert!(
+                (wrist - target).length() < 1e-3,
+                "{}",
+                (wrist - target).length()
+            );
+        }
+        // out of reach: straight toward the target
+        let far = root + Vec3::new(0.0, 0.0, 2.0);
+        let elbow = two_link(root, upper, lower, far, Vec3::NEG_Y);
+        assert!((elbow - root).normalize().dot(Vec3::Z) > 0.99);
+    }
+}

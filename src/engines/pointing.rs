@@ -1,0 +1,199 @@
+//! The pointing engine: `pointing` as real arm motion toward a named point of the [`World`] (A48).
+//! The wrist goes to 85 % of the arm's reach on the line from the shoulder to the target (analytic
+//! two-link IK, the elbow bending down and back), and the hand turns so that the index finger
+//! points at the target. The arm moves there from `start` to `ready` (minimum jerk), holds —
+//! following a moving target — until `relax`, and returns by `end` to the pose it started from
+//! (the preparation mirrored). `mode` picks the hand; without one, the hand on the target's side.
+//! A target the world does not have is refused when the behaviour starts.
+
+use glam::{Quat, Vec3};
+
+use crate::bml::{Behaviour, BehaviourKind, Mode};
+use crate::body::ik::two_link;
+use crate::body::{Pose, Skeleton};
+use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::engines::gaze::min_jerk;
+use crate::engines::timing_only::hands;
+use crate::schedule::SyncName;
+use crate::world::World;
+
+/// How far along its reach the wrist goes.
+pub const REACH: f32 = 0.85;
+
+#[derive(Debug, Clone)]
+struct PointingUnit {
+    target: String,
+    mode: Option<Mode>,
+}
+
+/// The pointing engine (see the module documentation).
+#[derive(Debug, Default)]
+pub struct PointingEngine {
+    models: DefaultTimingModels,
+    units: Units<PointingUnit>,
+}
+
+fn at(syncs: &[(SyncName, f64)], name: &str) -> Option<f64> {
+    syncs.iter().find(|s| s.0 == name).map(|s| s.1)
+}
+
+/// How far the arm is toward the pointing pose at `t` (0..1).
+fn weight(syncs: &[(SyncName, f64)], t: f64) -> Option<f32> {
+    let (start, ready, relax, end) = (
+        at(syncs, "start")?,
+        at(syncs, "ready")?,
+        at(syncs, "relax")?,
+        at(syncs, "end")?,
+    );
+    if t < start || t >= end {
+        return None;
+    }
+    let w = if t < ready {
+        min_jerk((t - start) / (ready - start).max(1e-9))
+    } else if t < relax {
+        1.0
+    } else {
+        1.0 - min_jerk((t - relax) / (end - relax).max(1e-9))
+    };
+    Some(w as f32)
+}
+
+/// The rotation taking direction `from` to direction `to` (shortest arc).
+fn arc(from: Vec3, to: Vec3) -> Quat {
+    Quat::from_rotation_arc(from.normalize_or(Vec3::X), to.normalize_or(Vec3::X))
+}
+
+/// Points the `side` arm (`l` or `r`) of `pose` at `target`, `w` of the way.
+fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32) -> Option<()> {
+    let j = |n: &str| skeleton.joint(&format!("{side}_{n}"));
+    let (shoulder, elbow, wrist, index) = (j("shoulder")?, j("elbow")?, j("wrist")?, j("index1")?);
+    let joints = skeleton.joints();
+    let (upper, lower) = (joints[elbow].offset, joints[wrist].offset);
+    let hand = joints[index].offset;
+    let world = pose.world(skeleton);
+    let s = world.positions[shoulder];
+    let reach = (upper.length() + lower.length()) * REACH;
+    let goal = s + (target - s).normalize_or(Vec3::Z) * reach;
+    let e = two_link(
+        s,
+        upper.length(),
+        lower.length(),
+        goal,
+        Vec3::new(0.0, -1.0, -0.4),
+    );
+    // shoulder: the upper arm toward the elbow
+    let parent = world.orientations[joints[shoulder].parent?];
+    let current_s = world.orientations[shoulder];
+    let q_s = arc(current_s * upper, e - s);
+    let local_s = parent.inverse() * q_s * current_s;
+    // elbow: the forearm toward the wrist goal
+    let o_s = parent * local_s;
+    let current_e = o_s * pose.rotations[elbow];
+    let q_e = arc(current_e * lower, goal - e);
+    let local_e = o_s.inverse() * q_e * current_e;
+    // wrist: the index finger (from its base, along its bones) toward the target; the base
+    // moves with the hand, so a few rounds settle it
+    let finger = match (j("index2"), j("index3")) {
+        (Some(a), Some(b)) => joints[a].offset + joints[b].offset,
+        _ => hand,
+    };
+    let o_e = o_s * local_e;
+    let mut o_w = o_e * pose.rotations[wrist];
+    for _ in 0..4 {
+        let base = goal + o_w * hand;
+        o_w = arc(o_w * finger, target - base) * o_w;
+    }
+    let local_w = o_e.inverse() * o_w;
+    for (i, full) in [(shoulder, local_s), (elbow, local_e), (wrist, local_w)] {
+        let from = pose.rotations[i];
+        pose.rotations[i] = from.slerp(full, w).normalize();
+    }
+    Some(())
+}
+
+impl Engine for PointingEngine {
+    fn name(&self) -> &'static str {
+        "pointing"
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        matches!(behaviour.kind, BehaviourKind::Pointing(_))
+            .then(|| self.models.model(behaviour))?
+    }
+
+    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
+        match &behaviour.kind {
+            BehaviourKind::Pointing(p) => hands(p.mode),
+            _ => &[],
+        }
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let BehaviourKind::Pointing(p) = &unit.behaviour.kind else {
+            return Err(EngineError(
+                "the pointing engine realizes <pointing>".into(),
+            ));
+        };
+        if unit.world.get(&p.target).is_none() {
+            let known: Vec<&str> = unit.world.points().map(|q| q.0).collect();
+            return Err(EngineError(format!(
+                "{}: there is no target '{}' in the world (it has {known:?})",
+                unit.key, p.target
+            )));
+        }
+        let target = p.target.clone();
+        let mode = p.mode;
+        self.units.add(unit, PointingUnit { target, mode });
+        Ok(())
+    }
+
+    fn remove(&mut self, key: &UnitKey) {
+        self.units.remove(key);
+    }
+
+    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+        let times = crate::engine::relax_now(now, syncs);
+        self.units.retime(key, &times);
+        times
+    }
+
+    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
+        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
+        self.units.retime(key, &times);
+    }
+
+    fn len(&self) -> usize {
+        self.units.len()
+    }
+
+    fn play(&mut self, now: f64, frame: &mut Frame) {
+        for (key, progress, _) in self.units.running(now) {
+            frame.outputs.push(Output {
+                key: key.clone(),
+                engine: "pointing",
+                progress,
+                params: Vec::new(),
+            });
+        }
+    }
+
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
+        for (syncs, u) in self.units.all() {
+            let (Some(w), Some(target)) = (weight(syncs, now), world.get(&u.target)) else {
+                continue;
+            };
+            let sides: &[&str] = match u.mode {
+                Some(Mode::LeftHand) => &["l"],
+                Some(Mode::RightHand) => &["r"],
+                Some(Mode::BothHands) => &["l", "r"],
+                // the hand on the target's side (the character's left is +x)
+                None if target.x > 0.0 => &["l"],
+                None => &["r"],
+            };
+            for side in sides {
+                point(skeleton, pose, side, target, w);
+            }
+        }
+    }
+}
