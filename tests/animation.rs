@@ -335,3 +335,37 @@ fn pointing_aims_the_index_finger_at_the_target_at_the_stroke_and_returns() {
         assert!(stroke.is_some());
     }
 }
+
+// ---- keyframes ----------------------------------------------------------------------------
+
+#[test]
+fn keyframes_hit_every_key_exactly_at_its_stretched_time() {
+    let skeleton = Skeleton::adult();
+    let elbow = skeleton.joint("r_elbow").unwrap();
+    let keys = [
+        (0.0, Quat::IDENTITY),
+        (1.0, Quat::from_rotation_y(1.0)),
+        (
+            3.0,
+            Quat::from_rotation_y(-0.5) * Quat::from_rotation_x(0.4),
+        ),
+    ];
+    let lines: String = keys
+        .iter()
+        .map(|(t, q)| format!("{t} {} {} {} {}\n", q.w, q.x, q.y, q.z))
+        .collect();
+    let mut r = Realizer::new();
+    // 3 s of keys stretched over 1..7: keys at 1, 3 and 7
+    r.perform_bml(&format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b">
+             <bmlt:keyframe id="kf" start="1" end="7">
+               <SkeletonInterpolator rotationEncoding="quaternions" parts="r_elbow" encoding="R">{lines}</SkeletonInterpolator>
+             </bmlt:keyframe></bml>"#
+    ))
+    .unwrap();
+    for ((_, q), t) in keys.iter().zip([1.0, 3.0, 7.0]) {
+        let frame = r.tick(t);
+        let got = frame.poses[0].pose.rotations[elbow];
+        assert!(got.angle_between(*q) < 1e-6, "key at {t}: {got:?} vs {q:?}");
+    }
+}

@@ -65,6 +65,9 @@ pub struct BlockManager {
     finished_set: HashSet<String>,
     changes: Vec<ParameterChange>,
     anticipators: Vec<Box<dyn Anticipator>>,
+    /// Units whose end passed during this advance: engines drop them after the frame, so that
+    /// the frame at their end still shows their last moment.
+    retiring: Vec<(usize, UnitKey)>,
     skeleton: Skeleton,
     /// The world as of the last advance (shared with the realizer).
     world: std::sync::Arc<World>,
@@ -126,6 +129,7 @@ impl BlockManager {
             finished_set: HashSet::new(),
             changes: Vec::new(),
             anticipators: Vec::new(),
+            retiring: Vec::new(),
             skeleton: Skeleton::adult(),
             world: std::sync::Arc::new(World::default()),
             now: 0.0,
@@ -749,10 +753,12 @@ impl BlockManager {
             self.lurking -= 1;
         }
         for x in &b.behaviours {
-            if matches!(x.phase, Phase::Added | Phase::Running | Phase::Ended) {
-                self.registry
-                    .engine_mut(x.engine)
-                    .remove(&UnitKey::new(&b.id, &x.id));
+            let key = UnitKey::new(&b.id, &x.id);
+            match x.phase {
+                // it reached its end: it shows its last moment in this frame, then goes
+                Phase::Ended => self.retiring.push((x.engine, key)),
+                Phase::Added | Phase::Running => self.registry.engine_mut(x.engine).remove(&key),
+                Phase::Planned | Phase::Removed => {}
             }
         }
         self.changes.retain(|c| c.target.block != b.id);
@@ -966,6 +972,9 @@ impl BlockManager {
             character: self.character.clone(),
             pose,
         });
+        for (engine, key) in std::mem::take(&mut self.retiring) {
+            self.registry.engine_mut(engine).remove(&key);
+        }
     }
 
     fn pass_sync(&mut self, bi: usize, xi: usize, t: f64) {
@@ -992,7 +1001,7 @@ impl BlockManager {
             .sync_passed(&key, &sync, t, &mut actions);
         if last {
             self.blocks[bi].behaviours[xi].phase = Phase::Ended;
-            self.registry.engine_mut(engine).remove(&key);
+            self.retiring.push((engine, key.clone()));
         }
         if self.blocks[bi].update_subsiding() {
             self.start_ready(t);

@@ -233,6 +233,20 @@ impl Engine for GazeEngine {
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
+        // a shift that has reached its end is the rest aim from then on
+        let done = self
+            .units
+            .all()
+            .filter(|(syncs, u)| u.shift && at(syncs, "end").is_some_and(|e| e <= now))
+            .max_by(|a, b| {
+                let end =
+                    |x: &(&crate::engine::SyncTimes, &GazeUnit)| at(x.0, "end").unwrap_or(0.0);
+                end(a).total_cmp(&end(b))
+            })
+            .map(|(_, u)| (u.target.clone(), u.influence));
+        if done.is_some() {
+            self.rest = done;
+        }
         // the gaze that started last wins (R33); ties go to the one that ends first
         let active = self
             .units

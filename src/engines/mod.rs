@@ -9,11 +9,13 @@
 //! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well);
 //! - [`head`]: head nods, shakes and tilts as real motion of the neck and skull;
 //! - [`gaze`]: gaze and gaze shifts as real motion of eyes, neck and trunk toward world targets;
-//! - [`pointing`]: pointing as real arm motion (two-link IK) toward world targets.
+//! - [`pointing`]: pointing as real arm motion (two-link IK) toward world targets;
+//! - [`keyframe`]: BMLT keyframe animations (SkeletonInterpolator), slerped between exact keys.
 
 pub mod control;
 pub mod gaze;
 pub mod head;
+pub mod keyframe;
 pub mod murml;
 pub mod pointing;
 pub mod speech;
@@ -36,7 +38,6 @@ pub const MOTION_KINDS: &[(&str, &str)] = &[
     (NS_BML, "locomotion"),
     (NS_BMLT, "procanimation"),
     (NS_BMLT, "procanimationgesture"),
-    (NS_BMLT, "keyframe"),
     (NS_BMLT, "noise"),
     (NS_BMLT, "transition"),
     (NS_BMLT, "controller"),
@@ -70,6 +71,11 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(timing_only::TimingOnlyEngine::audio(models)),
         &keys(&[(NS_BMLT, "audiofile")]),
+    );
+    // keyframes set joint rotations; the engines after them add to or aim from them
+    r.register(
+        Box::new(keyframe::KeyframeEngine::default()),
+        &keys(&[(NS_BMLT, "keyframe")]),
     );
     r.register(
         Box::new(head::HeadEngine::default()),

@@ -1,0 +1,314 @@
+//! The keyframe engine: BMLT `keyframe` behaviours with an inline `<SkeletonInterpolator>` — keys
+//! of local joint rotations (quaternions `w x y z`; with `encoding="T1R"` the root's translation
+//! first) at times in seconds:
+//!
+//! ```xml
+//! <bmlt:keyframe id="kf1">
+//!   <SkeletonInterpolator rotationEncoding="quaternions" parts="r_shoulder r_elbow" encoding="R">
+//!     0   1 0 0 0   1 0 0 0
+//!     0.5 0.92 0 0.38 0   0.71 0 0.71 0
+//!   </SkeletonInterpolator>
+//! </bmlt:keyframe>
+//! ```
+//!
+//! The keys are laid out linearly between the behaviour's `start` and `end` (its preferred length
+//! is the last key's time), each key is hit exactly at its time, and rotations are interpolated by
+//! slerp between neighbouring keys. The named joints take the keyframe's rotations (they replace,
+//! not add to, what other engines set).
+
+use glam::{Quat, Vec3};
+use quick_xml::events::Event;
+use quick_xml::Reader;
+
+use crate::bml::{Behaviour, BehaviourKind};
+use crate::body::{Pose, Skeleton};
+use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
+use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::schedule::SyncName;
+use crate::world::World;
+
+/// Keys read from a `<SkeletonInterpolator>`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Keys {
+    /// Joint names, in the order of each key's rotations.
+    pub parts: Vec<String>,
+    /// Whether each key starts with the root's translation.
+    pub root_translation: bool,
+    /// (time, root translation, rotation per part), by time.
+    pub keys: Vec<(f64, Vec3, Vec<Quat>)>,
+}
+
+/// Reads the first `<SkeletonInterpolator>` of `content`.
+pub fn read_keys(content: &str) -> Result<Keys, String> {
+    let mut reader = Reader::from_str(content);
+    let mut parts: Option<Vec<String>> = None;
+    let mut root_translation = false;
+    let mut text = String::new();
+    let mut inside = false;
+    loop {
+        match reader.read_event() {
+            Ok(Event::Start(e)) if e.local_name().as_ref() == b"SkeletonInterpolator" => {
+                inside = true;
+                for a in e.attributes().flatten() {
+                    let v = a.unescape_value().map_err(|x| x.to_string())?.into_owned();
+                    match a.key.local_name().as_ref() {
+                        b"parts" => {
+                            parts = Some(v.split_whitespace().map(str::to_string).collect())
+                        }
+                        b"encoding" => match v.trim() {
+                            "R" => root_translation = false,
+                            "T1R" => root_translation = true,
+                            other => {
+                                return Err(format!(
+                                    "encoding '{other}' is not supported (R or T1R)"
+                                ))
+                            }
+                        },
+                        b"rotationEncoding" if v.trim() != "quaternions" => {
+                            return Err(format!(
+                                "rotationEncoding '{v}' is not supported (quaternions)"
+                            ))
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            Ok(Event::Text(t)) if inside => text.push_str(&String::from_utf8_lossy(t.as_ref())),
+            Ok(Event::End(e)) if e.local_name().as_ref() == b"SkeletonInterpolator" => break,
+            Ok(Event::Eof) => {
+                if !inside {
+                    return Err("no <SkeletonInterpolator> in the keyframe".into());
+                }
+                break;
+            }
+            Err(e) => return Err(format!("the keyframe content is not well-formed: {e}")),
+            Ok(_) => {}
+        }
+    }
+    let parts = parts.ok_or("the SkeletonInterpolator has no parts")?;
+    let per_key = 1 + if root_translation { 3 } else { 0 } + 4 * parts.len();
+    let numbers: Vec<f64> = text
+        .split_whitespace()
+        .map(|n| {
+            n.parse::<f64>()
+                .map_err(|_| format!("'{n}' is not a number"))
+        })
+        .collect::<Result<_, _>>()?;
+    if numbers.is_empty() || numbers.len() % per_key != 0 {
+        return Err(format!(
+            "{} numbers do not make keys of {per_key} (time, {}{} quaternions)",
+            numbers.len(),
+            if root_translation { "root x y z, " } else { "" },
+            parts.len()
+        ));
+    }
+    let mut keys: Vec<(f64, Vec3, Vec<Quat>)> = Vec::new();
+    for k in numbers.chunks(per_key) {
+        let t = k[0];
+        if !t.is_finite() || keys.last().is_some_and(|l| t <= l.0) {
+            return Err(format!("key times must increase (at {t})"));
+        }
+        let (root, rest) = if root_translation {
+            (Vec3::new(k[1] as f32, k[2] as f32, k[3] as f32), &k[4..])
+        } else {
+            (Vec3::ZERO, &k[1..])
+        };
+        let rotations = rest
+            .chunks(4)
+            .map(|q| {
+                Quat::from_xyzw(q[1] as f32, q[2] as f32, q[3] as f32, q[0] as f32).normalize()
+            })
+            .collect();
+        keys.push((t, root, rotations));
+    }
+    Ok(Keys {
+        parts,
+        root_translation,
+        keys,
+    })
+}
+
+impl Keys {
+    /// Length from the first key to the last.
+    pub fn duration(&self) -> f64 {
+        self.keys.last().map_or(0.0, |l| l.0) - self.keys.first().map_or(0.0, |f| f.0)
+    }
+
+    /// The root translation and rotations at key time `t` (clamped to the keys).
+    pub fn sample(&self, t: f64) -> (Vec3, Vec<Quat>) {
+        let k = &self.keys;
+        if t <= k[0].0 || k.len() == 1 {
+            return (k[0].1, k[0].2.clone());
+        }
+        let last = &k[k.len() - 1];
+        if t >= last.0 {
+            return (last.1, last.2.clone());
+        }
+        let i = k.partition_point(|key| key.0 <= t) - 1;
+        let (a, b) = (&k[i], &k[i + 1]);
+        let u = ((t - a.0) / (b.0 - a.0)) as f32;
+        let rotations = a.2.iter().zip(&b.2).map(|(p, q)| p.slerp(*q, u)).collect();
+        (a.1.lerp(b.1, u), rotations)
+    }
+}
+
+fn content(b: &Behaviour) -> Option<&str> {
+    match &b.kind {
+        BehaviourKind::Keyframe(a) => Some(&a.content),
+        _ => None,
+    }
+}
+
+#[derive(Debug, Clone)]
+struct KeyframeUnit {
+    keys: Keys,
+}
+
+/// The keyframe engine (see the module documentation).
+#[derive(Debug, Default)]
+pub struct KeyframeEngine {
+    units: Units<KeyframeUnit>,
+}
+
+impl Engine for KeyframeEngine {
+    fn name(&self) -> &'static str {
+        "keyframe"
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        let c = content(behaviour)?;
+        // a keyframe that cannot be read is refused when it starts, with the reason
+        let d = read_keys(c).map_or(1.0, |k| k.duration());
+        Some(TimingModel {
+            keys: vec![
+                SyncKey {
+                    name: "start".into(),
+                    at: 0.0,
+                },
+                SyncKey {
+                    name: "end".into(),
+                    at: d.max(MIN_DURATION),
+                },
+            ],
+            flexibility: Flexibility::Stretchable {
+                min_duration: MIN_DURATION,
+                max_duration: f64::INFINITY,
+            },
+            persistent: false,
+        })
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let c = content(unit.behaviour)
+            .ok_or_else(|| EngineError("the keyframe engine realizes bmlt:keyframe".into()))?;
+        let keys = read_keys(c).map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
+        self.units.add(unit, KeyframeUnit { keys });
+        Ok(())
+    }
+
+    fn remove(&mut self, key: &UnitKey) {
+        self.units.remove(key);
+    }
+
+    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+        let times = crate::engine::stop_now(now, syncs);
+        self.units.retime(key, &times);
+        times
+    }
+
+    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
+        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
+        self.units.retime(key, &times);
+    }
+
+    fn len(&self) -> usize {
+        self.units.len()
+    }
+
+    fn play(&mut self, now: f64, frame: &mut Frame) {
+        for (key, progress, _) in self.units.running(now) {
+            frame.outputs.push(Output {
+                key: key.clone(),
+                engine: "keyframe",
+                progress,
+                params: Vec::new(),
+            });
+        }
+    }
+
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
+        for (syncs, u) in self.units.all() {
+            let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
+            else {
+                continue;
+            };
+            if now < start || now > end {
+                continue;
+            }
+            let k = &u.keys;
+            let first = k.keys[0].0;
+            let span = end - start;
+            let t = if span > 0.0 {
+                first + (now - start) / span * k.duration()
+            } else {
+                first + k.duration()
+            };
+            let (root, rotations) = k.sample(t);
+            if k.root_translation {
+                pose.root = root;
+            }
+            for (name, q) in k.parts.iter().zip(rotations) {
+                if let Some(i) = skeleton.joint(name) {
+                    pose.rotations[i] = q;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const KEYS: &str = r#"<SkeletonInterpolator rotationEncoding="quaternions" parts="r_elbow" encoding="R">
+        0 1 0 0 0
+        1 0.70710678 0 0.70710678 0
+        3 0 0 1 0
+    </SkeletonInterpolator>"#;
+
+    #[test]
+    fn keys_are_read_and_sampled_exactly_at_their_times() {
+        let k = read_keys(KEYS).unwrap();
+        assert_eq!(k.parts, ["r_elbow"]);
+        assert_eq!(k.keys.len(), 3);
+        assert_eq!(k.duration(), 3.0);
+        for (t, _, q) in &k.keys {
+            let (_, s) = k.sample(*t);
+            assert!(s[0].angle_between(q[0]) < 1e-6);
+        }
+        // slerp against its formula: q(u) = q0 sin((1-u)θ)/sin θ + q1 sin(uθ)/sin θ
+        let (_, mid) = k.sample(0.25);
+        let (q0, q1) = (k.keys[0].2[0], k.keys[1].2[0]);
+        let theta = q0.dot(q1).acos();
+        let u = 0.25f32;
+        let reference =
+            q0 * ((1.0 - u) * theta).sin() / theta.sin() + q1 * (u * theta).sin() / theta.sin();
+        assert!(mid[0].angle_between(reference.normalize()) < 1e-5);
+    }
+
+    #[test]
+    fn bad_keyframes_are_refused_with_a_reason() {
+        let bad = |c: &str| read_keys(c).unwrap_err();
+        assert_eq!(bad("<x/>"), "no <SkeletonInterpolator> in the keyframe");
+        assert!(bad(
+            r#"<SkeletonInterpolator parts="a" encoding="R">0 1 0 0</SkeletonInterpolator>"#
+        )
+        .contains("do not make keys"));
+        assert!(bad(r#"<SkeletonInterpolator parts="a" encoding="R">1 1 0 0 0 0 1 0 0 0</SkeletonInterpolator>"#)
+            .contains("must increase"));
+        assert!(bad(
+            r#"<SkeletonInterpolator parts="a" encoding="Q">0 1 0 0 0</SkeletonInterpolator>"#
+        )
+        .contains("encoding 'Q'"));
+    }
+}
