@@ -369,3 +369,30 @@ fn keyframes_hit_every_key_exactly_at_its_stretched_time() {
         assert!(got.angle_between(*q) < 1e-6, "key at {t}: {got:?} vs {q:?}");
     }
 }
+
+#[test]
+fn a_gaze_offset_looks_beside_the_target() {
+    let skeleton = Skeleton::adult();
+    let target = Vec3::new(0.0, 1.55, 2.0);
+    let mut r = Realizer::new();
+    r.world_mut().set("door", target);
+    r.perform_bml(&gaze_block(
+        "b",
+        "door",
+        r#"offsetAngle="15" offsetDirection="LEFT" start="0" ready="0.3" end="2""#,
+    ))
+    .unwrap();
+    let frame = r.tick(1.0);
+    let w = frame.poses[0].pose.world(&skeleton);
+    for e in ["l_eyeball_joint", "r_eyeball_joint"] {
+        let i = skeleton.joint(e).unwrap();
+        let sight = w.orientations[i] * Vec3::Z;
+        let to_target = target - w.positions[i];
+        let off = sight.angle_between(to_target).to_degrees();
+        assert!((off - 15.0).abs() < 1.0, "{e}: {off}° off the target");
+        assert!(
+            sight.x > to_target.normalize().x,
+            "to the character's left (+x)"
+        );
+    }
+}

@@ -14,12 +14,14 @@
 //!   until `relax`, then returns to the rest aim by `end`. A `gazeShift` moves over its whole span
 //!   and makes its target the new rest aim, kept after it ends.
 //! - Of several gazes running at once the one that started last wins (R33).
+//! - `offsetAngle` in `offsetDirection` turns the aim away from the target (LEFT, RIGHT, UP, DOWN
+//!   and the diagonals; POLAR gives no offset).
 //! - A target the world does not have is refused when the behaviour starts (the runtime reports
 //!   EXECUTION_FAILURE).
 
 use glam::{Quat, Vec3};
 
-use crate::bml::{Behaviour, BehaviourKind, Influence};
+use crate::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
@@ -80,6 +82,27 @@ struct GazeUnit {
     target: String,
     influence: Influence,
     shift: bool,
+    /// `offsetAngle` in `offsetDirection`, as (yaw, pitch) radians added to the aim.
+    offset: (f32, f32),
+}
+
+/// The (yaw, pitch) offset of `offsetAngle` degrees in `offsetDirection` (the character's right
+/// is −yaw, down is +pitch; diagonals split the angle evenly). POLAR has no direction of its own
+/// and gives no offset.
+pub fn offset(angle: Option<f64>, direction: Option<OffsetDirection>) -> (f32, f32) {
+    let a = angle.unwrap_or(0.0).to_radians() as f32;
+    let d = a * std::f32::consts::FRAC_1_SQRT_2;
+    match direction {
+        Some(OffsetDirection::Right) => (-a, 0.0),
+        Some(OffsetDirection::Left) => (a, 0.0),
+        Some(OffsetDirection::Up) => (0.0, -a),
+        Some(OffsetDirection::Down) => (0.0, a),
+        Some(OffsetDirection::UpRight) => (-d, -d),
+        Some(OffsetDirection::UpLeft) => (d, -d),
+        Some(OffsetDirection::DownRight) => (-d, d),
+        Some(OffsetDirection::DownLeft) => (d, d),
+        Some(OffsetDirection::Polar) | None => (0.0, 0.0),
+    }
 }
 
 /// The gaze engine (see the module documentation).
@@ -93,14 +116,18 @@ pub struct GazeEngine {
     eyes_at_rest: Option<Vec3>,
 }
 
-fn gaze(b: &Behaviour) -> Option<(&str, Influence, bool)> {
-    match &b.kind {
-        BehaviourKind::Gaze(g) => Some((&g.target, g.influence.unwrap_or(Influence::Neck), false)),
-        BehaviourKind::GazeShift(g) => {
-            Some((&g.target, g.influence.unwrap_or(Influence::Neck), true))
-        }
-        _ => None,
-    }
+fn gaze(b: &Behaviour) -> Option<(&str, Influence, bool, (f32, f32))> {
+    let (g, shift) = match &b.kind {
+        BehaviourKind::Gaze(g) => (g, false),
+        BehaviourKind::GazeShift(g) => (g, true),
+        _ => return None,
+    };
+    Some((
+        &g.target,
+        g.influence.unwrap_or(Influence::Neck),
+        shift,
+        offset(g.offset_angle, g.offset_direction),
+    ))
 }
 
 fn at(syncs: &[(SyncName, f64)], name: &str) -> Option<f64> {
@@ -176,7 +203,7 @@ impl Engine for GazeEngine {
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        let (target, influence, shift) = gaze(unit.behaviour)
+        let (target, influence, shift, offset) = gaze(unit.behaviour)
             .ok_or_else(|| EngineError("the gaze engine realizes gaze and gazeShift".into()))?;
         if unit.world.get(target).is_none() {
             let known: Vec<&str> = unit.world.points().map(|p| p.0).collect();
@@ -191,6 +218,7 @@ impl Engine for GazeEngine {
                 target: target.to_string(),
                 influence,
                 shift,
+                offset,
             },
         );
         Ok(())
@@ -260,7 +288,8 @@ impl Engine for GazeEngine {
             .rest
             .as_ref()
             .and_then(|(t, i)| Some((world.get(t)?, *i)));
-        let target = active.and_then(|(_, _, u, w)| Some((world.get(&u.target)?, u.influence, w)));
+        let target =
+            active.and_then(|(_, _, u, w)| Some((world.get(&u.target)?, u.influence, w, u.offset)));
         if target.is_none() && rest_aim.is_none() {
             return;
         }
@@ -275,10 +304,11 @@ impl Engine for GazeEngine {
         };
         // the body: blend of the rest aim's shares and the target's shares
         let (wb, we) = target.map_or((0.0, 0.0), |t| (t.2 .0 as f32, t.2 .1 as f32));
+        let off = target.map_or((0.0, 0.0), |t| t.3);
         let (t_yaw, t_pitch, t_influence) = match target {
-            Some((p, i, _)) => {
+            Some((p, i, _, _)) => {
                 let (y, pi) = aim_of(p);
-                (y, pi, i)
+                (y + off.0, pi + off.1, i)
             }
             None => (rest_yaw, rest_pitch, rest_influence),
         };
@@ -327,7 +357,11 @@ impl Engine for GazeEngine {
             };
             let (ry, rp) = eye_aim(rest_point);
             let (ty, tp) = if target_point.is_some() {
-                eye_aim(target_point)
+                let (y, p) = eye_aim(target_point);
+                (
+                    (y + off.0).clamp(-EYE_YAW_LIMIT.to_radians(), EYE_YAW_LIMIT.to_radians()),
+                    (p + off.1).clamp(-EYE_PITCH_LIMIT.to_radians(), EYE_PITCH_LIMIT.to_radians()),
+                )
             } else {
                 (ry, rp)
             };
