@@ -396,3 +396,57 @@ fn a_gaze_offset_looks_beside_the_target() {
         );
     }
 }
+
+// ---- gestures from the lexicon ------------------------------------------------------------
+
+#[test]
+fn a_beat_hits_its_bound_keys_at_its_syncs_and_the_left_hand_mirrors_them() {
+    use bml_realizer::engines::gesture::{mirror, Lexicon};
+    let skeleton = Skeleton::adult();
+    let lexicon = Lexicon::default_lexicon();
+    let beat = lexicon.keys("BEAT").unwrap();
+    for mode in ["RIGHT_HAND", "LEFT_HAND"] {
+        let mut r = Realizer::new();
+        let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let sink = log.clone();
+        r.add_listener(Box::new(move |f: &Feedback| {
+            sink.borrow_mut().push(f.clone())
+        }));
+        r.perform_bml(&format!(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gesture id="g" lexeme="BEAT" mode="{mode}" start="0.5" end="2"/></bml>"#
+        ))
+        .unwrap();
+        // the scheduled sync times, from the PENDING prediction
+        let predicted: Vec<(String, f64)> = log
+            .borrow()
+            .iter()
+            .find_map(|f| match f {
+                Feedback::Prediction(p) if !p.behaviours.is_empty() => {
+                    Some(p.behaviours[0].syncs.clone())
+                }
+                _ => None,
+            })
+            .unwrap();
+        for (sync, joints) in beat {
+            let t = predicted.iter().find(|s| &s.0 == sync).unwrap().1;
+            let frame = r.tick(t);
+            let pose = &frame.poses[0].pose;
+            for (joint, q) in joints {
+                let (name, q) = if mode == "LEFT_HAND" {
+                    mirror(joint, *q)
+                } else {
+                    (joint.clone(), *q)
+                };
+                let got = pose.rotations[skeleton.joint(&name).unwrap()];
+                assert!(got.angle_between(q) < 1e-5, "{mode} {sync} {name}");
+            }
+        }
+        let frame = r.tick(2.0);
+        for q in &frame.poses[0].pose.rotations {
+            assert!(
+                q.angle_between(Quat::IDENTITY) < 1e-5,
+                "{mode}: back at rest at the end"
+            );
+        }
+    }
+}

@@ -10,10 +10,12 @@
 //! - [`head`]: head nods, shakes and tilts as real motion of the neck and skull;
 //! - [`gaze`]: gaze and gaze shifts as real motion of eyes, neck and trunk toward world targets;
 //! - [`pointing`]: pointing as real arm motion (two-link IK) toward world targets;
-//! - [`keyframe`]: BMLT keyframe animations (SkeletonInterpolator), slerped between exact keys.
+//! - [`keyframe`]: BMLT keyframe animations (SkeletonInterpolator), slerped between exact keys;
+//! - [`gesture`]: gesture lexemes as arm motion from a bindings file (the default lexicon).
 
 pub mod control;
 pub mod gaze;
+pub mod gesture;
 pub mod head;
 pub mod keyframe;
 pub mod murml;
@@ -27,7 +29,6 @@ use crate::engine::{KindKey, Registry};
 
 /// Kinds the timing-only motion engine realizes (namespace, element).
 pub const MOTION_KINDS: &[(&str, &str)] = &[
-    (NS_BML, "gesture"),
     (NS_BML, "headDirectionShift"),
     (NS_BML, "posture"),
     (NS_BML, "postureShift"),
@@ -76,6 +77,10 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(keyframe::KeyframeEngine::default()),
         &keys(&[(NS_BMLT, "keyframe")]),
+    );
+    r.register(
+        Box::new(gesture::GestureEngine::default()),
+        &keys(&[(NS_BML, "gesture")]),
     );
     r.register(
         Box::new(head::HeadEngine::default()),

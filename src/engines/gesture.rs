@@ -1,0 +1,288 @@
+//! The gesture engine: `gesture` lexemes as arm motion defined by data (S77). A bindings file
+//! (`fixtures/bindings/gestures.json`, embedded as the default lexicon) gives for each lexeme the
+//! right arm's local joint rotations at some of the gesture's sync points (Z, X, Y Euler degrees).
+//! The arm is at those rotations exactly at those syncs, slerps between them, moves from where it
+//! was at `start` to the first key and back by `end`. `LEFT_HAND` mirrors the keys onto the left
+//! arm (across the body's middle plane), `BOTH_HANDS` plays both arms. A lexeme the lexicon lacks
+//! is played with its timing only.
+
+use std::collections::HashMap;
+
+use glam::{EulerRot, Quat};
+
+use crate::bml::{Behaviour, BehaviourKind, Mode};
+use crate::body::{Pose, Skeleton};
+use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::engines::timing_only::hands;
+use crate::schedule::SyncName;
+use crate::world::World;
+
+/// The embedded default lexicon.
+const DEFAULT: &str = include_str!("../../fixtures/bindings/gestures.json");
+
+/// A lexeme's keys: (sync name, [(right-arm joint, rotation)]).
+pub type GestureKeys = Vec<(String, Vec<(String, Quat)>)>;
+
+/// Gesture lexemes bound to keys.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Lexicon {
+    gestures: HashMap<String, GestureKeys>,
+}
+
+impl Lexicon {
+    /// The default lexicon (BEAT, WAVE, CONDUIT, CUP, POINT).
+    pub fn default_lexicon() -> Lexicon {
+        Lexicon::from_json(DEFAULT).expect("the embedded gesture lexicon is valid")
+    }
+
+    /// Reads a bindings file: `{"gestures": [{"lexeme": …, "keys": {SYNC: {JOINT: [z, x, y]}}}]}`.
+    pub fn from_json(text: &str) -> Result<Lexicon, String> {
+        let v: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
+        let list = v["gestures"].as_array().ok_or("no \"gestures\" list")?;
+        let mut gestures = HashMap::new();
+        for g in list {
+            let lexeme = g["lexeme"].as_str().ok_or("a gesture without \"lexeme\"")?;
+            let keys = g["keys"]
+                .as_object()
+                .ok_or_else(|| format!("{lexeme}: no \"keys\""))?;
+            let mut out: GestureKeys = Vec::new();
+            for (sync, joints) in keys {
+                let joints = joints
+                    .as_object()
+                    .ok_or_else(|| format!("{lexeme}:{sync}: joints must be an object"))?;
+                let mut rot = Vec::new();
+                for (joint, angles) in joints {
+                    let a: Vec<f32> = angles
+                        .as_array()
+                        .map(|a| {
+                            a.iter()
+                                .filter_map(|x| x.as_f64())
+                                .map(|x| x as f32)
+                                .collect()
+                        })
+                        .unwrap_or_default();
+                    if a.len() != 3 {
+                        return Err(format!("{lexeme}:{sync}:{joint}: three angles (z, x, y)"));
+                    }
+                    let q = Quat::from_euler(
+                        EulerRot::ZXY,
+                        a[0].to_radians(),
+                        a[1].to_radians(),
+                        a[2].to_radians(),
+                    );
+                    rot.push((joint.clone(), q));
+                }
+                out.push((sync.clone(), rot));
+            }
+            gestures.insert(lexeme.to_string(), out);
+        }
+        Ok(Lexicon { gestures })
+    }
+
+    /// The keys of `lexeme`.
+    pub fn keys(&self, lexeme: &str) -> Option<&GestureKeys> {
+        self.gestures.get(lexeme)
+    }
+}
+
+/// The left-arm twin of a right-arm joint and rotation (mirrored across the y-z plane).
+pub fn mirror(joint: &str, q: Quat) -> (String, Quat) {
+    let name = match joint.strip_prefix("r_") {
+        Some(rest) => format!("l_{rest}"),
+        None => joint.to_string(),
+    };
+    (name, Quat::from_xyzw(q.x, -q.y, -q.z, q.w))
+}
+
+#[derive(Debug, Clone)]
+struct GestureUnit {
+    /// (sync, [(joint, rotation)]) for the arms it moves, in sync order.
+    keys: Vec<(String, Vec<(String, Quat)>)>,
+}
+
+/// The gesture engine (see the module documentation).
+#[derive(Debug)]
+pub struct GestureEngine {
+    models: DefaultTimingModels,
+    lexicon: Lexicon,
+    units: Units<GestureUnit>,
+}
+
+impl Default for GestureEngine {
+    fn default() -> Self {
+        GestureEngine::new(Lexicon::default_lexicon())
+    }
+}
+
+impl GestureEngine {
+    /// A gesture engine with `lexicon`.
+    pub fn new(lexicon: Lexicon) -> Self {
+        GestureEngine {
+            models: DefaultTimingModels::default(),
+            lexicon,
+            units: Units::new(),
+        }
+    }
+}
+
+/// The joint rotations of a unit at `t`: slerp between the keys around `t` (rest before the
+/// first and after the last), `None` outside `start..=end`.
+fn sample(u: &GestureUnit, syncs: &[(SyncName, f64)], t: f64) -> Option<Vec<(String, Quat)>> {
+    let time = |s: &str| syncs.iter().find(|x| x.0 == s).map(|x| x.1);
+    let (start, end) = (time("start")?, time("end")?);
+    if t < start || t > end {
+        return None;
+    }
+    // the timeline: rest at start, the keys at their syncs, rest at end
+    let joints: Vec<&String> =
+        u.keys
+            .iter()
+            .flat_map(|k| k.1.iter().map(|j| &j.0))
+            .fold(Vec::new(), |mut v, j| {
+                if !v.contains(&j) {
+                    v.push(j);
+                }
+                v
+            });
+    let at = |k: &Vec<(String, Quat)>, j: &String| {
+        k.iter().find(|x| &x.0 == j).map_or(Quat::IDENTITY, |x| x.1)
+    };
+    let rest: Vec<(String, Quat)> = Vec::new();
+    let mut line: Vec<(f64, &Vec<(String, Quat)>)> = vec![(start, &rest)];
+    for (sync, k) in &u.keys {
+        if let Some(ts) = time(sync) {
+            line.push((ts, k));
+        }
+    }
+    line.push((end, &rest));
+    line.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let i = line.iter().rposition(|p| p.0 <= t).unwrap_or(0);
+    let (a, b) = (line[i], line[(i + 1).min(line.len() - 1)]);
+    let w = if b.0 > a.0 {
+        crate::engines::gaze::min_jerk((t - a.0) / (b.0 - a.0)) as f32
+    } else {
+        0.0
+    };
+    Some(
+        joints
+            .into_iter()
+            .map(|j| (j.clone(), at(a.1, j).slerp(at(b.1, j), w)))
+            .collect(),
+    )
+}
+
+impl Engine for GestureEngine {
+    fn name(&self) -> &'static str {
+        "gesture"
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        matches!(behaviour.kind, BehaviourKind::Gesture(_)).then(|| self.models.model(behaviour))?
+    }
+
+    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
+        match &behaviour.kind {
+            BehaviourKind::Gesture(g) => hands(g.mode),
+            _ => &[],
+        }
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let BehaviourKind::Gesture(g) = &unit.behaviour.kind else {
+            return Err(EngineError("the gesture engine realizes <gesture>".into()));
+        };
+        let right = self.lexicon.keys(&g.lexeme).cloned().unwrap_or_default();
+        let keys = right
+            .into_iter()
+            .map(|(sync, joints)| {
+                let arms: Vec<(String, Quat)> = match g.mode {
+                    Some(Mode::LeftHand) => joints.iter().map(|(j, q)| mirror(j, *q)).collect(),
+                    Some(Mode::BothHands) => joints
+                        .iter()
+                        .flat_map(|(j, q)| [(j.clone(), *q), mirror(j, *q)])
+                        .collect(),
+                    Some(Mode::RightHand) | None => joints,
+                };
+                (sync, arms)
+            })
+            .collect();
+        self.units.add(unit, GestureUnit { keys });
+        Ok(())
+    }
+
+    fn remove(&mut self, key: &UnitKey) {
+        self.units.remove(key);
+    }
+
+    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
+        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
+        self.units.retime(key, &times);
+    }
+
+    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+        let times = crate::engine::relax_now(now, syncs);
+        self.units.retime(key, &times);
+        times
+    }
+
+    fn len(&self) -> usize {
+        self.units.len()
+    }
+
+    fn play(&mut self, now: f64, frame: &mut Frame) {
+        for (key, progress, _) in self.units.running(now) {
+            frame.outputs.push(Output {
+                key: key.clone(),
+                engine: "gesture",
+                progress,
+                params: Vec::new(),
+            });
+        }
+    }
+
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
+        for (syncs, u) in self.units.all() {
+            let Some(rotations) = sample(u, syncs, now) else {
+                continue;
+            };
+            for (joint, q) in rotations {
+                if let Some(i) = skeleton.joint(&joint) {
+                    pose.rotate(i, q);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn the_default_lexicon_has_the_gestures_the_issue_names() {
+        let l = Lexicon::default_lexicon();
+        for lexeme in ["BEAT", "WAVE", "CONDUIT", "CUP", "POINT"] {
+            assert!(l.keys(lexeme).is_some(), "{lexeme}");
+        }
+        assert!(Lexicon::from_json(
+            r#"{"gestures": [{"lexeme": "X", "keys": {"stroke": {"r_elbow": [1, 2]}}}]}"#
+        )
+        .unwrap_err()
+        .contains("three angles"));
+    }
+
+    #[test]
+    fn mirroring_reflects_the_motion_across_the_middle_plane() {
+        let q = Quat::from_euler(EulerRot::ZXY, 0.4, 0.3, -0.5);
+        let (name, m) = mirror("r_shoulder", q);
+        assert_eq!(name, "l_shoulder");
+        // a reflected vector rotated by the mirror = the reflection of the rotated vector
+        let reflect = |v: Vec3| Vec3::new(-v.x, v.y, v.z);
+        for v in [Vec3::X, Vec3::Y, Vec3::new(0.3, -0.2, 0.9)] {
+            assert!((m * reflect(v) - reflect(q * v)).length() < 1e-5);
+        }
+    }
+}
