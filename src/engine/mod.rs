@@ -331,6 +331,11 @@ impl<T> Units<T> {
         self.units.iter().map(|(_, s, d)| (s, d))
     }
 
+    /// Every unit's sync times and data, the data mutable (engines that compile a unit lazily).
+    pub fn all_mut(&mut self) -> impl Iterator<Item = (&SyncTimes, &mut T)> + '_ {
+        self.units.iter_mut().map(|(_, s, d)| (&*s, d))
+    }
+
     /// The units running at `now` (start ≤ now < end) with their progress (0 at start, 1 at end;
     /// 0 for a unit without a finite end), in the order they were added.
     pub fn running(&self, now: f64) -> impl Iterator<Item = (&Arc<UnitKey>, f64, &T)> + '_ {

@@ -100,6 +100,74 @@ pub fn mirror(joint: &str, q: Quat) -> (String, Quat) {
 struct GestureUnit {
     /// (sync, [(joint, rotation)]) for the arms it moves, in sync order.
     keys: Vec<(String, Vec<(String, Quat)>)>,
+    /// The keys resolved against the skeleton and the unit's syncs, made on first use.
+    compiled: Option<Compiled>,
+}
+
+/// A unit's keys ready to play: the joints it moves, and per key the index of its sync and a
+/// rotation per joint (identity where the key leaves a joint out).
+#[derive(Debug, Clone)]
+struct Compiled {
+    joints: Vec<usize>,
+    keys: Vec<(usize, Vec<Quat>)>,
+}
+
+fn compile(u: &GestureUnit, skeleton: &Skeleton, syncs: &[(SyncName, f64)]) -> Compiled {
+    let mut names: Vec<&str> = Vec::new();
+    for (_, k) in &u.keys {
+        for (j, _) in k {
+            if !names.contains(&j.as_str()) && skeleton.joint(j).is_some() {
+                names.push(j);
+            }
+        }
+    }
+    let joints = names.iter().filter_map(|n| skeleton.joint(n)).collect();
+    let mut keys: Vec<(usize, Vec<Quat>)> = u
+        .keys
+        .iter()
+        .filter_map(|(sync, k)| {
+            let i = syncs.iter().position(|s| s.0 == *sync)?;
+            let rot = names
+                .iter()
+                .map(|n| k.iter().find(|x| x.0 == *n).map_or(Quat::IDENTITY, |x| x.1))
+                .collect();
+            Some((i, rot))
+        })
+        .collect();
+    keys.sort_by_key(|k| k.0);
+    Compiled { joints, keys }
+}
+
+/// Plays compiled keys at `t` into `pose`: rest at `start`, the keys at their syncs, rest at
+/// `end`, minimum-jerk slerp between neighbours. Nothing outside `start..=end`.
+fn play_keys(c: &Compiled, syncs: &[(SyncName, f64)], t: f64, pose: &mut Pose) {
+    let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1)) else {
+        return;
+    };
+    if t < start || t > end || c.keys.is_empty() {
+        return;
+    }
+    // the segment around t: (time, key index or None for rest)
+    let time = |k: usize| syncs[c.keys[k].0].1;
+    let mut before: (f64, Option<usize>) = (start, None);
+    let mut after: (f64, Option<usize>) = (end, None);
+    for k in 0..c.keys.len() {
+        if time(k) <= t {
+            before = (time(k), Some(k));
+        } else {
+            after = (time(k), Some(k));
+            break;
+        }
+    }
+    let w = if after.0 > before.0 {
+        crate::engines::gaze::min_jerk((t - before.0) / (after.0 - before.0)) as f32
+    } else {
+        0.0
+    };
+    for (j, &joint) in c.joints.iter().enumerate() {
+        let q = |k: Option<usize>| k.map_or(Quat::IDENTITY, |k| c.keys[k].1[j]);
+        pose.rotate(joint, q(before.1).slerp(q(after.1), w));
+    }
 }
 
 /// The gesture engine (see the module documentation).
@@ -125,52 +193,6 @@ impl GestureEngine {
             units: Units::new(),
         }
     }
-}
-
-/// The joint rotations of a unit at `t`: slerp between the keys around `t` (rest before the
-/// first and after the last), `None` outside `start..=end`.
-fn sample(u: &GestureUnit, syncs: &[(SyncName, f64)], t: f64) -> Option<Vec<(String, Quat)>> {
-    let time = |s: &str| syncs.iter().find(|x| x.0 == s).map(|x| x.1);
-    let (start, end) = (time("start")?, time("end")?);
-    if t < start || t > end {
-        return None;
-    }
-    // the timeline: rest at start, the keys at their syncs, rest at end
-    let joints: Vec<&String> =
-        u.keys
-            .iter()
-            .flat_map(|k| k.1.iter().map(|j| &j.0))
-            .fold(Vec::new(), |mut v, j| {
-                if !v.contains(&j) {
-                    v.push(j);
-                }
-                v
-            });
-    let at = |k: &Vec<(String, Quat)>, j: &String| {
-        k.iter().find(|x| &x.0 == j).map_or(Quat::IDENTITY, |x| x.1)
-    };
-    let rest: Vec<(String, Quat)> = Vec::new();
-    let mut line: Vec<(f64, &Vec<(String, Quat)>)> = vec![(start, &rest)];
-    for (sync, k) in &u.keys {
-        if let Some(ts) = time(sync) {
-            line.push((ts, k));
-        }
-    }
-    line.push((end, &rest));
-    line.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let i = line.iter().rposition(|p| p.0 <= t).unwrap_or(0);
-    let (a, b) = (line[i], line[(i + 1).min(line.len() - 1)]);
-    let w = if b.0 > a.0 {
-        crate::engines::gaze::min_jerk((t - a.0) / (b.0 - a.0)) as f32
-    } else {
-        0.0
-    };
-    Some(
-        joints
-            .into_iter()
-            .map(|j| (j.clone(), at(a.1, j).slerp(at(b.1, j), w)))
-            .collect(),
-    )
 }
 
 impl Engine for GestureEngine {
@@ -208,7 +230,13 @@ impl Engine for GestureEngine {
                 (sync, arms)
             })
             .collect();
-        self.units.add(unit, GestureUnit { keys });
+        self.units.add(
+            unit,
+            GestureUnit {
+                keys,
+                compiled: None,
+            },
+        );
         Ok(())
     }
 
@@ -243,14 +271,12 @@ impl Engine for GestureEngine {
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
-        for (syncs, u) in self.units.all() {
-            let Some(rotations) = sample(u, syncs, now) else {
-                continue;
-            };
-            for (joint, q) in rotations {
-                if let Some(i) = skeleton.joint(&joint) {
-                    pose.rotate(i, q);
-                }
+        for (syncs, u) in self.units.all_mut() {
+            if u.compiled.is_none() {
+                u.compiled = Some(compile(u, skeleton, syncs));
+            }
+            if let Some(c) = &u.compiled {
+                play_keys(c, syncs, now, pose);
             }
         }
     }
