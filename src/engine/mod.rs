@@ -354,6 +354,84 @@ impl<T> Units<T> {
     }
 }
 
+/// `Engine::retime` and `Engine::len` for an engine that keeps its units in `self.units`
+/// ([`Units`]).
+#[macro_export]
+macro_rules! units_retime_len {
+    () => {
+        fn retime(
+            &mut self,
+            key: &$crate::engine::UnitKey,
+            syncs: &[($crate::schedule::SyncName, f64)],
+        ) {
+            let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
+            self.units.retime(key, &times);
+        }
+
+        fn len(&self) -> usize {
+            self.units.len()
+        }
+    };
+}
+
+/// `Engine::remove` for an engine that keeps its units in `self.units`.
+#[macro_export]
+macro_rules! units_remove {
+    () => {
+        fn remove(&mut self, key: &$crate::engine::UnitKey) {
+            self.units.remove(key);
+        }
+    };
+}
+
+/// `Engine::play` showing each running unit's progress under the engine name `$name` (or, with
+/// `field f`, the name in the engine's field `f`).
+#[macro_export]
+macro_rules! units_play {
+    (field $f:ident) => {
+        fn play(&mut self, now: f64, frame: &mut $crate::engine::Frame) {
+            for (key, progress, _) in self.units.running(now) {
+                frame.outputs.push($crate::engine::Output {
+                    key: key.clone(),
+                    engine: self.$f,
+                    progress,
+                    params: Vec::new(),
+                });
+            }
+        }
+    };
+    ($name:expr) => {
+        fn play(&mut self, now: f64, frame: &mut $crate::engine::Frame) {
+            for (key, progress, _) in self.units.running(now) {
+                frame.outputs.push($crate::engine::Output {
+                    key: key.clone(),
+                    engine: $name,
+                    progress,
+                    params: Vec::new(),
+                });
+            }
+        }
+    };
+}
+
+/// `Engine::interrupt` with the timing `$how` ([`relax_now`] or [`stop_now`]), keeping the
+/// engine's own copy of the unit's times.
+#[macro_export]
+macro_rules! units_interrupt {
+    ($how:path) => {
+        fn interrupt(
+            &mut self,
+            key: &$crate::engine::UnitKey,
+            now: f64,
+            syncs: &[($crate::schedule::SyncName, f64)],
+        ) -> Vec<f64> {
+            let times = $how(now, syncs);
+            self.units.retime(key, &times);
+            times
+        }
+    };
+}
+
 /// Graceful interruption timing (see [`Engine::interrupt`]).
 pub fn relax_now(now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
     let relax = syncs

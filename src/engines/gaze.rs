@@ -24,7 +24,7 @@ use glam::{Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::engine::{Engine, EngineError, Unit, UnitKey, Units};
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -185,6 +185,10 @@ impl GazeEngine {
 }
 
 impl Engine for GazeEngine {
+    crate::units_retime_len!();
+    crate::units_play!("gaze");
+    crate::units_interrupt!(crate::engine::relax_now);
+
     fn name(&self) -> &'static str {
         "gaze"
     }
@@ -232,32 +236,6 @@ impl Engine for GazeEngine {
             }
         }
         self.units.remove(key);
-    }
-
-    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = crate::engine::relax_now(now, syncs);
-        self.units.retime(key, &times);
-        times
-    }
-
-    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
-        self.units.retime(key, &times);
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
-    }
-
-    fn play(&mut self, now: f64, frame: &mut Frame) {
-        for (key, progress, _) in self.units.running(now) {
-            frame.outputs.push(Output {
-                key: key.clone(),
-                engine: "gaze",
-                progress,
-                params: Vec::new(),
-            });
-        }
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {

@@ -13,7 +13,7 @@ use glam::{EulerRot, Quat};
 use crate::bml::{Behaviour, BehaviourKind, Mode};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::engine::{Engine, EngineError, Unit, Units};
 use crate::engines::timing_only::hands;
 use crate::schedule::SyncName;
 use crate::world::World;
@@ -196,6 +196,11 @@ impl GestureEngine {
 }
 
 impl Engine for GestureEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!("gesture");
+    crate::units_interrupt!(crate::engine::relax_now);
+
     fn name(&self) -> &'static str {
         "gesture"
     }
@@ -238,36 +243,6 @@ impl Engine for GestureEngine {
             },
         );
         Ok(())
-    }
-
-    fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
-    }
-
-    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
-        self.units.retime(key, &times);
-    }
-
-    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = crate::engine::relax_now(now, syncs);
-        self.units.retime(key, &times);
-        times
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
-    }
-
-    fn play(&mut self, now: f64, frame: &mut Frame) {
-        for (key, progress, _) in self.units.running(now) {
-            frame.outputs.push(Output {
-                key: key.clone(),
-                engine: "gesture",
-                progress,
-                params: Vec::new(),
-            });
-        }
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {

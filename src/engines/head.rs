@@ -11,7 +11,7 @@ use glam::{Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::engine::{Engine, EngineError, Unit, Units};
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -130,6 +130,11 @@ fn head(b: &Behaviour) -> Option<(Option<Motion>, f64, u32)> {
 }
 
 impl Engine for HeadEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!("head");
+    crate::units_interrupt!(crate::engine::relax_now);
+
     fn name(&self) -> &'static str {
         "head"
     }
@@ -155,36 +160,6 @@ impl Engine for HeadEngine {
             },
         );
         Ok(())
-    }
-
-    fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
-    }
-
-    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = crate::engine::relax_now(now, syncs);
-        self.units.retime(key, &times);
-        times
-    }
-
-    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
-        self.units.retime(key, &times);
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
-    }
-
-    fn play(&mut self, now: f64, frame: &mut Frame) {
-        for (key, progress, _) in self.units.running(now) {
-            frame.outputs.push(Output {
-                key: key.clone(),
-                engine: "head",
-                progress,
-                params: Vec::new(),
-            });
-        }
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {

@@ -23,8 +23,7 @@ use quick_xml::Reader;
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
-use crate::schedule::SyncName;
+use crate::engine::{Engine, EngineError, Unit, Units};
 use crate::world::World;
 
 /// Keys read from a `<SkeletonInterpolator>`.
@@ -171,6 +170,11 @@ pub struct KeyframeEngine {
 }
 
 impl Engine for KeyframeEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!("keyframe");
+    crate::units_interrupt!(crate::engine::stop_now);
+
     fn name(&self) -> &'static str {
         "keyframe"
     }
@@ -204,36 +208,6 @@ impl Engine for KeyframeEngine {
         let keys = read_keys(c).map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
         self.units.add(unit, KeyframeUnit { keys });
         Ok(())
-    }
-
-    fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
-    }
-
-    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = crate::engine::stop_now(now, syncs);
-        self.units.retime(key, &times);
-        times
-    }
-
-    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
-        self.units.retime(key, &times);
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
-    }
-
-    fn play(&mut self, now: f64, frame: &mut Frame) {
-        for (key, progress, _) in self.units.running(now) {
-            frame.outputs.push(Output {
-                key: key.clone(),
-                engine: "keyframe",
-                progress,
-                params: Vec::new(),
-            });
-        }
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {

@@ -10,8 +10,7 @@ use quick_xml::Reader;
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
-use crate::schedule::SyncName;
+use crate::engine::{Engine, EngineError, Unit, Units};
 
 /// The MURML namespace.
 pub const NS_MURML: &str = "http://www.techfak.uni-bielefeld.de/ags/soa/murml";
@@ -83,6 +82,11 @@ pub struct MurmlEngine {
 }
 
 impl Engine for MurmlEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!("murml");
+    crate::units_interrupt!(crate::engine::relax_now);
+
     fn name(&self) -> &'static str {
         "murml"
     }
@@ -122,36 +126,6 @@ impl Engine for MurmlEngine {
         duration(content).map_err(EngineError)?;
         self.units.add(unit, ());
         Ok(())
-    }
-
-    fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
-    }
-
-    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = crate::engine::relax_now(now, syncs);
-        self.units.retime(key, &times);
-        times
-    }
-
-    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
-        self.units.retime(key, &times);
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
-    }
-
-    fn play(&mut self, now: f64, frame: &mut Frame) {
-        for (key, progress, _) in self.units.running(now) {
-            frame.outputs.push(Output {
-                key: key.clone(),
-                engine: "murml",
-                progress,
-                params: Vec::new(),
-            });
-        }
     }
 }
 

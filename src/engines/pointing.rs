@@ -12,7 +12,7 @@ use crate::bml::{Behaviour, BehaviourKind, Mode};
 use crate::body::ik::two_link;
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::engine::{Engine, EngineError, Unit, Units};
 use crate::engines::gaze::min_jerk;
 use crate::engines::timing_only::hands;
 use crate::schedule::SyncName;
@@ -113,6 +113,11 @@ fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32)
 }
 
 impl Engine for PointingEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!("pointing");
+    crate::units_interrupt!(crate::engine::relax_now);
+
     fn name(&self) -> &'static str {
         "pointing"
     }
@@ -146,36 +151,6 @@ impl Engine for PointingEngine {
         let mode = p.mode;
         self.units.add(unit, PointingUnit { target, mode });
         Ok(())
-    }
-
-    fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
-    }
-
-    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = crate::engine::relax_now(now, syncs);
-        self.units.retime(key, &times);
-        times
-    }
-
-    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
-        self.units.retime(key, &times);
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
-    }
-
-    fn play(&mut self, now: f64, frame: &mut Frame) {
-        for (key, progress, _) in self.units.running(now) {
-            frame.outputs.push(Output {
-                key: key.clone(),
-                engine: "pointing",
-                progress,
-                params: Vec::new(),
-            });
-        }
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {

@@ -12,8 +12,7 @@
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::engine::timing::SyncKey;
 use crate::engine::timing::{SpeechTiming, TimingModel, TimingModels};
-use crate::engine::{stop_now, Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
-use crate::schedule::SyncName;
+use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
 
 /// Volume of a speech that no one changed.
 pub const DEFAULT_VOLUME: f64 = 100.0;
@@ -55,6 +54,10 @@ impl SpeechEngine {
 }
 
 impl Engine for SpeechEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_interrupt!(crate::engine::stop_now);
+
     fn name(&self) -> &'static str {
         "speech"
     }
@@ -105,25 +108,6 @@ impl Engine for SpeechEngine {
             },
         );
         Ok(())
-    }
-
-    fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
-    }
-
-    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = stop_now(now, syncs);
-        self.units.retime(key, &times);
-        times
-    }
-
-    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
-        self.units.retime(key, &times);
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
     }
 
     fn play(&mut self, now: f64, frame: &mut Frame) {

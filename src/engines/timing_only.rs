@@ -7,9 +7,7 @@
 
 use crate::bml::{Behaviour, BehaviourKind, Mode};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{
-    relax_now, stop_now, Engine, EngineError, Frame, Output, Unit, UnitKey, Units,
-};
+use crate::engine::{relax_now, stop_now, Engine, EngineError, Unit, UnitKey, Units};
 use crate::schedule::SyncName;
 
 /// The timing-only engine (see the module documentation).
@@ -44,6 +42,10 @@ impl TimingOnlyEngine {
 }
 
 impl Engine for TimingOnlyEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!(field name);
+
     fn name(&self) -> &'static str {
         self.name
     }
@@ -84,10 +86,6 @@ impl Engine for TimingOnlyEngine {
         Ok(())
     }
 
-    fn remove(&mut self, key: &UnitKey) {
-        self.units.remove(key);
-    }
-
     fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
         let times = if self.stop_on_interrupt {
             stop_now(now, syncs)
@@ -96,26 +94,6 @@ impl Engine for TimingOnlyEngine {
         };
         self.units.retime(key, &times);
         times
-    }
-
-    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
-        let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
-        self.units.retime(key, &times);
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
-    }
-
-    fn play(&mut self, now: f64, frame: &mut Frame) {
-        for (key, progress, _) in self.units.running(now) {
-            frame.outputs.push(Output {
-                key: key.clone(),
-                engine: self.name,
-                progress,
-                params: Vec::new(),
-            });
-        }
     }
 }
 
