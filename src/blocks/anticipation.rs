@@ -138,35 +138,23 @@ impl BlockManager {
             }
             if matches!(x.phase, Phase::Added | Phase::Running) {
                 let key = UnitKey::new(&block_id, &x.id);
-                let syncs: Vec<_> = x
-                    .syncs
-                    .iter()
-                    .map(|(n, l)| (n.clone(), start + l))
-                    .collect();
-                self.registry.engine_mut(x.engine).retime(&key, &syncs);
+                self.registry
+                    .engine_mut(x.engine)
+                    .retime(&key, &x.global(start));
             }
         }
         for xi in dropped {
-            let x = &mut self.blocks[i].behaviours[xi];
-            let key = UnitKey::new(&block_id, &x.id);
+            let x = &self.blocks[i].behaviours[xi];
             let behaviour = x.id.clone();
             let running = x.phase == Phase::Running;
             if running {
-                let global: Vec<_> = x
-                    .syncs
-                    .iter()
-                    .map(|(n, l)| (n.clone(), start + l))
-                    .collect();
-                let times = self
-                    .registry
-                    .engine_mut(x.engine)
-                    .interrupt(&key, t, &global);
-                x.retime(&times, start, t);
+                self.interrupt_unit(i, xi, t);
             } else {
                 if x.phase == Phase::Added {
+                    let key = UnitKey::new(&block_id, &x.id);
                     self.registry.engine_mut(x.engine).remove(&key);
                 }
-                x.phase = Phase::Removed;
+                self.blocks[i].behaviours[xi].phase = Phase::Removed;
             }
             self.warn(
                 format!("{block_id}:{behaviour}"),

@@ -41,6 +41,14 @@ pub(crate) struct LiveBehaviour {
 }
 
 impl LiveBehaviour {
+    /// (sync, global time) for a block that starts at `start`.
+    pub(crate) fn global(&self, start: f64) -> Vec<(SyncName, f64)> {
+        self.syncs
+            .iter()
+            .map(|(n, l)| (n.clone(), start + l))
+            .collect()
+    }
+
     /// Block-local time of `sync`.
     pub(crate) fn time(&self, sync: &str) -> Option<f64> {
         self.syncs.iter().find(|(n, _)| n == sync).map(|s| s.1)

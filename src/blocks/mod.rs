@@ -632,7 +632,7 @@ impl BlockManager {
                 .filter(|x| x.phase == Phase::Planned)
             {
                 let key = UnitKey::new(&b.id, &x.id);
-                let global: Vec<_> = x.syncs.iter().map(|(n, l)| (n.clone(), t + l)).collect();
+                let global = x.global(t);
                 let unit = Unit {
                     key: &key,
                     behaviour: &b.source.behaviours[x.index],
@@ -690,8 +690,6 @@ impl BlockManager {
         }
         for target in self.blocks[i].chunk_after.clone() {
             let Some(j) = self.pos(&target) else { continue };
-            let start = self.blocks[j].start;
-            let block_id = self.blocks[j].id.clone();
             for xi in 0..self.blocks[j].behaviours.len() {
                 let x = &self.blocks[j].behaviours[xi];
                 let relax = x.syncs.iter().position(|(n, _)| n == "relax");
@@ -706,15 +704,7 @@ impl BlockManager {
                 if !(retracting && shares) {
                     continue;
                 }
-                let key = UnitKey::new(&block_id, &x.id);
-                let global: Vec<_> = x
-                    .syncs
-                    .iter()
-                    .map(|(n, l)| (n.clone(), start + l))
-                    .collect();
-                let engine = x.engine;
-                let times = self.registry.engine_mut(engine).interrupt(&key, t, &global);
-                self.blocks[j].behaviours[xi].retime(&times, start, t);
+                self.interrupt_unit(j, xi, t);
             }
         }
     }
@@ -817,6 +807,19 @@ impl BlockManager {
         self.end_block(i, t, BlockStatus::Interrupted);
     }
 
+    /// Ends running behaviour `xi` of block `bi` at `t` the way its engine ends interrupted units
+    /// (speech stops, motion retracts from now); its remaining syncs take the engine's times.
+    fn interrupt_unit(&mut self, bi: usize, xi: usize, t: f64) {
+        let b = &self.blocks[bi];
+        let (start, x) = (b.start, &b.behaviours[xi]);
+        let key = UnitKey::new(&b.id, &x.id);
+        let times = self
+            .registry
+            .engine_mut(x.engine)
+            .interrupt(&key, t, &x.global(start));
+        self.blocks[bi].behaviours[xi].retime(&times, start, t);
+    }
+
     /// Interrupts behaviours of block `target` at `t` (a BMLA interrupt behaviour): a behaviour
     /// not yet started leaves the plan; a running one ends the way its engine says (speech stops,
     /// motion retracts from now).
@@ -847,33 +850,21 @@ impl BlockManager {
                 );
             }
         }
-        let b = &mut self.blocks[i];
-        let start = b.start;
-        for x in &mut b.behaviours {
+        for xi in 0..self.blocks[i].behaviours.len() {
+            let x = &self.blocks[i].behaviours[xi];
             let selected =
                 (include.is_empty() || include.contains(&x.id)) && !exclude.contains(&x.id);
             if !selected {
                 continue;
             }
-            let key = UnitKey::new(&b.id, &x.id);
             match x.phase {
-                Phase::Planned => x.phase = Phase::Removed,
+                Phase::Planned => self.blocks[i].behaviours[xi].phase = Phase::Removed,
                 Phase::Added => {
+                    let key = UnitKey::new(&self.blocks[i].id, &x.id);
                     self.registry.engine_mut(x.engine).remove(&key);
-                    x.phase = Phase::Removed;
+                    self.blocks[i].behaviours[xi].phase = Phase::Removed;
                 }
-                Phase::Running => {
-                    let global: Vec<_> = x
-                        .syncs
-                        .iter()
-                        .map(|(n, l)| (n.clone(), start + l))
-                        .collect();
-                    let times = self
-                        .registry
-                        .engine_mut(x.engine)
-                        .interrupt(&key, t, &global);
-                    x.retime(&times, start, t);
-                }
+                Phase::Running => self.interrupt_unit(i, xi, t),
                 Phase::Ended | Phase::Removed => {}
             }
         }
