@@ -771,18 +771,25 @@ impl BlockManager {
     // ---------------------------------------------------------------------------------------
     // interruption (S32, S33)
 
+    /// The live block `target` of an interrupt by `by`. A block that finished a moment ago is a
+    /// quiet no-op; one that never existed gets a NO_SUCH_TARGET warning.
+    fn interrupt_target(&mut self, target: &str, by: &str) -> Option<usize> {
+        let i = self.pos(target);
+        if i.is_none() && !self.finished_set.contains(target) {
+            self.warn(
+                by.to_string(),
+                KnownWarning::NoSuchTarget,
+                format!("cannot interrupt block '{target}': no such block"),
+            );
+        }
+        i
+    }
+
     /// Interrupts a whole block: before its start it is revoked; while running, every behaviour
     /// that started reports its remaining syncs now, the others are dropped, and it ends
     /// INTERRUPTED.
     fn interrupt_block_by_id(&mut self, target: &str, t: f64, by: &str) {
-        let Some(i) = self.pos(target) else {
-            if !self.finished_set.contains(target) {
-                self.warn(
-                    by.to_string(),
-                    KnownWarning::NoSuchTarget,
-                    format!("cannot interrupt block '{target}': no such block"),
-                );
-            }
+        let Some(i) = self.interrupt_target(target, by) else {
             return;
         };
         if !self.blocks[i].started() {
@@ -831,14 +838,7 @@ impl BlockManager {
         exclude: &[String],
         t: f64,
     ) {
-        let Some(i) = self.pos(target) else {
-            if !self.finished_set.contains(target) {
-                self.warn(
-                    by.to_string(),
-                    KnownWarning::NoSuchTarget,
-                    format!("cannot interrupt block '{target}': no such block"),
-                );
-            }
+        let Some(i) = self.interrupt_target(target, by) else {
             return;
         };
         for id in include.iter().chain(exclude) {
