@@ -838,7 +838,7 @@ impl BlockManager {
         exclude: &[String],
         t: f64,
     ) {
-        let Some(i) = self.interrupt_target(target, by) else {
+        let Some(i) = self.interrupt_target(target, &by.to_string()) else {
             return;
         };
         for id in include.iter().chain(exclude) {
