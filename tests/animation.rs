@@ -450,3 +450,58 @@ fn a_beat_hits_its_bound_keys_at_its_syncs_and_the_left_hand_mirrors_them() {
         }
     }
 }
+
+// ---- posture ------------------------------------------------------------------------------
+
+#[test]
+fn a_sitting_shift_folds_the_legs_and_stays_a_posture_returns() {
+    let skeleton = Skeleton::adult();
+    let (knee, hip) = (
+        skeleton.joint("l_knee").unwrap(),
+        skeleton.joint("l_hip").unwrap(),
+    );
+    let mut r = Realizer::new();
+    r.perform_bml(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><postureShift id="sit" start="0" end="2"><stance type="SITTING"/></postureShift></bml>"#,
+    )
+    .unwrap();
+    let rest_height = Skeleton::adult().joints()[0].offset.y;
+    let mid = r.tick(1.0);
+    let half = mid.poses[0].pose.root.y;
+    assert!(
+        half < rest_height && half > rest_height - 0.45,
+        "half way down: {half}"
+    );
+    let frame = r.tick(10.0);
+    let pose = &frame.poses[0].pose;
+    assert!(
+        (pose.root.y - (rest_height - 0.45)).abs() < 1e-5,
+        "seated: {}",
+        pose.root.y
+    );
+    let knee_deg = pose.rotations[knee]
+        .angle_between(Quat::IDENTITY)
+        .to_degrees();
+    let hip_deg = pose.rotations[hip]
+        .angle_between(Quat::IDENTITY)
+        .to_degrees();
+    assert!(
+        (knee_deg - 90.0).abs() < 0.5 && (hip_deg - 90.0).abs() < 0.5,
+        "{knee_deg} {hip_deg}"
+    );
+    // a posture (not a shift) goes back to the rest stance — now seated — by its end
+    r.perform_bml(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><posture id="up" start="0" ready="1" relax="2" end="3"><stance type="STANDING"/></posture></bml>"#,
+    )
+    .unwrap();
+    let standing = r.tick(11.5);
+    assert!(
+        (standing.poses[0].pose.root.y - rest_height).abs() < 1e-5,
+        "stood up"
+    );
+    let back = r.tick(13.5);
+    assert!(
+        (back.poses[0].pose.root.y - (rest_height - 0.45)).abs() < 1e-5,
+        "seated again"
+    );
+}

@@ -11,7 +11,8 @@
 //! - [`gaze`]: gaze and gaze shifts as real motion of eyes, neck and trunk toward world targets;
 //! - [`pointing`]: pointing as real arm motion (two-link IK) toward world targets;
 //! - [`keyframe`]: BMLT keyframe animations (SkeletonInterpolator), slerped between exact keys;
-//! - [`gesture`]: gesture lexemes as arm motion from a bindings file (the default lexicon).
+//! - [`gesture`]: gesture lexemes as arm motion from a bindings file (the default lexicon);
+//! - [`posture`]: posture stances (standing, sitting, crouching, lying) as leg and root motion.
 
 pub mod control;
 pub mod gaze;
@@ -20,6 +21,7 @@ pub mod head;
 pub mod keyframe;
 pub mod murml;
 pub mod pointing;
+pub mod posture;
 pub mod speech;
 pub mod timing_only;
 
@@ -30,8 +32,6 @@ use crate::engine::{KindKey, Registry};
 /// Kinds the timing-only motion engine realizes (namespace, element).
 pub const MOTION_KINDS: &[(&str, &str)] = &[
     (NS_BML, "headDirectionShift"),
-    (NS_BML, "posture"),
-    (NS_BML, "postureShift"),
     (NS_BML, "face"),
     (NS_BML, "faceLexeme"),
     (NS_BML, "faceShift"),
@@ -77,6 +77,10 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(keyframe::KeyframeEngine::default()),
         &keys(&[(NS_BMLT, "keyframe")]),
+    );
+    r.register(
+        Box::new(posture::PostureEngine::default()),
+        &keys(&[(NS_BML, "posture"), (NS_BML, "postureShift")]),
     );
     r.register(
         Box::new(gesture::GestureEngine::default()),

@@ -1,5 +1,5 @@
 //! The timing-only engine: realizes the BML kinds whose animation engine has not landed yet
-//! (gesture, pointing, head, gaze, posture, face, locomotion, BMLT animation kinds) and BMLT audio.
+//! (face, locomotion, the shifts of head and face, BMLT animation kinds) and BMLT audio.
 //! It takes the default timing models, plays units exactly at their scheduled sync times and lets
 //! the runtime report every sync point; the frame shows each unit's progress. Motion interrupted
 //! goes to `relax` at once and keeps its retraction; audio stops at once. It moves no joints: the
@@ -60,14 +60,6 @@ impl Engine for TimingOnlyEngine {
             | BehaviourKind::Activate(_)
             | BehaviourKind::ParameterValueChange(_) => None,
             _ => self.models.model(behaviour),
-        }
-    }
-
-    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&'static str> {
-        match behaviour.kind {
-            BehaviourKind::Gaze(_) => Some("gaze"),
-            BehaviourKind::Posture(_) => Some("posture"),
-            _ => None,
         }
     }
 
