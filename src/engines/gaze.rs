@@ -12,7 +12,7 @@
 //! - Timing: from `start` to `ready` the aim moves from the rest aim to the target along a
 //!   minimum-jerk profile (single-peaked velocity; the eyes arrive in the first half), it holds
 //!   until `relax`, then returns to the rest aim by `end`. A `gazeShift` moves over its whole span
-//!   and makes its target the new rest aim, kept after it ends.
+//!   and makes its target the new rest aim, kept after it ends (`engines::motion`).
 //! - Of several gazes running at once the one that started last wins (R33).
 //! - `offsetAngle` in `offsetDirection` turns the aim away from the target (LEFT, RIGHT, UP, DOWN
 //!   and the diagonals; POLAR gives no offset).
@@ -24,7 +24,8 @@ use glam::{Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Unit, UnitKey, Units};
+use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engines::motion::{at, envelope, finished_shift};
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -57,12 +58,6 @@ fn shares(influence: Influence) -> &'static [(&'static str, f32, f32)] {
             ("skullbase", 0.2, 0.35),
         ],
     }
-}
-
-/// Minimum-jerk profile: 0 at 0, 1 at 1, zero velocity and acceleration at both ends.
-pub fn min_jerk(u: f64) -> f64 {
-    let u = u.clamp(0.0, 1.0);
-    u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
 }
 
 /// A yaw-then-pitch rotation (no torsion).
@@ -130,42 +125,13 @@ fn gaze(b: &Behaviour) -> Option<(&str, Influence, bool, (f32, f32))> {
     ))
 }
 
-fn at(syncs: &[(SyncName, f64)], name: &str) -> Option<f64> {
-    syncs.iter().find(|s| s.0 == name).map(|s| s.1)
-}
-
-/// How far a unit has turned toward its target at `t` (0..1), for the body and for the eyes.
+/// How far a unit has turned toward its target at `t` (0..1), for the body and for the eyes
+/// (they lead: they arrive half way through the shift).
 fn weights(u: &GazeUnit, syncs: &[(SyncName, f64)], t: f64) -> Option<(f64, f64)> {
-    let start = at(syncs, "start")?;
-    let end = at(syncs, "end")?;
-    if t < start || t >= end {
-        return None;
-    }
-    let (ready, relax) = if u.shift {
-        (end, f64::INFINITY)
-    } else {
-        (at(syncs, "ready")?, at(syncs, "relax")?)
-    };
-    let rise = |span: f64, k: f64| {
-        if span > 0.0 {
-            min_jerk(((t - start) / span * k).min(1.0))
-        } else {
-            1.0
-        }
-    };
-    if t < ready {
-        // the eyes lead: they arrive half way through the shift
-        return Some((rise(ready - start, 1.0), rise(ready - start, 2.0)));
-    }
-    if t < relax {
-        return Some((1.0, 1.0));
-    }
-    let back = if end > relax {
-        1.0 - min_jerk((t - relax) / (end - relax))
-    } else {
-        0.0
-    };
-    Some((back, back))
+    Some((
+        envelope(syncs, t, u.shift, 1.0)?,
+        envelope(syncs, t, u.shift, 0.5)?,
+    ))
 }
 
 impl GazeEngine {
@@ -185,6 +151,7 @@ impl GazeEngine {
 }
 
 impl Engine for GazeEngine {
+    crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("gaze");
     crate::units_interrupt!(crate::engine::relax_now);
@@ -228,30 +195,10 @@ impl Engine for GazeEngine {
         Ok(())
     }
 
-    fn remove(&mut self, key: &UnitKey) {
-        // a shift that ran leaves its target as the new rest aim
-        if let Some(u) = self.units.get(key) {
-            if u.shift {
-                self.rest = Some((u.target.clone(), u.influence));
-            }
-        }
-        self.units.remove(key);
-    }
-
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
         // a shift that has reached its end is the rest aim from then on
-        let done = self
-            .units
-            .all()
-            .filter(|(syncs, u)| u.shift && at(syncs, "end").is_some_and(|e| e <= now))
-            .max_by(|a, b| {
-                let end =
-                    |x: &(&crate::engine::SyncTimes, &GazeUnit)| at(x.0, "end").unwrap_or(0.0);
-                end(a).total_cmp(&end(b))
-            })
-            .map(|(_, u)| (u.target.clone(), u.influence));
-        if done.is_some() {
-            self.rest = done;
+        if let Some(u) = finished_shift(&self.units, now, |u| u.shift) {
+            self.rest = Some((u.target.clone(), u.influence));
         }
         // the gaze that started last wins (R33); ties go to the one that ends first
         let active = self
@@ -353,15 +300,6 @@ impl Engine for GazeEngine {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn minimum_jerk_starts_and_ends_at_rest() {
-        assert_eq!(min_jerk(0.0), 0.0);
-        assert_eq!(min_jerk(1.0), 1.0);
-        assert!((min_jerk(0.5) - 0.5).abs() < 1e-12);
-        let v = |u: f64| (min_jerk(u + 1e-6) - min_jerk(u)) / 1e-6;
-        assert!(v(0.0) < 1e-4 && v(0.999_998) < 1e-3 && v(0.5) > 1.8);
-    }
 
     #[test]
     fn yaw_is_toward_the_left_and_pitch_down() {

@@ -14,7 +14,7 @@ use crate::bml::{Behaviour, BehaviourKind, Mode};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Unit, Units};
-use crate::engines::timing_only::hands;
+use crate::engines::motion::{hands, min_jerk};
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -160,7 +160,7 @@ fn play_keys(c: &Compiled, syncs: &[(SyncName, f64)], t: f64, pose: &mut Pose) {
         }
     }
     let w = if after.0 > before.0 {
-        crate::engines::gaze::min_jerk((t - before.0) / (after.0 - before.0)) as f32
+        min_jerk((t - before.0) / (after.0 - before.0)) as f32
     } else {
         0.0
     };

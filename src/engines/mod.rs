@@ -19,6 +19,7 @@ pub mod gaze;
 pub mod gesture;
 pub mod head;
 pub mod keyframe;
+pub mod motion;
 pub mod murml;
 pub mod pointing;
 pub mod posture;

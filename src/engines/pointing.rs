@@ -13,9 +13,7 @@ use crate::body::ik::two_link;
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Unit, Units};
-use crate::engines::gaze::min_jerk;
-use crate::engines::timing_only::hands;
-use crate::schedule::SyncName;
+use crate::engines::motion::{envelope, hands};
 use crate::world::World;
 
 /// How far along its reach the wrist goes.
@@ -32,31 +30,6 @@ struct PointingUnit {
 pub struct PointingEngine {
     models: DefaultTimingModels,
     units: Units<PointingUnit>,
-}
-
-fn at(syncs: &[(SyncName, f64)], name: &str) -> Option<f64> {
-    syncs.iter().find(|s| s.0 == name).map(|s| s.1)
-}
-
-/// How far the arm is toward the pointing pose at `t` (0..1).
-fn weight(syncs: &[(SyncName, f64)], t: f64) -> Option<f32> {
-    let (start, ready, relax, end) = (
-        at(syncs, "start")?,
-        at(syncs, "ready")?,
-        at(syncs, "relax")?,
-        at(syncs, "end")?,
-    );
-    if t < start || t >= end {
-        return None;
-    }
-    let w = if t < ready {
-        min_jerk((t - start) / (ready - start).max(1e-9))
-    } else if t < relax {
-        1.0
-    } else {
-        1.0 - min_jerk((t - relax) / (end - relax).max(1e-9))
-    };
-    Some(w as f32)
 }
 
 /// The rotation taking direction `from` to direction `to` (shortest arc).
@@ -155,7 +128,10 @@ impl Engine for PointingEngine {
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
         for (syncs, u) in self.units.all() {
-            let (Some(w), Some(target)) = (weight(syncs, now), world.get(&u.target)) else {
+            let (Some(w), Some(target)) = (
+                envelope(syncs, now, false, 1.0).map(|w| w as f32),
+                world.get(&u.target),
+            ) else {
                 continue;
             };
             let sides: &[&str] = match u.mode {

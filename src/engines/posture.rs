@@ -12,9 +12,8 @@ use glam::{Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind, StanceType};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Unit, UnitKey, Units};
-use crate::engines::gaze::min_jerk;
-use crate::schedule::SyncName;
+use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engines::motion::{at, envelope, finished_shift};
 use crate::world::World;
 
 /// A stance: pitch of the hips and knees and ankles (degrees, about +x), and the root's drop
@@ -73,31 +72,6 @@ fn posture(b: &Behaviour) -> Option<(StanceType, bool)> {
     }
 }
 
-fn at(syncs: &[(SyncName, f64)], name: &str) -> Option<f64> {
-    syncs.iter().find(|s| s.0 == name).map(|s| s.1)
-}
-
-/// How far a unit is toward its stance at `t` (0..1), `None` outside `start..end`.
-fn weight(u: &PostureUnit, syncs: &[(SyncName, f64)], t: f64) -> Option<f32> {
-    let (start, end) = (at(syncs, "start")?, at(syncs, "end")?);
-    if t < start || t >= end {
-        return None;
-    }
-    let (ready, relax) = if u.shift {
-        (end, f64::INFINITY)
-    } else {
-        (at(syncs, "ready")?, at(syncs, "relax")?)
-    };
-    let w = if t < ready {
-        min_jerk((t - start) / (ready - start).max(1e-9))
-    } else if t < relax {
-        1.0
-    } else {
-        1.0 - min_jerk((t - relax) / (end - relax).max(1e-9))
-    };
-    Some(w as f32)
-}
-
 /// Puts `s` into `pose` (legs and root).
 fn apply(skeleton: &Skeleton, pose: &mut Pose, s: Stance) {
     for side in ["l", "r"] {
@@ -124,6 +98,7 @@ fn blend(a: Stance, b: Stance, w: f32) -> Stance {
 }
 
 impl Engine for PostureEngine {
+    crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("posture");
     crate::units_interrupt!(crate::engine::relax_now);
@@ -153,27 +128,19 @@ impl Engine for PostureEngine {
         Ok(())
     }
 
-    fn remove(&mut self, key: &UnitKey) {
-        if let Some(u) = self.units.get(key) {
-            if u.shift {
-                self.rest = Some(u.stance);
-            }
-        }
-        self.units.remove(key);
-    }
-
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         // a shift that reached its end is the rest stance from then on
-        for (syncs, u) in self.units.all() {
-            if u.shift && at(syncs, "end").is_some_and(|e| e <= now) {
-                self.rest = Some(u.stance);
-            }
+        if let Some(u) = finished_shift(&self.units, now, |u| u.shift) {
+            self.rest = Some(u.stance);
         }
         let rest = stance(self.rest.unwrap_or(StanceType::Standing));
         let active = self
             .units
             .all()
-            .filter_map(|(syncs, u)| Some((at(syncs, "start")?, weight(u, syncs, now)?, u)))
+            .filter_map(|(syncs, u)| {
+                let w = envelope(syncs, now, u.shift, 1.0)? as f32;
+                Some((at(syncs, "start")?, w, u))
+            })
             .max_by(|a, b| a.0.total_cmp(&b.0));
         let s = match active {
             Some((_, w, u)) => blend(rest, stance(u.stance), w),

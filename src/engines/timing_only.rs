@@ -5,7 +5,7 @@
 //! goes to `relax` at once and keeps its retraction; audio stops at once. It moves no joints: the
 //! support table (`docs/bml-support.md`) marks these kinds "timing only".
 
-use crate::bml::{Behaviour, BehaviourKind, Mode};
+use crate::bml::{Behaviour, BehaviourKind};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{relax_now, stop_now, Engine, EngineError, Unit, UnitKey, Units};
 use crate::schedule::SyncName;
@@ -63,15 +63,6 @@ impl Engine for TimingOnlyEngine {
         }
     }
 
-    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
-        let mode = match &behaviour.kind {
-            BehaviourKind::Gesture(g) => g.mode,
-            BehaviourKind::Pointing(p) => p.mode,
-            _ => return &[],
-        };
-        hands(mode)
-    }
-
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         // keys are unique: the runtime never adds a unit twice
         self.units.add(unit, ());
@@ -86,14 +77,5 @@ impl Engine for TimingOnlyEngine {
         };
         self.units.retime(key, &times);
         times
-    }
-}
-
-/// The hands a gesture mode occupies (the right hand when none is given).
-pub fn hands(mode: Option<Mode>) -> &'static [&'static str] {
-    match mode {
-        Some(Mode::LeftHand) => &["left_hand"],
-        Some(Mode::BothHands) => &["left_hand", "right_hand"],
-        Some(Mode::RightHand) | None => &["right_hand"],
     }
 }
