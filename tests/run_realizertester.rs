@@ -10,18 +10,9 @@ use std::process::Command;
 use bml_realizer::feedback::{self, BlockStatus, Feedback, SyncPointProgress, WarningFeedback};
 
 const EPS: f64 = 0.1;
-const GESTURE7: &[&str] = &[
-    "start",
-    "ready",
-    "strokeStart",
-    "stroke",
-    "strokeEnd",
-    "relax",
-    "end",
-];
-const GAZE4: &[&str] = &["start", "ready", "relax", "end"];
-const FACE4: &[&str] = &["start", "attackPeak", "relax", "end"];
-const SE: &[&str] = &["start", "end"];
+use bml_realizer::bml::{
+    FACE_SYNCS as FACE4, GAZE_SYNCS as GAZE4, GESTURE_SYNCS as GESTURE7, START_END as SE,
+};
 
 struct Log {
     fb: Vec<Feedback>,

@@ -35,6 +35,16 @@ pub struct Skeleton {
 #[error("skeleton: {0}")]
 pub struct SkeletonError(pub String);
 
+/// A JSON array of exactly three finite numbers (data files: offsets, angles).
+pub(crate) fn three_numbers(v: &serde_json::Value) -> Option<[f32; 3]> {
+    let a = v.as_array().filter(|a| a.len() == 3)?;
+    let mut out = [0.0f32; 3];
+    for (o, x) in out.iter_mut().zip(a) {
+        *o = x.as_f64().filter(|x| x.is_finite())? as f32;
+    }
+    Some(out)
+}
+
 impl Skeleton {
     /// The default adult.
     pub fn adult() -> Skeleton {
@@ -76,25 +86,16 @@ impl Skeleton {
             if parent.is_none() && !s.joints.is_empty() {
                 return Err(e(format!("joint '{jname}' is a second root")));
             }
-            let o: Vec<f32> = j["offset"]
-                .as_array()
-                .map(|a| {
-                    a.iter()
-                        .filter_map(|x| x.as_f64())
-                        .map(|x| x as f32)
-                        .collect()
-                })
-                .unwrap_or_default();
-            if o.len() != 3 || o.iter().any(|x| !x.is_finite()) {
+            let Some(o) = three_numbers(&j["offset"]) else {
                 return Err(e(format!("joint '{jname}': offset must be three numbers")));
-            }
+            };
             if s.index.insert(jname.to_string(), s.joints.len()).is_some() {
                 return Err(e(format!("joint '{jname}' is defined twice")));
             }
             s.joints.push(Joint {
                 name: jname.to_string(),
                 parent,
-                offset: Vec3::new(o[0], o[1], o[2]),
+                offset: Vec3::from_array(o),
             });
         }
         if s.joints.is_empty() {

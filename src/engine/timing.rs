@@ -114,6 +114,21 @@ impl TimingModel {
         )
     }
 
+    /// The default gesture timing (ready, stroke phases, relax at their usual places) lasting
+    /// `duration` seconds.
+    pub fn gesture(duration: f64) -> Self {
+        let m = Self::stretchable(GESTURE);
+        let preferred = m.preferred_duration();
+        m.scaled(duration / preferred)
+    }
+
+    /// The default face timing (attack peak, relax at their usual places) lasting `duration`.
+    pub fn face(duration: f64) -> Self {
+        let m = Self::stretchable(FACE);
+        let preferred = m.preferred_duration();
+        m.scaled(duration / preferred)
+    }
+
     /// The same keys with every offset multiplied by `factor`.
     fn scaled(mut self, factor: f64) -> Self {
         for k in &mut self.keys {

@@ -54,18 +54,9 @@ impl Lexicon {
                     .ok_or_else(|| format!("{lexeme}:{sync}: joints must be an object"))?;
                 let mut rot = Vec::new();
                 for (joint, angles) in joints {
-                    let a: Vec<f32> = angles
-                        .as_array()
-                        .map(|a| {
-                            a.iter()
-                                .filter_map(|x| x.as_f64())
-                                .map(|x| x as f32)
-                                .collect()
-                        })
-                        .unwrap_or_default();
-                    if a.len() != 3 {
-                        return Err(format!("{lexeme}:{sync}:{joint}: three angles (z, x, y)"));
-                    }
+                    let a = crate::body::skeleton::three_numbers(angles).ok_or_else(|| {
+                        format!("{lexeme}:{sync}:{joint}: three angles (z, x, y)")
+                    })?;
                     let q = Quat::from_euler(
                         EulerRot::ZXY,
                         a[0].to_radians(),

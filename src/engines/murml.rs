@@ -9,7 +9,7 @@ use quick_xml::events::Event;
 use quick_xml::Reader;
 
 use crate::bml::{Behaviour, BehaviourKind};
-use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
+use crate::engine::timing::TimingModel;
 use crate::engine::{Engine, EngineError, Unit, Units};
 
 /// The MURML namespace.
@@ -17,23 +17,6 @@ pub const NS_MURML: &str = "http://www.techfak.uni-bielefeld.de/ags/soa/murml";
 
 /// Duration of a MURML description without keyframes.
 pub const DEFAULT_DURATION: f64 = 1.0;
-
-/// Gesture syncs at their usual fractions of the duration.
-const GESTURE: &[(&str, f64)] = &[
-    ("start", 0.0),
-    ("ready", 0.3),
-    ("strokeStart", 0.4),
-    ("stroke", 0.5),
-    ("strokeEnd", 0.6),
-    ("relax", 0.8),
-    ("end", 1.0),
-];
-const FACE: &[(&str, f64)] = &[
-    ("start", 0.0),
-    ("attackPeak", 0.2),
-    ("relax", 0.8),
-    ("end", 1.0),
-];
 
 /// How long a MURML description lasts: its last keyframe time, or [`DEFAULT_DURATION`]. `Err` if
 /// the content is not well-formed XML.
@@ -63,13 +46,20 @@ pub fn duration(content: &str) -> Result<f64, String> {
     Ok(last.filter(|&d| d > 0.0).unwrap_or(DEFAULT_DURATION))
 }
 
-fn kind(b: &Behaviour) -> Option<(&'static [(&'static str, f64)], &str)> {
+/// The two MURML kinds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    Gesture,
+    Face,
+}
+
+fn kind(b: &Behaviour) -> Option<(Kind, &str)> {
     match &b.kind {
         BehaviourKind::Unknown(u) if u.ns == NS_MURML && u.name == "murmlgesture" => {
-            Some((GESTURE, &u.content))
+            Some((Kind::Gesture, &u.content))
         }
         BehaviourKind::Unknown(u) if u.ns == NS_MURML && u.name == "murmlface" => {
-            Some((FACE, &u.content))
+            Some((Kind::Face, &u.content))
         }
         _ => None,
     }
@@ -92,29 +82,19 @@ impl Engine for MurmlEngine {
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        let (keys, content) = kind(behaviour)?;
+        let (k, content) = kind(behaviour)?;
         // a malformed description is refused when the unit is added, with the reason
         let d = duration(content).unwrap_or(DEFAULT_DURATION);
-        Some(TimingModel {
-            keys: keys
-                .iter()
-                .map(|&(n, f)| SyncKey {
-                    name: n.into(),
-                    at: f * d,
-                })
-                .collect(),
-            flexibility: Flexibility::Stretchable {
-                min_duration: MIN_DURATION,
-                max_duration: f64::INFINITY,
-            },
-            persistent: false,
+        Some(match k {
+            Kind::Gesture => TimingModel::gesture(d),
+            Kind::Face => TimingModel::face(d),
         })
     }
 
     fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
         match kind(behaviour) {
-            Some((keys, _)) if keys.len() == GESTURE.len() => &["left_hand", "right_hand"],
-            Some(_) => &["face"],
+            Some((Kind::Gesture, _)) => &["left_hand", "right_hand"],
+            Some((Kind::Face, _)) => &["face"],
             None => &[],
         }
     }
@@ -147,6 +127,12 @@ mod tests {
             Ok(DEFAULT_DURATION)
         );
         assert!(duration(r#"<frame ftime="soon"/>"#).is_err());
+        // the keyframes' length is the gesture's, its syncs at the usual places
+        let m = TimingModel::gesture(2.5);
+        assert_eq!(m.preferred_duration(), 2.5);
+        assert!((m.keys[m.key("stroke").unwrap()].at - 1.25).abs() < 1e-12);
+        let f = TimingModel::face(3.0);
+        assert!((f.keys[f.key("attackPeak").unwrap()].at - 0.6).abs() < 1e-12);
         assert!(duration(r#"<murml-description><frame></murml-description>"#).is_err());
     }
 }
