@@ -161,6 +161,8 @@ fn content(b: &Behaviour) -> Option<&str> {
 #[derive(Debug, Clone)]
 struct KeyframeUnit {
     keys: Keys,
+    /// The skeleton joint of each part, resolved on first use.
+    joints: Option<Vec<Option<usize>>>,
 }
 
 /// The keyframe engine (see the module documentation).
@@ -206,12 +208,12 @@ impl Engine for KeyframeEngine {
         let c = content(unit.behaviour)
             .ok_or_else(|| EngineError("the keyframe engine realizes bmlt:keyframe".into()))?;
         let keys = read_keys(c).map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
-        self.units.add(unit, KeyframeUnit { keys });
+        self.units.add(unit, KeyframeUnit { keys, joints: None });
         Ok(())
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
-        for (syncs, u) in self.units.all() {
+        for (syncs, u) in self.units.all_mut() {
             let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
             else {
                 continue;
@@ -231,8 +233,11 @@ impl Engine for KeyframeEngine {
             if k.root_translation {
                 pose.root = root;
             }
-            for (name, q) in k.parts.iter().zip(rotations) {
-                if let Some(i) = skeleton.joint(name) {
+            let joints = u
+                .joints
+                .get_or_insert_with(|| k.parts.iter().map(|p| skeleton.joint(p)).collect());
+            for (joint, q) in joints.iter().zip(rotations) {
+                if let Some(i) = *joint {
                     pose.rotations[i] = q;
                 }
             }
