@@ -200,14 +200,16 @@ impl Timeline {
         self.links
             .retain(|l| !(l.label == "≈" && l.from.0 == block.id));
         let point = |a: &Anchor| match a {
-            Anchor::Point(SyncPoint::Local { behaviour, sync }) => {
-                Some((block.id.clone(), behaviour.clone(), sync.clone()))
-            }
+            Anchor::Point(SyncPoint::Local { behaviour, sync }) => Some((
+                block.id.to_string(),
+                behaviour.to_string(),
+                sync.to_string(),
+            )),
             Anchor::Point(SyncPoint::External {
                 block: b,
                 behaviour,
                 sync,
-            }) => Some((b.clone(), behaviour.clone(), sync.clone())),
+            }) => Some((b.to_string(), behaviour.to_string(), sync.to_string())),
             _ => None,
         };
         for c in bml::extract(block) {

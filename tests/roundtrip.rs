@@ -47,18 +47,23 @@ fn foreign() -> impl Strategy<Value = Vec<ForeignAttr>> {
     })
 }
 
+/// An id as the model stores it.
+fn sid() -> impl Strategy<Value = bml_realizer::bml::Id> {
+    id().prop_map(Into::into)
+}
+
 fn sync_ref() -> impl Strategy<Value = SyncRef> {
     let point = prop_oneof![
-        (id(), id()).prop_map(|(b, s)| SyncPoint::Local {
+        (sid(), sid()).prop_map(|(b, s)| SyncPoint::Local {
             behaviour: b,
             sync: s
         }),
-        (id(), id(), id()).prop_map(|(k, b, s)| SyncPoint::External {
+        (sid(), sid(), sid()).prop_map(|(k, b, s)| SyncPoint::External {
             block: k,
             behaviour: b,
             sync: s
         }),
-        (id(), id()).prop_map(|(a, s)| SyncPoint::Anticipator {
+        (sid(), sid()).prop_map(|(a, s)| SyncPoint::Anticipator {
             anticipator: a,
             sync: s
         }),
@@ -73,7 +78,7 @@ fn speech() -> impl Strategy<Value = Speech> {
     vec(
         prop_oneof![
             text().prop_map(TextPart::Text),
-            id().prop_map(TextPart::Sync)
+            sid().prop_map(TextPart::Sync)
         ],
         0..5,
     )
@@ -307,7 +312,7 @@ fn behaviour() -> impl Strategy<Value = Behaviour> {
             }
             let unknown = matches!(kind, BehaviourKind::Unknown(_));
             Behaviour {
-                id,
+                id: id.into(),
                 kind,
                 syncs: attrs,
                 required,
@@ -409,7 +414,7 @@ fn block() -> impl Strategy<Value = Block> {
     )
         .prop_map(
             |(id, character_id, composition, ext, behaviours, constraints, foreign_attrs)| Block {
-                id,
+                id: id.into(),
                 character_id,
                 composition,
                 ext,

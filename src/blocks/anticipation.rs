@@ -4,6 +4,7 @@
 
 use super::live::Phase;
 use super::BlockManager;
+use crate::bml;
 use crate::engine::UnitKey;
 use crate::feedback::KnownWarning;
 use crate::plan::anticipator::Anticipator;
@@ -41,7 +42,7 @@ impl BlockManager {
         if changed.is_empty() {
             return;
         }
-        let ids: Vec<String> = self
+        let ids: Vec<bml::Id> = self
             .blocks
             .iter()
             .filter(|b| b.pegs.is_some())

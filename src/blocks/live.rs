@@ -26,7 +26,7 @@ pub(crate) enum Phase {
 /// A scheduled behaviour at run time.
 #[derive(Debug, Clone)]
 pub(crate) struct LiveBehaviour {
-    pub(crate) id: String,
+    pub(crate) id: bml::Id,
     /// Index in the block's `behaviours` (document order).
     pub(crate) index: usize,
     /// Registry index of its engine.
@@ -81,7 +81,7 @@ impl LiveBehaviour {
 /// A block in the plan.
 #[derive(Debug, Clone)]
 pub(crate) struct LiveBlock {
-    pub(crate) id: String,
+    pub(crate) id: bml::Id,
     /// Arrival number: ties between blocks go to the earlier one.
     pub(crate) seq: u64,
     pub(crate) status: BlockStatus,
@@ -91,9 +91,9 @@ pub(crate) struct LiveBlock {
     pub(crate) source: bml::Block,
     pub(crate) behaviours: Vec<LiveBehaviour>,
     /// Blocks that must end before this one starts.
-    pub(crate) waits_for: Vec<String>,
+    pub(crate) waits_for: Vec<bml::Id>,
     /// Blocks that must be subsiding before this one starts.
-    pub(crate) chunk_after: Vec<String>,
+    pub(crate) chunk_after: Vec<bml::Id>,
     /// Waiting for an activation.
     pub(crate) preplan: bool,
     /// The block's own peg board, for blocks tied to anticipators: moving an anticipator's peg
@@ -163,8 +163,8 @@ impl LiveBlock {
         source: bml::Block,
         seq: u64,
         start: f64,
-        waits_for: Vec<String>,
-        chunk_after: Vec<String>,
+        waits_for: Vec<bml::Id>,
+        chunk_after: Vec<bml::Id>,
     ) -> Self {
         LiveBlock {
             id: source.id.clone(),
@@ -203,7 +203,7 @@ impl LiveBlock {
 
     /// R33: behaviours of one exclusive group (gaze, posture) with the same start and end cannot
     /// both run; all but the first in document order leave the plan. Returns (id, reason) of each.
-    pub(crate) fn resolve_exclusive_ties(&mut self, registry: &Registry) -> Vec<(String, String)> {
+    pub(crate) fn resolve_exclusive_ties(&mut self, registry: &Registry) -> Vec<(bml::Id, String)> {
         let mut dropped = Vec::new();
         for i in 0..self.behaviours.len() {
             let a = &self.behaviours[i];

@@ -58,11 +58,11 @@ pub struct BlockManager {
     /// Live blocks in arrival order (so sorted by `seq`).
     blocks: Vec<LiveBlock>,
     /// Block id → seq, to find a block without scanning.
-    index: HashMap<String, u64>,
+    index: HashMap<bml::Id, u64>,
     /// How many blocks are LURKING (nothing to check when none is).
     lurking: usize,
-    finished: VecDeque<String>,
-    finished_set: HashSet<String>,
+    finished: VecDeque<bml::Id>,
+    finished_set: HashSet<bml::Id>,
     changes: Vec<ParameterChange>,
     anticipators: Vec<Box<dyn Anticipator>>,
     /// Units whose end passed during this advance: engines drop them after the frame, so that
@@ -79,13 +79,13 @@ pub struct BlockManager {
 /// Times of other blocks' syncs relative to the start of a block being scheduled.
 struct OtherBlocks<'a> {
     blocks: &'a [LiveBlock],
-    index: &'a HashMap<String, u64>,
+    index: &'a HashMap<bml::Id, u64>,
     anticipators: &'a [Box<dyn Anticipator>],
     start: f64,
 }
 
 /// Where block `id` is in `blocks` (sorted by seq).
-fn position(blocks: &[LiveBlock], index: &HashMap<String, u64>, id: &str) -> Option<usize> {
+fn position(blocks: &[LiveBlock], index: &HashMap<bml::Id, u64>, id: &str) -> Option<usize> {
     let seq = *index.get(id)?;
     blocks.binary_search_by_key(&seq, |b| b.seq).ok()
 }
@@ -193,7 +193,7 @@ impl BlockManager {
     pub fn live_blocks(&self) -> Vec<(String, BlockStatus)> {
         self.blocks
             .iter()
-            .map(|b| (b.id.clone(), b.status))
+            .map(|b| (b.id.to_string(), b.status))
             .collect()
     }
 
@@ -218,10 +218,10 @@ impl BlockManager {
         self.out.push(fb);
     }
 
-    fn warn(&mut self, id: String, kind: KnownWarning, text: String) {
+    fn warn(&mut self, id: impl Into<String>, kind: KnownWarning, text: String) {
         let character_id = self.character.clone();
         self.emit(Feedback::Warning(WarningFeedback {
-            id,
+            id: id.into(),
             kind: kind.into(),
             character_id,
             text,
@@ -241,8 +241,8 @@ impl BlockManager {
                 .filter(|x| x.phase != Phase::Removed)
                 .map(|x| BehaviourPrediction {
                     kind: b.source.behaviours[x.index].kind.element_name().to_string(),
-                    block: b.id.clone(),
-                    behaviour: x.id.clone(),
+                    block: b.id.to_string(),
+                    behaviour: x.id.to_string(),
                     syncs: x
                         .syncs
                         .iter()
@@ -257,7 +257,7 @@ impl BlockManager {
         let fb = PredictionFeedback {
             character_id: self.character.clone(),
             blocks: vec![BlockPrediction {
-                id: b.id.clone(),
+                id: b.id.to_string(),
                 global_start: Some(b.start),
                 // unknown while scheduling (the harness waits for a known end)
                 global_end: end.filter(|e| e.is_finite() && b.status != BlockStatus::InPrep),
@@ -290,7 +290,7 @@ impl BlockManager {
     fn parse_warnings(&mut self, block: &bml::Block, warnings: &[Diagnostic]) {
         for a in &block.foreign_attrs {
             self.warn(
-                block.id.clone(),
+                block.id.to_string(),
                 KnownWarning::CustomAttributeNotSupported,
                 format!(
                     "attribute '{}' (namespace {}) on <bml id=\"{}\"> is not interpreted and is ignored",
@@ -326,7 +326,7 @@ impl BlockManager {
                     .any(|b| (b.pos.line, b.pos.col) == (d.pos.line, d.pos.col));
             if ignored_content {
                 self.warn(
-                    block.id.clone(),
+                    block.id.to_string(),
                     KnownWarning::BehaviorTypeNotSupported,
                     format!("{}:{}: {}", d.pos.line, d.pos.col, d.message),
                 );
@@ -342,7 +342,7 @@ impl BlockManager {
         if let Some(i) = self.pos(&block.id) {
             let status = self.blocks[i].status;
             self.warn(
-                block.id.clone(),
+                block.id.to_string(),
                 KnownWarning::ImpossibleToSchedule,
                 format!(
                     "block id '{}' is still in use (status {status}); the new block is ignored",
@@ -358,13 +358,13 @@ impl BlockManager {
         }
         // S35: REPLACE removes everything
         if block.composition == bml::Composition::Replace {
-            let ids: Vec<String> = self.blocks.iter().map(|b| b.id.clone()).collect();
+            let ids: Vec<bml::Id> = self.blocks.iter().map(|b| b.id.clone()).collect();
             for id in ids {
                 self.interrupt_block_by_id(&id, now, &block.id);
             }
         }
         // S36, S37: blocks this one waits for
-        let mut waits_for: Vec<String> = match &block.composition {
+        let mut waits_for: Vec<bml::Id> = match &block.composition {
             bml::Composition::Append => self
                 .blocks
                 .iter()
@@ -512,12 +512,12 @@ impl BlockManager {
     }
 
     /// The ids of `ids` that name live blocks. Unknown ids that never existed get a warning.
-    fn existing(&mut self, ids: &[String], by: &str) -> Vec<String> {
+    fn existing(&mut self, ids: &[String], by: &str) -> Vec<bml::Id> {
         let mut v = Vec::new();
         for id in ids {
             if self.pos(id).is_some() {
-                v.push(id.clone());
-            } else if !self.finished_set.contains(id) {
+                v.push(bml::Id::new(id));
+            } else if !self.finished_set.contains(id.as_str()) {
                 self.warn(
                     by.to_string(),
                     KnownWarning::NoSuchTarget,
@@ -528,7 +528,7 @@ impl BlockManager {
         v
     }
 
-    fn predicted_start(&self, now: f64, waits_for: &[String], chunk_after: &[String]) -> f64 {
+    fn predicted_start(&self, now: f64, waits_for: &[bml::Id], chunk_after: &[bml::Id]) -> f64 {
         let mut start = now;
         for (ids, subsiding) in [(waits_for, false), (chunk_after, true)] {
             for b in ids
@@ -581,7 +581,7 @@ impl BlockManager {
     /// S29: every append target is done and every chunk target subsiding or done.
     fn ready(&self, i: usize) -> bool {
         let b = &self.blocks[i];
-        let live = |id: &String| self.pos(id).map(|i| &self.blocks[i]);
+        let live = |id: &bml::Id| self.pos(id).map(|i| &self.blocks[i]);
         b.waits_for.iter().all(|id| live(id).is_none())
             && b.chunk_after.iter().all(|id| {
                 live(id)
@@ -757,7 +757,7 @@ impl BlockManager {
         self.start_ready(t);
     }
 
-    fn remember(&mut self, id: String) {
+    fn remember(&mut self, id: bml::Id) {
         if self.finished_set.insert(id.clone()) {
             self.finished.push_back(id);
             if self.finished.len() > FINISHED_HISTORY {
@@ -852,8 +852,8 @@ impl BlockManager {
         }
         for xi in 0..self.blocks[i].behaviours.len() {
             let x = &self.blocks[i].behaviours[xi];
-            let selected =
-                (include.is_empty() || include.contains(&x.id)) && !exclude.contains(&x.id);
+            let selected = (include.is_empty() || include.iter().any(|s| *s == x.id))
+                && !exclude.iter().any(|s| *s == x.id);
             if !selected {
                 continue;
             }

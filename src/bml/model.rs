@@ -5,6 +5,10 @@
 use super::diagnostic::Pos;
 use super::syncref::SyncRef;
 
+/// An id (of a block, behaviour, sync point or anticipator): immutable, cheap to clone, stored
+/// inline without allocation up to 23 bytes.
+pub type Id = smol_str::SmolStr;
+
 /// Namespace of BML 1.0 core elements and of feedback messages.
 pub const NS_BML: &str = "http://www.bml-initiative.org/bml/bml-1.0";
 /// Namespace of the BML 1.0 core extensions (e.g. `faceFacs`).
@@ -194,7 +198,7 @@ pub struct BlockExt {
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Block {
     /// Block id (required).
-    pub id: String,
+    pub id: Id,
     /// Character the block is for, if named.
     pub character_id: Option<String>,
     /// How the block combines with the plan (`composition`, or the draft alias `scheduling`).
@@ -250,7 +254,7 @@ pub enum TextPart {
     /// Text as written (unescaped).
     Text(String),
     /// An inline sync point.
-    Sync(String),
+    Sync(Id),
 }
 
 /// A `name`/`value` parameter of a BMLT behaviour.
@@ -266,7 +270,7 @@ pub struct Param {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Behaviour {
     /// Behaviour id, unique within the block.
-    pub id: String,
+    pub id: Id,
     /// What the behaviour is, with its kind-specific attributes.
     pub kind: BehaviourKind,
     /// Shorthand sync attributes in document order.

@@ -721,7 +721,7 @@ impl<'i> Parser<'i> {
         let mut attrs = Attrs::new(std::mem::take(&mut el.attrs));
         match attrs.take("id") {
             Some(a) if !a.value.trim_ascii().is_empty() => {
-                block.id = a.value.trim_ascii().to_string();
+                block.id = Id::new(a.value.trim_ascii());
                 if block.id.contains(':') {
                     self.error(
                         Code::InvalidId,
@@ -996,7 +996,7 @@ impl<'i> Parser<'i> {
         let mut attrs = Attrs::new(std::mem::take(&mut el.attrs));
         let id = match attrs.take("id") {
             Some(a) if !a.value.trim_ascii().is_empty() => {
-                let id = a.value.trim_ascii().to_string();
+                let id = Id::new(a.value.trim_ascii());
                 if id.contains(':') {
                     self.error(
                         Code::InvalidId,
@@ -1359,7 +1359,7 @@ impl<'i> Parser<'i> {
                         let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
                         match attrs.take("id") {
                             Some(a) if !a.value.trim_ascii().is_empty() => {
-                                out.push(TextPart::Sync(a.value.trim_ascii().to_string()))
+                                out.push(TextPart::Sync(Id::new(a.value.trim_ascii())))
                             }
                             _ => self.error(
                                 Code::MissingId,

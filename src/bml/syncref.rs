@@ -4,6 +4,7 @@
 use std::fmt;
 
 use super::diagnostic::Code;
+use super::model::Id;
 
 /// The reserved first part of an anticipator reference (`anticipators:ID:SYNC`).
 pub const ANTICIPATORS: &str = "anticipators";
@@ -29,25 +30,25 @@ pub enum SyncPoint {
     /// `beh:sync` — a behaviour of the same block.
     Local {
         /// Behaviour id.
-        behaviour: String,
+        behaviour: Id,
         /// Sync point id.
-        sync: String,
+        sync: Id,
     },
     /// `block:beh:sync` — a behaviour of another block (BMLA/BMLT external reference).
     External {
         /// Block id.
-        block: String,
+        block: Id,
         /// Behaviour id.
-        behaviour: String,
+        behaviour: Id,
         /// Sync point id.
-        sync: String,
+        sync: Id,
     },
     /// `anticipators:id:sync` — a predicted time of an anticipator (R10).
     Anticipator {
         /// Anticipator id.
-        anticipator: String,
+        anticipator: Id,
         /// Sync id of the anticipator.
-        sync: String,
+        sync: Id,
     },
 }
 
@@ -55,8 +56,8 @@ impl SyncPoint {
     /// A local sync point `behaviour:sync`.
     pub fn local(behaviour: &str, sync: &str) -> Self {
         SyncPoint::Local {
-            behaviour: behaviour.to_string(),
-            sync: sync.to_string(),
+            behaviour: Id::new(behaviour),
+            sync: Id::new(sync),
         }
     }
 
@@ -132,26 +133,38 @@ fn err(code: Code, message: String) -> SyncRefError {
 /// optional exponent. Rejects `inf`, `NaN`, hex and empty text.
 pub(crate) fn parse_seconds(s: &str) -> Option<f64> {
     let s = s.trim_ascii();
-    let body = s.strip_prefix(['+', '-']).unwrap_or(s);
-    let (mantissa, exp) = match body.find(['e', 'E']) {
-        Some(i) => (&body[..i], Some(&body[i + 1..])),
-        None => (body, None),
-    };
-    let digits_ok = !mantissa.is_empty()
-        && mantissa.chars().any(|c| c.is_ascii_digit())
-        && mantissa.chars().all(|c| c.is_ascii_digit() || c == '.')
-        && mantissa.matches('.').count() <= 1;
-    let exp_ok = exp.is_none_or(|e| {
-        let e = e.strip_prefix(['+', '-']).unwrap_or(e);
-        !e.is_empty() && e.chars().all(|c| c.is_ascii_digit())
-    });
-    if !(digits_ok && exp_ok) {
+    let body = s.strip_prefix(['+', '-']).unwrap_or(s).as_bytes();
+    // mantissa: digits with at most one point, at least one digit
+    let (mut digits, mut points, mut i) = (0, 0, 0);
+    while let Some(&c) = body.get(i) {
+        match c {
+            b'0'..=b'9' => digits += 1,
+            b'.' => points += 1,
+            _ => break,
+        }
+        i += 1;
+    }
+    if digits == 0 || points > 1 {
         return None;
+    }
+    // optional exponent: e or E, an optional sign, at least one digit
+    if i < body.len() {
+        if !matches!(body[i], b'e' | b'E') {
+            return None;
+        }
+        let exp = &body[i + 1..];
+        let exp = exp
+            .strip_prefix(b"+")
+            .or(exp.strip_prefix(b"-"))
+            .unwrap_or(exp);
+        if exp.is_empty() || !exp.iter().all(u8::is_ascii_digit) {
+            return None;
+        }
     }
     s.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
-fn check_id(part: &str, what: &str, text: &str) -> Result<String, SyncRefError> {
+fn check_id(part: &str, what: &str, text: &str) -> Result<Id, SyncRefError> {
     if part.is_empty() {
         return Err(err(
             Code::MalformedSyncRef,
@@ -164,7 +177,7 @@ fn check_id(part: &str, what: &str, text: &str) -> Result<String, SyncRefError> 
             format!("sync reference '{text}': {what} '{part}' contains whitespace"),
         ));
     }
-    Ok(part.to_string())
+    Ok(Id::new(part))
 }
 
 impl SyncRef {

@@ -334,7 +334,7 @@ impl Writer {
                     match part {
                         TextPart::Text(t) => body.push_str(&escape(t)),
                         TextPart::Sync(id) => {
-                            let _ = write!(body, "<sync id=\"{}\"/>", escape(id));
+                            let _ = write!(body, "<sync id=\"{}\"/>", escape(id.as_str()));
                         }
                     }
                 }

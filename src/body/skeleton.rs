@@ -46,9 +46,12 @@ pub(crate) fn three_numbers(v: &serde_json::Value) -> Option<[f32; 3]> {
 }
 
 impl Skeleton {
-    /// The default adult.
+    /// The default adult (read from its embedded JSON once per process, then copied).
     pub fn adult() -> Skeleton {
-        Skeleton::from_json(ADULT).expect("the embedded adult skeleton is valid")
+        static ADULT_SKELETON: std::sync::LazyLock<Skeleton> = std::sync::LazyLock::new(|| {
+            Skeleton::from_json(ADULT).expect("the embedded adult skeleton is valid")
+        });
+        ADULT_SKELETON.clone()
     }
 
     /// Reads a skeleton from JSON (see the module documentation).

@@ -467,10 +467,11 @@ pub fn stop_now(now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::borrow::Cow;
 
     fn syncs(v: &[(&'static str, f64)]) -> Vec<(SyncName, f64)> {
-        v.iter().map(|&(s, t)| (Cow::Borrowed(s), t)).collect()
+        v.iter()
+            .map(|&(s, t)| (crate::bml::Id::new_static(s), t))
+            .collect()
     }
 
     #[test]

@@ -4,8 +4,6 @@
 //! kind, so that the scheduler works before the animation engines exist, and a deterministic
 //! headless speech timing model (syllables at a configurable rate, inline syncs at word boundaries).
 
-use std::borrow::Cow;
-
 use crate::bml::{Behaviour, BehaviourKind, Speech, TextPart};
 
 /// Duration of behaviours that act once and end (interrupt, activate, parametervaluechange): the
@@ -33,7 +31,7 @@ pub enum Flexibility {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SyncKey {
     /// Sync point name (`start`, `stroke`, an inline speech sync, ...).
-    pub name: Cow<'static, str>,
+    pub name: crate::bml::Id,
     /// Preferred offset from `start`, seconds.
     pub at: f64,
 }
@@ -53,7 +51,7 @@ impl TimingModel {
     /// Whether sync times (in key order; a persistent end may be infinite) realize this model:
     /// non-decreasing, a duration within the bounds of a stretchable model, the internal distances
     /// of a rigid one (within 1 µs).
-    pub fn admits(&self, syncs: &[(Cow<'static, str>, f64)]) -> Result<(), String> {
+    pub fn admits(&self, syncs: &[(crate::bml::Id, f64)]) -> Result<(), String> {
         const TOLERANCE: f64 = 1e-6;
         if let Some(w) = syncs.windows(2).find(|w| w[1].1 < w[0].1 - 1e-9) {
             return Err(format!("'{}' comes before '{}'", w[1].0, w[0].0));
@@ -94,7 +92,7 @@ impl TimingModel {
             keys: keys
                 .iter()
                 .map(|(name, at)| SyncKey {
-                    name: Cow::Borrowed(name),
+                    name: crate::bml::Id::new_static(name),
                     at: *at,
                 })
                 .collect(),
@@ -234,6 +232,31 @@ pub fn syllables(word: &str) -> usize {
     count.total()
 }
 
+const OTHER: u8 = 0;
+const SPACE: u8 = 1;
+const LETTER: u8 = 2;
+const DIGIT: u8 = 3;
+
+/// The class of each ASCII byte for the one-pass syllable count.
+static ASCII_CLASS: [u8; 256] = {
+    let mut t = [OTHER; 256];
+    let mut b = 0;
+    while b < 128 {
+        let c = b as u8;
+        t[b] = if c.is_ascii_whitespace() {
+            SPACE
+        } else if c.is_ascii_alphabetic() {
+            LETTER
+        } else if c.is_ascii_digit() {
+            DIGIT
+        } else {
+            OTHER
+        };
+        b += 1;
+    }
+    t
+};
+
 /// The running state of [`syllables`].
 #[derive(Default)]
 struct Syllables {
@@ -294,21 +317,21 @@ impl SpeechTiming {
                 .map(|w| self.word(syllables(w), w.chars().last().unwrap_or(' ')))
                 .sum();
         }
-        // one pass over the bytes, no splitting (nearly every text)
+        // one pass over the bytes with a class table, no splitting (nearly every text)
         let (mut total, mut word, mut last) = (0.0, Syllables::default(), None);
         for &b in text.as_bytes() {
-            if b.is_ascii_whitespace() {
-                if let Some(l) = last.take() {
-                    total += self.word(std::mem::take(&mut word).total(), char::from(l));
+            match ASCII_CLASS[usize::from(b)] {
+                SPACE => {
+                    if let Some(l) = last.take() {
+                        total += self.word(std::mem::take(&mut word).total(), char::from(l));
+                    }
+                    continue;
                 }
-                continue;
+                LETTER => word.letter(b | 0x20),
+                DIGIT => word.any = true,
+                _ => {}
             }
             last = Some(b);
-            if b.is_ascii_alphabetic() {
-                word.letter(b.to_ascii_lowercase());
-            } else {
-                word.any |= b.is_ascii_digit();
-            }
         }
         if let Some(l) = last {
             total += self.word(word.total(), char::from(l));
@@ -320,7 +343,7 @@ impl SpeechTiming {
     /// `end` after the last word. An empty text lasts one syllable.
     pub fn model(&self, speech: &Speech) -> TimingModel {
         let mut keys = vec![SyncKey {
-            name: Cow::Borrowed("start"),
+            name: crate::bml::Id::new_static("start"),
             at: 0.0,
         }];
         let mut t = 0.0;
@@ -328,14 +351,14 @@ impl SpeechTiming {
             match part {
                 TextPart::Text(text) => t += self.text(text),
                 TextPart::Sync(id) => keys.push(SyncKey {
-                    name: Cow::Owned(id.clone()),
+                    name: id.clone(),
                     at: t,
                 }),
             }
         }
         let end = if t > 0.0 { t } else { self.syllable_seconds };
         keys.push(SyncKey {
-            name: Cow::Borrowed("end"),
+            name: crate::bml::Id::new_static("end"),
             at: end,
         });
         let flexibility = if self.retimable {
@@ -492,9 +515,29 @@ mod tests {
     }
 
     #[test]
+    fn the_one_pass_text_timing_equals_word_by_word_timing() {
+        let sp = SpeechTiming::default();
+        for text in [
+            "Welcome! I am Griet, I am 16 year old.",
+            "  make\tlike\nthe  rest;  ",
+            "a, b: c? ... 42 x",
+            "",
+            "Gentlemen,realizers!",
+        ] {
+            let by_word: f64 = text
+                .split_whitespace()
+                .map(|w| sp.word(syllables(w), w.chars().last().unwrap()))
+                .sum();
+            assert!((sp.text(text) - by_word).abs() < 1e-12, "{text:?}");
+        }
+    }
+
+    #[test]
     fn s58_s59_timing_models_admit_only_ordered_times_within_their_bounds() {
-        let syncs = |v: &[(&'static str, f64)]| -> Vec<(Cow<'static, str>, f64)> {
-            v.iter().map(|&(n, t)| (Cow::Borrowed(n), t)).collect()
+        let syncs = |v: &[(&'static str, f64)]| -> Vec<(crate::bml::Id, f64)> {
+            v.iter()
+                .map(|&(n, t)| (crate::bml::Id::new_static(n), t))
+                .collect()
         };
         let mut m = TimingModel::stretchable(&[("start", 0.0), ("stroke", 0.5), ("end", 1.0)]);
         assert!(m

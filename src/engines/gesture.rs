@@ -33,7 +33,11 @@ pub struct Lexicon {
 impl Lexicon {
     /// The default lexicon (BEAT, WAVE, CONDUIT, CUP, POINT).
     pub fn default_lexicon() -> Lexicon {
-        Lexicon::from_json(DEFAULT).expect("the embedded gesture lexicon is valid")
+        // read from its embedded JSON once per process, then copied
+        static LEXICON: std::sync::LazyLock<Lexicon> = std::sync::LazyLock::new(|| {
+            Lexicon::from_json(DEFAULT).expect("the embedded gesture lexicon is valid")
+        });
+        LEXICON.clone()
     }
 
     /// Reads a bindings file: `{"gestures": [{"lexeme": …, "keys": {SYNC: {JOINT: [z, x, y]}}}]}`.

@@ -180,7 +180,6 @@ impl Engine for HeadEngine {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::borrow::Cow;
 
     fn nod_syncs() -> Vec<(SyncName, f64)> {
         [
@@ -193,7 +192,7 @@ mod tests {
             ("end", 1.6),
         ]
         .iter()
-        .map(|&(n, t)| (Cow::Borrowed(n), t))
+        .map(|&(n, t)| (crate::bml::Id::new_static(n), t))
         .collect()
     }
 

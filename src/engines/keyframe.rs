@@ -93,7 +93,7 @@ pub fn read_keys(content: &str) -> Result<Keys, String> {
                 .map_err(|_| format!("'{n}' is not a number"))
         })
         .collect::<Result<_, _>>()?;
-    if numbers.is_empty() || numbers.len() % per_key != 0 {
+    if numbers.is_empty() || !numbers.len().is_multiple_of(per_key) {
         return Err(format!(
             "{} numbers do not make keys of {per_key} (time, {}{} quaternions)",
             numbers.len(),

@@ -73,10 +73,11 @@ pub fn hands(mode: Option<Mode>) -> &'static [&'static str] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::borrow::Cow;
 
     fn syncs(v: &[(&'static str, f64)]) -> Vec<(SyncName, f64)> {
-        v.iter().map(|&(n, t)| (Cow::Borrowed(n), t)).collect()
+        v.iter()
+            .map(|&(n, t)| (crate::bml::Id::new_static(n), t))
+            .collect()
     }
 
     #[test]

@@ -65,6 +65,14 @@ impl DiffSystem {
         Self::default()
     }
 
+    /// An empty system with room for `vars` variables and `edges` edges.
+    pub fn with_capacity(vars: usize, edges: usize) -> Self {
+        DiffSystem {
+            lower: Vec::with_capacity(vars),
+            edges: Vec::with_capacity(edges),
+        }
+    }
+
     /// Adds a variable with lower bound `lower`; returns its index.
     pub fn var(&mut self, lower: f64) -> usize {
         self.lower.push(lower);

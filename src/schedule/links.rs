@@ -1,8 +1,6 @@
 //! Behaviours and constraints prepared for a strategy: each behaviour with its timing model, and
 //! each normalised constraint resolved to sync keys of those behaviours or to known times.
 
-use std::collections::HashMap;
-
 use super::strategy::{Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour};
 use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
 use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
@@ -48,17 +46,20 @@ pub(crate) fn items<'b>(
     order.sort_by(|a, b| a.id.cmp(&b.id));
     let mut items = Vec::new();
     for beh in order {
-        match models.model(beh) {
-            Some(model) if model.check().is_err() => dropped.push(Dropped {
+        let model = models.model(beh).map(|m| {
+            let valid = m.check();
+            (m, valid)
+        });
+        match model {
+            Some((_, Err(why))) => dropped.push(Dropped {
                 behaviour: beh.id.clone(),
                 warning: KnownWarning::InvalidTiming,
                 reason: format!(
-                    "the engine's timing model for '{}' is invalid: {}",
-                    beh.id,
-                    model.check().err().unwrap_or_default()
+                    "the engine's timing model for '{}' is invalid: {why}",
+                    beh.id
                 ),
             }),
-            Some(model) => {
+            Some((model, Ok(()))) => {
                 // a persistent behaviour has no end unless a constraint names it
                 let end_named = constraints.iter().any(|c| {
                     [&c.left, &c.right].iter().any(|a| {
@@ -82,6 +83,36 @@ pub(crate) fn items<'b>(
     items
 }
 
+/// Positions of ids in a list: a linear scan for the few behaviours of a typical block, a binary
+/// search over a sorted copy for large ones (cheaper than hashing either way).
+pub(crate) struct IdIndex<'a> {
+    ids: Vec<(&'a str, usize)>,
+    sorted: bool,
+}
+
+impl<'a> IdIndex<'a> {
+    const LINEAR: usize = 16;
+
+    pub(crate) fn new(ids: impl Iterator<Item = &'a str>) -> Self {
+        let mut ids: Vec<(&str, usize)> = ids.enumerate().map(|(i, id)| (id, i)).collect();
+        let sorted = ids.len() > Self::LINEAR;
+        if sorted {
+            ids.sort_unstable();
+        }
+        IdIndex { ids, sorted }
+    }
+
+    /// The position of `id` (the first, if it occurs twice).
+    pub(crate) fn get(&self, id: &str) -> Option<usize> {
+        if self.sorted {
+            let at = self.ids.partition_point(|(k, _)| *k < id);
+            self.ids.get(at).filter(|(k, _)| *k == id).map(|(_, i)| *i)
+        } else {
+            self.ids.iter().find(|(k, _)| *k == id).map(|(_, i)| *i)
+        }
+    }
+}
+
 /// A behaviour is required if it sits in `<required>` or a required constraint names it.
 pub(crate) fn is_required(item: &Item, constraints: &[Constraint]) -> bool {
     item.beh.required
@@ -101,11 +132,7 @@ pub(crate) fn resolve(
     constraints: &[Constraint],
     external: &dyn ExternalTimes,
 ) -> (Vec<Link>, Option<(usize, KnownWarning, String)>) {
-    let index: HashMap<&str, usize> = items
-        .iter()
-        .enumerate()
-        .map(|(i, it)| (it.beh.id.as_str(), i))
-        .collect();
+    let index = IdIndex::new(items.iter().map(|it| it.beh.id.as_str()));
     let mut links = Vec::new();
     for (ci, c) in constraints.iter().enumerate() {
         let mut owner = None;
@@ -125,7 +152,7 @@ pub(crate) fn resolve(
                     ));
                 }
             };
-            let Some(&i) = index.get(behaviour.as_str()) else {
+            let Some(i) = index.get(behaviour) else {
                 return Ok(None); // behaviour dropped or unsupported: the constraint lapses
             };
             owner.get_or_insert(i);

@@ -20,14 +20,12 @@
 //!    kept at that minimum. The program is built in a canonical order (behaviours sorted by id), so the
 //!    same block in any order gives the same program and the same answer.
 
-use std::collections::HashMap;
-
 use good_lp::{
     constraint, microlp, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
 };
 
 use super::diff::{DiffSystem, EPSILON};
-use super::links::{is_required, items, resolve_all, scheduled, Item, Link, Term};
+use super::links::{is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
 use super::offsets::Offsets;
 use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
@@ -80,13 +78,8 @@ impl SchedulingStrategy for Optimal {
                 .map(|(it, t)| scheduled(it, &t, 0.0))
                 .collect();
             // document order
-            let pos: HashMap<&str, usize> = block
-                .behaviours
-                .iter()
-                .enumerate()
-                .map(|(i, b)| (b.id.as_str(), i))
-                .collect();
-            behaviours.sort_by_key(|b| pos.get(b.id.as_str()).copied().unwrap_or(usize::MAX));
+            let pos = IdIndex::new(block.behaviours.iter().map(|b| b.id.as_str()));
+            behaviours.sort_by_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
             return Ok(BlockSchedule {
                 behaviours,
                 dropped,
@@ -236,7 +229,7 @@ fn feasible(items: &[Item], links: &[Link], constraints: &[Constraint]) -> Resul
 /// Every behaviour at its preferred timing: one variable per behaviour start. `None` if the
 /// constraints need some behaviour to stretch.
 fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
-    let mut s = DiffSystem::new();
+    let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
     let block = s.var(0.0);
     let starts: Vec<usize> = items.iter().map(|_| s.var(f64::MIN / 4.0)).collect();
     for (i, &v) in starts.iter().enumerate() {
@@ -360,7 +353,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
         }
     }
     // least solution over the nodes
-    let mut s = DiffSystem::new();
+    let mut s = DiffSystem::with_capacity(n, 2 * links.len() + items.len());
     for v in 0..n {
         s.var(if v == 0 { 0.0 } else { f64::MIN / 4.0 });
     }

@@ -2,8 +2,6 @@
 //! produces, the reasons it drops behaviours or fails a block, and the source of times for references
 //! that leave the block.
 
-use std::borrow::Cow;
-
 use crate::bml::{Block, SyncPoint};
 use crate::engine::timing::TimingModels;
 use crate::feedback::KnownWarning;
@@ -40,13 +38,13 @@ impl ExternalTimes for NoExternal {
 }
 
 /// A sync point's name: static for the standard names, owned for a speech's inline syncs.
-pub type SyncName = Cow<'static, str>;
+pub type SyncName = crate::bml::Id;
 
 /// One behaviour's scheduled sync times (block-local seconds; a persistent end is infinite).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ScheduledBehaviour {
     /// Behaviour id.
-    pub id: String,
+    pub id: crate::bml::Id,
     /// (sync id, time) in sync order. Standard sync names are static; a speech's inline syncs
     /// are owned.
     pub syncs: Vec<(SyncName, f64)>,
@@ -65,7 +63,7 @@ impl ScheduledBehaviour {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Dropped {
     /// Behaviour id.
-    pub behaviour: String,
+    pub behaviour: crate::bml::Id,
     /// Warning type.
     pub warning: KnownWarning,
     /// Explanation, naming the constraints involved.

@@ -18,7 +18,7 @@ use std::collections::HashMap;
 
 use super::offsets::Offsets;
 use super::{BlockSchedule, ExternalTimes, SyncName};
-use crate::bml::{extract, Anchor, Block, Relation, SyncPoint};
+use crate::bml::{extract, Anchor, Block, Id, Relation, SyncPoint};
 use crate::plan::pegs::{BlockPegId, PegBoard, PegId, SyncAddr};
 
 /// Where a planned sync's time comes from.
@@ -43,7 +43,7 @@ pub struct PlannedBlock {
     /// The block's peg.
     pub block: BlockPegId,
     /// Behaviours in schedule order: (id, [(sync, placement)]).
-    pub behaviours: Vec<(String, Vec<(SyncName, Placement)>)>,
+    pub behaviours: Vec<(Id, Vec<(SyncName, Placement)>)>,
 }
 
 impl PlannedBlock {
@@ -158,7 +158,7 @@ pub fn plan_block(
     let n = times.len();
     let mut joined = Offsets::new(n);
     let mut named = vec![false; n];
-    let mut on_anticipator: Vec<Option<(String, String, f64)>> = vec![None; n];
+    let mut on_anticipator: Vec<Option<(Id, Id, f64)>> = vec![None; n];
     let mut orders = Vec::new();
     let mut ant_orders = Vec::new();
     let constraints = extract(block);
@@ -326,7 +326,7 @@ pub fn plan_block(
 
 /// Behaviours of a planned block whose timing is no longer valid: syncs out of order, before the
 /// block start, or an end not after the start (S57, S58).
-pub fn invalid(board: &PegBoard, planned: &PlannedBlock) -> Vec<String> {
+pub fn invalid(board: &PegBoard, planned: &PlannedBlock) -> Vec<Id> {
     let start = board.block_start(planned.block);
     planned
         .behaviours

@@ -144,7 +144,7 @@ fn run(mut realizer: Realizer, events: Receiver<Event>, per_client: bool, fps: f
                             if !errors.is_empty() || block.is_none() {
                                 // the sender's problem: only the sender hears of it
                                 let id = block
-                                    .map(|b| b.id)
+                                    .map(|b| b.id.to_string())
                                     .filter(|id| !id.is_empty())
                                     .unwrap_or_else(|| NO_ID.to_string());
                                 routed.push((
@@ -159,14 +159,14 @@ fn run(mut realizer: Realizer, events: Receiver<Event>, per_client: bool, fps: f
                                 continue;
                             }
                             let Some(block) = block else { continue };
-                            owner.entry(block.id.clone()).or_insert(c);
+                            owner.entry(block.id.to_string()).or_insert(c);
                             let _ = realizer.perform_bml(&line);
                             let live = realizer
                                 .character(block.character_id.as_deref().unwrap_or(""))
                                 .and_then(|m| m.status(&block.id))
                                 .is_some();
                             if !live {
-                                owner.remove(&block.id); // rejected: it will never end
+                                owner.remove(block.id.as_str()); // rejected: it will never end
                             }
                             let frame = realizer.tick(clock.now());
                             // what this submission produced right away concerns its sender
