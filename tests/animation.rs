@@ -505,3 +505,163 @@ fn a_sitting_shift_folds_the_legs_and_stays_a_posture_returns() {
         "seated again"
     );
 }
+
+/// What [`track`] records: per frame (time, joint position), the sync times, the warnings.
+struct Track {
+    positions: Vec<(f64, Vec3)>,
+    syncs: Vec<(String, f64)>,
+    warnings: Vec<String>,
+}
+
+/// Runs `bml` at 60 Hz and records the world position of `joint` every frame, with the sync
+/// times ("block:behaviour:sync") and warnings reported.
+fn track(bml: &str, joint: &str, until: f64) -> Track {
+    let skeleton = Skeleton::adult();
+    let j = skeleton.joint(joint).unwrap();
+    let mut r = Realizer::new();
+    r.perform_bml(bml).unwrap();
+    let (mut out, mut syncs, mut warnings) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..=(until * FPS).ceil() as u32 {
+        let t = f64::from(i) / FPS;
+        let frame = r.tick(t);
+        for fb in &frame.feedback {
+            match fb {
+                Feedback::SyncPointProgress(p) => syncs.push((
+                    format!("{}:{}:{}", p.block, p.behaviour, p.sync),
+                    p.global_time,
+                )),
+                Feedback::Warning(w) => warnings.push(format!("{} {}", w.kind.as_str(), w.text)),
+                _ => {}
+            }
+        }
+        out.push((t, frame.poses[0].pose.world(&skeleton).positions[j]));
+    }
+    Track {
+        positions: out,
+        syncs,
+        warnings,
+    }
+}
+
+const BMLT: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
+
+#[test]
+fn a40_a_procedural_wrist_follows_its_expression_by_ik_and_keeps_its_keys_when_stretched() {
+    // lift: keys start 0, stroke 0.5, end 1; preferred 1 s, stretched here to 2 s (max 3 s)
+    let Track {
+        positions: wrist,
+        syncs,
+        warnings,
+    } = track(
+        &format!(
+            r#"<bml {BMLT} id="b"><bmlt:procanimation id="p" name="lift" start="1" end="3"/></bml>"#
+        ),
+        "r_wrist",
+        3.5,
+    );
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!((at(&syncs, "b:p:stroke") - 2.0).abs() < 1e-9, "{syncs:?}");
+    assert!((at(&syncs, "b:p:end") - 3.0).abs() < 1e-9);
+    // every frame of the unit: the wrist where the expression puts it, within a millimetre
+    // (position [-0.3, hermite(1.1, 1.35, 0, 0, α), 0.2], α linear in time from 1 s to 3 s)
+    for (t, p) in wrist.iter().filter(|(t, _)| (1.0..=3.0).contains(t)) {
+        let a = (t - 1.0) / 2.0;
+        let y = 1.1 + (1.35 - 1.1) * (3.0 * a * a - 2.0 * a * a * a);
+        let goal = Vec3::new(-0.3, y as f32, 0.2);
+        assert!((*p - goal).length() < 1e-3, "at {t}: {p} vs {goal}");
+    }
+    // at the stroke (α = 0.5) halfway up
+    let stroke = wrist
+        .iter()
+        .find(|(t, _)| (*t - 2.0).abs() < 1e-9)
+        .unwrap()
+        .1;
+    assert!((stroke.y - 1.225).abs() < 1e-3);
+    // before and after, the arm is at rest (T-pose: the wrist out at the side)
+    let rest = wrist[0].1;
+    assert!((wrist.last().unwrap().1 - rest).length() < 1e-6);
+}
+
+#[test]
+fn a58_a_procedural_unit_stretched_beyond_its_maximum_is_invalid_and_dropped() {
+    // 4 s asked, the unit lasts at most 3 s
+    let Track {
+        positions: wrist,
+        syncs,
+        warnings,
+    } = track(
+        &format!(
+            r#"<bml {BMLT} id="b"><bmlt:procanimation id="p" name="lift" start="1" end="5"/><gesture id="g" lexeme="BEAT" mode="LEFT_HAND" start="1"/></bml>"#
+        ),
+        "r_wrist",
+        5.5,
+    );
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].starts_with("INVALID_TIMING"), "{warnings:?}");
+    assert!(
+        warnings[0].contains("'p'") && warnings[0].contains("duration"),
+        "{warnings:?}"
+    );
+    assert!(syncs.iter().all(|s| !s.0.starts_with("b:p:")), "{syncs:?}");
+    assert!(
+        syncs.iter().any(|s| s.0 == "b:g:end"),
+        "the rest of the block runs"
+    );
+    // the right arm never moves (the beat is left-handed)
+    let rest = wrist[0].1;
+    assert!(wrist.iter().all(|(_, p)| (*p - rest).length() < 1e-6));
+}
+
+#[test]
+fn a40_a_limb_frame_effector_lifts_the_foot_relative_to_the_hip() {
+    let skeleton = Skeleton::adult();
+    let hip = skeleton.joint("l_hip").unwrap();
+    let ankle = skeleton.joint("l_talocrural").unwrap();
+    let mut r = Realizer::new();
+    r.perform_bml(&format!(
+        r#"<bml {BMLT} id="b"><bmlt:procanimation id="f" name="foot_lift" start="0.5"/></bml>"#
+    ))
+    .unwrap();
+    // preferred 0.8 s: the stroke (α = 0.5) at 0.9 s
+    r.tick(0.0);
+    let w = r.tick(0.9).poses[0].pose.world(&skeleton);
+    let rel = w.positions[ankle] - w.positions[hip];
+    assert!(
+        (rel - Vec3::new(0.0, -0.845 + 0.12, 0.1)).length() < 1e-3,
+        "{rel}"
+    );
+}
+
+#[test]
+fn a35_a_procedural_parameter_changes_while_the_unit_runs() {
+    let skeleton = Skeleton::adult();
+    let wrist = skeleton.joint("r_wrist").unwrap();
+    let mut r = Realizer::new();
+    r.perform_bml(&format!(
+        r#"<bml {BMLT} xmlns:bmla="http://www.asap-project.org/bmla" id="b"><bmlt:procanimation id="p" name="lift" start="0" end="2"><bmlt:parameter name="height" value="1.2"/></bmlt:procanimation><bmla:parametervaluechange id="c" target="b:p" paramId="height" start="0.5" end="0.6"><bmla:trajectory type="instant" targetValue="1.4"/></bmla:parametervaluechange></bml>"#
+    ))
+    .unwrap();
+    let y = |r: &mut Realizer, t: f64| r.tick(t).poses[0].pose.world(&skeleton).positions[wrist].y;
+    // at the end (α = 1) the wrist is at the height: the one changed to, not the one written
+    y(&mut r, 0.0);
+    y(&mut r, 0.4);
+    let end = y(&mut r, 2.0);
+    assert!((end - 1.4).abs() < 1e-3, "{end}");
+}
+
+#[test]
+fn a_procanimation_naming_a_unit_the_library_lacks_is_refused_with_the_reason() {
+    let Track { warnings, .. } = track(
+        &format!(
+            r#"<bml {BMLT} id="b"><bmlt:procanimation id="p" name="moonwalk" start="0"/></bml>"#
+        ),
+        "r_wrist",
+        0.5,
+    );
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("no procedural unit 'moonwalk'") && w.contains("lift")),
+        "{warnings:?}"
+    );
+}

@@ -1,7 +1,46 @@
 //! Analytic two-link inverse kinematics (A40): where to put the middle joint (elbow, knee) so that
 //! the end of the second link (wrist, ankle) reaches a target, bending toward a pole direction.
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
+
+use super::pose::{Pose, WorldPose};
+use super::skeleton::Skeleton;
+
+/// Where elbows bend: down and back.
+pub const ARM_POLE: Vec3 = Vec3::new(0.0, -1.0, -0.4);
+/// Where knees bend: forward.
+pub const LEG_POLE: Vec3 = Vec3::new(0.0, 0.0, 1.0);
+
+/// The rotation taking direction `from` to direction `to` (shortest arc).
+pub fn arc(from: Vec3, to: Vec3) -> Quat {
+    Quat::from_rotation_arc(from.normalize_or(Vec3::X), to.normalize_or(Vec3::X))
+}
+
+/// The local rotations of a limb's `root` and `mid` joints (shoulder and elbow, hip and knee) that
+/// put its `end` joint (wrist, ankle) at `goal` (the space of `world`), the middle joint bending
+/// toward `pole`; `world` is `pose`'s forward kinematics. `None` if `root` is the skeleton's root.
+pub fn place_limb(
+    skeleton: &Skeleton,
+    pose: &Pose,
+    world: &WorldPose,
+    [root, mid, end]: [usize; 3],
+    goal: Vec3,
+    pole: Vec3,
+) -> Option<(Quat, Quat)> {
+    let joints = skeleton.joints();
+    let (upper, lower) = (joints[mid].offset, joints[end].offset);
+    let s = world.positions[root];
+    let e = two_link(s, upper.length(), lower.length(), goal, pole);
+    // root: the upper link toward the middle joint
+    let parent = world.orientations[joints[root].parent?];
+    let current_s = world.orientations[root];
+    let local_s = parent.inverse() * arc(current_s * upper, e - s) * current_s;
+    // middle: the lower link toward the goal
+    let o_s = parent * local_s;
+    let current_e = o_s * pose.rotations[mid];
+    let local_e = o_s.inverse() * arc(current_e * lower, goal - e) * current_e;
+    Some((local_s, local_e))
+}
 
 /// The middle joint's position for links of lengths `upper` and `lower` from `root` to reach
 /// `target`, bending toward `pole`. A target out of reach is approached along the same line (the

@@ -12,7 +12,8 @@
 //! - [`pointing`]: pointing as real arm motion (two-link IK) toward world targets;
 //! - [`keyframe`]: BMLT keyframe animations (SkeletonInterpolator), slerped between exact keys;
 //! - [`gesture`]: gesture lexemes as arm motion from a bindings file (the default lexicon);
-//! - [`posture`]: posture stances (standing, sitting, crouching, lying) as leg and root motion.
+//! - [`posture`]: posture stances (standing, sitting, crouching, lying) as leg and root motion;
+//! - [`procedural`]: BMLT procanimation(gesture) as procedural units from data (expressions, IK).
 
 pub mod control;
 pub mod gaze;
@@ -23,6 +24,7 @@ pub mod motion;
 pub mod murml;
 pub mod pointing;
 pub mod posture;
+pub mod procedural;
 pub mod speech;
 pub mod timing_only;
 
@@ -38,8 +40,6 @@ pub const MOTION_KINDS: &[(&str, &str)] = &[
     (NS_BML, "faceShift"),
     (NS_CORE_EXT, "faceFacs"),
     (NS_BML, "locomotion"),
-    (NS_BMLT, "procanimation"),
-    (NS_BMLT, "procanimationgesture"),
     (NS_BMLT, "noise"),
     (NS_BMLT, "transition"),
     (NS_BMLT, "controller"),
@@ -78,6 +78,13 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(keyframe::KeyframeEngine::default()),
         &keys(&[(NS_BMLT, "keyframe")]),
+    );
+    r.register(
+        Box::new(procedural::ProceduralEngine::default()),
+        &keys(&[
+            (NS_BMLT, "procanimation"),
+            (NS_BMLT, "procanimationgesture"),
+        ]),
     );
     r.register(
         Box::new(posture::PostureEngine::default()),

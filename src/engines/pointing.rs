@@ -6,10 +6,10 @@
 //! (the preparation mirrored). `mode` picks the hand; without one, the hand on the target's side.
 //! A target the world does not have is refused when the behaviour starts.
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 use crate::bml::{Behaviour, BehaviourKind, Mode};
-use crate::body::ik::two_link;
+use crate::body::ik::{arc, place_limb, ARM_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Unit, Units};
@@ -32,11 +32,6 @@ pub struct PointingEngine {
     units: Units<PointingUnit>,
 }
 
-/// The rotation taking direction `from` to direction `to` (shortest arc).
-fn arc(from: Vec3, to: Vec3) -> Quat {
-    Quat::from_rotation_arc(from.normalize_or(Vec3::X), to.normalize_or(Vec3::X))
-}
-
 /// Points the `side` arm (`l` or `r`) of `pose` at `target`, `w` of the way.
 fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32) -> Option<()> {
     let j = |n: &str| skeleton.joint(&format!("{side}_{n}"));
@@ -48,23 +43,16 @@ fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32)
     let s = world.positions[shoulder];
     let reach = (upper.length() + lower.length()) * REACH;
     let goal = s + (target - s).normalize_or(Vec3::Z) * reach;
-    let e = two_link(
-        s,
-        upper.length(),
-        lower.length(),
+    // shoulder and elbow put the wrist at the goal, the elbow bending down and back
+    let (local_s, local_e) = place_limb(
+        skeleton,
+        pose,
+        &world,
+        [shoulder, elbow, wrist],
         goal,
-        Vec3::new(0.0, -1.0, -0.4),
-    );
-    // shoulder: the upper arm toward the elbow
-    let parent = world.orientations[joints[shoulder].parent?];
-    let current_s = world.orientations[shoulder];
-    let q_s = arc(current_s * upper, e - s);
-    let local_s = parent.inverse() * q_s * current_s;
-    // elbow: the forearm toward the wrist goal
-    let o_s = parent * local_s;
-    let current_e = o_s * pose.rotations[elbow];
-    let q_e = arc(current_e * lower, goal - e);
-    let local_e = o_s.inverse() * q_e * current_e;
+        ARM_POLE,
+    )?;
+    let o_s = world.orientations[joints[shoulder].parent?] * local_s;
     // wrist: the index finger (from its base, along its bones) toward the target; the base
     // moves with the hand, so a few rounds settle it
     let finger = match (j("index2"), j("index3")) {

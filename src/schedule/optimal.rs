@@ -31,7 +31,7 @@ use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
 };
 use crate::bml::{extract, Block, Constraint, Relation};
-use crate::engine::timing::{Flexibility, TimingModels};
+use crate::engine::timing::{Flexibility, TimingModels, MIN_DURATION};
 use crate::feedback::KnownWarning;
 
 /// Cost of one second of non-uniform phase change relative to one second of uniform stretch: above
@@ -109,9 +109,15 @@ fn drop_one(
             reason: format!("required behaviours cannot satisfy: {text}"),
         });
     };
+    // S58/A58: constraints that would stretch a behaviour beyond its bounds make its timing invalid
+    let warning = if involved.bounded.contains(&i) {
+        KnownWarning::InvalidTiming
+    } else {
+        KnownWarning::CannotSatisfyConstraints
+    };
     dropped.push(Dropped {
         behaviour: items[i].beh.id.clone(),
-        warning: KnownWarning::CannotSatisfyConstraints,
+        warning,
         reason: format!(
             "'{}' dropped: these constraints contradict each other: {text}",
             items[i].beh.id
@@ -127,6 +133,8 @@ struct Involved {
     texts: Vec<String>,
     /// For each conflicting explicit constraint, the item on its left side.
     owners: Vec<usize>,
+    /// Items whose own minimum or maximum duration is part of the conflict.
+    bounded: Vec<usize>,
 }
 
 impl Involved {
@@ -165,10 +173,17 @@ fn hard_system(items: &[Item], links: &[Link]) -> (DiffSystem, Vec<usize>) {
             true,
         ) = (it.model.flexibility, it.len == keys.len())
         {
-            let end = first + it.len - 1;
-            s.at_least(end, first, min_duration, tag); // S5
+            // real duration bounds have their own tags: a conflict through them is invalid
+            // timing; the least duration of every model only keeps the end after the start
+            let (end, bound) = (first + it.len - 1, links.len() + items.len() + i);
+            let min_tag = if min_duration > MIN_DURATION {
+                bound
+            } else {
+                tag
+            };
+            s.at_least(end, first, min_duration, min_tag); // S5
             if max_duration.is_finite() {
-                s.at_most(end, first, max_duration, tag);
+                s.at_most(end, first, max_duration, bound);
             }
         }
     }
@@ -195,6 +210,7 @@ fn feasible(items: &[Item], links: &[Link], constraints: &[Constraint]) -> Resul
                 items: Vec::new(),
                 texts: Vec::new(),
                 owners: Vec::new(),
+                bounded: Vec::new(),
             };
             for tag in conflict.tags() {
                 if tag < links.len() {
@@ -211,12 +227,29 @@ fn feasible(items: &[Item], links: &[Link], constraints: &[Constraint]) -> Resul
                             involved.items.push(i);
                         }
                     }
-                } else {
+                } else if tag < links.len() + items.len() {
                     let i = tag - links.len();
                     involved
                         .texts
                         .push(format!("the timing of '{}'", items[i].beh.id));
                     involved.items.push(i);
+                } else {
+                    let i = tag - links.len() - items.len();
+                    if let Flexibility::Stretchable {
+                        min_duration,
+                        max_duration,
+                    } = items[i].model.flexibility
+                    {
+                        let text = format!(
+                            "the duration of '{}' ({} to {} s)",
+                            items[i].beh.id, min_duration, max_duration
+                        );
+                        if !involved.texts.contains(&text) {
+                            involved.texts.push(text);
+                        }
+                    }
+                    involved.items.push(i);
+                    involved.bounded.push(i);
                 }
             }
             involved.items.sort_unstable();

@@ -1,0 +1,805 @@
+//! Procedural motion units from data (A37, A40–A42): joint rotations and end-effector positions
+//! given as expressions in the unit's canonical time α ∈ [0, 1] and named parameters, compiled
+//! once (the `fasteval` crate) and evaluated every frame.
+//!
+//! A library file (`fixtures/procedural/units.json`, embedded as the default library) names each
+//! unit with its keys (sync name → α), its preferred/min/max duration, default parameters,
+//! per-joint rotations (`[z, x, y]` Euler degrees, as in BVH and the gesture lexicon) and
+//! end effectors (wrist or ankle positions in metres, reached by analytic two-link IK):
+//!
+//! ```json
+//! {"units": {"lift": {
+//!   "parameters": {"height": 1.2},
+//!   "keys": {"start": 0, "stroke": 0.5, "end": 1},
+//!   "duration": {"preferred": 1.0, "min": 0.5, "max": 3.0},
+//!   "rotations": {"r_wrist": ["0", "0", "20 * sin(pi * t)"]},
+//!   "effectors": {"r_wrist": {"frame": "body", "position": ["-0.3", "height * t", "0.3"]}}
+//! }}}
+//! ```
+//!
+//! Expressions have arithmetic, comparisons, `&&`/`||`, `sin`, `cos`, `tan`, `asin`, …, `abs`,
+//! `min`, `max`, `floor`, `pi` (or `pi()`), the unit's time as `t` or `alpha`, its parameters by
+//! name, and the macros `if(c, a, b)`, `hermite(p0, p1, m0, m1, s)`, `tcb(p0, p1, p2, p3, tension,
+//! continuity, bias, s)` (Kochanek–Bartels between `p1` and `p2`) and `perlin(x)` / `perlin(x,
+//! seed)` (1-D gradient noise in [−1, 1], zero at integers).
+//!
+//! Time is warped linearly between keys (A37): at each key's scheduled time α is exactly the key's
+//! α. Effector `frame` is `body` (the character's space, as [`Pose::world`] gives it) or `limb`
+//! (relative to the limb's root joint: the shoulder for a wrist, the hip for an ankle). A mirrored
+//! unit (A42) swaps left and right joints first, then reflects every rotation and position in the
+//! body's mid-sagittal plane (x ↦ −x); mirroring twice gives the unit back.
+//!
+//! The [`ProceduralEngine`] realizes BMLT `procanimation` and `procanimationgesture` with units of
+//! its library (by `name`, or by the stem of `fileName`), `<bmlt:parameter>` children overriding
+//! the defaults; every parameter can change while the unit runs (`parametervaluechange`).
+
+use std::collections::HashMap;
+use std::fmt;
+use std::sync::Arc;
+
+use fasteval::{Compiler, EvalNamespace, Evaler, Instruction, Slab};
+use glam::{EulerRot, Quat, Vec3};
+
+use crate::bml::{Behaviour, BehaviourKind, Id, Param};
+use crate::body::ik::{place_limb, ARM_POLE, LEG_POLE};
+use crate::body::{Pose, Skeleton};
+use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
+use crate::engine::{Engine, EngineError, Unit, UnitKey, Units};
+use crate::schedule::SyncName;
+use crate::world::World;
+
+/// The embedded default library.
+const DEFAULT: &str = include_str!("../../fixtures/procedural/units.json");
+
+/// One compiled expression.
+struct Expr {
+    text: String,
+    slab: Slab,
+    code: Instruction,
+}
+
+impl fmt::Debug for Expr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:?}", self.text)
+    }
+}
+
+impl Expr {
+    fn compile(text: &str) -> Result<Expr, String> {
+        if text.contains("print") {
+            return Err(format!("'{text}': print is not allowed"));
+        }
+        let mut slab = Slab::new();
+        let parsed = fasteval::Parser::new()
+            .parse(text, &mut slab.ps)
+            .map_err(|e| format!("'{text}' is not an expression: {e:?}"))?;
+        let code = parsed.from(&slab.ps).compile(&slab.ps, &mut slab.cs);
+        Ok(Expr {
+            text: text.to_string(),
+            slab,
+            code,
+        })
+    }
+
+    fn eval(&self, ns: &mut Names) -> Result<f64, String> {
+        match self.code.eval(&self.slab, ns) {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(v) => Err(format!("'{}' gives {v}", self.text)),
+            Err(e) => Err(format!("'{}': {e:?}", self.text)),
+        }
+    }
+}
+
+/// What expressions can name: the unit's time, its parameters and the macros.
+struct Names<'a> {
+    alpha: f64,
+    params: &'a [(String, f64)],
+}
+
+impl EvalNamespace for Names<'_> {
+    fn lookup(&mut self, name: &str, args: Vec<f64>, _keybuf: &mut String) -> Option<f64> {
+        match (name, args.as_slice()) {
+            ("t" | "alpha", []) => Some(self.alpha),
+            ("pi", []) => Some(std::f64::consts::PI),
+            ("if", &[c, a, b]) => Some(if c != 0.0 { a } else { b }),
+            ("hermite", &[p0, p1, m0, m1, s]) => Some(hermite(p0, p1, m0, m1, s)),
+            ("tcb", &[p0, p1, p2, p3, t, c, b, s]) => Some(tcb([p0, p1, p2, p3], t, c, b, s)),
+            ("perlin", &[x]) => Some(perlin(x, 0.0)),
+            ("perlin", &[x, seed]) => Some(perlin(x, seed)),
+            (_, []) => self.params.iter().find(|p| p.0 == name).map(|p| p.1),
+            _ => None,
+        }
+    }
+}
+
+/// The cubic Hermite curve from `p0` (tangent `m0`) to `p1` (tangent `m1`) at `s` ∈ [0, 1].
+pub fn hermite(p0: f64, p1: f64, m0: f64, m1: f64, s: f64) -> f64 {
+    let (s2, s3) = (s * s, s * s * s);
+    (2.0 * s3 - 3.0 * s2 + 1.0) * p0
+        + (s3 - 2.0 * s2 + s) * m0
+        + (-2.0 * s3 + 3.0 * s2) * p1
+        + (s3 - s2) * m1
+}
+
+/// The Kochanek–Bartels (TCB) spline segment from `p[1]` to `p[2]` at `s` ∈ [0, 1], with `p[0]` and
+/// `p[3]` as neighbours; tension, continuity and bias 0 give Catmull–Rom.
+pub fn tcb(p: [f64; 4], tension: f64, continuity: f64, bias: f64, s: f64) -> f64 {
+    let (t, c, b) = (tension, continuity, bias);
+    let out1 = (1.0 - t) * (1.0 + b) * (1.0 + c) / 2.0 * (p[1] - p[0])
+        + (1.0 - t) * (1.0 - b) * (1.0 - c) / 2.0 * (p[2] - p[1]);
+    let in2 = (1.0 - t) * (1.0 + b) * (1.0 - c) / 2.0 * (p[2] - p[1])
+        + (1.0 - t) * (1.0 - b) * (1.0 + c) / 2.0 * (p[3] - p[2]);
+    hermite(p[1], p[2], out1, in2, s)
+}
+
+/// One-dimensional gradient (Perlin) noise: smooth (C²), zero at every integer, within [−1, 1];
+/// `seed` picks an independent sequence.
+pub fn perlin(x: f64, seed: f64) -> f64 {
+    // a gradient in [-1, 1] per lattice point, from an integer hash of (point, seed)
+    let gradient = |i: f64| {
+        let mut h = (i as i64 as u64) ^ (seed.to_bits().rotate_left(17));
+        h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        h ^= h >> 31;
+        (h >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    };
+    let i = x.floor();
+    let f = x - i;
+    let fade = f * f * f * (f * (f * 6.0 - 15.0) + 10.0);
+    let (a, b) = (gradient(i) * f, gradient(i + 1.0) * (f - 1.0));
+    // the two ramps meet at most 0.5 apart: doubling keeps the result within [-1, 1]
+    2.0 * (a + fade * (b - a))
+}
+
+/// Where an end effector's position is measured from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Frame {
+    /// The character's space (as [`Pose::world`] gives it).
+    Body,
+    /// The limb's root joint (shoulder, hip), axes of the character's space.
+    Limb,
+}
+
+#[derive(Debug)]
+struct Effector {
+    joint: String,
+    frame: Frame,
+    position: [Expr; 3],
+}
+
+/// A procedural unit from a library (see the module documentation).
+#[derive(Debug)]
+pub struct ProcUnit {
+    /// Its name in the library.
+    pub name: String,
+    /// Default parameters, by name.
+    pub params: Vec<(String, f64)>,
+    /// (sync name, α), α increasing from 0 at `start` to 1 at `end`.
+    pub keys: Vec<(Id, f64)>,
+    /// Preferred, minimum and maximum duration (seconds).
+    pub duration: (f64, f64, f64),
+    rotations: Vec<(String, [Expr; 3])>,
+    effectors: Vec<Effector>,
+}
+
+fn number(v: &serde_json::Value, what: &str) -> Result<f64, String> {
+    v.as_f64()
+        .filter(|x| x.is_finite())
+        .ok_or_else(|| format!("{what} must be a number"))
+}
+
+fn three_exprs(v: &serde_json::Value, what: &str) -> Result<[Expr; 3], String> {
+    let list = v
+        .as_array()
+        .filter(|a| a.len() == 3)
+        .ok_or_else(|| format!("{what}: three expressions"))?;
+    let one = |i: usize| -> Result<Expr, String> {
+        match &list[i] {
+            serde_json::Value::String(s) => Expr::compile(s),
+            serde_json::Value::Number(n) => Expr::compile(&n.to_string()),
+            _ => Err(format!("{what}: an expression is a string or a number")),
+        }
+        .map_err(|e| format!("{what}: {e}"))
+    };
+    Ok([one(0)?, one(1)?, one(2)?])
+}
+
+impl ProcUnit {
+    fn from_json(name: &str, v: &serde_json::Value) -> Result<ProcUnit, String> {
+        let at = |what: &str| format!("unit '{name}': {what}");
+        let mut params = Vec::new();
+        if let Some(p) = v.get("parameters") {
+            let p = p
+                .as_object()
+                .ok_or_else(|| at("parameters must be an object"))?;
+            for (k, x) in p {
+                params.push((k.clone(), number(x, &at(&format!("parameter '{k}'")))?));
+            }
+        }
+        let keys_v = v["keys"]
+            .as_object()
+            .ok_or_else(|| at("no \"keys\" object (sync name → α)"))?;
+        let mut keys = Vec::new();
+        for (k, x) in keys_v {
+            keys.push((Id::new(k), number(x, &at(&format!("key '{k}'")))?));
+        }
+        let ordered = keys.windows(2).all(|w| w[1].1 >= w[0].1);
+        let ends = keys.first().is_some_and(|k| k.0 == "start" && k.1 == 0.0)
+            && keys.last().is_some_and(|k| k.0 == "end" && k.1 == 1.0);
+        if !ordered || !ends || keys.len() < 2 {
+            return Err(at(
+                "keys must go from start at 0 to end at 1, α not decreasing",
+            ));
+        }
+        let d = &v["duration"];
+        let preferred = number(&d["preferred"], &at("duration.preferred"))?;
+        let min = d
+            .get("min")
+            .map_or(Ok(MIN_DURATION), |x| number(x, &at("duration.min")))?;
+        let max = d
+            .get("max")
+            .map_or(Ok(f64::INFINITY), |x| number(x, &at("duration.max")))?;
+        if !(min.max(MIN_DURATION) <= preferred && preferred <= max) {
+            return Err(at("duration: min ≤ preferred ≤ max, all positive"));
+        }
+        let mut rotations = Vec::new();
+        if let Some(r) = v.get("rotations") {
+            let r = r
+                .as_object()
+                .ok_or_else(|| at("rotations must be an object"))?;
+            for (joint, e) in r {
+                rotations.push((
+                    joint.clone(),
+                    three_exprs(e, &at(&format!("rotation of {joint}")))?,
+                ));
+            }
+        }
+        let mut effectors = Vec::new();
+        if let Some(r) = v.get("effectors") {
+            let r = r
+                .as_object()
+                .ok_or_else(|| at("effectors must be an object"))?;
+            for (joint, e) in r {
+                let frame = match e["frame"].as_str().unwrap_or("body") {
+                    "body" => Frame::Body,
+                    "limb" => Frame::Limb,
+                    other => {
+                        return Err(at(&format!(
+                            "effector {joint}: frame '{other}' (body or limb)"
+                        )))
+                    }
+                };
+                let position = three_exprs(&e["position"], &at(&format!("effector {joint}")))?;
+                effectors.push(Effector {
+                    joint: joint.clone(),
+                    frame,
+                    position,
+                });
+            }
+        }
+        let unit = ProcUnit {
+            name: name.to_string(),
+            params,
+            keys,
+            duration: (preferred, min.max(MIN_DURATION), max),
+            rotations,
+            effectors,
+        };
+        // every name an expression uses must be known: try both ends with the defaults
+        for alpha in [0.0, 1.0] {
+            unit.evaluate(alpha, &unit.params).map_err(|e| at(&e))?;
+        }
+        Ok(unit)
+    }
+
+    /// The timing model: keys at α × the preferred duration, stretchable within [min, max].
+    pub fn timing(&self) -> TimingModel {
+        let (preferred, min, max) = self.duration;
+        TimingModel {
+            keys: self
+                .keys
+                .iter()
+                .map(|(name, alpha)| SyncKey {
+                    name: name.clone(),
+                    at: alpha * preferred,
+                })
+                .collect(),
+            flexibility: Flexibility::Stretchable {
+                min_duration: min,
+                max_duration: max,
+            },
+            persistent: false,
+        }
+    }
+
+    /// Every rotation (radians, z x y) and effector position at `alpha` with `params`.
+    fn evaluate(&self, alpha: f64, params: &[(String, f64)]) -> Result<Evaluated, String> {
+        let mut names = Names { alpha, params };
+        let mut three = |e: &[Expr; 3]| -> Result<[f64; 3], String> {
+            Ok([
+                e[0].eval(&mut names)?,
+                e[1].eval(&mut names)?,
+                e[2].eval(&mut names)?,
+            ])
+        };
+        let rotations = self
+            .rotations
+            .iter()
+            .map(|(_, e)| three(e))
+            .collect::<Result<_, _>>()?;
+        let positions = self
+            .effectors
+            .iter()
+            .map(|f| three(&f.position))
+            .collect::<Result<_, _>>()?;
+        Ok(Evaluated {
+            rotations,
+            positions,
+        })
+    }
+
+    /// Checks parameter overrides against the unit's parameters.
+    pub fn parameters(&self, overrides: &[Param]) -> Result<Vec<(String, f64)>, String> {
+        let mut params = self.params.clone();
+        for p in overrides {
+            let Some(slot) = params.iter_mut().find(|x| x.0 == p.name) else {
+                let known: Vec<&str> = self.params.iter().map(|x| x.0.as_str()).collect();
+                return Err(format!(
+                    "unit '{}' has no parameter '{}' (it has {known:?})",
+                    self.name, p.name
+                ));
+            };
+            slot.1 = p
+                .value
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("parameter '{}' = '{}' is not a number", p.name, p.value))?;
+        }
+        Ok(params)
+    }
+
+    /// Applies the unit at `alpha` to `pose`: rotations first, then effectors by IK. `mirrored`
+    /// swaps left and right and reflects in the mid-sagittal plane (A42).
+    pub fn apply(
+        &self,
+        alpha: f64,
+        params: &[(String, f64)],
+        mirrored: bool,
+        skeleton: &Skeleton,
+        pose: &mut Pose,
+    ) -> Result<(), String> {
+        let v = self.evaluate(alpha.clamp(0.0, 1.0), params)?;
+        for ((joint, _), [z, x, y]) in self.rotations.iter().zip(&v.rotations) {
+            let q = Quat::from_euler(
+                EulerRot::ZXY,
+                z.to_radians() as f32,
+                x.to_radians() as f32,
+                y.to_radians() as f32,
+            );
+            let (name, q) = if mirrored {
+                (mirror_name(joint), mirror_rotation(q))
+            } else {
+                (joint.clone(), q)
+            };
+            if let Some(i) = skeleton.joint(&name) {
+                pose.rotations[i] = q;
+            }
+        }
+        for (f, p) in self.effectors.iter().zip(&v.positions) {
+            let mut goal = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+            let name = if mirrored {
+                goal.x = -goal.x;
+                mirror_name(&f.joint)
+            } else {
+                f.joint.clone()
+            };
+            reach(skeleton, pose, &name, f.frame, goal);
+        }
+        Ok(())
+    }
+}
+
+struct Evaluated {
+    rotations: Vec<[f64; 3]>,
+    positions: Vec<[f64; 3]>,
+}
+
+/// The other side's joint name: `l_…` ↔ `r_…`; other joints are their own mirror image.
+pub fn mirror_name(joint: &str) -> String {
+    if let Some(rest) = joint.strip_prefix("r_") {
+        format!("l_{rest}")
+    } else if let Some(rest) = joint.strip_prefix("l_") {
+        format!("r_{rest}")
+    } else {
+        joint.to_string()
+    }
+}
+
+/// A rotation reflected in the mid-sagittal (y-z) plane.
+pub fn mirror_rotation(q: Quat) -> Quat {
+    Quat::from_xyzw(q.x, -q.y, -q.z, q.w)
+}
+
+/// Puts end joint `name` (a wrist or an ankle) at `goal` by two-link IK of its limb.
+fn reach(skeleton: &Skeleton, pose: &mut Pose, name: &str, frame: Frame, goal: Vec3) {
+    let Some(end) = skeleton.joint(name) else {
+        return;
+    };
+    let joints = skeleton.joints();
+    let Some(mid) = joints[end].parent else {
+        return;
+    };
+    let Some(root) = joints[mid].parent else {
+        return;
+    };
+    let world = pose.world(skeleton);
+    let goal = match frame {
+        Frame::Body => goal,
+        Frame::Limb => world.positions[root] + goal,
+    };
+    let pole = if name.contains("talocrural") || name.contains("ankle") {
+        LEG_POLE
+    } else {
+        ARM_POLE
+    };
+    if let Some((r, m)) = place_limb(skeleton, pose, &world, [root, mid, end], goal, pole) {
+        pose.rotations[root] = r;
+        pose.rotations[mid] = m;
+    }
+}
+
+/// α at global time `t` for a unit whose keys are at `syncs` (linear warping between keys, A37):
+/// exactly each key's α at its time, monotone in between, clamped to [0, 1].
+pub fn alpha_at(keys: &[(Id, f64)], syncs: &[(SyncName, f64)], t: f64) -> f64 {
+    let mut prev: Option<(f64, f64)> = None;
+    for (name, a) in keys {
+        let Some(&(_, time)) = syncs.iter().find(|s| s.0 == *name) else {
+            continue;
+        };
+        match prev {
+            None if t <= time => return *a,
+            Some((t0, a0)) if t <= time => {
+                return if time > t0 {
+                    a0 + (t - t0) / (time - t0) * (a - a0)
+                } else {
+                    *a
+                };
+            }
+            _ => prev = Some((time, *a)),
+        }
+    }
+    prev.map_or(0.0, |p| p.1)
+}
+
+/// Procedural units by name.
+#[derive(Debug, Clone, Default)]
+pub struct Library {
+    units: HashMap<String, Arc<ProcUnit>>,
+}
+
+impl Library {
+    /// The embedded default library.
+    pub fn default_library() -> Library {
+        static LIBRARY: std::sync::LazyLock<Library> = std::sync::LazyLock::new(|| {
+            Library::from_json(DEFAULT).expect("the embedded procedural library is valid")
+        });
+        LIBRARY.clone()
+    }
+
+    /// Reads a library file: `{"units": {NAME: UNIT, …}}` (see the module documentation).
+    pub fn from_json(text: &str) -> Result<Library, String> {
+        let v: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
+        let list = v["units"].as_object().ok_or("no \"units\" object")?;
+        let mut units = HashMap::new();
+        for (name, u) in list {
+            units.insert(name.clone(), Arc::new(ProcUnit::from_json(name, u)?));
+        }
+        Ok(Library { units })
+    }
+
+    /// The unit called `name`.
+    pub fn get(&self, name: &str) -> Option<&Arc<ProcUnit>> {
+        self.units.get(name)
+    }
+
+    /// Unit names, sorted.
+    pub fn names(&self) -> Vec<&str> {
+        let mut n: Vec<&str> = self.units.keys().map(String::as_str).collect();
+        n.sort_unstable();
+        n
+    }
+
+    /// The unit a `procanimation` or `procanimationgesture` asks for (by `name`, else by the stem
+    /// of `fileName`), with its parameters; `None` for other behaviours.
+    fn for_behaviour(&self, b: &Behaviour) -> Option<Result<Running, String>> {
+        let a = match &b.kind {
+            BehaviourKind::ProcAnimation(a) | BehaviourKind::ProcAnimationGesture(a) => a,
+            _ => return None,
+        };
+        let name = a.name.clone().or_else(|| {
+            a.file_name.as_deref().map(|f| {
+                let base = f.rsplit(['/', '\\']).next().unwrap_or(f);
+                base.split('.').next().unwrap_or(base).to_string()
+            })
+        });
+        let Some(name) = name else {
+            return Some(Err("a procanimation needs a name or fileName".into()));
+        };
+        Some(match self.get(&name) {
+            None => Err(format!(
+                "no procedural unit '{name}' (the library has {:?})",
+                self.names()
+            )),
+            Some(u) => u.parameters(&a.params).map(|params| Running {
+                unit: u.clone(),
+                params,
+            }),
+        })
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Running {
+    unit: Arc<ProcUnit>,
+    params: Vec<(String, f64)>,
+}
+
+/// The procedural engine (see the module documentation).
+#[derive(Debug)]
+pub struct ProceduralEngine {
+    library: Library,
+    units: Units<Running>,
+}
+
+impl Default for ProceduralEngine {
+    fn default() -> Self {
+        ProceduralEngine::new(Library::default_library())
+    }
+}
+
+impl ProceduralEngine {
+    /// An engine playing the units of `library`.
+    pub fn new(library: Library) -> Self {
+        ProceduralEngine {
+            library,
+            units: Units::new(),
+        }
+    }
+}
+
+impl Engine for ProceduralEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!("procedural");
+    crate::units_interrupt!(crate::engine::stop_now);
+
+    fn name(&self) -> &'static str {
+        "procedural"
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        match self.library.for_behaviour(behaviour)? {
+            Ok(r) => Some(r.unit.timing()),
+            // refused with the reason when it starts
+            Err(_) => Some(TimingModel::stretchable(&[("start", 0.0), ("end", 1.0)])),
+        }
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let running = self
+            .library
+            .for_behaviour(unit.behaviour)
+            .ok_or_else(|| EngineError("the procedural engine realizes bmlt:procanimation".into()))?
+            .map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
+        self.units.add(unit, running);
+        Ok(())
+    }
+
+    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
+        let r = self.units.get(key)?;
+        r.params.iter().find(|p| p.0 == name).map(|p| p.1)
+    }
+
+    fn set_parameter(
+        &mut self,
+        key: &UnitKey,
+        name: &str,
+        value: f64,
+        _now: f64,
+    ) -> Result<Option<Vec<f64>>, EngineError> {
+        let (_, r) = self
+            .units
+            .get_mut(key)
+            .ok_or_else(|| EngineError(format!("{key} is not running")))?;
+        match r.params.iter_mut().find(|p| p.0 == name) {
+            Some(p) if value.is_finite() => {
+                p.1 = value;
+                Ok(None)
+            }
+            Some(_) => Err(EngineError(format!(
+                "{key}: {name} = {value} is not finite"
+            ))),
+            None => Err(EngineError(format!(
+                "{key}: unit '{}' has no parameter '{name}'",
+                r.unit.name
+            ))),
+        }
+    }
+
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
+        for (syncs, r) in self.units.all() {
+            let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
+            else {
+                continue;
+            };
+            // active from start to end (A38); the end frame shows α = 1
+            if now < start || now > end {
+                continue;
+            }
+            let alpha = alpha_at(&r.unit.keys, syncs, now);
+            // parameters were checked when the unit was added and on every change; an
+            // expression that still fails (a division by zero) leaves the pose as it is
+            let _ = r.unit.apply(alpha, &r.params, false, skeleton, pose);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ids(v: &[(&'static str, f64)]) -> Vec<(Id, f64)> {
+        v.iter().map(|&(n, t)| (Id::new_static(n), t)).collect()
+    }
+
+    #[test]
+    fn a37_time_warps_linearly_and_hits_every_key_exactly() {
+        let keys = ids(&[("start", 0.0), ("stroke", 0.4), ("end", 1.0)]);
+        let syncs = ids(&[("start", 2.0), ("stroke", 2.3), ("end", 4.0)]);
+        for (k, s) in keys.iter().zip(&syncs) {
+            assert!((alpha_at(&keys, &syncs, s.1) - k.1).abs() < 1e-12);
+        }
+        assert!((alpha_at(&keys, &syncs, 2.15) - 0.2).abs() < 1e-12);
+        assert!((alpha_at(&keys, &syncs, 3.15) - 0.7).abs() < 1e-12);
+        let mut last = -1.0;
+        for i in 0..=300 {
+            let a = alpha_at(&keys, &syncs, 1.5 + i as f64 * 0.01);
+            assert!(a >= last && (0.0..=1.0).contains(&a));
+            last = a;
+        }
+    }
+
+    #[test]
+    fn a41_macros_match_their_definitions() {
+        // Hermite: ends and end tangents
+        assert_eq!(hermite(1.0, 3.0, 0.5, -2.0, 0.0), 1.0);
+        assert_eq!(hermite(1.0, 3.0, 0.5, -2.0, 1.0), 3.0);
+        let d = |f: &dyn Fn(f64) -> f64, s: f64| (f(s + 1e-6) - f(s - 1e-6)) / 2e-6;
+        assert!((d(&|s| hermite(1.0, 3.0, 0.5, -2.0, s), 0.0) - 0.5).abs() < 1e-6);
+        assert!((d(&|s| hermite(1.0, 3.0, 0.5, -2.0, s), 1.0) + 2.0).abs() < 1e-6);
+        // TCB with zero parameters is Catmull-Rom: the tangent at p1 is (p2 - p0) / 2
+        let p = [0.0, 1.0, 4.0, 5.0];
+        assert_eq!(tcb(p, 0.0, 0.0, 0.0, 0.0), 1.0);
+        assert_eq!(tcb(p, 0.0, 0.0, 0.0, 1.0), 4.0);
+        assert!((d(&|s| tcb(p, 0.0, 0.0, 0.0, s), 0.0) - 2.0).abs() < 1e-6);
+        // full tension: zero tangents
+        assert!(d(&|s| tcb(p, 1.0, 0.0, 0.0, s), 0.0).abs() < 1e-6);
+        // Perlin: zero at integers, bounded, continuous, different seeds differ
+        let mut max: f64 = 0.0;
+        for i in 0..4000 {
+            let x = i as f64 * 0.0137 - 20.0;
+            let v = perlin(x, 0.0);
+            assert!(v.abs() <= 1.0);
+            assert!((perlin(x + 1e-7, 0.0) - v).abs() < 1e-5);
+            max = max.max(v.abs());
+        }
+        assert!(max > 0.3, "the noise moves ({max})");
+        for i in -5..5 {
+            assert_eq!(perlin(i as f64, 3.0), 0.0);
+        }
+        assert_ne!(perlin(0.5, 1.0), perlin(0.5, 2.0));
+    }
+
+    #[test]
+    fn a41_expressions_have_trig_if_parameters_and_alpha() {
+        let e = Expr::compile("if(t < 0.5, a * sin(pi * t), cos(pi) + max(a, 2)) + alpha").unwrap();
+        let params = [("a".to_string(), 3.0)];
+        let at = |t: f64| {
+            e.eval(&mut Names {
+                alpha: t,
+                params: &params,
+            })
+            .unwrap()
+        };
+        assert!((at(0.25) - (3.0 * (std::f64::consts::PI * 0.25).sin() + 0.25)).abs() < 1e-12);
+        assert!((at(0.75) - (-1.0 + 3.0 + 0.75)).abs() < 1e-12);
+        let unknown = Expr::compile("b + 1").unwrap();
+        assert!(unknown
+            .eval(&mut Names {
+                alpha: 0.0,
+                params: &params
+            })
+            .is_err());
+        assert!(Expr::compile("print(1)").is_err());
+        assert!(Expr::compile("1 +").is_err());
+    }
+
+    #[test]
+    fn a42_a_mirrored_unit_is_the_reflected_motion_on_the_other_side_and_mirrors_back() {
+        let skeleton = Skeleton::adult();
+        let lib = Library::default_library();
+        let reflect = |v: Vec3| Vec3::new(-v.x, v.y, v.z);
+        for (name, end) in [
+            ("lift", "wrist"),
+            ("wave", "wrist"),
+            ("foot_lift", "talocrural"),
+        ] {
+            let u = lib.get(name).unwrap();
+            for alpha in [0.1, 0.5, 0.9] {
+                let (mut plain, mut mirrored) = (Pose::rest(&skeleton), Pose::rest(&skeleton));
+                u.apply(alpha, &u.params, false, &skeleton, &mut plain)
+                    .unwrap();
+                u.apply(alpha, &u.params, true, &skeleton, &mut mirrored)
+                    .unwrap();
+                let (wp, wm) = (plain.world(&skeleton), mirrored.world(&skeleton));
+                for side in ["l", "r"] {
+                    let other = if side == "l" { "r" } else { "l" };
+                    let a = skeleton.joint(&format!("{side}_{end}")).unwrap();
+                    let b = skeleton.joint(&format!("{other}_{end}")).unwrap();
+                    let d = (wm.positions[b] - reflect(wp.positions[a])).length();
+                    assert!(d < 1e-3, "{name} at {alpha}: {side} {d}");
+                }
+            }
+        }
+        // the rotation of a mirrored joint, and mirroring twice
+        let q = Quat::from_euler(EulerRot::ZXY, 0.3, -0.2, 0.7);
+        assert!(mirror_rotation(mirror_rotation(q)).angle_between(q) < 1e-6);
+        assert_eq!(mirror_name(&mirror_name("r_elbow")), "r_elbow");
+        assert_eq!(mirror_name("l_hip"), "r_hip");
+        assert_eq!(mirror_name("vl5"), "vl5");
+    }
+
+    #[test]
+    fn bad_units_are_refused_with_a_reason() {
+        let bad =
+            |u: &str| Library::from_json(&format!(r#"{{"units": {{"u": {u}}}}}"#)).unwrap_err();
+        let keys = r#""keys": {"start": 0, "end": 1}, "duration": {"preferred": 1}"#;
+        assert!(
+            bad(r#"{"keys": {"start": 0.2, "end": 1}, "duration": {"preferred": 1}}"#)
+                .contains("keys must go from start at 0")
+        );
+        assert!(bad(&format!(
+            r#"{{{keys}, "rotations": {{"r_elbow": ["x", "0", "0"]}}}}"#
+        ))
+        .contains("'x'"));
+        assert!(bad(&format!(
+            r#"{{{keys}, "rotations": {{"r_elbow": ["1", "0"]}}}}"#
+        ))
+        .contains("three expressions"));
+        assert!(bad(
+            r#"{"keys": {"start": 0, "end": 1}, "duration": {"preferred": 1, "max": 0.5}}"#
+        )
+        .contains("min ≤ preferred ≤ max"));
+        assert!(bad(&format!(
+            r#"{{{keys}, "effectors": {{"r_wrist": {{"frame": "moon", "position": [0, 0, 0]}}}}}}"#
+        ))
+        .contains("frame 'moon'"));
+        let lib = Library::default_library();
+        let u = lib.get("lift").unwrap();
+        let p = |n: &str, v: &str| Param {
+            name: n.into(),
+            value: v.into(),
+        };
+        assert!(u
+            .parameters(&[p("nope", "1")])
+            .unwrap_err()
+            .contains("no parameter 'nope'"));
+        assert!(u
+            .parameters(&[p("height", "high")])
+            .unwrap_err()
+            .contains("not a number"));
+    }
+}
