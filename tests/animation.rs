@@ -665,3 +665,52 @@ fn a_procanimation_naming_a_unit_the_library_lacks_is_refused_with_the_reason() 
         "{warnings:?}"
     );
 }
+
+#[test]
+fn noise_moves_its_joint_smoothly_within_its_amplitude_and_fades_in_and_out() {
+    let skeleton = Skeleton::adult();
+    let skull = skeleton.joint("skullbase").unwrap();
+    let mut r = Realizer::new();
+    r.perform_bml(&format!(
+        r#"<bml {BMLT} id="b"><bmlt:noise id="n" type="perlin" joint="skullbase" start="1" end="6"><bmlt:parameter name="baseamplitudex" value="3"/><bmlt:parameter name="basefreqx" value="0.7"/></bmlt:noise></bml>"#
+    ))
+    .unwrap();
+    let rest = glam::Quat::IDENTITY;
+    let mut angles = Vec::new();
+    for i in 0..=(7.0 * FPS) as u32 {
+        let t = f64::from(i) / FPS;
+        let q = r.tick(t).poses[0].pose.rotations[skull];
+        angles.push((t, q.angle_between(rest).to_degrees() as f64));
+    }
+    // bounded by the amplitudes over both octaves: (3 + 2) · (1 + 0.5) degrees
+    assert!(angles.iter().all(|(_, a)| *a <= 7.5), "{angles:?}");
+    let peak = angles.iter().map(|a| a.1).fold(0.0, f64::max);
+    assert!(peak > 0.3, "it moves ({peak})");
+    // still before the start and after the end, and at both ends (the fades)
+    for (t, a) in &angles {
+        if *t <= 1.0 || *t >= 6.0 {
+            assert!(*a < 1e-3, "{a} at {t}");
+        }
+    }
+    // smooth: no jump between frames
+    for w in angles.windows(2) {
+        assert!((w[1].1 - w[0].1).abs() < 0.5, "{w:?}");
+    }
+}
+
+#[test]
+fn noise_of_an_unknown_type_is_refused_with_the_reason() {
+    let Track { warnings, .. } = track(
+        &format!(
+            r#"<bml {BMLT} id="b"><bmlt:noise id="n" type="white" joint="skullbase" start="0" end="1"/></bml>"#
+        ),
+        "skullbase",
+        0.5,
+    );
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("noise type 'white'") && w.contains("perlin")),
+        "{warnings:?}"
+    );
+}

@@ -13,7 +13,8 @@
 //! - [`keyframe`]: BMLT keyframe animations (SkeletonInterpolator), slerped between exact keys;
 //! - [`gesture`]: gesture lexemes as arm motion from a bindings file (the default lexicon);
 //! - [`posture`]: posture stances (standing, sitting, crouching, lying) as leg and root motion;
-//! - [`procedural`]: BMLT procanimation(gesture) as procedural units from data (expressions, IK).
+//! - [`procedural`]: BMLT procanimation(gesture) as procedural units from data (expressions, IK);
+//! - [`noise`]: BMLT Perlin noise on a joint, added on top of the other engines.
 
 pub mod control;
 pub mod gaze;
@@ -22,6 +23,7 @@ pub mod head;
 pub mod keyframe;
 pub mod motion;
 pub mod murml;
+pub mod noise;
 pub mod pointing;
 pub mod posture;
 pub mod procedural;
@@ -40,7 +42,6 @@ pub const MOTION_KINDS: &[(&str, &str)] = &[
     (NS_BML, "faceShift"),
     (NS_CORE_EXT, "faceFacs"),
     (NS_BML, "locomotion"),
-    (NS_BMLT, "noise"),
     (NS_BMLT, "transition"),
     (NS_BMLT, "controller"),
     (NS_BMLT, "facemorph"),
@@ -97,6 +98,11 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(head::HeadEngine::default()),
         &keys(&[(NS_BML, "head")]),
+    );
+    // noise adds to whatever the joint has
+    r.register(
+        Box::new(noise::NoiseEngine::default()),
+        &keys(&[(NS_BMLT, "noise")]),
     );
     r.register(
         Box::new(murml::MurmlEngine::default()),

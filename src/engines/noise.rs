@@ -1,0 +1,215 @@
+//! The noise engine: BMLT `noise` as Perlin noise on one joint, added on top of what the other
+//! engines set (an additive layer), e.g. a slight idle sway of the head:
+//!
+//! ```xml
+//! <bmlt:noise id="n1" type="perlin" joint="skullbase" start="0" end="10">
+//!   <bmlt:parameter name="basefreqx" value="0.5"/>
+//!   <bmlt:parameter name="baseamplitudex" value="3"/>
+//! </bmlt:noise>
+//! ```
+//!
+//! Each axis (x pitch, y yaw, z roll, in the joint's frame) turns by
+//! `baseamplitude · Σₖ persistenceᵏ · perlin(basefreq · 2ᵏ · (t − start))` degrees over `octaves`
+//! octaves, fading in and out over `fade` seconds (minimum jerk) so that the joint never jumps.
+//! Parameters (defaults): `basefreqx/y/z` (1 Hz), `baseamplitudex/y/z` (2°, 2°, 0°),
+//! `persistence` (0.5), `octaves` (2), `fade` (0.3 s); they can change while it runs. The only
+//! `type` is `perlin`. Noise has no natural end (A59): without a constrained end it runs until
+//! its block is interrupted or replaced.
+
+use glam::{EulerRot, Quat};
+
+use crate::bml::{Behaviour, BehaviourKind};
+use crate::body::{Pose, Skeleton};
+use crate::engine::timing::{Flexibility, TimingModel, MIN_DURATION};
+use crate::engine::{Engine, EngineError, Unit, UnitKey, Units};
+use crate::engines::motion::min_jerk;
+use crate::engines::procedural::perlin;
+use crate::world::World;
+
+/// Parameter names and defaults.
+const PARAMS: &[(&str, f64)] = &[
+    ("basefreqx", 1.0),
+    ("basefreqy", 1.0),
+    ("basefreqz", 1.0),
+    ("baseamplitudex", 2.0),
+    ("baseamplitudey", 2.0),
+    ("baseamplitudez", 0.0),
+    ("persistence", 0.5),
+    ("octaves", 2.0),
+    ("fade", 0.3),
+];
+
+#[derive(Debug, Clone)]
+struct NoiseUnit {
+    joint: String,
+    /// Values of [`PARAMS`], in order.
+    values: [f64; 9],
+}
+
+impl NoiseUnit {
+    fn value(&self, name: &str) -> f64 {
+        PARAMS
+            .iter()
+            .position(|p| p.0 == name)
+            .map_or(0.0, |i| self.values[i])
+    }
+
+    /// The rotation (degrees about x, y, z) `dt` seconds after the start.
+    fn angles(&self, dt: f64) -> [f64; 3] {
+        let octaves = self.value("octaves").clamp(1.0, 8.0) as u32;
+        let persistence = self.value("persistence");
+        let mut out = [0.0; 3];
+        for (axis, (f, a)) in ["x", "y", "z"]
+            .iter()
+            .map(|x| {
+                (
+                    self.value(&format!("basefreq{x}")),
+                    self.value(&format!("baseamplitude{x}")),
+                )
+            })
+            .enumerate()
+        {
+            let mut sum = 0.0;
+            for k in 0..octaves {
+                let scale = 2f64.powi(k as i32);
+                sum += persistence.powi(k as i32)
+                    * perlin(f * scale * dt, (axis * 8) as f64 + k as f64);
+            }
+            out[axis] = a * sum;
+        }
+        out
+    }
+}
+
+/// The noise engine (see the module documentation).
+#[derive(Debug, Default)]
+pub struct NoiseEngine {
+    units: Units<NoiseUnit>,
+}
+
+impl Engine for NoiseEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!("noise");
+    crate::units_interrupt!(crate::engine::stop_now);
+
+    fn name(&self) -> &'static str {
+        "noise"
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        matches!(behaviour.kind, BehaviourKind::Noise(_)).then(|| {
+            let mut m = TimingModel::new(
+                &[("start", 0.0), ("end", 1.0)],
+                Flexibility::Stretchable {
+                    min_duration: MIN_DURATION,
+                    max_duration: f64::INFINITY,
+                },
+            );
+            m.persistent = true;
+            m
+        })
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let BehaviourKind::Noise(n) = &unit.behaviour.kind else {
+            return Err(EngineError("the noise engine realizes bmlt:noise".into()));
+        };
+        let fail = |why: String| EngineError(format!("{}: {why}", unit.key));
+        if !n.kind.eq_ignore_ascii_case("perlin") {
+            return Err(fail(format!(
+                "noise type '{}' is not supported (perlin)",
+                n.kind
+            )));
+        }
+        let mut values = [0.0; 9];
+        for (v, p) in values.iter_mut().zip(PARAMS) {
+            *v = p.1;
+        }
+        for p in &n.params {
+            let i = PARAMS
+                .iter()
+                .position(|x| x.0.eq_ignore_ascii_case(&p.name))
+                .ok_or_else(|| {
+                    let known: Vec<&str> = PARAMS.iter().map(|x| x.0).collect();
+                    fail(format!(
+                        "noise has no parameter '{}' (it has {known:?})",
+                        p.name
+                    ))
+                })?;
+            values[i] = p
+                .value
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    fail(format!(
+                        "parameter '{}' = '{}' is not a number",
+                        p.name, p.value
+                    ))
+                })?;
+        }
+        let joint = n.joint.clone();
+        self.units.add(unit, NoiseUnit { joint, values });
+        Ok(())
+    }
+
+    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
+        let u = self.units.get(key)?;
+        PARAMS.iter().any(|p| p.0 == name).then(|| u.value(name))
+    }
+
+    fn set_parameter(
+        &mut self,
+        key: &UnitKey,
+        name: &str,
+        value: f64,
+        _now: f64,
+    ) -> Result<Option<Vec<f64>>, EngineError> {
+        let (_, u) = self
+            .units
+            .get_mut(key)
+            .ok_or_else(|| EngineError(format!("{key} is not running")))?;
+        let i = PARAMS
+            .iter()
+            .position(|p| p.0 == name)
+            .ok_or_else(|| EngineError(format!("{key}: noise has no parameter '{name}'")))?;
+        if !value.is_finite() {
+            return Err(EngineError(format!(
+                "{key}: {name} = {value} is not finite"
+            )));
+        }
+        u.values[i] = value;
+        Ok(None)
+    }
+
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
+        for (syncs, u) in self.units.all() {
+            let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
+            else {
+                continue;
+            };
+            if now < start || now > end {
+                continue;
+            }
+            let Some(j) = skeleton.joint(&u.joint) else {
+                continue;
+            };
+            let fade = u.value("fade").max(0.0);
+            let w = if fade > 0.0 {
+                min_jerk((now - start) / fade).min(min_jerk((end - now) / fade))
+            } else {
+                1.0
+            };
+            let [x, y, z] = u.angles(now - start);
+            let q = Quat::from_euler(
+                EulerRot::XYZ,
+                (w * x).to_radians() as f32,
+                (w * y).to_radians() as f32,
+                (w * z).to_radians() as f32,
+            );
+            pose.rotate(j, q);
+        }
+    }
+}
