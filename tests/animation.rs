@@ -714,3 +714,36 @@ fn noise_of_an_unknown_type_is_refused_with_the_reason() {
         "{warnings:?}"
     );
 }
+
+#[test]
+fn s77_a_gesture_bound_to_a_procedural_unit_takes_its_timing_and_both_hands_mirror() {
+    let skeleton = Skeleton::adult();
+    let (l, r) = (
+        skeleton.joint("l_wrist").unwrap(),
+        skeleton.joint("r_wrist").unwrap(),
+    );
+    let mut realizer = Realizer::new();
+    realizer
+        .perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gesture id="g" lexeme="HELLO" mode="BOTH_HANDS" start="0.5"/></bml>"#)
+        .unwrap();
+    let mut syncs = Vec::new();
+    let mut moved = 0.0f32;
+    let rest = bml_realizer::body::Pose::rest(&skeleton).world(&skeleton);
+    for i in 0..=(3.0 * FPS) as u32 {
+        let t = f64::from(i) / FPS;
+        let frame = realizer.tick(t);
+        for fb in &frame.feedback {
+            if let Feedback::SyncPointProgress(p) = fb {
+                syncs.push((p.sync.clone(), p.global_time));
+            }
+        }
+        let w = frame.poses[0].pose.world(&skeleton);
+        let reflected = Vec3::new(-w.positions[r].x, w.positions[r].y, w.positions[r].z);
+        assert!((w.positions[l] - reflected).length() < 1e-3, "at {t}");
+        moved = moved.max((w.positions[r] - rest.positions[r]).length());
+    }
+    // the procedural wave's timing: 2 s preferred, stroke at α 0.5
+    assert!((at(&syncs, "end") - 2.5).abs() < 1e-9, "{syncs:?}");
+    assert!((at(&syncs, "stroke") - 1.5).abs() < 1e-9);
+    assert!(moved > 0.1, "the arms wave ({moved} m)");
+}

@@ -6,15 +6,16 @@
 //! arm (across the body's middle plane), `BOTH_HANDS` plays both arms. A lexeme the lexicon lacks
 //! is played with its timing only.
 
-use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::{EulerRot, Quat};
 
-use crate::bml::{Behaviour, BehaviourKind, Mode};
+use crate::bml::{Behaviour, BehaviourKind, Mode, Param};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Unit, Units};
 use crate::engines::motion::{hands, min_jerk};
+use crate::engines::procedural::{alpha_at, mirror_name, mirror_rotation, Library, ProcUnit};
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -24,79 +25,192 @@ const DEFAULT: &str = include_str!("../../fixtures/bindings/gestures.json");
 /// A lexeme's keys: (sync name, [(right-arm joint, rotation)]).
 pub type GestureKeys = Vec<(String, Vec<(String, Quat)>)>;
 
-/// Gesture lexemes bound to keys.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// What a binding plays: keys of the right arm, or a procedural unit (authored for the right arm)
+/// with parameters.
+#[derive(Debug, Clone)]
+pub enum Bound {
+    /// Rotations at sync points.
+    Keys(GestureKeys),
+    /// A unit of the procedural library and its parameters.
+    Procedural(Arc<ProcUnit>, Vec<(String, f64)>),
+}
+
+/// One binding (S77): a lexeme, an attribute filter, and what it plays.
+#[derive(Debug, Clone)]
+struct Binding {
+    lexeme: String,
+    /// (attribute, value) pairs the gesture must have: `mode`, or an extension attribute's local
+    /// name.
+    when: Vec<(String, String)>,
+    bound: Bound,
+}
+
+/// Gesture lexemes bound to keys or procedural units.
+#[derive(Debug, Clone, Default)]
 pub struct Lexicon {
-    gestures: HashMap<String, GestureKeys>,
+    bindings: Vec<Binding>,
 }
 
 impl Lexicon {
-    /// The default lexicon (BEAT, WAVE, CONDUIT, CUP, POINT).
+    /// The default lexicon (BEAT, WAVE, CONDUIT, CUP, POINT as keys; HELLO as the procedural
+    /// `wave` unit).
     pub fn default_lexicon() -> Lexicon {
         // read from its embedded JSON once per process, then copied
         static LEXICON: std::sync::LazyLock<Lexicon> = std::sync::LazyLock::new(|| {
-            Lexicon::from_json(DEFAULT).expect("the embedded gesture lexicon is valid")
+            Lexicon::from_json(DEFAULT, &Library::default_library())
+                .expect("the embedded gesture lexicon is valid")
         });
         LEXICON.clone()
     }
 
-    /// Reads a bindings file: `{"gestures": [{"lexeme": …, "keys": {SYNC: {JOINT: [z, x, y]}}}]}`.
-    pub fn from_json(text: &str) -> Result<Lexicon, String> {
+    /// Reads a bindings file: `{"gestures": [BINDING, …]}`, each binding a `lexeme`, an optional
+    /// filter `"when": {ATTRIBUTE: VALUE}`, and either `"keys": {SYNC: {JOINT: [z, x, y]}}` or
+    /// `"procedural": UNIT` (a unit of `library`) with optional `"parameters": {NAME: NUMBER}`.
+    pub fn from_json(text: &str, library: &Library) -> Result<Lexicon, String> {
         let v: serde_json::Value =
             serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
         let list = v["gestures"].as_array().ok_or("no \"gestures\" list")?;
-        let mut gestures = HashMap::new();
+        let mut bindings = Vec::new();
         for g in list {
             let lexeme = g["lexeme"].as_str().ok_or("a gesture without \"lexeme\"")?;
-            let keys = g["keys"]
-                .as_object()
-                .ok_or_else(|| format!("{lexeme}: no \"keys\""))?;
-            let mut out: GestureKeys = Vec::new();
-            for (sync, joints) in keys {
-                let joints = joints
+            let mut when = Vec::new();
+            if let Some(w) = g.get("when") {
+                let w = w
                     .as_object()
-                    .ok_or_else(|| format!("{lexeme}:{sync}: joints must be an object"))?;
-                let mut rot = Vec::new();
-                for (joint, angles) in joints {
-                    let a = crate::body::skeleton::three_numbers(angles).ok_or_else(|| {
-                        format!("{lexeme}:{sync}:{joint}: three angles (z, x, y)")
-                    })?;
-                    let q = Quat::from_euler(
-                        EulerRot::ZXY,
-                        a[0].to_radians(),
-                        a[1].to_radians(),
-                        a[2].to_radians(),
-                    );
-                    rot.push((joint.clone(), q));
+                    .ok_or_else(|| format!("{lexeme}: \"when\" must be an object"))?;
+                for (k, x) in w {
+                    let x = x
+                        .as_str()
+                        .ok_or_else(|| format!("{lexeme}: when.{k} must be a string"))?;
+                    when.push((k.clone(), x.to_string()));
                 }
-                out.push((sync.clone(), rot));
             }
-            gestures.insert(lexeme.to_string(), out);
+            let bound = match (g.get("keys"), g.get("procedural")) {
+                (Some(keys), None) => Bound::Keys(read_keys(lexeme, keys)?),
+                (None, Some(name)) => {
+                    let name = name
+                        .as_str()
+                        .ok_or_else(|| format!("{lexeme}: \"procedural\" names a unit"))?;
+                    let unit = library.get(name).ok_or_else(|| {
+                        format!("{lexeme}: no procedural unit '{name}' in the library")
+                    })?;
+                    let mut overrides = Vec::new();
+                    if let Some(p) = g.get("parameters") {
+                        let p = p
+                            .as_object()
+                            .ok_or_else(|| format!("{lexeme}: parameters must be an object"))?;
+                        for (k, x) in p {
+                            overrides.push(Param {
+                                name: k.clone(),
+                                value: x.to_string(),
+                            });
+                        }
+                    }
+                    let params = unit
+                        .parameters(&overrides)
+                        .map_err(|e| format!("{lexeme}: {e}"))?;
+                    Bound::Procedural(unit.clone(), params)
+                }
+                _ => return Err(format!("{lexeme}: either \"keys\" or \"procedural\"")),
+            };
+            bindings.push(Binding {
+                lexeme: lexeme.to_string(),
+                when,
+                bound,
+            });
         }
-        Ok(Lexicon { gestures })
+        Ok(Lexicon { bindings })
     }
 
-    /// The keys of `lexeme`.
+    /// The keys of `lexeme` (its first binding without a filter, if that is keys).
     pub fn keys(&self, lexeme: &str) -> Option<&GestureKeys> {
-        self.gestures.get(lexeme)
+        match &self
+            .bindings
+            .iter()
+            .find(|b| b.lexeme == lexeme && b.when.is_empty())?
+            .bound
+        {
+            Bound::Keys(k) => Some(k),
+            Bound::Procedural(..) => None,
+        }
     }
+
+    /// What `behaviour` (a gesture) plays: the first binding of its lexeme whose filter it passes.
+    pub fn find(&self, behaviour: &Behaviour) -> Option<&Bound> {
+        let BehaviourKind::Gesture(g) = &behaviour.kind else {
+            return None;
+        };
+        let attr = |name: &str| -> Option<&str> {
+            if name == "mode" {
+                return g.mode.map(|m| m.as_str());
+            }
+            behaviour
+                .foreign_attrs
+                .iter()
+                .find(|a| a.name == name)
+                .map(|a| a.value.as_str())
+        };
+        self.bindings
+            .iter()
+            .find(|b| {
+                b.lexeme == g.lexeme && b.when.iter().all(|(k, v)| attr(k) == Some(v.as_str()))
+            })
+            .map(|b| &b.bound)
+    }
+
+    /// Whether some binding filters on the extension attribute `name`.
+    fn filters_on(&self, name: &str) -> bool {
+        self.bindings
+            .iter()
+            .any(|b| b.when.iter().any(|(k, _)| k == name))
+    }
+}
+
+fn read_keys(lexeme: &str, keys: &serde_json::Value) -> Result<GestureKeys, String> {
+    let keys = keys
+        .as_object()
+        .ok_or_else(|| format!("{lexeme}: \"keys\" must be an object"))?;
+    let mut out: GestureKeys = Vec::new();
+    for (sync, joints) in keys {
+        let joints = joints
+            .as_object()
+            .ok_or_else(|| format!("{lexeme}:{sync}: joints must be an object"))?;
+        let mut rot = Vec::new();
+        for (joint, angles) in joints {
+            let a = crate::body::skeleton::three_numbers(angles)
+                .ok_or_else(|| format!("{lexeme}:{sync}:{joint}: three angles (z, x, y)"))?;
+            let q = Quat::from_euler(
+                EulerRot::ZXY,
+                a[0].to_radians(),
+                a[1].to_radians(),
+                a[2].to_radians(),
+            );
+            rot.push((joint.clone(), q));
+        }
+        out.push((sync.clone(), rot));
+    }
+    Ok(out)
 }
 
 /// The left-arm twin of a right-arm joint and rotation (mirrored across the y-z plane).
 pub fn mirror(joint: &str, q: Quat) -> (String, Quat) {
-    let name = match joint.strip_prefix("r_") {
-        Some(rest) => format!("l_{rest}"),
-        None => joint.to_string(),
-    };
-    (name, Quat::from_xyzw(q.x, -q.y, -q.z, q.w))
+    (mirror_name(joint), mirror_rotation(q))
 }
 
 #[derive(Debug, Clone)]
-struct GestureUnit {
-    /// (sync, [(joint, rotation)]) for the arms it moves, in sync order.
-    keys: Vec<(String, Vec<(String, Quat)>)>,
-    /// The keys resolved against the skeleton and the unit's syncs, made on first use.
-    compiled: Option<Compiled>,
+enum GestureUnit {
+    Keys {
+        /// (sync, [(joint, rotation)]) for the arms it moves, in sync order.
+        keys: GestureKeys,
+        /// The keys resolved against the skeleton and the unit's syncs, made on first use.
+        compiled: Option<Compiled>,
+    },
+    Procedural {
+        unit: Arc<ProcUnit>,
+        params: Vec<(String, f64)>,
+        /// Mirrorings to play: `[false]` right arm, `[true]` left arm, both for both hands.
+        sides: &'static [bool],
+    },
 }
 
 /// A unit's keys ready to play: the joints it moves, and per key the index of its sync and a
@@ -107,9 +221,9 @@ struct Compiled {
     keys: Vec<(usize, Vec<Quat>)>,
 }
 
-fn compile(u: &GestureUnit, skeleton: &Skeleton, syncs: &[(SyncName, f64)]) -> Compiled {
+fn compile(keys: &GestureKeys, skeleton: &Skeleton, syncs: &[(SyncName, f64)]) -> Compiled {
     let mut names: Vec<&str> = Vec::new();
-    for (_, k) in &u.keys {
+    for (_, k) in keys {
         for (j, _) in k {
             if !names.contains(&j.as_str()) && skeleton.joint(j).is_some() {
                 names.push(j);
@@ -117,8 +231,7 @@ fn compile(u: &GestureUnit, skeleton: &Skeleton, syncs: &[(SyncName, f64)]) -> C
         }
     }
     let joints = names.iter().filter_map(|n| skeleton.joint(n)).collect();
-    let mut keys: Vec<(usize, Vec<Quat>)> = u
-        .keys
+    let mut keys: Vec<(usize, Vec<Quat>)> = keys
         .iter()
         .filter_map(|(sync, k)| {
             let i = syncs.iter().position(|s| s.0 == *sync)?;
@@ -201,7 +314,17 @@ impl Engine for GestureEngine {
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        matches!(behaviour.kind, BehaviourKind::Gesture(_)).then(|| self.models.model(behaviour))?
+        if !matches!(behaviour.kind, BehaviourKind::Gesture(_)) {
+            return None;
+        }
+        match self.lexicon.find(behaviour) {
+            Some(Bound::Procedural(unit, _)) => Some(unit.timing()),
+            _ => self.models.model(behaviour),
+        }
+    }
+
+    fn interprets(&self, _ns: &str, name: &str) -> bool {
+        self.lexicon.filters_on(name)
     }
 
     fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
@@ -215,7 +338,27 @@ impl Engine for GestureEngine {
         let BehaviourKind::Gesture(g) = &unit.behaviour.kind else {
             return Err(EngineError("the gesture engine realizes <gesture>".into()));
         };
-        let right = self.lexicon.keys(&g.lexeme).cloned().unwrap_or_default();
+        let right = match self.lexicon.find(unit.behaviour) {
+            Some(Bound::Procedural(p, params)) => {
+                let sides: &'static [bool] = match g.mode {
+                    Some(Mode::LeftHand) => &[true],
+                    Some(Mode::BothHands) => &[false, true],
+                    Some(Mode::RightHand) | None => &[false],
+                };
+                let (unit_data, params) = (p.clone(), params.clone());
+                self.units.add(
+                    unit,
+                    GestureUnit::Procedural {
+                        unit: unit_data,
+                        params,
+                        sides,
+                    },
+                );
+                return Ok(());
+            }
+            Some(Bound::Keys(k)) => k.clone(),
+            None => Vec::new(),
+        };
         let keys = right
             .into_iter()
             .map(|(sync, joints)| {
@@ -232,7 +375,7 @@ impl Engine for GestureEngine {
             .collect();
         self.units.add(
             unit,
-            GestureUnit {
+            GestureUnit::Keys {
                 keys,
                 compiled: None,
             },
@@ -242,11 +385,30 @@ impl Engine for GestureEngine {
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         for (syncs, u) in self.units.all_mut() {
-            if u.compiled.is_none() {
-                u.compiled = Some(compile(u, skeleton, syncs));
-            }
-            if let Some(c) = &u.compiled {
-                play_keys(c, syncs, now, pose);
+            match u {
+                GestureUnit::Keys { keys, compiled } => {
+                    let c = compiled.get_or_insert_with(|| compile(keys, skeleton, syncs));
+                    play_keys(c, syncs, now, pose);
+                }
+                GestureUnit::Procedural {
+                    unit,
+                    params,
+                    sides,
+                } => {
+                    let (Some(start), Some(end)) =
+                        (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
+                    else {
+                        continue;
+                    };
+                    if now < start || now > end {
+                        continue;
+                    }
+                    let alpha = alpha_at(&unit.keys, syncs, now);
+                    for &mirrored in sides.iter() {
+                        // checked when the lexicon was read; a failing expression leaves the pose
+                        let _ = unit.apply(alpha, params, mirrored, skeleton, pose);
+                    }
+                }
             }
         }
     }
@@ -263,11 +425,69 @@ mod tests {
         for lexeme in ["BEAT", "WAVE", "CONDUIT", "CUP", "POINT"] {
             assert!(l.keys(lexeme).is_some(), "{lexeme}");
         }
-        assert!(Lexicon::from_json(
-            r#"{"gestures": [{"lexeme": "X", "keys": {"stroke": {"r_elbow": [1, 2]}}}]}"#
+        let lib = Library::default_library();
+        let bad = |j: &str| Lexicon::from_json(j, &lib).unwrap_err();
+        assert!(
+            bad(r#"{"gestures": [{"lexeme": "X", "keys": {"stroke": {"r_elbow": [1, 2]}}}]}"#)
+                .contains("three angles")
+        );
+        assert!(
+            bad(r#"{"gestures": [{"lexeme": "X", "procedural": "nope"}]}"#)
+                .contains("no procedural unit 'nope'")
+        );
+        assert!(bad(
+            r#"{"gestures": [{"lexeme": "X", "procedural": "wave", "parameters": {"speed": 2}}]}"#
         )
-        .unwrap_err()
-        .contains("three angles"));
+        .contains("no parameter 'speed'"));
+        assert!(bad(r#"{"gestures": [{"lexeme": "X"}]}"#).contains("either"));
+        assert!(matches!(
+            l.find(&gesture("HELLO", None)),
+            Some(Bound::Procedural(..))
+        ));
+    }
+
+    fn gesture(lexeme: &str, mode: Option<Mode>) -> Behaviour {
+        crate::bml::load(&format!(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:x="urn:x" id="b"><gesture id="g" lexeme="{lexeme}"{}{}/></bml>"#,
+            mode.map_or(String::new(), |m| format!(r#" mode="{}""#, m.as_str())),
+            if lexeme == "STYLED" { r#" x:style="big""# } else { "" }
+        ))
+        .unwrap()
+        .block
+        .behaviours
+        .remove(0)
+    }
+
+    #[test]
+    fn s77_bindings_pick_by_lexeme_and_attribute_filter_in_file_order() {
+        let l = Lexicon::from_json(
+            r#"{"gestures": [
+                {"lexeme": "B", "when": {"mode": "LEFT_HAND"}, "procedural": "lift"},
+                {"lexeme": "B", "keys": {"stroke": {"r_elbow": [0, 0, 10]}}},
+                {"lexeme": "STYLED", "when": {"style": "big"}, "procedural": "wave", "parameters": {"cycles": 5}},
+                {"lexeme": "STYLED", "procedural": "wave"}
+            ]}"#,
+            &Library::default_library(),
+        )
+        .unwrap();
+        assert!(matches!(
+            l.find(&gesture("B", Some(Mode::LeftHand))),
+            Some(Bound::Procedural(u, _)) if u.name == "lift"
+        ));
+        assert!(matches!(l.find(&gesture("B", None)), Some(Bound::Keys(_))));
+        assert!(matches!(
+            l.find(&gesture("B", Some(Mode::RightHand))),
+            Some(Bound::Keys(_))
+        ));
+        match l.find(&gesture("STYLED", None)) {
+            Some(Bound::Procedural(u, p)) => {
+                assert_eq!(u.name, "wave");
+                assert!(p.contains(&("cycles".to_string(), 5.0)));
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(l.find(&gesture("NONE", None)).is_none());
+        assert!(l.filters_on("style") && !l.filters_on("lexeme"));
     }
 
     #[test]
