@@ -747,3 +747,23 @@ fn s77_a_gesture_bound_to_a_procedural_unit_takes_its_timing_and_both_hands_mirr
     assert!((at(&syncs, "stroke") - 1.5).abs() < 1e-9);
     assert!(moved > 0.1, "the arms wave ({moved} m)");
 }
+
+#[test]
+fn a39_two_units_of_one_replacement_group_with_the_same_timing_keep_one_and_warn() {
+    let Track {
+        warnings, syncs, ..
+    } = track(
+        &format!(
+            r#"<bml {BMLT} id="b"><bmlt:procanimation id="p1" name="lift" start="0" end="2"/><bmlt:procanimation id="p2" name="wave" start="0" end="2"/></bml>"#
+        ),
+        "r_wrist",
+        2.5,
+    );
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].contains("'p1' and 'p2'") && warnings[0].contains("right_arm"),
+        "{warnings:?}"
+    );
+    assert!(syncs.iter().any(|s| s.0 == "b:p1:end"));
+    assert!(syncs.iter().all(|s| !s.0.starts_with("b:p2:")), "{syncs:?}");
+}

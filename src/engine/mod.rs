@@ -171,8 +171,9 @@ pub trait Engine {
     /// The timing model of `behaviour`, or `None` if this engine cannot realize it.
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel>;
 
-    /// Behaviours of the same exclusive group cannot run at once (R33: gaze, posture).
-    fn exclusive_group(&self, _behaviour: &Behaviour) -> Option<&'static str> {
+    /// Behaviours of the same exclusive group cannot run at once (R33: gaze, posture; A39: the
+    /// replacement groups of procedural units).
+    fn exclusive_group(&self, _behaviour: &Behaviour) -> Option<&str> {
         None
     }
 

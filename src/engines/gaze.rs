@@ -165,7 +165,7 @@ impl Engine for GazeEngine {
         self.models.model(behaviour)
     }
 
-    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&'static str> {
+    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
         matches!(behaviour.kind, BehaviourKind::Gaze(_)).then_some("gaze")
     }
 

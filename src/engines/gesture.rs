@@ -404,9 +404,10 @@ impl Engine for GestureEngine {
                         continue;
                     }
                     let alpha = alpha_at(&unit.keys, syncs, now);
+                    let weight = unit.weight(start, end, now);
                     for &mirrored in sides.iter() {
                         // checked when the lexicon was read; a failing expression leaves the pose
-                        let _ = unit.apply(alpha, params, mirrored, skeleton, pose);
+                        let _ = unit.apply(alpha, params, mirrored, weight, skeleton, pose);
                     }
                 }
             }

@@ -112,7 +112,7 @@ impl Engine for PostureEngine {
         self.models.model(behaviour)
     }
 
-    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&'static str> {
+    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
         matches!(behaviour.kind, BehaviourKind::Posture(_)).then_some("posture")
     }
 

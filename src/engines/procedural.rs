@@ -23,6 +23,13 @@
 //! continuity, bias, s)` (Kochanek–Bartels between `p1` and `p2`) and `perlin(x)` / `perlin(x,
 //! seed)` (1-D gradient noise in [−1, 1], zero at integers).
 //!
+//! A unit may also declare a replacement `group` (A39: of the running units of a group only the
+//! one with the latest start plays, ties going to the earliest end; units of one block with the
+//! same start and end leave one and a warning, R33), that it is `additive` (its rotations add to
+//! what the joints have: a layer, e.g. a sway over a posture) and a `blend` time (it eases in
+//! from what the joints have after its start and back out before its end; otherwise it replaces
+//! the joints it sets).
+//!
 //! Time is warped linearly between keys (A37): at each key's scheduled time α is exactly the key's
 //! α. Effector `frame` is `body` (the character's space, as [`Pose::world`] gives it) or `limb`
 //! (relative to the limb's root joint: the shoulder for a wrist, the hip for an ankle). A mirrored
@@ -44,7 +51,8 @@ use crate::bml::{Behaviour, BehaviourKind, Id, Param};
 use crate::body::ik::{place_limb, ARM_POLE, LEG_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, Unit, UnitKey, Units};
+use crate::engine::{Engine, EngineError, SyncTimes, Unit, UnitKey, Units};
+use crate::engines::motion::min_jerk;
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -178,6 +186,13 @@ pub struct ProcUnit {
     pub keys: Vec<(Id, f64)>,
     /// Preferred, minimum and maximum duration (seconds).
     pub duration: (f64, f64, f64),
+    /// Whether its rotations add to what the joints have (a layer) instead of replacing it.
+    pub additive: bool,
+    /// Seconds over which it blends in after its start and out before its end (0: none).
+    pub blend: f64,
+    /// Its replacement group (A39): of the running units of a group, only the one with the
+    /// latest start plays (ties: the earliest end).
+    pub group: Option<String>,
     rotations: Vec<(String, [Expr; 3])>,
     effectors: Vec<Effector>,
 }
@@ -277,11 +292,32 @@ impl ProcUnit {
                 });
             }
         }
+        let additive = match v.get("additive") {
+            None => false,
+            Some(b) => b
+                .as_bool()
+                .ok_or_else(|| at("additive must be true or false"))?,
+        };
+        let blend = v
+            .get("blend")
+            .map_or(Ok(0.0), |b| number(b, &at("blend")))?
+            .max(0.0);
+        let group = match v.get("group") {
+            None => None,
+            Some(g) => Some(
+                g.as_str()
+                    .ok_or_else(|| at("group must be a string"))?
+                    .to_string(),
+            ),
+        };
         let unit = ProcUnit {
             name: name.to_string(),
             params,
             keys,
             duration: (preferred, min.max(MIN_DURATION), max),
+            additive,
+            blend,
+            group,
             rotations,
             effectors,
         };
@@ -360,16 +396,35 @@ impl ProcUnit {
         Ok(params)
     }
 
-    /// Applies the unit at `alpha` to `pose`: rotations first, then effectors by IK. `mirrored`
-    /// swaps left and right and reflects in the mid-sagittal plane (A42).
+    /// Its weight at global time `t` for a run from `start` to `end`: blending in after `start`
+    /// and out before `end` over [`blend`](Self::blend) seconds (minimum jerk), else 1.
+    pub fn weight(&self, start: f64, end: f64, t: f64) -> f32 {
+        if self.blend <= 0.0 {
+            return 1.0;
+        }
+        min_jerk((t - start) / self.blend).min(min_jerk((end - t) / self.blend)) as f32
+    }
+
+    /// Applies the unit at `alpha` with `weight` to `pose`: rotations first, then effectors by
+    /// IK. A weight below 1 slerps from what the joints have toward the unit's rotations (for an
+    /// additive unit: from none of its rotation); `mirrored` swaps left and right and reflects in
+    /// the mid-sagittal plane (A42).
     pub fn apply(
         &self,
         alpha: f64,
         params: &[(String, f64)],
         mirrored: bool,
+        weight: f32,
         skeleton: &Skeleton,
         pose: &mut Pose,
     ) -> Result<(), String> {
+        let blend = |from: Quat, to: Quat| {
+            if weight >= 1.0 {
+                to
+            } else {
+                from.slerp(to, weight.max(0.0)).normalize()
+            }
+        };
         let v = self.evaluate(alpha.clamp(0.0, 1.0), params)?;
         for ((joint, _), [z, x, y]) in self.rotations.iter().zip(&v.rotations) {
             let q = Quat::from_euler(
@@ -384,7 +439,11 @@ impl ProcUnit {
                 (joint.clone(), q)
             };
             if let Some(i) = skeleton.joint(&name) {
-                pose.rotations[i] = q;
+                if self.additive {
+                    pose.rotate(i, blend(Quat::IDENTITY, q));
+                } else {
+                    pose.rotations[i] = blend(pose.rotations[i], q);
+                }
             }
         }
         for (f, p) in self.effectors.iter().zip(&v.positions) {
@@ -395,7 +454,10 @@ impl ProcUnit {
             } else {
                 f.joint.clone()
             };
-            reach(skeleton, pose, &name, f.frame, goal);
+            if let Some(([root, mid], (r, m))) = reach(skeleton, pose, &name, f.frame, goal) {
+                pose.rotations[root] = blend(pose.rotations[root], r);
+                pose.rotations[mid] = blend(pose.rotations[mid], m);
+            }
         }
         Ok(())
     }
@@ -422,18 +484,19 @@ pub fn mirror_rotation(q: Quat) -> Quat {
     Quat::from_xyzw(q.x, -q.y, -q.z, q.w)
 }
 
-/// Puts end joint `name` (a wrist or an ankle) at `goal` by two-link IK of its limb.
-fn reach(skeleton: &Skeleton, pose: &mut Pose, name: &str, frame: Frame, goal: Vec3) {
-    let Some(end) = skeleton.joint(name) else {
-        return;
-    };
+/// The limb joints and their local rotations that put end joint `name` (a wrist or an ankle) at
+/// `goal` by two-link IK.
+fn reach(
+    skeleton: &Skeleton,
+    pose: &Pose,
+    name: &str,
+    frame: Frame,
+    goal: Vec3,
+) -> Option<([usize; 2], (Quat, Quat))> {
+    let end = skeleton.joint(name)?;
     let joints = skeleton.joints();
-    let Some(mid) = joints[end].parent else {
-        return;
-    };
-    let Some(root) = joints[mid].parent else {
-        return;
-    };
+    let mid = joints[end].parent?;
+    let root = joints[mid].parent?;
     let world = pose.world(skeleton);
     let goal = match frame {
         Frame::Body => goal,
@@ -444,10 +507,8 @@ fn reach(skeleton: &Skeleton, pose: &mut Pose, name: &str, frame: Frame, goal: V
     } else {
         ARM_POLE
     };
-    if let Some((r, m)) = place_limb(skeleton, pose, &world, [root, mid, end], goal, pole) {
-        pose.rotations[root] = r;
-        pose.rotations[mid] = m;
-    }
+    let rotations = place_limb(skeleton, pose, &world, [root, mid, end], goal, pole)?;
+    Some(([root, mid], rotations))
 }
 
 /// α at global time `t` for a unit whose keys are at `syncs` (linear warping between keys, A37):
@@ -629,20 +690,46 @@ impl Engine for ProceduralEngine {
         }
     }
 
+    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
+        let name = match &behaviour.kind {
+            BehaviourKind::ProcAnimation(a) | BehaviourKind::ProcAnimationGesture(a) => {
+                a.name.as_deref()?
+            }
+            _ => return None,
+        };
+        self.library.get(name)?.group.as_deref()
+    }
+
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
-        for (syncs, r) in self.units.all() {
-            let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
-            else {
-                continue;
-            };
-            // active from start to end (A38); the end frame shows α = 1
-            if now < start || now > end {
+        // active from start to end (A38); the end frame shows α = 1
+        let active: Vec<(&SyncTimes, &Running, f64, f64)> = self
+            .units
+            .all()
+            .filter_map(|(syncs, r)| {
+                let (start, end) = (syncs.first()?.1, syncs.last()?.1);
+                (start <= now && now <= end).then_some((syncs, r, start, end))
+            })
+            .collect();
+        for (i, &(syncs, r, start, end)) in active.iter().enumerate() {
+            // A39: in a replacement group the latest start plays; ties go to the earliest end,
+            // then to the unit added first
+            let replaced = r.unit.group.as_ref().is_some_and(|g| {
+                active.iter().enumerate().any(|(k, &(_, o, s, e))| {
+                    k != i
+                        && o.unit.group.as_ref() == Some(g)
+                        && (s > start || (s == start && (e < end || (e == end && k < i))))
+                })
+            });
+            if replaced {
                 continue;
             }
             let alpha = alpha_at(&r.unit.keys, syncs, now);
+            let weight = r.unit.weight(start, end, now);
             // parameters were checked when the unit was added and on every change; an
             // expression that still fails (a division by zero) leaves the pose as it is
-            let _ = r.unit.apply(alpha, &r.params, false, skeleton, pose);
+            let _ = r
+                .unit
+                .apply(alpha, &r.params, false, weight, skeleton, pose);
         }
     }
 }
@@ -740,9 +827,9 @@ mod tests {
             let u = lib.get(name).unwrap();
             for alpha in [0.1, 0.5, 0.9] {
                 let (mut plain, mut mirrored) = (Pose::rest(&skeleton), Pose::rest(&skeleton));
-                u.apply(alpha, &u.params, false, &skeleton, &mut plain)
+                u.apply(alpha, &u.params, false, 1.0, &skeleton, &mut plain)
                     .unwrap();
-                u.apply(alpha, &u.params, true, &skeleton, &mut mirrored)
+                u.apply(alpha, &u.params, true, 1.0, &skeleton, &mut mirrored)
                     .unwrap();
                 let (wp, wm) = (plain.world(&skeleton), mirrored.world(&skeleton));
                 for side in ["l", "r"] {
@@ -760,6 +847,88 @@ mod tests {
         assert_eq!(mirror_name(&mirror_name("r_elbow")), "r_elbow");
         assert_eq!(mirror_name("l_hip"), "r_hip");
         assert_eq!(mirror_name("vl5"), "vl5");
+    }
+
+    /// An engine over `units` (library JSON) with `(id, unit name, start, end)` added.
+    fn engine(units: &str, runs: &[(&str, &str, f64, f64)]) -> ProceduralEngine {
+        let mut e = ProceduralEngine::new(Library::from_json(units).unwrap());
+        let world = World::default();
+        for &(id, name, start, end) in runs {
+            let block = crate::bml::load(&format!(
+                r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b"><bmlt:procanimation id="{id}" name="{name}"/></bml>"#
+            ))
+            .unwrap()
+            .block;
+            let key = UnitKey::new("b", id);
+            let syncs = ids(&[("start", start), ("end", end)]);
+            e.add(Unit {
+                key: &key,
+                behaviour: &block.behaviours[0],
+                syncs: &syncs,
+                world: &world,
+            })
+            .unwrap();
+        }
+        e
+    }
+
+    /// The r_elbow's angle (degrees, about z) after the engine animates a rest pose at `t`.
+    fn elbow(e: &mut ProceduralEngine, t: f64) -> f64 {
+        let skeleton = Skeleton::adult();
+        let mut pose = Pose::rest(&skeleton);
+        e.animate(t, &skeleton, &World::default(), &mut pose);
+        let q = pose.rotations[skeleton.joint("r_elbow").unwrap()];
+        let (z, _, _) = q.to_euler(EulerRot::ZXY);
+        f64::from(z).to_degrees()
+    }
+
+    const UNITS: &str = r#"{"units": {
+        "a": {"keys": {"start": 0, "end": 1}, "duration": {"preferred": 1}, "group": "arm",
+              "rotations": {"r_elbow": ["30", "0", "0"]}},
+        "b": {"keys": {"start": 0, "end": 1}, "duration": {"preferred": 1}, "group": "arm",
+              "rotations": {"r_elbow": ["60", "0", "0"]}},
+        "layer": {"keys": {"start": 0, "end": 1}, "duration": {"preferred": 1}, "additive": true,
+              "rotations": {"r_elbow": ["10", "0", "0"]}},
+        "soft": {"keys": {"start": 0, "end": 1}, "duration": {"preferred": 1}, "blend": 0.5,
+              "rotations": {"r_elbow": ["60", "0", "0"]}}
+    }}"#;
+
+    #[test]
+    fn a39_in_a_replacement_group_the_latest_start_plays_then_the_earliest_end() {
+        // b starts later: from its start it replaces a
+        let mut e = engine(UNITS, &[("pa", "a", 0.0, 4.0), ("pb", "b", 1.0, 2.0)]);
+        assert!((elbow(&mut e, 0.5) - 30.0).abs() < 1e-3);
+        assert!((elbow(&mut e, 1.5) - 60.0).abs() < 1e-3);
+        assert!(
+            (elbow(&mut e, 3.0) - 30.0).abs() < 1e-3,
+            "a again once b ended"
+        );
+        // same start: the earlier end plays
+        let mut e = engine(UNITS, &[("pa", "a", 0.0, 4.0), ("pb", "b", 0.0, 2.0)]);
+        assert!((elbow(&mut e, 1.0) - 60.0).abs() < 1e-3);
+        // full tie: the unit added first (the runtime drops the other with a warning, R33)
+        let mut e = engine(UNITS, &[("pa", "a", 0.0, 2.0), ("pb", "b", 0.0, 2.0)]);
+        assert!((elbow(&mut e, 1.0) - 30.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn additive_units_layer_and_blending_units_ease_in_and_out_over_what_was_there() {
+        // an additive unit adds its rotation to the one under it
+        let mut e = engine(UNITS, &[("pa", "a", 0.0, 2.0), ("pl", "layer", 0.0, 2.0)]);
+        assert!((elbow(&mut e, 1.0) - 40.0).abs() < 1e-3);
+        // a blending unit over a: from a's 30° at its start to its own 60° after 0.5 s, back
+        // to 30° at its end, smoothly (minimum jerk: half way at a quarter second)
+        let mut e = engine(UNITS, &[("pa", "a", 0.0, 4.0), ("ps", "soft", 1.0, 3.0)]);
+        assert!((elbow(&mut e, 1.0) - 30.0).abs() < 1e-3);
+        assert!((elbow(&mut e, 1.25) - 45.0).abs() < 1e-2);
+        assert!((elbow(&mut e, 2.0) - 60.0).abs() < 1e-3);
+        assert!((elbow(&mut e, 3.0) - 30.0).abs() < 1e-3);
+        let mut last = elbow(&mut e, 1.0);
+        for i in 1..=50 {
+            let v = elbow(&mut e, 1.0 + f64::from(i) * 0.01);
+            assert!(v >= last - 1e-6, "monotone while blending in");
+            last = v;
+        }
     }
 
     #[test]
