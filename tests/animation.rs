@@ -767,3 +767,53 @@ fn a39_two_units_of_one_replacement_group_with_the_same_timing_keep_one_and_warn
     assert!(syncs.iter().any(|s| s.0 == "b:p1:end"));
     assert!(syncs.iter().all(|s| !s.0.starts_with("b:p2:")), "{syncs:?}");
 }
+
+#[test]
+fn a54_a_transition_starts_at_the_current_pose_and_ends_at_the_predicted_one() {
+    let skeleton = Skeleton::adult();
+    let (shoulder, elbow, wrist) = (
+        skeleton.joint("r_shoulder").unwrap(),
+        skeleton.joint("r_elbow").unwrap(),
+        skeleton.joint("r_wrist").unwrap(),
+    );
+    // a keyframe bends the arm until 1 s; the transition (1 s to 1.5 s) leads into the
+    // procedural lift that starts at 1.5 s
+    let mut r = Realizer::new();
+    r.perform_bml(&format!(
+        r#"<bml {BMLT} id="b">
+        <bmlt:keyframe id="kf" start="0" end="1"><SkeletonInterpolator rotationEncoding="quaternions" parts="r_shoulder r_elbow" encoding="R">
+            0 1 0 0 0 1 0 0 0
+            1 0.9239 0 0 0.3827 0.7071 0 0.7071 0
+        </SkeletonInterpolator></bmlt:keyframe>
+        <bmlt:transition id="tr" class="SlerpTransition" start="kf:end" end="p:start"><bmlt:parameter name="joints" value="r_shoulder r_elbow"/></bmlt:transition>
+        <bmlt:procanimation id="p" name="lift" start="1.5" end="2.5"/></bml>"#
+    ))
+    .unwrap();
+    let mut frames = Vec::new();
+    for i in 0..=(2.6 * FPS).round() as u32 {
+        let t = f64::from(i) / FPS;
+        frames.push((t, r.tick(t).poses[0].pose.clone()));
+    }
+    let frame = |t: f64| &frames.iter().find(|f| (f.0 - t).abs() < 1e-9).unwrap().1;
+    // its first frame is the pose the body had (the frame before)
+    let (before, first) = (frame(59.0 / FPS), frame(1.0));
+    for j in [shoulder, elbow] {
+        assert!(first.rotations[j].angle_between(before.rotations[j]) < 1e-4);
+    }
+    // its last frame is the lift's first pose: the wrist at the unit's start target
+    let last = frame(1.5).world(&skeleton);
+    assert!(
+        (last.positions[wrist] - Vec3::new(-0.3, 1.1, 0.2)).length() < 1e-3,
+        "{}",
+        last.positions[wrist]
+    );
+    // no jump anywhere from the keyframe through the transition into the lift
+    for w in frames.windows(2).filter(|w| w[0].0 >= 0.5 && w[1].0 <= 2.0) {
+        for j in [shoulder, elbow] {
+            let step = w[1].1.rotations[j]
+                .angle_between(w[0].1.rotations[j])
+                .to_degrees();
+            assert!(step < 6.0, "{step}° at {} (joint {j})", w[1].0);
+        }
+    }
+}

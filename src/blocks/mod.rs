@@ -954,6 +954,7 @@ impl BlockManager {
         self.now = to;
         self.update_anticipators(to);
         self.apply_changes(to);
+        self.predict_poses(to);
         let mut pose = Pose::rest(&self.skeleton);
         for e in self.registry.engines_mut() {
             e.play(to, frame);
@@ -965,6 +966,28 @@ impl BlockManager {
         });
         for (engine, key) in std::mem::take(&mut self.retiring) {
             self.registry.engine_mut(engine).remove(&key);
+        }
+    }
+
+    /// Gives every engine that asks for them the poses the predictable units will have at the
+    /// times it names (A43, A54).
+    fn predict_poses(&mut self, now: f64) {
+        for i in 0..self.registry.len() {
+            let times = self.registry.engine(i).prediction_times(now);
+            if times.is_empty() {
+                continue;
+            }
+            let poses = times
+                .into_iter()
+                .map(|t| {
+                    let mut pose = Pose::rest(&self.skeleton);
+                    for e in self.registry.engines() {
+                        e.predict(t, &self.skeleton, &self.world, &mut pose);
+                    }
+                    (t, pose)
+                })
+                .collect();
+            self.registry.engine_mut(i).predicted(poses);
         }
     }
 

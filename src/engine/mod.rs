@@ -238,6 +238,26 @@ pub trait Engine {
     /// default.
     fn animate(&mut self, _now: f64, _skeleton: &Skeleton, _world: &World, _pose: &mut Pose) {}
 
+    /// The animation predictor's part (A43, A54): writes what this engine's *predictable* units
+    /// (whose motion is a function of time alone, such as keyframes and procedural units) will
+    /// have set at global time `t` into `pose`, without changing any state. Returns whether any
+    /// of its units is running then. Engines whose motion depends on the world or on the past
+    /// keep the default (nothing predictable).
+    fn predict(&self, _t: f64, _skeleton: &Skeleton, _world: &World, _pose: &mut Pose) -> bool {
+        false
+    }
+
+    /// Global times at which this engine needs the predicted pose for its frame at `now` (a
+    /// transition's end, A54); the runtime then calls [`predicted`](Engine::predicted) before
+    /// [`animate`](Engine::animate).
+    fn prediction_times(&self, _now: f64) -> Vec<f64> {
+        Vec::new()
+    }
+
+    /// The predicted poses (rest pose plus every engine's [`predict`](Engine::predict)) at the
+    /// times [`prediction_times`](Engine::prediction_times) asked for.
+    fn predicted(&mut self, _poses: Vec<(f64, Pose)>) {}
+
     /// Current value of parameter `name` of unit `key`.
     fn parameter(&self, _key: &UnitKey, _name: &str) -> Option<f64> {
         None

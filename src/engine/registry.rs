@@ -65,6 +65,16 @@ impl Registry {
             .map(|(_, &i)| i)
     }
 
+    /// Number of engines.
+    pub fn len(&self) -> usize {
+        self.engines.len()
+    }
+
+    /// Whether no engine is registered.
+    pub fn is_empty(&self) -> bool {
+        self.engines.is_empty()
+    }
+
     /// Engine `i`.
     pub fn engine(&self, i: usize) -> &dyn Engine {
         self.engines[i].as_ref()

@@ -24,6 +24,7 @@ use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
 use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::schedule::SyncName;
 use crate::world::World;
 
 /// Keys read from a `<SkeletonInterpolator>`.
@@ -151,6 +152,40 @@ impl Keys {
     }
 }
 
+/// Sets the keyframe's rotations at global time `now` for a unit timed by `syncs`; false
+/// outside its time.
+fn play(
+    k: &Keys,
+    joints: &[Option<usize>],
+    syncs: &[(SyncName, f64)],
+    now: f64,
+    pose: &mut Pose,
+) -> bool {
+    let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1)) else {
+        return false;
+    };
+    if now < start || now > end {
+        return false;
+    }
+    let first = k.keys[0].0;
+    let span = end - start;
+    let t = if span > 0.0 {
+        first + (now - start) / span * k.duration()
+    } else {
+        first + k.duration()
+    };
+    let (root, rotations) = k.sample(t);
+    if k.root_translation {
+        pose.root = root;
+    }
+    for (joint, q) in joints.iter().zip(rotations) {
+        if let Some(i) = *joint {
+            pose.rotations[i] = q;
+        }
+    }
+    true
+}
+
 fn content(b: &Behaviour) -> Option<&str> {
     match &b.kind {
         BehaviourKind::Keyframe(a) => Some(&a.content),
@@ -214,34 +249,28 @@ impl Engine for KeyframeEngine {
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         for (syncs, u) in self.units.all_mut() {
-            let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
-            else {
-                continue;
-            };
-            if now < start || now > end {
-                continue;
-            }
             let k = &u.keys;
-            let first = k.keys[0].0;
-            let span = end - start;
-            let t = if span > 0.0 {
-                first + (now - start) / span * k.duration()
-            } else {
-                first + k.duration()
-            };
-            let (root, rotations) = k.sample(t);
-            if k.root_translation {
-                pose.root = root;
-            }
             let joints = u
                 .joints
                 .get_or_insert_with(|| k.parts.iter().map(|p| skeleton.joint(p)).collect());
-            for (joint, q) in joints.iter().zip(rotations) {
-                if let Some(i) = *joint {
-                    pose.rotations[i] = q;
-                }
-            }
+            play(k, joints, syncs, now, pose);
         }
+    }
+
+    fn predict(&self, t: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) -> bool {
+        let mut any = false;
+        for (syncs, u) in self.units.all() {
+            let resolved;
+            let joints = match &u.joints {
+                Some(j) => j,
+                None => {
+                    resolved = u.keys.parts.iter().map(|p| skeleton.joint(p)).collect();
+                    &resolved
+                }
+            };
+            any |= play(&u.keys, joints, syncs, t, pose);
+        }
+        any
     }
 }
 

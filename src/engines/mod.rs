@@ -14,7 +14,8 @@
 //! - [`gesture`]: gesture lexemes as arm motion from a bindings file (the default lexicon);
 //! - [`posture`]: posture stances (standing, sitting, crouching, lying) as leg and root motion;
 //! - [`procedural`]: BMLT procanimation(gesture) as procedural units from data (expressions, IK);
-//! - [`noise`]: BMLT Perlin noise on a joint, added on top of the other engines.
+//! - [`noise`]: BMLT Perlin noise on a joint, added on top of the other engines;
+//! - [`transition`]: BMLT transitions from the current pose to the predicted one (A54).
 
 pub mod control;
 pub mod gaze;
@@ -29,6 +30,7 @@ pub mod posture;
 pub mod procedural;
 pub mod speech;
 pub mod timing_only;
+pub mod transition;
 
 use crate::bml::{NS_BML, NS_BMLA, NS_BMLT, NS_CORE_EXT};
 use crate::engine::timing::DefaultTimingModels;
@@ -42,7 +44,6 @@ pub const MOTION_KINDS: &[(&str, &str)] = &[
     (NS_BML, "faceShift"),
     (NS_CORE_EXT, "faceFacs"),
     (NS_BML, "locomotion"),
-    (NS_BMLT, "transition"),
     (NS_BMLT, "controller"),
     (NS_BMLT, "facemorph"),
 ];
@@ -119,6 +120,11 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(gaze::GazeEngine::default()),
         &keys(&[(NS_BML, "gaze"), (NS_BML, "gazeShift")]),
+    );
+    // after everything: a transition starts from the frame's final pose and blends over it
+    r.register(
+        Box::new(transition::TransitionEngine::default()),
+        &keys(&[(NS_BMLT, "transition")]),
     );
     r
 }

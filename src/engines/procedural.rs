@@ -700,7 +700,11 @@ impl Engine for ProceduralEngine {
         self.library.get(name)?.group.as_deref()
     }
 
-    fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
+        self.predict(now, skeleton, world, pose);
+    }
+
+    fn predict(&self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) -> bool {
         // active from start to end (A38); the end frame shows α = 1
         let active: Vec<(&SyncTimes, &Running, f64, f64)> = self
             .units
@@ -731,6 +735,7 @@ impl Engine for ProceduralEngine {
                 .unit
                 .apply(alpha, &r.params, false, weight, skeleton, pose);
         }
+        !active.is_empty()
     }
 }
 
