@@ -817,3 +817,25 @@ fn a54_a_transition_starts_at_the_current_pose_and_ends_at_the_predicted_one() {
         }
     }
 }
+
+#[test]
+fn a_hermite_keyframe_is_accepted_and_an_unknown_interpolation_refused() {
+    let kf = |how: &str| {
+        format!(
+            r#"<bml {BMLT} id="b"><bmlt:keyframe id="kf" start="0" end="1"><bmlt:parameter name="interpolation" value="{how}"/><SkeletonInterpolator rotationEncoding="quaternions" parts="r_elbow" encoding="R">
+            0 1 0 0 0
+            0.5 0.9239 0 0.3827 0
+            1 0.7071 0 0.7071 0
+            </SkeletonInterpolator></bmlt:keyframe></bml>"#
+        )
+    };
+    let Track { warnings, .. } = track(&kf("hermite"), "r_wrist", 1.2);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let Track { warnings, .. } = track(&kf("cubic"), "r_wrist", 1.2);
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("interpolation") && w.contains("cubic")),
+        "{warnings:?}"
+    );
+}

@@ -13,7 +13,8 @@
 //!
 //! The keys are laid out linearly between the behaviour's `start` and `end` (its preferred length
 //! is the last key's time), each key is hit exactly at its time, and rotations are interpolated by
-//! slerp between neighbouring keys. The named joints take the keyframe's rotations (they replace,
+//! slerp between neighbouring keys, or, with `<bmlt:parameter name="interpolation"
+//! value="hermite"/>` (or `squad`), by a C¹ Hermite spline (see [`Interpolation`]). The named joints take the keyframe's rotations (they replace,
 //! not add to, what other engines set).
 
 use glam::{Quat, Vec3};
@@ -36,6 +37,63 @@ pub struct Keys {
     pub root_translation: bool,
     /// (time, root translation, rotation per part), by time.
     pub keys: Vec<(f64, Vec3, Vec<Quat>)>,
+}
+
+/// How rotations are interpolated between keys.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Interpolation {
+    /// Spherical linear, key to key (continuous, with a kink at every key).
+    #[default]
+    Slerp,
+    /// A cubic Hermite spline on the rotation sphere (C¹: the angular velocity is continuous
+    /// through every key, whatever the key spacing), in its Bézier form evaluated by repeated
+    /// slerp; each key's tangent is the average of the angular velocities toward its neighbours
+    /// (one-sided at the first and last key).
+    Hermite,
+}
+
+/// A rotation as a rotation vector (axis × angle), the shorter way round.
+fn rotvec(q: Quat) -> Vec3 {
+    if q.w < 0.0 { -q } else { q }.to_scaled_axis()
+}
+
+/// The Hermite control rotations `(a, b)` of every segment and part: segment `i` runs from key
+/// `i` through `a` and `b` to key `i + 1`.
+pub fn hermite_controls(keys: &[(f64, Vec3, Vec<Quat>)]) -> Vec<Vec<(Quat, Quat)>> {
+    let n = keys.len();
+    let parts = keys.first().map_or(0, |k| k.2.len());
+    // angular velocity (rotation vector per second, in the key's own frame) at every key
+    let velocity = |i: usize, p: usize| -> Vec3 {
+        let q = keys[i].2[p];
+        let next = (i + 1 < n)
+            .then(|| rotvec(q.inverse() * keys[i + 1].2[p]) / (keys[i + 1].0 - keys[i].0) as f32);
+        let prev = (i > 0)
+            .then(|| -rotvec(q.inverse() * keys[i - 1].2[p]) / (keys[i].0 - keys[i - 1].0) as f32);
+        match (prev, next) {
+            (Some(a), Some(b)) => (a + b) / 2.0,
+            (Some(v), None) | (None, Some(v)) => v,
+            (None, None) => Vec3::ZERO,
+        }
+    };
+    (0..n.saturating_sub(1))
+        .map(|i| {
+            let dt = (keys[i + 1].0 - keys[i].0) as f32;
+            (0..parts)
+                .map(|p| {
+                    let a = keys[i].2[p] * Quat::from_scaled_axis(velocity(i, p) * dt / 3.0);
+                    let b =
+                        keys[i + 1].2[p] * Quat::from_scaled_axis(-velocity(i + 1, p) * dt / 3.0);
+                    (a.normalize(), b.normalize())
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The cubic Bézier curve `q0, a, b, q1` on the rotation sphere at `u` (repeated slerp).
+fn bezier(q0: Quat, a: Quat, b: Quat, q1: Quat, u: f32) -> Quat {
+    let (p01, p12, p23) = (q0.slerp(a, u), a.slerp(b, u), b.slerp(q1, u));
+    p01.slerp(p12, u).slerp(p12.slerp(p23, u), u).normalize()
 }
 
 /// Reads the first `<SkeletonInterpolator>` of `content`.
@@ -134,7 +192,38 @@ impl Keys {
         self.keys.last().map_or(0.0, |l| l.0) - self.keys.first().map_or(0.0, |f| f.0)
     }
 
-    /// The root translation and rotations at key time `t` (clamped to the keys).
+    /// The root translation and rotations at key time `t` (clamped to the keys) with `how`;
+    /// `controls` are [`hermite_controls`] of the keys (used by [`Interpolation::Hermite`]).
+    pub fn sample_with(
+        &self,
+        t: f64,
+        how: Interpolation,
+        controls: &[Vec<(Quat, Quat)>],
+    ) -> (Vec3, Vec<Quat>) {
+        let k = &self.keys;
+        if how == Interpolation::Slerp || controls.len() + 1 != k.len() {
+            return self.sample(t);
+        }
+        if t <= k[0].0 || k.len() == 1 {
+            return (k[0].1, k[0].2.clone());
+        }
+        let last = &k[k.len() - 1];
+        if t >= last.0 {
+            return (last.1, last.2.clone());
+        }
+        let i = k.partition_point(|key| key.0 <= t) - 1;
+        let (a, b) = (&k[i], &k[i + 1]);
+        let u = ((t - a.0) / (b.0 - a.0)) as f32;
+        let rotations =
+            a.2.iter()
+                .zip(&b.2)
+                .zip(&controls[i])
+                .map(|((p, q), (ca, cb))| bezier(*p, *ca, *cb, *q, u))
+                .collect();
+        (a.1.lerp(b.1, u), rotations)
+    }
+
+    /// The root translation and rotations at key time `t` (clamped to the keys), slerped.
     pub fn sample(&self, t: f64) -> (Vec3, Vec<Quat>) {
         let k = &self.keys;
         if t <= k[0].0 || k.len() == 1 {
@@ -155,7 +244,7 @@ impl Keys {
 /// Sets the keyframe's rotations at global time `now` for a unit timed by `syncs`; false
 /// outside its time.
 fn play(
-    k: &Keys,
+    (k, how, controls): (&Keys, Interpolation, &[Vec<(Quat, Quat)>]),
     joints: &[Option<usize>],
     syncs: &[(SyncName, f64)],
     now: f64,
@@ -174,7 +263,7 @@ fn play(
     } else {
         first + k.duration()
     };
-    let (root, rotations) = k.sample(t);
+    let (root, rotations) = k.sample_with(t, how, controls);
     if k.root_translation {
         pose.root = root;
     }
@@ -196,6 +285,9 @@ fn content(b: &Behaviour) -> Option<&str> {
 #[derive(Debug, Clone)]
 struct KeyframeUnit {
     keys: Keys,
+    how: Interpolation,
+    /// Hermite control rotations per segment (empty for slerp).
+    controls: Vec<Vec<(Quat, Quat)>>,
     /// The skeleton joint of each part, resolved on first use.
     joints: Option<Vec<Option<usize>>>,
 }
@@ -243,7 +335,34 @@ impl Engine for KeyframeEngine {
         let c = content(unit.behaviour)
             .ok_or_else(|| EngineError("the keyframe engine realizes bmlt:keyframe".into()))?;
         let keys = read_keys(c).map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
-        self.units.add(unit, KeyframeUnit { keys, joints: None });
+        let mut how = Interpolation::Slerp;
+        if let BehaviourKind::Keyframe(a) = &unit.behaviour.kind {
+            for p in &a.params {
+                match (p.name.as_str(), p.value.trim()) {
+                    ("interpolation", "slerp") => how = Interpolation::Slerp,
+                    ("interpolation", "hermite" | "squad") => how = Interpolation::Hermite,
+                    (name, value) => {
+                        return Err(EngineError(format!(
+                            "{}: keyframe parameter {name}=\"{value}\" is not supported (interpolation = slerp or hermite)",
+                            unit.key
+                        )))
+                    }
+                }
+            }
+        }
+        let controls = match how {
+            Interpolation::Slerp => Vec::new(),
+            Interpolation::Hermite => hermite_controls(&keys.keys),
+        };
+        self.units.add(
+            unit,
+            KeyframeUnit {
+                keys,
+                how,
+                controls,
+                joints: None,
+            },
+        );
         Ok(())
     }
 
@@ -253,7 +372,7 @@ impl Engine for KeyframeEngine {
             let joints = u
                 .joints
                 .get_or_insert_with(|| k.parts.iter().map(|p| skeleton.joint(p)).collect());
-            play(k, joints, syncs, now, pose);
+            play((k, u.how, &u.controls), joints, syncs, now, pose);
         }
     }
 
@@ -268,7 +387,7 @@ impl Engine for KeyframeEngine {
                     &resolved
                 }
             };
-            any |= play(&u.keys, joints, syncs, t, pose);
+            any |= play((&u.keys, u.how, &u.controls), joints, syncs, t, pose);
         }
         any
     }
@@ -302,6 +421,45 @@ mod tests {
         let reference =
             q0 * ((1.0 - u) * theta).sin() / theta.sin() + q1 * (u * theta).sin() / theta.sin();
         assert!(mid[0].angle_between(reference.normalize()) < 1e-5);
+    }
+
+    #[test]
+    fn hermite_keys_are_exact_and_the_angular_velocity_is_continuous_through_them() {
+        // unevenly spaced keys turning about changing axes
+        let k = read_keys(
+            r#"<SkeletonInterpolator rotationEncoding="quaternions" parts="a" encoding="R">
+            0   1 0 0 0
+            0.4 0.9239 0.3827 0 0
+            1.5 0.7071 0 0.7071 0
+            2   0.5 0.5 0.5 0.5
+            </SkeletonInterpolator>"#,
+        )
+        .unwrap();
+        let controls = hermite_controls(&k.keys);
+        let at = |how, t: f64| k.sample_with(t, how, &controls).1[0];
+        for (t, _, q) in &k.keys {
+            assert!(at(Interpolation::Hermite, *t).angle_between(q[0]) < 1e-6);
+        }
+        // angular velocity (rad/s) just before and just after a key
+        let velocity =
+            |how, t: f64, dt: f64| rotvec(at(how, t).inverse() * at(how, t + dt)) / dt as f32;
+        let h = 1e-4;
+        for key in [0.4, 1.5] {
+            let (before, after) = (
+                velocity(Interpolation::Hermite, key - h, h),
+                velocity(Interpolation::Hermite, key, h),
+            );
+            assert!(
+                (before - after).length() < 0.01,
+                "{key}: {before} vs {after}"
+            );
+            // slerp kinks there
+            let (sb, sa) = (
+                velocity(Interpolation::Slerp, key - h, h),
+                velocity(Interpolation::Slerp, key, h),
+            );
+            assert!((sb - sa).length() > 0.3, "{key}: slerp {sb} vs {sa}");
+        }
     }
 
     #[test]
