@@ -839,3 +839,49 @@ fn a_hermite_keyframe_is_accepted_and_an_unknown_interpolation_refused() {
         "{warnings:?}"
     );
 }
+
+#[test]
+fn a_posture_pose_holds_the_arms_akimbo_with_its_stance_and_lets_go_by_its_end() {
+    let skeleton = Skeleton::adult();
+    let (l, r) = (
+        skeleton.joint("l_wrist").unwrap(),
+        skeleton.joint("r_wrist").unwrap(),
+    );
+    let mut realizer = Realizer::new();
+    realizer
+        .perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><posture id="p" start="0" ready="0.5" relax="2" end="2.5"><stance type="STANDING"/><pose part="ARMS" lexeme="AKIMBO"/></posture></bml>"#)
+        .unwrap();
+    let rest = bml_realizer::body::Pose::rest(&skeleton).world(&skeleton);
+    let mut at = |t: f64| realizer.tick(t).poses[0].pose.world(&skeleton);
+    at(0.0);
+    for t in [0.5, 1.2, 2.0] {
+        let w = at(t);
+        assert!(
+            (w.positions[r] - Vec3::new(-0.24, 1.0, 0.02)).length() < 1e-3,
+            "{t}: {}",
+            w.positions[r]
+        );
+        assert!(
+            (w.positions[l] - Vec3::new(0.24, 1.0, 0.02)).length() < 1e-3,
+            "{t}: {}",
+            w.positions[l]
+        );
+    }
+    let end = at(2.5);
+    assert!((end.positions[r] - rest.positions[r]).length() < 1e-4);
+}
+
+#[test]
+fn a_posture_with_a_pose_the_bindings_lack_is_refused_naming_the_poses() {
+    let Track { warnings, .. } = track(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><posture id="p" start="0"><stance type="SITTING"/><pose part="ARMS" lexeme="JUGGLING"/></posture></bml>"#,
+        "r_wrist",
+        0.5,
+    );
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("no pose JUGGLING for ARMS") && w.contains("ARMS AKIMBO")),
+        "{warnings:?}"
+    );
+}

@@ -5,15 +5,21 @@
 //! to its stance from `start` to `ready` (minimum jerk), holds it until `relax` and returns to the
 //! rest stance by `end`; a `postureShift` moves over its whole span and its stance becomes the rest
 //! stance, kept after it ends. Of several postures running at once the one that started last wins
-//! (R33). `<pose part lexeme>` children are not interpreted yet (the support table says so).
+//! (R33). `<pose part lexeme>` children hold a part of the body in a pose bound in
+//! `fixtures/bindings/poses.json` to a procedural unit (arms akimbo, crossed or hanging, legs
+//! spread, head tilted; mirrored for the other side), eased in and out with the stance; a pose
+//! the bindings lack refuses the posture, naming the poses there are.
+
+use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 
-use crate::bml::{Behaviour, BehaviourKind, StanceType};
+use crate::bml::{Behaviour, BehaviourKind, PosePart, StanceType};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Unit, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
+use crate::engines::procedural::{Library, ProcUnit};
 use crate::world::World;
 
 /// A stance: pitch of the hips and knees and ankles (degrees, about +x), and the root's drop
@@ -49,19 +55,114 @@ pub fn stance(t: StanceType) -> Stance {
     }
 }
 
+/// The embedded pose bindings.
+const POSES: &str = include_str!("../../fixtures/bindings/poses.json");
+
+/// A pose held by a unit of the procedural library on some sides (`false` as authored, `true`
+/// mirrored).
+type HeldPose = (Arc<ProcUnit>, &'static [bool]);
+
+/// `<pose part lexeme>` bound to procedural units.
+#[derive(Debug, Clone, Default)]
+pub struct PoseBindings {
+    poses: Vec<(PosePart, String, HeldPose)>,
+}
+
+impl PoseBindings {
+    /// The default bindings.
+    pub fn default_bindings() -> PoseBindings {
+        static BINDINGS: std::sync::LazyLock<PoseBindings> = std::sync::LazyLock::new(|| {
+            PoseBindings::from_json(POSES, &Library::default_library())
+                .expect("the embedded pose bindings are valid")
+        });
+        BINDINGS.clone()
+    }
+
+    /// Reads `{"poses": [{"part", "lexeme", "procedural", "sides": right|left|both}]}`.
+    pub fn from_json(text: &str, library: &Library) -> Result<PoseBindings, String> {
+        let v: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
+        let list = v["poses"].as_array().ok_or("no \"poses\" list")?;
+        let mut poses = Vec::new();
+        for p in list {
+            let field = |k: &str| {
+                p[k].as_str()
+                    .ok_or_else(|| format!("a pose binding needs \"{k}\" ({p})"))
+            };
+            let part = PosePart::parse(field("part")?)
+                .ok_or_else(|| format!("unknown pose part '{}'", field("part").unwrap_or("")))?;
+            let lexeme = field("lexeme")?.to_string();
+            let unit = field("procedural")?;
+            let unit = library
+                .get(unit)
+                .ok_or_else(|| format!("{lexeme}: no procedural unit '{unit}'"))?
+                .clone();
+            let sides: &'static [bool] = match field("sides")? {
+                "right" => &[false],
+                "left" => &[true],
+                "both" => &[false, true],
+                other => return Err(format!("{lexeme}: sides '{other}' (right, left or both)")),
+            };
+            poses.push((part, lexeme, (unit, sides)));
+        }
+        Ok(PoseBindings { poses })
+    }
+
+    fn get(&self, part: PosePart, lexeme: &str) -> Result<HeldPose, String> {
+        self.poses
+            .iter()
+            .find(|p| p.0 == part && p.1 == lexeme)
+            .map(|p| p.2.clone())
+            .ok_or_else(|| {
+                let known: Vec<String> = self
+                    .poses
+                    .iter()
+                    .map(|p| format!("{} {}", p.0.as_str(), p.1))
+                    .collect();
+                format!(
+                    "no pose {lexeme} for {} (the pose bindings have {known:?})",
+                    part.as_str()
+                )
+            })
+    }
+}
+
 #[derive(Debug, Clone)]
 struct PostureUnit {
     stance: StanceType,
     shift: bool,
+    poses: Vec<HeldPose>,
 }
 
 /// The posture engine (see the module documentation).
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct PostureEngine {
     models: DefaultTimingModels,
+    bindings: PoseBindings,
     units: Units<PostureUnit>,
-    /// The stance held when no posture runs (set by posture shifts).
-    rest: Option<StanceType>,
+    /// The stance and poses held when no posture runs (set by posture shifts).
+    rest: Option<(StanceType, Vec<HeldPose>)>,
+}
+
+impl Default for PostureEngine {
+    fn default() -> Self {
+        PostureEngine {
+            models: DefaultTimingModels::default(),
+            bindings: PoseBindings::default_bindings(),
+            units: Units::new(),
+            rest: None,
+        }
+    }
+}
+
+/// Holds `poses` on `pose` with weight `w`.
+fn hold(skeleton: &Skeleton, pose: &mut Pose, poses: &[HeldPose], w: f32) {
+    for (unit, sides) in poses {
+        for &mirrored in sides.iter() {
+            // the bound units were checked when the bindings were read
+            let _ = unit.apply(0.5, &unit.params, mirrored, w, skeleton, pose);
+        }
+    }
 }
 
 fn posture(b: &Behaviour) -> Option<(StanceType, bool)> {
@@ -124,16 +225,36 @@ impl Engine for PostureEngine {
         let (stance, shift) = posture(unit.behaviour).ok_or_else(|| {
             EngineError("the posture engine realizes posture and postureShift".into())
         })?;
-        self.units.add(unit, PostureUnit { stance, shift });
+        let written = match &unit.behaviour.kind {
+            BehaviourKind::Posture(p) | BehaviourKind::PostureShift(p) => &p.poses,
+            _ => return Err(EngineError("not a posture".into())),
+        };
+        let poses = written
+            .iter()
+            .map(|p| self.bindings.get(p.part, &p.lexeme))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
+        self.units.add(
+            unit,
+            PostureUnit {
+                stance,
+                shift,
+                poses,
+            },
+        );
         Ok(())
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
-        // a shift that reached its end is the rest stance from then on
+        // a shift that reached its end is the rest stance (and poses) from then on
         if let Some(u) = finished_shift(&self.units, now, |u| u.shift) {
-            self.rest = Some(u.stance);
+            self.rest = Some((u.stance, u.poses.clone()));
         }
-        let rest = stance(self.rest.unwrap_or(StanceType::Standing));
+        let (rest_type, rest_poses) = match &self.rest {
+            Some((s, p)) => (*s, p.as_slice()),
+            None => (StanceType::Standing, &[][..]),
+        };
+        let rest = stance(rest_type);
         let active = self
             .units
             .all()
@@ -148,6 +269,14 @@ impl Engine for PostureEngine {
         };
         if s != stance(StanceType::Standing) {
             apply(skeleton, pose, s);
+        }
+        // the rest poses fade out while a posture with other poses holds, and its poses in
+        match active {
+            Some((_, w, u)) => {
+                hold(skeleton, pose, rest_poses, 1.0 - w);
+                hold(skeleton, pose, &u.poses, w);
+            }
+            None => hold(skeleton, pose, rest_poses, 1.0),
         }
     }
 }
