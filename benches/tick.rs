@@ -1,11 +1,14 @@
 //! Criterion bench `tick`: the per-frame cost of the runtime. 100 characters, each running one
-//! block of 20 units (gestures, nods, gaze, a speech) that last long enough to stay active; each
-//! iteration advances the clock by one 60 Hz frame.
+//! block of 20 units (gestures, nods, gaze, a speech) that last long enough to stay active; and
+//! one or 100 characters each running 10 units of every motion engine (keyed and procedural
+//! gestures, a procanimation with IK, a keyframe, a nod, a gaze, noise, a posture with a pose, a
+//! speech). Each iteration advances the clock by one 60 Hz frame.
 //!
 //! Run: `cargo bench --bench tick`
 
 use std::hint::black_box;
 
+use bml_realizer::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 use criterion::{criterion_group, criterion_main, Criterion};
 
@@ -30,6 +33,53 @@ fn block(character: usize) -> String {
     )
 }
 
+/// Ten units of every motion engine, all lasting past the end of the bench.
+fn mixed(character: usize) -> String {
+    let body = r#"
+        <gesture id="g1" lexeme="BEAT" start="0" end="1000000"/>
+        <gesture id="g2" lexeme="WAVE" mode="LEFT_HAND" start="0" end="1000000"/>
+        <bmlt:procanimation id="p" name="sway" start="0" end="1000000"/>
+        <bmlt:keyframe id="kf" start="0" end="1000000"><SkeletonInterpolator rotationEncoding="quaternions" parts="l_elbow vt12" encoding="R">
+            0 1 0 0 0 1 0 0 0
+            1 0.9239 0 0.3827 0 0.9962 0.0872 0 0
+        </SkeletonInterpolator></bmlt:keyframe>
+        <head id="h" lexeme="NOD" start="0" end="1000000"/>
+        <gaze id="look" target="user" start="0" end="1000000"/>
+        <pointing id="pt" target="bluebox" mode="RIGHT_HAND" start="0" end="1000000"/>
+        <bmlt:noise id="n" type="perlin" joint="skullbase" start="0" end="1000000"/>
+        <posture id="po" start="0" end="1000000"><stance type="STANDING"/><pose part="ARMS" lexeme="AKIMBO"/><pose part="LEGS" lexeme="SPREAD"/></posture>"#;
+    let words = "la ".repeat(100_000);
+    format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b" characterId="c{character}">{body}<speech id="s"><text>{words}</text></speech></bml>"#
+    )
+}
+
+fn tick_mixed(c: &mut Criterion) {
+    for n in [1usize, 100] {
+        let mut r = Realizer::new();
+        for ch in 0..n {
+            r.perform_bml(&mixed(ch)).unwrap();
+        }
+        let mut t = 1.0;
+        let first = r.tick(t);
+        let warnings: Vec<String> = first
+            .feedback
+            .iter()
+            .filter(|f| matches!(f, Feedback::Warning(_)))
+            .map(|f| format!("{f:?}"))
+            .collect();
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let active: usize = r.tick(t).outputs.len();
+        assert_eq!(active, n * 10, "every unit is active");
+        c.bench_function(&format!("tick/{n}-characters-x-10-mixed-units"), |b| {
+            b.iter(|| {
+                t += 1.0 / 60.0;
+                black_box(r.tick(t))
+            })
+        });
+    }
+}
+
 fn tick(c: &mut Criterion) {
     let mut r = Realizer::new();
     for ch in 0..100 {
@@ -47,5 +97,5 @@ fn tick(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, tick);
+criterion_group!(benches, tick, tick_mixed);
 criterion_main!(benches);

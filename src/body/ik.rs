@@ -4,6 +4,7 @@
 use glam::{Quat, Vec3};
 
 use super::pose::{Pose, WorldPose};
+
 use super::skeleton::Skeleton;
 
 /// Where elbows bend: down and back.
@@ -16,24 +17,58 @@ pub fn arc(from: Vec3, to: Vec3) -> Quat {
     Quat::from_rotation_arc(from.normalize_or(Vec3::X), to.normalize_or(Vec3::X))
 }
 
+/// The world frame of a limb's root joint: its position, its orientation and its parent's
+/// orientation (from [`Pose::world`] or [`Pose::joint_world`]).
+#[derive(Debug, Clone, Copy)]
+pub struct LimbRoot {
+    /// Position of the root joint.
+    pub position: Vec3,
+    /// Orientation of the root joint.
+    pub orientation: Quat,
+    /// Orientation of its parent.
+    pub parent: Quat,
+}
+
+impl LimbRoot {
+    /// The frame of joint `root` in `world`; `None` for the skeleton's root.
+    pub fn of(skeleton: &Skeleton, world: &WorldPose, root: usize) -> Option<LimbRoot> {
+        Some(LimbRoot {
+            position: world.positions[root],
+            orientation: world.orientations[root],
+            parent: world.orientations[skeleton.joints()[root].parent?],
+        })
+    }
+
+    /// The frame of joint `root` by forward kinematics along its ancestors only.
+    pub fn chain(skeleton: &Skeleton, pose: &Pose, root: usize) -> Option<LimbRoot> {
+        skeleton.joints()[root].parent?;
+        let (position, orientation) = pose.joint_world(skeleton, root);
+        Some(LimbRoot {
+            position,
+            orientation,
+            parent: orientation * pose.rotations[root].inverse(),
+        })
+    }
+}
+
 /// The local rotations of a limb's `root` and `mid` joints (shoulder and elbow, hip and knee) that
-/// put its `end` joint (wrist, ankle) at `goal` (the space of `world`), the middle joint bending
-/// toward `pole`; `world` is `pose`'s forward kinematics. `None` if `root` is the skeleton's root.
+/// put its `end` joint (wrist, ankle) at `goal` (the space of `frame`), the middle joint bending
+/// toward `pole`; `frame` is the root joint's world frame in `pose`.
 pub fn place_limb(
     skeleton: &Skeleton,
     pose: &Pose,
-    world: &WorldPose,
-    [root, mid, end]: [usize; 3],
+    frame: LimbRoot,
+    [_root, mid, end]: [usize; 3],
     goal: Vec3,
     pole: Vec3,
 ) -> Option<(Quat, Quat)> {
     let joints = skeleton.joints();
     let (upper, lower) = (joints[mid].offset, joints[end].offset);
-    let s = world.positions[root];
+    let s = frame.position;
     let e = two_link(s, upper.length(), lower.length(), goal, pole);
     // root: the upper link toward the middle joint
-    let parent = world.orientations[joints[root].parent?];
-    let current_s = world.orientations[root];
+    let parent = frame.parent;
+    let current_s = frame.orientation;
     let local_s = parent.inverse() * arc(current_s * upper, e - s) * current_s;
     // middle: the lower link toward the goal
     let o_s = parent * local_s;

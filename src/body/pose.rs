@@ -41,6 +41,33 @@ impl Pose {
         }
     }
 
+    /// Forward kinematics of one joint only (along its ancestors): its world position and
+    /// orientation, as [`world`](Self::world) gives them.
+    pub fn joint_world(&self, skeleton: &Skeleton, i: usize) -> (Vec3, Quat) {
+        let joints = skeleton.joints();
+        // the chain from the root down to i (skeletons are shallow)
+        let mut chain = [0usize; 64];
+        let (mut n, mut j) = (0, Some(i));
+        while let Some(k) = j {
+            if n == chain.len() {
+                let w = self.world(skeleton);
+                return (w.positions[i], w.orientations[i]);
+            }
+            chain[n] = k;
+            n += 1;
+            j = joints[k].parent;
+        }
+        let (mut p, mut o) = (self.root, Quat::IDENTITY);
+        for (step, &k) in chain[..n].iter().rev().enumerate() {
+            let local = self.rotations.get(k).copied().unwrap_or(Quat::IDENTITY);
+            if step > 0 {
+                p += o * joints[k].offset;
+            }
+            o *= local;
+        }
+        (p, o)
+    }
+
     /// Forward kinematics: every joint's world position and orientation.
     pub fn world(&self, skeleton: &Skeleton) -> WorldPose {
         let n = skeleton.len();
@@ -70,6 +97,30 @@ impl Pose {
 mod tests {
     use super::*;
     use std::f32::consts::FRAC_PI_2;
+
+    #[test]
+    fn one_joint_forward_kinematics_equals_the_full_one() {
+        let s = Skeleton::adult();
+        let mut pose = Pose::rest(&s);
+        for (i, r) in pose.rotations.iter_mut().enumerate() {
+            *r = Quat::from_euler(glam::EulerRot::ZXY, 0.1 * i as f32, -0.05 * i as f32, 0.3);
+        }
+        pose.root = glam::Vec3::new(0.3, 0.9, -0.2);
+        let w = pose.world(&s);
+        for i in 0..s.len() {
+            let (p, o) = pose.joint_world(&s, i);
+            assert!((p - w.positions[i]).length() < 1e-5, "{i}");
+            assert!(
+                1.0 - o.dot(w.orientations[i]).abs() < 1e-6,
+                "{i}: {o} {}",
+                w.orientations[i]
+            );
+        }
+        assert_eq!(s.joint_mirrored("r_elbow", true), s.joint("l_elbow"));
+        assert_eq!(s.joint_mirrored("r_elbow", false), s.joint("r_elbow"));
+        assert_eq!(s.joint_mirrored("vl5", true), s.joint("vl5"));
+        assert_eq!(s.joint_mirrored("l_nothing", true), None);
+    }
 
     #[test]
     fn forward_kinematics_matches_a_hand_computed_arm() {

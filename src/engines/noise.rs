@@ -59,16 +59,8 @@ impl NoiseUnit {
         let octaves = self.value("octaves").clamp(1.0, 8.0) as u32;
         let persistence = self.value("persistence");
         let mut out = [0.0; 3];
-        for (axis, (f, a)) in ["x", "y", "z"]
-            .iter()
-            .map(|x| {
-                (
-                    self.value(&format!("basefreq{x}")),
-                    self.value(&format!("baseamplitude{x}")),
-                )
-            })
-            .enumerate()
-        {
+        // PARAMS: three frequencies, then three amplitudes
+        for (axis, (f, a)) in self.values[0..3].iter().zip(&self.values[3..6]).enumerate() {
             let mut sum = 0.0;
             for k in 0..octaves {
                 let scale = 2f64.powi(k as i32);

@@ -9,7 +9,7 @@
 use glam::Vec3;
 
 use crate::bml::{Behaviour, BehaviourKind, Mode};
-use crate::body::ik::{arc, place_limb, ARM_POLE};
+use crate::body::ik::{arc, place_limb, LimbRoot, ARM_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Unit, Units};
@@ -34,8 +34,14 @@ pub struct PointingEngine {
 
 /// Points the `side` arm (`l` or `r`) of `pose` at `target`, `w` of the way.
 fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32) -> Option<()> {
-    let j = |n: &str| skeleton.joint(&format!("{side}_{n}"));
-    let (shoulder, elbow, wrist, index) = (j("shoulder")?, j("elbow")?, j("wrist")?, j("index1")?);
+    // right-side names, mirrored for the left without allocating
+    let j = |n: &str| skeleton.joint_mirrored(n, side == "l");
+    let (shoulder, elbow, wrist, index) = (
+        j("r_shoulder")?,
+        j("r_elbow")?,
+        j("r_wrist")?,
+        j("r_index1")?,
+    );
     let joints = skeleton.joints();
     let (upper, lower) = (joints[elbow].offset, joints[wrist].offset);
     let hand = joints[index].offset;
@@ -47,7 +53,7 @@ fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32)
     let (local_s, local_e) = place_limb(
         skeleton,
         pose,
-        &world,
+        LimbRoot::of(skeleton, &world, shoulder)?,
         [shoulder, elbow, wrist],
         goal,
         ARM_POLE,
@@ -55,7 +61,7 @@ fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32)
     let o_s = world.orientations[joints[shoulder].parent?] * local_s;
     // wrist: the index finger (from its base, along its bones) toward the target; the base
     // moves with the hand, so a few rounds settle it
-    let finger = match (j("index2"), j("index3")) {
+    let finger = match (j("r_index2"), j("r_index3")) {
         (Some(a), Some(b)) => joints[a].offset + joints[b].offset,
         _ => hand,
     };

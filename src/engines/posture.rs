@@ -175,9 +175,13 @@ fn posture(b: &Behaviour) -> Option<(StanceType, bool)> {
 
 /// Puts `s` into `pose` (legs and root).
 fn apply(skeleton: &Skeleton, pose: &mut Pose, s: Stance) {
-    for side in ["l", "r"] {
-        for (joint, deg) in [("hip", s.hips), ("knee", s.knees), ("talocrural", s.ankles)] {
-            if let Some(i) = skeleton.joint(&format!("{side}_{joint}")) {
+    for mirrored in [false, true] {
+        for (joint, deg) in [
+            ("r_hip", s.hips),
+            ("r_knee", s.knees),
+            ("r_talocrural", s.ankles),
+        ] {
+            if let Some(i) = skeleton.joint_mirrored(joint, mirrored) {
                 pose.rotate(i, Quat::from_rotation_x(deg.to_radians()));
             }
         }

@@ -48,7 +48,7 @@ use fasteval::{Compiler, EvalNamespace, Evaler, Instruction, Slab};
 use glam::{EulerRot, Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind, Id, Param};
-use crate::body::ik::{place_limb, ARM_POLE, LEG_POLE};
+use crate::body::ik::{place_limb, LimbRoot, ARM_POLE, LEG_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
 use crate::engine::{Engine, EngineError, SyncTimes, Unit, UnitKey, Units};
@@ -348,30 +348,16 @@ impl ProcUnit {
         }
     }
 
-    /// Every rotation (radians, z x y) and effector position at `alpha` with `params`.
-    fn evaluate(&self, alpha: f64, params: &[(String, f64)]) -> Result<Evaluated, String> {
+    /// Evaluates every expression at `alpha` with `params` (an error names the failing one).
+    fn evaluate(&self, alpha: f64, params: &[(String, f64)]) -> Result<(), String> {
         let mut names = Names { alpha, params };
-        let mut three = |e: &[Expr; 3]| -> Result<[f64; 3], String> {
-            Ok([
-                e[0].eval(&mut names)?,
-                e[1].eval(&mut names)?,
-                e[2].eval(&mut names)?,
-            ])
-        };
-        let rotations = self
-            .rotations
-            .iter()
-            .map(|(_, e)| three(e))
-            .collect::<Result<_, _>>()?;
-        let positions = self
-            .effectors
-            .iter()
-            .map(|f| three(&f.position))
-            .collect::<Result<_, _>>()?;
-        Ok(Evaluated {
-            rotations,
-            positions,
-        })
+        for (_, e) in &self.rotations {
+            three(e, &mut names)?;
+        }
+        for f in &self.effectors {
+            three(&f.position, &mut names)?;
+        }
+        Ok(())
     }
 
     /// Checks parameter overrides against the unit's parameters.
@@ -425,20 +411,20 @@ impl ProcUnit {
                 from.slerp(to, weight.max(0.0)).normalize()
             }
         };
-        let v = self.evaluate(alpha.clamp(0.0, 1.0), params)?;
-        for ((joint, _), [z, x, y]) in self.rotations.iter().zip(&v.rotations) {
+        let mut names = Names {
+            alpha: alpha.clamp(0.0, 1.0),
+            params,
+        };
+        for (joint, e) in &self.rotations {
+            let [z, x, y] = three(e, &mut names)?;
             let q = Quat::from_euler(
                 EulerRot::ZXY,
                 z.to_radians() as f32,
                 x.to_radians() as f32,
                 y.to_radians() as f32,
             );
-            let (name, q) = if mirrored {
-                (mirror_name(joint), mirror_rotation(q))
-            } else {
-                (joint.clone(), q)
-            };
-            if let Some(i) = skeleton.joint(&name) {
+            let q = if mirrored { mirror_rotation(q) } else { q };
+            if let Some(i) = skeleton.joint_mirrored(joint, mirrored) {
                 if self.additive {
                     pose.rotate(i, blend(Quat::IDENTITY, q));
                 } else {
@@ -446,15 +432,16 @@ impl ProcUnit {
                 }
             }
         }
-        for (f, p) in self.effectors.iter().zip(&v.positions) {
+        for f in &self.effectors {
+            let p = three(&f.position, &mut names)?;
             let mut goal = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
-            let name = if mirrored {
+            if mirrored {
                 goal.x = -goal.x;
-                mirror_name(&f.joint)
-            } else {
-                f.joint.clone()
+            }
+            let Some(end) = skeleton.joint_mirrored(&f.joint, mirrored) else {
+                continue;
             };
-            if let Some(([root, mid], (r, m))) = reach(skeleton, pose, &name, f.frame, goal) {
+            if let Some(([root, mid], (r, m))) = reach(skeleton, pose, end, f.frame, goal) {
                 pose.rotations[root] = blend(pose.rotations[root], r);
                 pose.rotations[mid] = blend(pose.rotations[mid], m);
             }
@@ -463,9 +450,9 @@ impl ProcUnit {
     }
 }
 
-struct Evaluated {
-    rotations: Vec<[f64; 3]>,
-    positions: Vec<[f64; 3]>,
+/// The values of three expressions.
+fn three(e: &[Expr; 3], names: &mut Names) -> Result<[f64; 3], String> {
+    Ok([e[0].eval(names)?, e[1].eval(names)?, e[2].eval(names)?])
 }
 
 /// The other side's joint name: `l_…` ↔ `r_…`; other joints are their own mirror image.
@@ -489,25 +476,25 @@ pub fn mirror_rotation(q: Quat) -> Quat {
 fn reach(
     skeleton: &Skeleton,
     pose: &Pose,
-    name: &str,
+    end: usize,
     frame: Frame,
     goal: Vec3,
 ) -> Option<([usize; 2], (Quat, Quat))> {
-    let end = skeleton.joint(name)?;
     let joints = skeleton.joints();
+    let name = &joints[end].name;
     let mid = joints[end].parent?;
     let root = joints[mid].parent?;
-    let world = pose.world(skeleton);
+    let limb = LimbRoot::chain(skeleton, pose, root)?;
     let goal = match frame {
         Frame::Body => goal,
-        Frame::Limb => world.positions[root] + goal,
+        Frame::Limb => limb.position + goal,
     };
     let pole = if name.contains("talocrural") || name.contains("ankle") {
         LEG_POLE
     } else {
         ARM_POLE
     };
-    let rotations = place_limb(skeleton, pose, &world, [root, mid, end], goal, pole)?;
+    let rotations = place_limb(skeleton, pose, limb, [root, mid, end], goal, pole)?;
     Some(([root, mid], rotations))
 }
 

@@ -133,6 +133,8 @@ impl Engine for TransitionEngine {
             }
         }
         self.predictions.clear();
+        // keep this frame's pose for a transition that starts next frame (its block may start
+        // then: units are added when their block starts); a copy of one pose, no allocation
         match &mut self.last {
             Some(last) => last.clone_from(pose),
             None => self.last = Some(pose.clone()),
