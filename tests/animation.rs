@@ -885,3 +885,34 @@ fn a_posture_with_a_pose_the_bindings_lack_is_refused_naming_the_poses() {
         "{warnings:?}"
     );
 }
+
+#[test]
+fn a_head_direction_shift_turns_the_face_to_its_target_and_keeps_it_there() {
+    let skeleton = Skeleton::adult();
+    let skull = skeleton.joint("skullbase").unwrap();
+    let eyes: Vec3 = {
+        let w = bml_realizer::body::Pose::rest(&skeleton).world(&skeleton);
+        (w.positions[skeleton.joint("l_eyeball_joint").unwrap()]
+            + w.positions[skeleton.joint("r_eyeball_joint").unwrap()])
+            / 2.0
+    };
+    let target = Vec3::new(-0.4, 1.6, 1.5); // the default world's speaker
+    let mut r = Realizer::new();
+    r.perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><headDirectionShift id="h" target="speaker" start="0.5" end="1.5"/></bml>"#)
+        .unwrap();
+    let face = |r: &mut Realizer, t: f64| {
+        let w = r.tick(t).poses[0].pose.world(&skeleton);
+        (w.orientations[skull] * Vec3::Z).angle_between((target - eyes).normalize())
+    };
+    let at_start = face(&mut r, 0.5);
+    assert!(at_start.to_degrees() > 10.0, "not turned yet");
+    let mut last = at_start;
+    for i in 1..=60 {
+        let a = face(&mut r, 0.5 + f64::from(i) / 60.0);
+        assert!(a <= last + 1e-4, "turning steadily toward it");
+        last = a;
+    }
+    assert!(last.to_degrees() < 0.5, "{}", last.to_degrees());
+    // kept after the shift
+    assert!(face(&mut r, 3.0).to_degrees() < 0.5);
+}

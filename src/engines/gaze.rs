@@ -61,12 +61,12 @@ fn shares(influence: Influence) -> &'static [(&'static str, f32, f32)] {
 }
 
 /// A yaw-then-pitch rotation (no torsion).
-fn donders(yaw: f32, pitch: f32) -> Quat {
+pub(crate) fn donders(yaw: f32, pitch: f32) -> Quat {
     Quat::from_rotation_y(yaw) * Quat::from_rotation_x(pitch)
 }
 
 /// Yaw and pitch of direction `d` (in a frame facing +z, y up).
-fn yaw_pitch(d: Vec3) -> (f32, f32) {
+pub(crate) fn yaw_pitch(d: Vec3) -> (f32, f32) {
     let yaw = d.x.atan2(d.z);
     let pitch = (-d.y).atan2((d.x * d.x + d.z * d.z).sqrt());
     (yaw, pitch)

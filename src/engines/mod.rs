@@ -8,6 +8,7 @@
 //!   scheduled pegs and reports every sync point, but moves no body;
 //! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well);
 //! - [`head`]: head nods, shakes and tilts as real motion of the neck and skull;
+//! - [`head_direction`]: `headDirectionShift` turns the head toward a world point, for good;
 //! - [`gaze`]: gaze and gaze shifts as real motion of eyes, neck and trunk toward world targets;
 //! - [`pointing`]: pointing as real arm motion (two-link IK) toward world targets;
 //! - [`keyframe`]: BMLT keyframe animations (SkeletonInterpolator), slerped between exact keys;
@@ -21,6 +22,7 @@ pub mod control;
 pub mod gaze;
 pub mod gesture;
 pub mod head;
+pub mod head_direction;
 pub mod keyframe;
 pub mod motion;
 pub mod murml;
@@ -38,7 +40,6 @@ use crate::engine::{KindKey, Registry};
 
 /// Kinds the timing-only motion engine realizes (namespace, element).
 pub const MOTION_KINDS: &[(&str, &str)] = &[
-    (NS_BML, "headDirectionShift"),
     (NS_BML, "face"),
     (NS_BML, "faceLexeme"),
     (NS_BML, "faceShift"),
@@ -115,6 +116,10 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
     r.register(
         Box::new(pointing::PointingEngine::default()),
         &keys(&[(NS_BML, "pointing")]),
+    );
+    r.register(
+        Box::new(head_direction::HeadDirectionEngine::default()),
+        &keys(&[(NS_BML, "headDirectionShift")]),
     );
     // last: the eyes are aimed from the head where the other engines put it
     r.register(
