@@ -916,3 +916,32 @@ fn a_head_direction_shift_turns_the_face_to_its_target_and_keeps_it_there() {
     // kept after the shift
     assert!(face(&mut r, 3.0).to_degrees() < 0.5);
 }
+
+#[test]
+fn a_murml_keyframed_gesture_turns_its_joints_exactly_at_its_frames() {
+    let skeleton = Skeleton::adult();
+    let shoulder = skeleton.joint("l_shoulder").unwrap();
+    let mut r = Realizer::new();
+    r.perform_bml(include_str!(
+        "../fixtures/realizertester/bml-1/murml/murmlbodykeyframe.xml"
+    ))
+    .unwrap();
+    let mut angle = |t: f64| {
+        let q = r.tick(t).poses[0].pose.rotations[shoulder];
+        let (x, y, z) = q.to_euler(glam::EulerRot::XYZ);
+        assert!(y.abs() < 1e-4 && z.abs() < 1e-4);
+        f64::from(x).to_degrees()
+    };
+    // frames at 0, 0.5, 1, 1.5, 2 (0°, 100°, 0°, 100°, 0°) from the start at 2 s
+    for (t, deg) in [
+        (1.0, 0.0),
+        (2.0, 0.0),
+        (2.25, 50.0),
+        (2.5, 100.0),
+        (3.0, 0.0),
+        (3.5, 100.0),
+        (4.0, 0.0),
+    ] {
+        assert!((angle(t) - deg).abs() < 1e-2, "{t}: {} vs {deg}", angle(t));
+    }
+}

@@ -241,9 +241,9 @@ impl Keys {
     }
 }
 
-/// Sets the keyframe's rotations at global time `now` for a unit timed by `syncs`; false
-/// outside its time.
-fn play(
+/// Sets the keyframe's rotations at global time `now` for a unit timed by `syncs` (the keys laid
+/// linearly from its first sync to its last); false outside its time.
+pub(crate) fn play(
     (k, how, controls): (&Keys, Interpolation, &[Vec<(Quat, Quat)>]),
     joints: &[Option<usize>],
     syncs: &[(SyncName, f64)],

@@ -1,16 +1,29 @@
 //! MURML behaviours (`murmlgesture`, `murmlface` in the namespace
-//! `http://www.techfak.uni-bielefeld.de/ags/soa/murml`), timing only: the `<murml-description>` is
-//! read for its timing — a `<keyframing>` lasts until its last `<frame ftime>`, a `<dynamic>`
-//! movement or a `<static>` posture gets the default second — and the behaviour is played with
-//! gesture syncs (`murmlgesture`) or face syncs (`murmlface`, as the conformance suite expects).
-//! No joints or face targets move until the animation engine (issue #7) interprets the frames.
+//! `http://www.techfak.uni-bielefeld.de/ags/soa/murml`). The `<murml-description>` is read for its
+//! timing — a `<keyframing>` lasts until its last `<frame ftime>`, a `<dynamic>` movement or a
+//! `<static>` posture gets the default second — and the behaviour is played with gesture syncs
+//! (`murmlgesture`) or face syncs (`murmlface`, as the conformance suite expects).
+//!
+//! The keyframe subset moves the body: in a `murmlgesture`, each `<frame>`'s
+//! `<posture>Humanoid (JOINT 3 X Y Z) …</posture>` sets joint rotations (Euler angles in degrees,
+//! x then y then z; `(JOINT 1 A)` turns about x), the frames are laid linearly from `start` to
+//! `end` (the last frame's time is the preferred length) and slerped, each frame exact at its
+//! time; a joint a frame leaves out keeps its previous rotation, names the skeleton lacks are
+//! skipped. The keyframing's `easescale`/`easeturningpoint` are not applied (linear time), the
+//! procedural MURML parts (hand location, palm orientation, `<static>`) and `murmlface` morph
+//! targets are timing only.
 
 use quick_xml::events::Event;
 use quick_xml::Reader;
 
+use glam::{EulerRot, Quat, Vec3};
+
 use crate::bml::{Behaviour, BehaviourKind};
+use crate::body::{Pose, Skeleton};
 use crate::engine::timing::TimingModel;
 use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engines::keyframe::{play, Interpolation, Keys};
+use crate::world::World;
 
 /// The MURML namespace.
 pub const NS_MURML: &str = "http://www.techfak.uni-bielefeld.de/ags/soa/murml";
@@ -46,6 +59,126 @@ pub fn duration(content: &str) -> Result<f64, String> {
     Ok(last.filter(|&d| d > 0.0).unwrap_or(DEFAULT_DURATION))
 }
 
+/// The body keys of a keyframed description: every frame's `<posture>` joint rotations, sorted
+/// by time; `None` if it has no frame with a posture.
+pub fn body_keys(content: &str) -> Result<Option<Keys>, String> {
+    let mut reader = Reader::from_str(content);
+    let mut frames: Vec<(f64, Vec<(String, Quat)>)> = Vec::new();
+    let (mut time, mut in_posture, mut text) = (None, false, String::new());
+    loop {
+        match reader.read_event() {
+            Ok(Event::Start(e)) | Ok(Event::Empty(e)) if e.local_name().as_ref() == b"frame" => {
+                time = e
+                    .attributes()
+                    .flatten()
+                    .find(|a| a.key.local_name().as_ref() == b"ftime")
+                    .and_then(|a| a.unescape_value().ok()?.trim().parse::<f64>().ok())
+                    .filter(|t| t.is_finite() && *t >= 0.0);
+                if time.is_none() {
+                    return Err("a MURML <frame> needs a time ftime >= 0".into());
+                }
+            }
+            Ok(Event::Start(e)) if e.local_name().as_ref() == b"posture" => {
+                in_posture = true;
+                text.clear();
+            }
+            Ok(Event::Text(t)) if in_posture => text.push_str(&String::from_utf8_lossy(&t)),
+            Ok(Event::End(e)) if e.local_name().as_ref() == b"posture" => {
+                in_posture = false;
+                let t = time.ok_or("a MURML <posture> outside a <frame>")?;
+                frames.push((t, posture(&text)?));
+            }
+            Ok(Event::Eof) => break,
+            Err(e) => return Err(format!("the MURML description is not well-formed: {e}")),
+            Ok(_) => {}
+        }
+    }
+    if frames.is_empty() {
+        return Ok(None);
+    }
+    frames.sort_by(|a, b| a.0.total_cmp(&b.0));
+    frames.dedup_by(|later, earlier| {
+        let same = later.0 == earlier.0;
+        if same {
+            earlier.1 = std::mem::take(&mut later.1);
+        }
+        same
+    });
+    let mut parts: Vec<String> = Vec::new();
+    for (_, joints) in &frames {
+        for (j, _) in joints {
+            if !parts.contains(j) {
+                parts.push(j.clone());
+            }
+        }
+    }
+    // a joint a frame leaves out keeps its previous rotation
+    let mut current = vec![Quat::IDENTITY; parts.len()];
+    let keys = frames
+        .into_iter()
+        .map(|(t, joints)| {
+            for (j, q) in joints {
+                if let Some(i) = parts.iter().position(|p| *p == j) {
+                    current[i] = q;
+                }
+            }
+            (t, Vec3::ZERO, current.clone())
+        })
+        .collect();
+    Ok(Some(Keys {
+        parts,
+        root_translation: false,
+        keys,
+    }))
+}
+
+/// Reads `Humanoid (JOINT N V…) …`: joints with 3 Euler angles (x, y, z degrees) or 1 (about x).
+fn posture(text: &str) -> Result<Vec<(String, Quat)>, String> {
+    let mut out = Vec::new();
+    let mut rest = text.trim();
+    if let Some(r) = rest.strip_prefix("Humanoid") {
+        rest = r;
+    }
+    while let Some(open) = rest.find('(') {
+        let close = rest[open..]
+            .find(')')
+            .ok_or_else(|| format!("unclosed '(' in MURML posture '{}'", text.trim()))?;
+        let group: Vec<&str> = rest[open + 1..open + close].split_whitespace().collect();
+        rest = &rest[open + close + 1..];
+        let bad = || {
+            format!(
+                "MURML posture group '({})' is not (JOINT N VALUES…)",
+                group.join(" ")
+            )
+        };
+        let (name, n) = match group.as_slice() {
+            [name, n, ..] => (*name, n.parse::<usize>().map_err(|_| bad())?),
+            _ => return Err(bad()),
+        };
+        let values: Vec<f32> = group[2..]
+            .iter()
+            .map(|v| v.parse::<f32>().ok().filter(|v| v.is_finite()))
+            .collect::<Option<_>>()
+            .ok_or_else(bad)?;
+        if values.len() != n {
+            return Err(bad());
+        }
+        let q = match values.as_slice() {
+            [x, y, z] => Quat::from_euler(
+                EulerRot::XYZ,
+                x.to_radians(),
+                y.to_radians(),
+                z.to_radians(),
+            ),
+            [a] => Quat::from_rotation_x(a.to_radians()),
+            // morph targets and other channels do not turn a joint
+            _ => continue,
+        };
+        out.push((name.to_string(), q));
+    }
+    Ok(out)
+}
+
 /// The two MURML kinds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Kind {
@@ -65,10 +198,18 @@ fn kind(b: &Behaviour) -> Option<(Kind, &str)> {
     }
 }
 
+#[derive(Debug, Clone)]
+struct MurmlUnit {
+    /// Body keys of a keyframed `murmlgesture`.
+    keys: Option<Keys>,
+    /// The skeleton joint of each part, resolved on first use.
+    joints: Option<Vec<Option<usize>>>,
+}
+
 /// The MURML engine (see the module documentation).
 #[derive(Debug, Default)]
 pub struct MurmlEngine {
-    units: Units<()>,
+    units: Units<MurmlUnit>,
 }
 
 impl Engine for MurmlEngine {
@@ -100,18 +241,66 @@ impl Engine for MurmlEngine {
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        let (_, content) = kind(unit.behaviour).ok_or_else(|| {
+        let (k, content) = kind(unit.behaviour).ok_or_else(|| {
             EngineError("the MURML engine realizes murmlgesture and murmlface".into())
         })?;
         duration(content).map_err(EngineError)?;
-        self.units.add(unit, ());
+        let keys = match k {
+            Kind::Gesture => {
+                body_keys(content).map_err(|e| EngineError(format!("{}: {e}", unit.key)))?
+            }
+            Kind::Face => None,
+        };
+        self.units.add(unit, MurmlUnit { keys, joints: None });
         Ok(())
+    }
+
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
+        for (syncs, u) in self.units.all_mut() {
+            let Some(k) = &u.keys else { continue };
+            let joints = u
+                .joints
+                .get_or_insert_with(|| k.parts.iter().map(|p| skeleton.joint(p)).collect());
+            play((k, Interpolation::Slerp, &[]), joints, syncs, now, pose);
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn keyframe_postures_are_read_as_joint_rotations_frame_by_frame() {
+        let k = body_keys(
+            r#"<murml-description><dynamic><keyframing><phase>
+                 <frame ftime="1"><posture>Humanoid (l_shoulder 3 90 0 0) (l_elbow 1 30)</posture></frame>
+                 <frame ftime="0"><posture>Humanoid (l_shoulder 3 0 0 0)</posture></frame>
+                 <frame ftime="2"><posture>Humanoid (l_elbow 1 0)</posture></frame>
+               </phase></keyframing></dynamic></murml-description>"#,
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!(k.parts, ["l_shoulder", "l_elbow"]);
+        let times: Vec<f64> = k.keys.iter().map(|x| x.0).collect();
+        assert_eq!(times, [0.0, 1.0, 2.0]);
+        let q = |deg: f32| Quat::from_rotation_x(deg.to_radians());
+        let same = |a: Quat, b: Quat| 1.0 - a.dot(b).abs() < 1e-6;
+        assert!(same(k.keys[1].2[0], q(90.0)));
+        assert!(same(k.keys[1].2[1], q(30.0)));
+        // the shoulder is left out of the last frame: it keeps 90°
+        assert!(same(k.keys[2].2[0], q(90.0)));
+        assert!(same(k.keys[2].2[1], q(0.0)));
+        assert!(body_keys(
+            r#"<frame ftime="0"><posture>Humanoid (l_elbow 3 1 2)</posture></frame>"#
+        )
+        .unwrap_err()
+        .contains("(l_elbow 3 1 2)"));
+        assert_eq!(
+            body_keys("<murml-description><static/></murml-description>"),
+            Ok(None)
+        );
+    }
 
     #[test]
     fn a_keyframed_description_lasts_until_its_last_frame() {
