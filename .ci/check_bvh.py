@@ -14,6 +14,7 @@ RUNS = [
     ["fixtures/examples/gaze-then-point.xml"],
     ["fixtures/examples/long-speech.xml", "+1.5", "fixtures/examples/interrupt-speech.xml"],
     ["fixtures/examples/reply.xml", "+2", "fixtures/examples/listen.xml"],
+    ["fixtures/examples/lift-and-wave.xml"],
 ]
 FPS = 30
 skeleton = json.load(open("fixtures/skeletons/adult.json"))

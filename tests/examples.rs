@@ -114,3 +114,17 @@ fn preplanned_reply() {
     assert_eq!(sync(&fb, "reply:answer:start"), 2.0);
     assert_eq!(block(&fb, "reply", "end").1, Some(BlockStatus::Done));
 }
+
+#[test]
+fn motion_from_data() {
+    let fb = run("run fixtures/examples/lift-and-wave.xml");
+    no_warnings(&fb);
+    assert_eq!(ms(sync(&fb, "moves:raise:end")), 1.0);
+    assert_eq!(ms(sync(&fb, "moves:lead:start")), 1.0);
+    assert_eq!(ms(sync(&fb, "moves:lead:end")), 1.5);
+    assert_eq!(ms(sync(&fb, "moves:lift:start")), 1.5);
+    assert_eq!(ms(sync(&fb, "moves:lift:stroke")), 2.25);
+    assert_eq!(ms(sync(&fb, "moves:hello:end")), 2.5);
+    assert_eq!(ms(sync(&fb, "moves:sway:end")), 3.0);
+    assert_eq!(block(&fb, "moves", "end"), (3.0, Some(BlockStatus::Done)));
+}
