@@ -945,3 +945,75 @@ fn a_murml_keyframed_gesture_turns_its_joints_exactly_at_its_frames() {
         assert!((angle(t) - deg).abs() < 1e-2, "{t}: {} vs {deg}", angle(t));
     }
 }
+
+#[test]
+fn a36_every_motion_behaviour_declares_the_joints_it_steers() {
+    use bml_realizer::engine::timing::DefaultTimingModels;
+    use bml_realizer::engine::MotionKind;
+    use bml_realizer::engines::default_registry;
+    let skeleton = Skeleton::adult();
+    let registry = default_registry(DefaultTimingModels::default());
+    let block = bml_realizer::bml::load(&format!(
+        r#"<bml {BMLT} xmlns:m="http://www.techfak.uni-bielefeld.de/ags/soa/murml" id="b">
+        <head id="nod" lexeme="NOD"/>
+        <headDirectionShift id="hd" target="user"/>
+        <gaze id="gz" target="user" influence="SHOULDER"/>
+        <pointing id="pt" target="bluebox" mode="LEFT_HAND"/>
+        <gesture id="beat" lexeme="BEAT" mode="BOTH_HANDS"/>
+        <gesture id="hello" lexeme="HELLO" mode="LEFT_HAND"/>
+        <posture id="po"><stance type="SITTING"/><pose part="ARMS" lexeme="AKIMBO"/></posture>
+        <bmlt:procanimation id="pa" name="lift"/>
+        <bmlt:keyframe id="kf"><SkeletonInterpolator rotationEncoding="quaternions" parts="r_elbow" encoding="R">0 1 0 0 0</SkeletonInterpolator></bmlt:keyframe>
+        <bmlt:noise id="n" type="perlin" joint="vl5"/>
+        <bmlt:transition id="tr" class="SlerpTransition"><bmlt:parameter name="joints" value="l_elbow"/></bmlt:transition>
+        <m:murmlgesture id="mg"><m:murml-description><m:dynamic><m:keyframing><m:phase><m:frame ftime="1"><m:posture>Humanoid (l_shoulder 3 10 0 0)</m:posture></m:frame></m:phase></m:keyframing></m:dynamic></m:murml-description></m:murmlgesture>
+        <speech id="s"><text>Not a motion.</text></speech>
+        </bml>"#
+    ))
+    .unwrap()
+    .block;
+    let names = |id: &str| -> Vec<String> {
+        let b = block.behaviour(id).unwrap();
+        let e = registry.engine(registry.engine_for(b).unwrap());
+        let s = e
+            .steers(b, &skeleton)
+            .unwrap_or_else(|| panic!("{id} steers nothing"));
+        assert_eq!(s.kind, MotionKind::Kinematic);
+        s.joints
+            .iter()
+            .map(|&j| skeleton.joints()[j].name.clone())
+            .collect()
+    };
+    let has = |id: &str, joints: &[&str]| {
+        let n = names(id);
+        for j in joints {
+            assert!(n.iter().any(|x| x == j), "{id}: {j} not in {n:?}");
+        }
+        n
+    };
+    has("nod", &["vc4", "skullbase"]);
+    has("hd", &["vc4", "skullbase"]);
+    has("gz", &["vt6", "l_eyeball_joint", "r_eyeball_joint"]);
+    let pt = has("pt", &["l_shoulder", "l_elbow", "l_wrist"]);
+    assert!(!pt.iter().any(|j| j.starts_with("r_")), "{pt:?}");
+    has("beat", &["r_shoulder", "l_shoulder", "r_elbow", "l_elbow"]);
+    let hello = has("hello", &["l_wrist", "l_elbow", "l_shoulder"]);
+    assert!(
+        !hello.iter().any(|j| j.starts_with("r_")),
+        "mirrored: {hello:?}"
+    );
+    has(
+        "po",
+        &["l_knee", "r_hip", "HumanoidRoot", "l_wrist", "r_elbow"],
+    );
+    has("pa", &["r_wrist", "r_elbow", "r_shoulder"]);
+    assert_eq!(names("kf"), ["r_elbow"]);
+    assert_eq!(names("n"), ["vl5"]);
+    assert_eq!(names("tr"), ["l_elbow"]);
+    assert_eq!(names("mg"), ["l_shoulder"]);
+    let s = block.behaviour("s").unwrap();
+    assert!(registry
+        .engine(registry.engine_for(s).unwrap())
+        .steers(s, &skeleton)
+        .is_none());
+}

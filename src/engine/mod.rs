@@ -42,6 +42,48 @@ impl fmt::Display for UnitKey {
     }
 }
 
+/// How a motion unit moves its joints (A36).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionKind {
+    /// It sets or changes joint rotations directly.
+    Kinematic,
+    /// It applies torques to a physically simulated body (mixed dynamics).
+    Physical,
+}
+
+/// What a motion unit steers (A36): its joints, how, and whether it layers over other units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Steering {
+    /// Joints whose rotation it sets or changes (the root joint also for its translation), in
+    /// the skeleton's joint order.
+    pub joints: Vec<usize>,
+    /// Kinematic or physical.
+    pub kind: MotionKind,
+    /// Whether it adds to what other units set (a layer) rather than replacing it.
+    pub additive: bool,
+}
+
+impl Steering {
+    /// Kinematic steering of the joints of `skeleton` named `names` (unknown names are left out).
+    pub fn kinematic<'a>(
+        skeleton: &Skeleton,
+        names: impl IntoIterator<Item = &'a str>,
+        additive: bool,
+    ) -> Steering {
+        let mut joints: Vec<usize> = names
+            .into_iter()
+            .filter_map(|n| skeleton.joint(n))
+            .collect();
+        joints.sort_unstable();
+        joints.dedup();
+        Steering {
+            joints,
+            kind: MotionKind::Kinematic,
+            additive,
+        }
+    }
+}
+
 /// A scheduled behaviour handed to its engine: the behaviour and its sync points' global times
 /// (in sync order; a persistent end is infinite).
 #[derive(Debug, Clone, Copy)]
@@ -237,6 +279,12 @@ pub trait Engine {
     /// what earlier engines set), with targets from `world`. Engines that move nothing keep the
     /// default.
     fn animate(&mut self, _now: f64, _skeleton: &Skeleton, _world: &World, _pose: &mut Pose) {}
+
+    /// The joints a unit for `behaviour` steers on `skeleton`, how, and whether additively (A36);
+    /// `None` for behaviours that move no joints.
+    fn steers(&self, _behaviour: &Behaviour, _skeleton: &Skeleton) -> Option<Steering> {
+        None
+    }
 
     /// The animation predictor's part (A43, A54): writes what this engine's *predictable* units
     /// (whose motion is a function of time alone, such as keyframes and procedural units) will

@@ -24,7 +24,7 @@ use glam::{Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
 use crate::schedule::SyncName;
 use crate::world::World;
@@ -171,6 +171,16 @@ impl Engine for GazeEngine {
 
     fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
         &["eyes"]
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let (_, influence, _, _) = gaze(behaviour)?;
+        let eyes = ["l_eyeball_joint", "r_eyeball_joint"];
+        Some(Steering::kinematic(
+            skeleton,
+            shares(influence).iter().map(|s| s.0).chain(eyes),
+            true,
+        ))
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {

@@ -13,7 +13,7 @@ use glam::{EulerRot, Quat};
 use crate::bml::{Behaviour, BehaviourKind, Mode, Param};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{hands, min_jerk};
 use crate::engines::procedural::{alpha_at, mirror_name, mirror_rotation, Library, ProcUnit};
 use crate::schedule::SyncName;
@@ -325,6 +325,37 @@ impl Engine for GestureEngine {
 
     fn interprets(&self, _ns: &str, name: &str) -> bool {
         self.lexicon.filters_on(name)
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let BehaviourKind::Gesture(g) = &behaviour.kind else {
+            return None;
+        };
+        let sides: &[bool] = match g.mode {
+            Some(Mode::LeftHand) => &[true],
+            Some(Mode::BothHands) => &[false, true],
+            Some(Mode::RightHand) | None => &[false],
+        };
+        match self.lexicon.find(behaviour)? {
+            Bound::Procedural(unit, _) => Some(unit.steering(skeleton, sides)),
+            Bound::Keys(keys) => {
+                let mut joints: Vec<usize> = sides
+                    .iter()
+                    .flat_map(|&m| {
+                        keys.iter()
+                            .flat_map(|(_, js)| js.iter())
+                            .filter_map(move |(j, _)| skeleton.joint_mirrored(j, m))
+                    })
+                    .collect();
+                joints.sort_unstable();
+                joints.dedup();
+                Some(Steering {
+                    joints,
+                    kind: crate::engine::MotionKind::Kinematic,
+                    additive: true,
+                })
+            }
+        }
     }
 
     fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {

@@ -11,7 +11,7 @@ use glam::{Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -137,6 +137,11 @@ impl Engine for HeadEngine {
 
     fn name(&self) -> &'static str {
         "head"
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        matches!(behaviour.kind, BehaviourKind::Head(_))
+            .then(|| Steering::kinematic(skeleton, ["vc4", "skullbase"], true))
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {

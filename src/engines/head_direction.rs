@@ -12,7 +12,7 @@ use glam::{Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::gaze::{donders, yaw_pitch};
 use crate::engines::motion::{envelope, finished_shift};
 use crate::world::World;
@@ -56,6 +56,11 @@ impl Engine for HeadDirectionEngine {
 
     fn name(&self) -> &'static str {
         "headDirection"
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        matches!(behaviour.kind, BehaviourKind::HeadDirectionShift { .. })
+            .then(|| Steering::kinematic(skeleton, SHARES.iter().map(|s| s.0), true))
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {

@@ -24,7 +24,7 @@ use quick_xml::Reader;
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -306,6 +306,15 @@ impl Engine for KeyframeEngine {
 
     fn name(&self) -> &'static str {
         "keyframe"
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let keys = read_keys(content(behaviour)?).ok()?;
+        let mut s = Steering::kinematic(skeleton, keys.parts.iter().map(String::as_str), false);
+        if keys.root_translation && !s.joints.contains(&0) {
+            s.joints.insert(0, 0);
+        }
+        Some(s)
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {

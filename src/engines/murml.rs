@@ -21,7 +21,7 @@ use glam::{EulerRot, Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::TimingModel;
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::keyframe::{play, Interpolation, Keys};
 use crate::world::World;
 
@@ -230,6 +230,18 @@ impl Engine for MurmlEngine {
             Kind::Gesture => TimingModel::gesture(d),
             Kind::Face => TimingModel::face(d),
         })
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let (Kind::Gesture, content) = kind(behaviour)? else {
+            return None;
+        };
+        let keys = body_keys(content).ok()??;
+        Some(Steering::kinematic(
+            skeleton,
+            keys.parts.iter().map(String::as_str),
+            false,
+        ))
     }
 
     fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {

@@ -21,7 +21,7 @@ use glam::{EulerRot, Quat};
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, Unit, UnitKey, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, UnitKey, Units};
 use crate::engines::motion::min_jerk;
 use crate::engines::procedural::perlin;
 use crate::world::World;
@@ -87,6 +87,13 @@ impl Engine for NoiseEngine {
 
     fn name(&self) -> &'static str {
         "noise"
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let BehaviourKind::Noise(n) = &behaviour.kind else {
+            return None;
+        };
+        Some(Steering::kinematic(skeleton, [n.joint.as_str()], true))
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {

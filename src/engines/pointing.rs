@@ -12,7 +12,7 @@ use crate::bml::{Behaviour, BehaviourKind, Mode};
 use crate::body::ik::{arc, place_limb, LimbRoot, ARM_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{envelope, hands};
 use crate::world::World;
 
@@ -92,6 +92,32 @@ impl Engine for PointingEngine {
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         matches!(behaviour.kind, BehaviourKind::Pointing(_))
             .then(|| self.models.model(behaviour))?
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let BehaviourKind::Pointing(p) = &behaviour.kind else {
+            return None;
+        };
+        let arm = ["r_shoulder", "r_elbow", "r_wrist"];
+        let sides: &[bool] = match p.mode {
+            Some(Mode::RightHand) => &[false],
+            Some(Mode::LeftHand) => &[true],
+            // both hands, or the target's side (known only while it runs)
+            Some(Mode::BothHands) | None => &[false, true],
+        };
+        let mut joints: Vec<usize> = sides
+            .iter()
+            .flat_map(|&m| {
+                arm.iter()
+                    .filter_map(move |j| skeleton.joint_mirrored(j, m))
+            })
+            .collect();
+        joints.sort_unstable();
+        Some(Steering {
+            joints,
+            kind: crate::engine::MotionKind::Kinematic,
+            additive: false,
+        })
     }
 
     fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {

@@ -17,7 +17,7 @@ use glam::{Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind, PosePart, StanceType};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
 use crate::engines::procedural::{Library, ProcUnit};
 use crate::world::World;
@@ -219,6 +219,31 @@ impl Engine for PostureEngine {
 
     fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
         matches!(behaviour.kind, BehaviourKind::Posture(_)).then_some("posture")
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let poses = match &behaviour.kind {
+            BehaviourKind::Posture(p) | BehaviourKind::PostureShift(p) => &p.poses,
+            _ => return None,
+        };
+        let legs = [
+            "HumanoidRoot",
+            "l_hip",
+            "l_knee",
+            "l_talocrural",
+            "r_hip",
+            "r_knee",
+            "r_talocrural",
+        ];
+        let mut s = Steering::kinematic(skeleton, legs, poses.is_empty());
+        for p in poses {
+            if let Ok((unit, sides)) = self.bindings.get(p.part, &p.lexeme) {
+                s.joints.extend(unit.steering(skeleton, sides).joints);
+            }
+        }
+        s.joints.sort_unstable();
+        s.joints.dedup();
+        Some(s)
     }
 
     fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {

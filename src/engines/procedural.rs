@@ -51,7 +51,7 @@ use crate::bml::{Behaviour, BehaviourKind, Id, Param};
 use crate::body::ik::{place_limb, LimbRoot, ARM_POLE, LEG_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, SyncTimes, Unit, UnitKey, Units};
+use crate::engine::{Engine, EngineError, Steering, SyncTimes, Unit, UnitKey, Units};
 use crate::engines::motion::min_jerk;
 use crate::schedule::SyncName;
 use crate::world::World;
@@ -326,6 +326,45 @@ impl ProcUnit {
             unit.evaluate(alpha, &unit.params).map_err(|e| at(&e))?;
         }
         Ok(unit)
+    }
+
+    /// The joints it steers on `skeleton` (its rotated joints and each effector's limb),
+    /// mirrored or not, sorted.
+    pub fn joints(&self, skeleton: &Skeleton, mirrored: bool) -> Vec<usize> {
+        let joints = skeleton.joints();
+        let mut out: Vec<usize> = self
+            .rotations
+            .iter()
+            .filter_map(|(j, _)| skeleton.joint_mirrored(j, mirrored))
+            .collect();
+        for f in &self.effectors {
+            let Some(end) = skeleton.joint_mirrored(&f.joint, mirrored) else {
+                continue;
+            };
+            out.push(end);
+            if let Some(mid) = joints[end].parent {
+                out.push(mid);
+                out.extend(joints[mid].parent);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The steering of a unit played on `sides` (`false` as authored, `true` mirrored).
+    pub fn steering(&self, skeleton: &Skeleton, sides: &[bool]) -> Steering {
+        let mut joints: Vec<usize> = sides
+            .iter()
+            .flat_map(|&m| self.joints(skeleton, m))
+            .collect();
+        joints.sort_unstable();
+        joints.dedup();
+        Steering {
+            joints,
+            kind: crate::engine::MotionKind::Kinematic,
+            additive: self.additive,
+        }
     }
 
     /// The timing model: keys at α × the preferred duration, stretchable within [min, max].
@@ -626,6 +665,11 @@ impl Engine for ProceduralEngine {
 
     fn name(&self) -> &'static str {
         "procedural"
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let r = self.library.for_behaviour(behaviour)?.ok()?;
+        Some(r.unit.steering(skeleton, &[false]))
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {

@@ -17,7 +17,7 @@
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::min_jerk;
 use crate::world::World;
 
@@ -47,6 +47,21 @@ impl Engine for TransitionEngine {
 
     fn name(&self) -> &'static str {
         "transition"
+    }
+
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let BehaviourKind::Transition(t) = &behaviour.kind else {
+            return None;
+        };
+        let named = t.params.iter().find(|p| p.name == "joints");
+        Some(match named {
+            Some(p) => Steering::kinematic(skeleton, p.value.split_whitespace(), false),
+            None => Steering {
+                joints: (0..skeleton.len()).collect(),
+                kind: crate::engine::MotionKind::Kinematic,
+                additive: false,
+            },
+        })
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
