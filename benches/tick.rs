@@ -80,6 +80,40 @@ fn tick_mixed(c: &mut Criterion) {
     }
 }
 
+/// A frame with many live blocks whose behaviours lie in the future (N chained blocks, each
+/// speech starting when the previous one ends): the frame's cost should not grow with N.
+fn tick_many_live_blocks(c: &mut Criterion) {
+    for n in [10usize, 1000] {
+        let mut r = Realizer::new();
+        for i in 0..n {
+            let start = if i == 0 {
+                String::new()
+            } else {
+                format!(r#" start="b{}:s:end""#, i - 1)
+            };
+            // the first speech lasts long enough for the whole bench (20 000 s)
+            let words = if i == 0 {
+                "la ".repeat(100_000)
+            } else {
+                "One two three.".to_string()
+            };
+            r.perform_bml(&format!(
+                r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b{i}"><speech id="s"{start}><text>{words}</text></speech><gesture id="g" lexeme="BEAT" stroke="s:end"/></bml>"#
+            ))
+            .unwrap();
+        }
+        let mut t = 0.0;
+        r.tick(t);
+        c.bench_function(&format!("tick/{n}-live-chained-blocks"), |b| {
+            b.iter(|| {
+                // frames inside the first speech: no block starts or ends
+                t += 1.0 / 60.0;
+                black_box(r.tick(t))
+            })
+        });
+    }
+}
+
 fn tick(c: &mut Criterion) {
     let mut r = Realizer::new();
     for ch in 0..100 {
@@ -97,5 +131,5 @@ fn tick(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, tick, tick_mixed);
+criterion_group!(benches, tick, tick_mixed, tick_many_live_blocks);
 criterion_main!(benches);

@@ -1017,3 +1017,80 @@ fn a36_every_motion_behaviour_declares_the_joints_it_steers() {
         .steers(s, &skeleton)
         .is_none());
 }
+
+#[test]
+fn a47_a45_the_eyes_saccade_in_an_amplitude_dependent_time_then_the_head_catches_up() {
+    use bml_realizer::engines::gaze::{saccade_duration, SACCADE_PEAK_VELOCITY};
+    let skeleton = Skeleton::adult();
+    let target = Vec3::new(0.6, 1.2, 1.2); // bluebox
+    let eyes_rest = {
+        let w = bml_realizer::body::Pose::rest(&skeleton).world(&skeleton);
+        (w.positions[skeleton.joint("l_eyeball_joint").unwrap()]
+            + w.positions[skeleton.joint("r_eyeball_joint").unwrap()])
+            / 2.0
+    };
+    let amplitude = f64::from(Vec3::Z.angle_between(target - eyes_rest));
+    let d = saccade_duration(amplitude);
+    assert!((d - (0.021 + 1.875 / 8.7 * amplitude)).abs() < 1e-12);
+    let mut r = Realizer::new();
+    r.perform_bml(&gaze_block(
+        "b",
+        "bluebox",
+        r#"start="0" ready="1.5" relax="3" end="4""#,
+    ))
+    .unwrap();
+    let eye = skeleton.joint("l_eyeball_joint").unwrap();
+    let hz = 1000.0;
+    let (mut last_sight, mut peak, mut on_target_at) = (None::<Vec3>, 0.0f64, None::<f64>);
+    let mut in_head = Vec::new();
+    for i in 0..=(1.5 * hz) as u32 {
+        let t = f64::from(i) / hz;
+        let pose = r.tick(t).poses[0].pose.clone();
+        let w = pose.world(&skeleton);
+        let sight = w.orientations[eye] * Vec3::Z;
+        if let Some(prev) = last_sight {
+            peak = peak.max(f64::from(prev.angle_between(sight)) * hz);
+        }
+        last_sight = Some(sight);
+        if on_target_at.is_none() && eye_error(&skeleton, &pose, target) < 0.5 {
+            on_target_at = Some(t);
+        }
+        if on_target_at.is_some() {
+            assert!(
+                eye_error(&skeleton, &pose, target) < 0.5,
+                "stays on target at {t}"
+            );
+        }
+        if t >= d {
+            // the saccade is over
+            in_head.push(f64::from(pose.rotations[eye].angle_between(Quat::IDENTITY)));
+        }
+    }
+    // the eyes are there after about one saccade (not at ready, 1.5 s), at a bounded speed
+    let reached = on_target_at.expect("the eyes reach the target");
+    assert!(
+        reached <= d + 0.01 && reached >= 0.5 * d,
+        "{reached} vs saccade {d}"
+    );
+    assert!(peak <= SACCADE_PEAK_VELOCITY * 1.02, "peak {peak} rad/s");
+    // then the head catches up: the eye-in-head angle only shrinks
+    assert!(in_head.windows(2).all(|w| w[1] <= w[0] + 1e-4));
+    assert!(in_head.last().unwrap() < &(in_head[0] * 0.8));
+}
+
+#[test]
+fn a47_saccades_are_affine_in_amplitude_and_never_too_fast() {
+    use bml_realizer::engines::gaze::{saccade_duration, SACCADE_PEAK_VELOCITY};
+    for deg in [1.0f64, 5.0, 10.0, 20.0, 40.0, 60.0, 90.0] {
+        let a = deg.to_radians();
+        let d = saccade_duration(a);
+        assert!(1.875 * a / d <= SACCADE_PEAK_VELOCITY + 1e-9, "{deg}°");
+    }
+    // affine: equal steps in amplitude give equal steps in duration
+    let (d1, d2, d3) = (
+        saccade_duration(0.1),
+        saccade_duration(0.2),
+        saccade_duration(0.3),
+    );
+    assert!(((d2 - d1) - (d3 - d2)).abs() < 1e-12);
+}

@@ -15,6 +15,7 @@ impl BlockManager {
     /// Registers an anticipator (replacing one with the same id). Blocks scheduled from now on
     /// can refer to its syncs as `anticipators:ID:SYNC`.
     pub fn add_anticipator(&mut self, anticipator: Box<dyn Anticipator>) {
+        self.touch();
         self.anticipators.retain(|a| a.id() != anticipator.id());
         self.anticipators.push(anticipator);
     }
@@ -42,6 +43,7 @@ impl BlockManager {
         if changed.is_empty() {
             return;
         }
+        self.touch();
         let ids: Vec<bml::Id> = self
             .blocks
             .iter()

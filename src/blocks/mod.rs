@@ -52,6 +52,8 @@ pub struct Sizes {
 
 /// The blocks of one character and the engines that realize them.
 pub struct BlockManager {
+    /// The next sync point due, while the plan has not changed (`None`: to be found again).
+    next_cache: std::cell::Cell<Option<Option<(f64, usize, usize)>>>,
     registry: Registry,
     strategy: Box<dyn SchedulingStrategy>,
     character: Option<String>,
@@ -119,6 +121,7 @@ impl BlockManager {
         character: Option<String>,
     ) -> Self {
         BlockManager {
+            next_cache: std::cell::Cell::new(None),
             registry,
             strategy,
             character,
@@ -338,6 +341,7 @@ impl BlockManager {
     /// nothing holds it back. Every problem becomes a warning; the block is rejected only if its
     /// id is in use or its required behaviours cannot be scheduled.
     pub fn submit(&mut self, block: bml::Block, warnings: &[Diagnostic]) {
+        self.touch();
         let now = self.now;
         if let Some(i) = self.pos(&block.id) {
             let status = self.blocks[i].status;
@@ -878,7 +882,24 @@ impl BlockManager {
 
     /// The earliest unreported sync of a running block: (global time, block index, behaviour
     /// index). Ties go to the earlier block, then document order.
+    /// The next sync point due: (global time, block, behaviour). Cached between changes of the
+    /// plan ([`touch`](Self::touch)), so that frames without events do not scan every live
+    /// behaviour (no slowdown with many live blocks).
     fn next_sync(&self) -> Option<(f64, usize, usize)> {
+        if let Some(next) = self.next_cache.get() {
+            return next;
+        }
+        let next = self.scan_next_sync();
+        self.next_cache.set(Some(next));
+        next
+    }
+
+    /// Forgets the cached next sync: the plan changed (blocks, phases or sync times).
+    fn touch(&self) {
+        self.next_cache.set(None);
+    }
+
+    fn scan_next_sync(&self) -> Option<(f64, usize, usize)> {
         // times equal within a nanosecond (float noise of the solver) count as ties
         let mut best: Option<((i64, u64, usize), usize, usize)> = None;
         for (bi, b) in self.blocks.iter().enumerate() {
@@ -947,6 +968,7 @@ impl BlockManager {
                 (Some((t, bi, xi)), _) => {
                     self.now = t;
                     self.pass_sync(bi, xi, t);
+                    self.touch();
                 }
                 (None, None) => break,
             }
@@ -1075,6 +1097,9 @@ impl BlockManager {
     /// Sets every running parameter change's value at `t`; changes past their end are done (the
     /// value stays, S65).
     fn apply_changes(&mut self, t: f64) {
+        if !self.changes.is_empty() {
+            self.touch(); // a change may retime its target
+        }
         let changes = std::mem::take(&mut self.changes);
         for c in changes {
             let found = self.pos(&c.target.block).and_then(|bi| {

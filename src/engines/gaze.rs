@@ -10,7 +10,10 @@
 //!   came from. The eyes then take what is left, aimed exactly from their real position
 //!   (vergence), within ±35° yaw and ±30° pitch.
 //! - Timing: from `start` to `ready` the aim moves from the rest aim to the target along a
-//!   minimum-jerk profile (single-peaked velocity; the eyes arrive in the first half), it holds
+//!   minimum-jerk profile (single-peaked velocity). The eyes lead with a saccade whose duration is
+//!   affine in its amplitude (21 ms + 3.8 ms per degree, A47: the slope that keeps the symmetric
+//!   profile's peak velocity below 8.7 rad/s at any amplitude), and then stay on the target while
+//!   the head catches up (the eye-in-head angle shrinks: A45); it holds
 //!   until `relax`, then returns to the rest aim by `end`. A `gazeShift` moves over its whole span
 //!   and makes its target the new rest aim, kept after it ends (`engines::motion`).
 //! - Of several gazes running at once the one that started last wins (R33).
@@ -28,6 +31,20 @@ use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
 use crate::schedule::SyncName;
 use crate::world::World;
+
+/// Saccade duration at zero amplitude (seconds), A47.
+pub const SACCADE_BASE: f64 = 0.021;
+/// The eyes' peak angular velocity never exceeds this (rad/s), A47.
+pub const SACCADE_PEAK_VELOCITY: f64 = 8.7;
+/// Saccade duration per radian of amplitude (seconds; 3.8 ms per degree): the least slope for
+/// which the symmetric minimum-jerk profile, whose peak velocity is 1.875 × amplitude /
+/// duration, stays below [`SACCADE_PEAK_VELOCITY`] at every amplitude.
+pub const SACCADE_PER_RADIAN: f64 = 1.875 / SACCADE_PEAK_VELOCITY;
+
+/// How long a saccade of `amplitude` radians takes: affine in the amplitude (A47).
+pub fn saccade_duration(amplitude: f64) -> f64 {
+    SACCADE_BASE + SACCADE_PER_RADIAN * amplitude.abs()
+}
 
 /// Eye yaw limit (each side), degrees.
 pub const EYE_YAW_LIMIT: f32 = 35.0;
@@ -125,12 +142,23 @@ fn gaze(b: &Behaviour) -> Option<(&str, Influence, bool, (f32, f32))> {
     ))
 }
 
-/// How far a unit has turned toward its target at `t` (0..1), for the body and for the eyes
-/// (they lead: they arrive half way through the shift).
-fn weights(u: &GazeUnit, syncs: &[(SyncName, f64)], t: f64) -> Option<(f64, f64)> {
+/// How far a unit has turned toward its target at `t` (0..1), for the body and for the eyes:
+/// they lead with a saccade of `amplitude` radians ([`saccade_duration`], at most the whole
+/// shift), the body follows until `ready`.
+fn weights(u: &GazeUnit, syncs: &[(SyncName, f64)], t: f64, amplitude: f64) -> Option<(f64, f64)> {
+    let span = if u.shift {
+        at(syncs, "end")? - at(syncs, "start")?
+    } else {
+        at(syncs, "ready")? - at(syncs, "start")?
+    };
+    let lead = if span > 0.0 {
+        (saccade_duration(amplitude) / span).min(1.0)
+    } else {
+        1.0
+    };
     Some((
         envelope(syncs, t, u.shift, 1.0)?,
-        envelope(syncs, t, u.shift, 0.5)?,
+        envelope(syncs, t, u.shift, lead)?,
     ))
 }
 
@@ -210,25 +238,32 @@ impl Engine for GazeEngine {
         if let Some(u) = finished_shift(&self.units, now, |u| u.shift) {
             self.rest = Some((u.target.clone(), u.influence));
         }
+        let eyes = self.eyes_at_rest(skeleton);
+        let rest_aim = self
+            .rest
+            .as_ref()
+            .and_then(|(t, i)| Some((world.get(t)?, *i)));
+        // the saccade's amplitude: from the rest aim (straight ahead without one) to the target
+        let from = rest_aim.map_or(Vec3::Z, |(p, _)| p - eyes);
+        let amplitude = |target: &str| {
+            world
+                .get(target)
+                .map_or(0.0, |p| f64::from(from.angle_between(p - eyes)))
+        };
         // the gaze that started last wins (R33); ties go to the one that ends first
         let active = self
             .units
             .all()
             .filter_map(|(syncs, u)| {
-                let w = weights(u, syncs, now)?;
+                let w = weights(u, syncs, now, amplitude(&u.target))?;
                 Some((at(syncs, "start")?, at(syncs, "end")?, u, w))
             })
             .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
-        let rest_aim = self
-            .rest
-            .as_ref()
-            .and_then(|(t, i)| Some((world.get(t)?, *i)));
         let target =
             active.and_then(|(_, _, u, w)| Some((world.get(&u.target)?, u.influence, w, u.offset)));
         if target.is_none() && rest_aim.is_none() {
             return;
         }
-        let eyes = self.eyes_at_rest(skeleton);
         let aim_of = |p: Vec3| yaw_pitch(p - eyes);
         let (rest_yaw, rest_pitch, rest_influence) = match rest_aim {
             Some((p, i)) => {
