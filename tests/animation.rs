@@ -94,6 +94,17 @@ fn a_louder_nod_goes_further_and_a_shake_turns_instead() {
     );
 }
 
+#[test]
+fn a_head_lexeme_bound_only_in_the_data_file_moves_the_head() {
+    // TOSS: pitch back by 20° at amount 1 (fixtures/bindings/heads.json)
+    let (toss, _) = run(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><head id="t" lexeme="TOSS" amount="1" start="0" end="1"/></bml>"#,
+        1.0,
+    );
+    let min = toss.iter().map(|p| p.1).fold(0.0, f64::min);
+    assert!((min + 20.0).abs() <= 1.0, "{min}");
+}
+
 // ---- gaze ---------------------------------------------------------------------------------
 
 use bml_realizer::engines::gaze::{EYE_PITCH_LIMIT, EYE_YAW_LIMIT};

@@ -1,10 +1,11 @@
-//! The head engine: `head` NOD, SHAKE and TILT as real motion of the neck and skull. A nod pitches
-//! the head forward (about +x), a shake turns it (about +y, alternating sides), a tilt rolls it
-//! (about +z); each of the `repetition` cycles rises smoothly to its peak — the first one exactly
-//! at `stroke` — and falls back, so the head is at rest again at `relax` and stays there until
+//! The head engine: `head` lexemes as real motion of the neck and skull, defined as data in
+//! `fixtures/bindings/heads.json` (the default [`HeadLexicon`]: NOD pitches the head forward
+//! about +x, SHAKE turns it about +y alternating sides, TILT rolls it about +z, TOSS pitches it
+//! back). Each of the `repetition` cycles rises smoothly to its peak — the first one exactly at
+//! `stroke` — and falls back, so the head is at rest again at `relax` and stays there until
 //! `end`. The amplitude is `amount` × the lexeme's full amplitude; 70 % of the rotation is at the
 //! skull base and 30 % at the neck (vc4). Head motions add up with other rotations of those joints.
-//! Other lexemes are played with their timing only (no motion).
+//! Lexemes the lexicon lacks are played with their timing only (no motion).
 
 use glam::{Quat, Vec3};
 
@@ -15,53 +16,84 @@ use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::schedule::SyncName;
 use crate::world::World;
 
-/// Full amplitude (amount 1) of a nod, degrees.
+/// The embedded default head lexicon.
+const HEADS: &str = include_str!("../../fixtures/bindings/heads.json");
+
+/// Full amplitude (amount 1) of a nod in the default lexicon, degrees.
 pub const NOD_DEGREES: f64 = 30.0;
-/// Full amplitude of a shake, degrees.
+/// Full amplitude of a shake in the default lexicon, degrees.
 pub const SHAKE_DEGREES: f64 = 45.0;
-/// Full amplitude of a tilt, degrees.
+/// Full amplitude of a tilt in the default lexicon, degrees.
 pub const TILT_DEGREES: f64 = 25.0;
 /// Amount when the behaviour gives none.
 pub const DEFAULT_AMOUNT: f64 = 0.5;
 /// Share of the rotation at the skull base (the rest is at the neck).
 pub const SKULL_SHARE: f32 = 0.7;
 
-/// The head motions.
+/// A head motion: about one axis, by a full amplitude, alternating sides or not.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Motion {
-    /// Pitch forward and back.
-    Nod,
-    /// Turn to one side and the other.
-    Shake,
-    /// Roll to the side.
-    Tilt,
+pub struct Motion {
+    /// The axis (in the joints' frames).
+    pub axis: Vec3,
+    /// Full amplitude (amount 1), degrees; negative turns the other way.
+    pub degrees: f64,
+    /// Whether every other repetition goes to the other side (a shake).
+    pub alternate: bool,
 }
 
-impl Motion {
-    /// The motion of a head lexeme, if this engine knows it.
-    pub fn of(lexeme: &str) -> Option<Motion> {
-        match lexeme {
-            "NOD" => Some(Motion::Nod),
-            "SHAKE" => Some(Motion::Shake),
-            "TILT" => Some(Motion::Tilt),
-            _ => None,
-        }
+/// Head lexemes bound to motions.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct HeadLexicon {
+    motions: Vec<(String, Motion)>,
+}
+
+impl HeadLexicon {
+    /// The default lexicon (`fixtures/bindings/heads.json`: NOD, SHAKE, TILT, TOSS).
+    pub fn default_lexicon() -> HeadLexicon {
+        static LEXICON: std::sync::LazyLock<HeadLexicon> = std::sync::LazyLock::new(|| {
+            HeadLexicon::from_json(HEADS).expect("the embedded head lexicon is valid")
+        });
+        LEXICON.clone()
     }
 
-    fn axis(self) -> Vec3 {
-        match self {
-            Motion::Nod => Vec3::X,
-            Motion::Shake => Vec3::Y,
-            Motion::Tilt => Vec3::Z,
+    /// Reads `{"heads": [{"lexeme", "axis": x|y|z, "degrees", "alternate"?}]}`.
+    pub fn from_json(text: &str) -> Result<HeadLexicon, String> {
+        let v: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
+        let list = v["heads"].as_array().ok_or("no \"heads\" list")?;
+        let mut motions = Vec::new();
+        for h in list {
+            let lexeme = h["lexeme"]
+                .as_str()
+                .ok_or("a head binding without \"lexeme\"")?;
+            let axis = match h["axis"].as_str() {
+                Some("x") => Vec3::X,
+                Some("y") => Vec3::Y,
+                Some("z") => Vec3::Z,
+                other => return Err(format!("{lexeme}: axis {other:?} (x, y or z)")),
+            };
+            let degrees = h["degrees"]
+                .as_f64()
+                .filter(|d| d.is_finite())
+                .ok_or_else(|| format!("{lexeme}: degrees must be a number"))?;
+            let alternate = h
+                .get("alternate")
+                .is_some_and(|a| a.as_bool() == Some(true));
+            motions.push((
+                lexeme.to_string(),
+                Motion {
+                    axis,
+                    degrees,
+                    alternate,
+                },
+            ));
         }
+        Ok(HeadLexicon { motions })
     }
 
-    fn full(self) -> f64 {
-        match self {
-            Motion::Nod => NOD_DEGREES,
-            Motion::Shake => SHAKE_DEGREES,
-            Motion::Tilt => TILT_DEGREES,
-        }
+    /// The motion of `lexeme`, if bound.
+    pub fn get(&self, lexeme: &str) -> Option<Motion> {
+        self.motions.iter().find(|m| m.0 == lexeme).map(|m| m.1)
     }
 }
 
@@ -100,7 +132,7 @@ fn angle(u: &HeadUnit, syncs: &[(SyncName, f64)], t: f64) -> f64 {
         (1.0 + (std::f64::consts::PI * (v - peak) / (1.0 - peak)).cos()) / 2.0
     };
     // a shake alternates sides, a nod and a tilt repeat
-    let sign = if u.motion == Some(Motion::Shake) && (k as u64) % 2 == 1 {
+    let sign = if u.motion.is_some_and(|m| m.alternate) && (k as u64) % 2 == 1 {
         -1.0
     } else {
         1.0
@@ -109,23 +141,41 @@ fn angle(u: &HeadUnit, syncs: &[(SyncName, f64)], t: f64) -> f64 {
 }
 
 /// The head engine (see the module documentation).
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct HeadEngine {
     models: DefaultTimingModels,
+    lexicon: HeadLexicon,
     units: Units<HeadUnit>,
 }
 
-fn head(b: &Behaviour) -> Option<(Option<Motion>, f64, u32)> {
-    match &b.kind {
-        BehaviourKind::Head(h) => {
-            let amount = h.amount.unwrap_or(DEFAULT_AMOUNT).clamp(0.0, 1.0);
-            Some((
-                Motion::of(&h.lexeme),
-                amount,
-                h.repetition.unwrap_or(1).max(1),
-            ))
+impl Default for HeadEngine {
+    fn default() -> Self {
+        HeadEngine::new(HeadLexicon::default_lexicon())
+    }
+}
+
+impl HeadEngine {
+    /// A head engine with `lexicon`.
+    pub fn new(lexicon: HeadLexicon) -> Self {
+        HeadEngine {
+            models: DefaultTimingModels::default(),
+            lexicon,
+            units: Units::new(),
         }
-        _ => None,
+    }
+
+    fn head(&self, b: &Behaviour) -> Option<(Option<Motion>, f64, u32)> {
+        match &b.kind {
+            BehaviourKind::Head(h) => {
+                let amount = h.amount.unwrap_or(DEFAULT_AMOUNT).clamp(0.0, 1.0);
+                Some((
+                    self.lexicon.get(&h.lexeme),
+                    amount,
+                    h.repetition.unwrap_or(1).max(1),
+                ))
+            }
+            _ => None,
+        }
     }
 }
 
@@ -145,7 +195,7 @@ impl Engine for HeadEngine {
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        head(behaviour)?;
+        self.head(behaviour)?;
         self.models.model(behaviour)
     }
 
@@ -154,13 +204,14 @@ impl Engine for HeadEngine {
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        let (motion, amount, cycles) = head(unit.behaviour)
+        let (motion, amount, cycles) = self
+            .head(unit.behaviour)
             .ok_or_else(|| EngineError("the head engine realizes <head> only".into()))?;
         self.units.add(
             unit,
             HeadUnit {
                 motion,
-                amplitude: motion.map_or(0.0, |m| (amount * m.full()).to_radians()),
+                amplitude: motion.map_or(0.0, |m| (amount * m.degrees).to_radians()),
                 cycles,
             },
         );
@@ -174,7 +225,7 @@ impl Engine for HeadEngine {
         for (syncs, u) in self.units.all() {
             let a = angle(u, syncs, now) as f32;
             if let (true, Some(m)) = (a != 0.0, u.motion) {
-                let axis = m.axis();
+                let axis = m.axis;
                 pose.rotate(neck, Quat::from_axis_angle(axis, a * (1.0 - SKULL_SHARE)));
                 pose.rotate(skull, Quat::from_axis_angle(axis, a * SKULL_SHARE));
             }
@@ -202,9 +253,30 @@ mod tests {
     }
 
     #[test]
+    fn the_default_head_lexicon_binds_nod_shake_tilt_as_documented() {
+        let l = HeadLexicon::default_lexicon();
+        let m = |x: &str| l.get(x).unwrap();
+        assert_eq!(
+            (m("NOD").axis, m("NOD").degrees, m("NOD").alternate),
+            (Vec3::X, NOD_DEGREES, false)
+        );
+        assert_eq!(
+            (m("SHAKE").axis, m("SHAKE").degrees, m("SHAKE").alternate),
+            (Vec3::Y, SHAKE_DEGREES, true)
+        );
+        assert_eq!((m("TILT").axis, m("TILT").degrees), (Vec3::Z, TILT_DEGREES));
+        assert!(l.get("WOBBLE").is_none());
+        assert!(HeadLexicon::from_json(
+            r#"{"heads": [{"lexeme": "X", "axis": "w", "degrees": 1}]}"#
+        )
+        .unwrap_err()
+        .contains("axis"));
+    }
+
+    #[test]
     fn a_nod_peaks_at_its_stroke_and_rests_from_relax() {
         let u = HeadUnit {
-            motion: Some(Motion::Nod),
+            motion: HeadLexicon::default_lexicon().get("NOD"),
             amplitude: 0.2,
             cycles: 1,
         };
@@ -224,7 +296,7 @@ mod tests {
     #[test]
     fn a_shake_alternates_sides() {
         let u = HeadUnit {
-            motion: Some(Motion::Shake),
+            motion: HeadLexicon::default_lexicon().get("SHAKE"),
             amplitude: 0.3,
             cycles: 2,
         };
