@@ -156,5 +156,63 @@ fn chained_blocks(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, solve, optimal, anticipator_move, chained_blocks);
+/// Twenty small blocks (testspeechgestures) submitted to a realizer that is empty, and to one
+/// that already runs a large block of 1000 behaviours: the second should cost the same.
+fn after_large_block(c: &mut Criterion) {
+    use bml_realizer::realizer::Realizer;
+    // 20 small blocks per iteration (a one-off cost, such as an engine's unit list growing,
+    // is shared by them as it is in a real stream)
+    let smalls: Vec<String> = (0..20)
+        .map(|i| {
+            include_str!("../fixtures/realizertester/bml-1/core/testspeechgestures.xml")
+                .replace(r#"id="bml1""#, &format!(r#"id="small{i}""#))
+        })
+        .collect();
+    let mut body = String::new();
+    for i in 0..1000 {
+        body.push_str(&format!(
+            r#"<gesture id="g{i}" lexeme="BEAT" start="{}"/>"#,
+            f64::from(i) * 0.5
+        ));
+    }
+    let large = format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="large">{body}</bml>"#
+    );
+    let warm = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="warm"><wait id="w" start="0" end="0.5"/></bml>"#.to_string();
+    let mut g = c.benchmark_group("schedule/small-block");
+    for (name, with_large) in [
+        ("into-an-empty-realizer", false),
+        ("after-a-1000-behaviour-block", true),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter_batched(
+                || {
+                    let mut r = Realizer::new();
+                    // the character's block manager exists in both cases
+                    r.perform_bml(if with_large { &large } else { &warm })
+                        .unwrap();
+                    r.tick(1.0);
+                    r
+                },
+                |mut r| {
+                    for text in &smalls {
+                        r.perform_bml(black_box(text)).unwrap();
+                    }
+                    r
+                },
+                BatchSize::PerIteration,
+            )
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    solve,
+    optimal,
+    anticipator_move,
+    chained_blocks,
+    after_large_block
+);
 criterion_main!(benches);

@@ -31,16 +31,38 @@ impl fmt::Display for Pos {
 #[derive(Debug, Clone)]
 pub struct LineIndex {
     starts: Vec<usize>,
+    /// Per line, the offset of its first byte outside ASCII (or of its end): columns before it
+    /// are byte counts, so a long line does not make every position cost its length.
+    ascii_until: Vec<usize>,
 }
 
 impl LineIndex {
     /// Index the line starts of `src`.
     pub fn new(src: &str) -> Self {
-        let lines = memchr::memchr_iter(b'\n', src.as_bytes()).count();
+        let bytes = src.as_bytes();
+        let lines = memchr::memchr_iter(b'\n', bytes).count();
         let mut starts = Vec::with_capacity(lines + 1);
         starts.push(0);
-        starts.extend(memchr::memchr_iter(b'\n', src.as_bytes()).map(|i| i + 1));
-        LineIndex { starts }
+        starts.extend(memchr::memchr_iter(b'\n', bytes).map(|i| i + 1));
+        let ascii_until = if src.is_ascii() {
+            starts.iter().skip(1).copied().chain([src.len()]).collect()
+        } else {
+            let ends = starts.iter().skip(1).copied().chain([src.len()]);
+            starts
+                .iter()
+                .zip(ends)
+                .map(|(&s, e)| {
+                    bytes[s..e]
+                        .iter()
+                        .position(|b| !b.is_ascii())
+                        .map_or(e, |p| s + p)
+                })
+                .collect()
+        };
+        LineIndex {
+            starts,
+            ascii_until,
+        }
     }
 
     /// The position of byte offset `offset` in `src` (the text this index was built from).
@@ -48,9 +70,15 @@ impl LineIndex {
         let offset = offset.min(src.len());
         let line = self.starts.partition_point(|&s| s <= offset) - 1;
         let start = self.starts[line];
-        let col = src
-            .get(start..offset)
-            .map_or(offset - start, |s| s.chars().count());
+        let ascii = self.ascii_until.get(line).copied().unwrap_or(start);
+        let col = if offset <= ascii {
+            offset - start
+        } else {
+            (ascii - start)
+                + src
+                    .get(ascii..offset)
+                    .map_or(offset - ascii, |s| s.chars().count())
+        };
         Pos {
             line: line as u32 + 1,
             col: col as u32 + 1,
@@ -252,5 +280,23 @@ mod tests {
         // 'f' is after a two-byte character: byte 8, char column 5
         assert_eq!(p(src.find('f').unwrap()), (2, 5));
         assert_eq!(p(src.find('x').unwrap()), (4, 1));
+    }
+
+    #[test]
+    fn columns_are_characters_at_every_offset_of_mixed_lines() {
+        for src in [
+            "plain ascii\nline two",
+            "é début\nfin ü x\n\n€€ a",
+            "ab\r\ncd",
+            "ä",
+        ] {
+            let idx = LineIndex::new(src);
+            for (o, _) in src.char_indices().chain([(src.len(), ' ')]) {
+                let line_start = src[..o].rfind('\n').map_or(0, |i| i + 1);
+                let line = src[..o].matches('\n').count() as u32 + 1;
+                let col = src[line_start..o].chars().count() as u32 + 1;
+                assert_eq!(idx.pos(src, o), Pos { line, col }, "{src:?} at {o}");
+            }
+        }
     }
 }
