@@ -1,5 +1,5 @@
-//! The timing-only engine: realizes the BML kinds whose animation engine has not landed yet
-//! (face, locomotion, the shifts of head and face, BMLT animation kinds) and BMLT audio.
+//! The timing-only engine: realizes the BML kinds whose engine has not landed yet (face and face
+//! shifts, locomotion, BMLT controllers and face morphs) and BMLT audio.
 //! It takes the default timing models, plays units exactly at their scheduled sync times and lets
 //! the runtime report every sync point; the frame shows each unit's progress. Motion interrupted
 //! goes to `relax` at once and keeps its retraction; audio stops at once. It moves no joints: the
