@@ -307,18 +307,19 @@ impl Engine for GazeEngine {
             pose.rotate(i, donders(yaw, pitch));
         }
         // the eyes: aimed exactly from where they are now, blended from the rest aim
-        let now_world = pose.world(skeleton);
         let rest_point = rest_aim.map(|r| r.0);
         let target_point = target.map(|t| t.0);
         for eye in ["l_eyeball_joint", "r_eyeball_joint"] {
             let Some(e) = skeleton.joint(eye) else {
                 continue;
             };
-            let parent = skeleton.joints()[e].parent.unwrap_or(0);
-            let inv = now_world.orientations[parent].inverse();
+            // where the eye is now and how its parent (the head) is turned: forward kinematics
+            // along the eye's ancestors only
+            let (at_eye, eye_orientation) = pose.joint_world(skeleton, e);
+            let inv = (eye_orientation * pose.rotations[e].inverse()).inverse();
             let eye_aim = |p: Option<Vec3>| {
                 p.map_or((0.0, 0.0), |p| {
-                    let (y, pi) = yaw_pitch(inv * (p - now_world.positions[e]));
+                    let (y, pi) = yaw_pitch(inv * (p - at_eye));
                     (
                         y.clamp(-EYE_YAW_LIMIT.to_radians(), EYE_YAW_LIMIT.to_radians()),
                         pi.clamp(-EYE_PITCH_LIMIT.to_radians(), EYE_PITCH_LIMIT.to_radians()),

@@ -45,20 +45,21 @@ fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32)
     let joints = skeleton.joints();
     let (upper, lower) = (joints[elbow].offset, joints[wrist].offset);
     let hand = joints[index].offset;
-    let world = pose.world(skeleton);
-    let s = world.positions[shoulder];
+    // the shoulder's frame by forward kinematics along its ancestors only
+    let limb = LimbRoot::chain(skeleton, pose, shoulder)?;
+    let s = limb.position;
     let reach = (upper.length() + lower.length()) * REACH;
     let goal = s + (target - s).normalize_or(Vec3::Z) * reach;
     // shoulder and elbow put the wrist at the goal, the elbow bending down and back
     let (local_s, local_e) = place_limb(
         skeleton,
         pose,
-        LimbRoot::of(skeleton, &world, shoulder)?,
+        limb,
         [shoulder, elbow, wrist],
         goal,
         ARM_POLE,
     )?;
-    let o_s = world.orientations[joints[shoulder].parent?] * local_s;
+    let o_s = limb.parent * local_s;
     // wrist: the index finger (from its base, along its bones) toward the target; the base
     // moves with the hand, so a few rounds settle it
     let finger = match (j("r_index2"), j("r_index3")) {
