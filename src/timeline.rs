@@ -101,12 +101,12 @@ impl Timeline {
                                 continue;
                             }
                             row.lanes.push(Lane {
-                                behaviour: x.behaviour.clone(),
-                                kind: Some(x.kind.clone()),
+                                behaviour: x.behaviour.to_string(),
+                                kind: Some(x.kind.to_string()),
                                 syncs: x
                                     .syncs
                                     .iter()
-                                    .map(|(s, v)| (s.clone(), start + v))
+                                    .map(|(s, v)| (s.to_string(), start + v))
                                     .collect(),
                                 warned: false,
                             });
@@ -139,7 +139,7 @@ impl Timeline {
                         Some(i) => &mut row.lanes[i],
                         None => {
                             row.lanes.push(Lane {
-                                behaviour: p.behaviour.clone(),
+                                behaviour: p.behaviour.to_string(),
                                 kind: None,
                                 syncs: Vec::new(),
                                 warned: false,
@@ -149,7 +149,7 @@ impl Timeline {
                     };
                     match lane.syncs.iter_mut().find(|s| s.0 == p.sync) {
                         Some(s) => s.1 = p.global_time,
-                        None => lane.syncs.push((p.sync.clone(), p.global_time)),
+                        None => lane.syncs.push((p.sync.to_string(), p.global_time)),
                     }
                 }
                 Feedback::Warning(w) => t.warnings.push((w.id.clone(), w.text.clone())),

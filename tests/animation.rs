@@ -25,7 +25,7 @@ fn run(bml: &str, until: f64) -> (Series, Vec<(String, f64)>) {
         let frame = r.tick(t);
         for fb in &frame.feedback {
             if let Feedback::SyncPointProgress(p) = fb {
-                syncs.push((p.sync.clone(), p.global_time));
+                syncs.push((p.sync.to_string(), p.global_time));
             }
         }
         let w = frame.poses[0].pose.world(&skeleton);
@@ -432,9 +432,13 @@ fn a_beat_hits_its_bound_keys_at_its_syncs_and_the_left_hand_mirrors_them() {
             .borrow()
             .iter()
             .find_map(|f| match f {
-                Feedback::Prediction(p) if !p.behaviours.is_empty() => {
-                    Some(p.behaviours[0].syncs.clone())
-                }
+                Feedback::Prediction(p) if !p.behaviours.is_empty() => Some(
+                    p.behaviours[0]
+                        .syncs
+                        .iter()
+                        .map(|(n, t)| (n.to_string(), *t))
+                        .collect(),
+                ),
                 _ => None,
             })
             .unwrap();
@@ -745,7 +749,7 @@ fn s77_a_gesture_bound_to_a_procedural_unit_takes_its_timing_and_both_hands_mirr
         let frame = realizer.tick(t);
         for fb in &frame.feedback {
             if let Feedback::SyncPointProgress(p) = fb {
-                syncs.push((p.sync.clone(), p.global_time));
+                syncs.push((p.sync.to_string(), p.global_time));
             }
         }
         let w = frame.poses[0].pose.world(&skeleton);

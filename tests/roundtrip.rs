@@ -445,8 +445,8 @@ fn feedback() -> impl Strategy<Value = Feedback> {
             .prop_map(
                 |(block, sync, global_time, character_id, status, posix_time)| {
                     Feedback::BlockProgress(BlockProgress {
-                        block,
-                        sync,
+                        block: block.into(),
+                        sync: sync.into(),
                         global_time,
                         character_id,
                         status,
@@ -466,9 +466,9 @@ fn feedback() -> impl Strategy<Value = Feedback> {
             .prop_map(
                 |(block, behaviour, sync, time, global_time, character_id, posix_time)| {
                     Feedback::SyncPointProgress(SyncPointProgress {
-                        block,
-                        behaviour,
-                        sync,
+                        block: block.into(),
+                        behaviour: behaviour.into(),
+                        sync: sync.into(),
                         time,
                         global_time,
                         character_id,
@@ -481,7 +481,7 @@ fn feedback() -> impl Strategy<Value = Feedback> {
             vec(
                 (id(), option::of(time()), option::of(time()), status()).prop_map(
                     |(id, global_start, global_end, status)| BlockPrediction {
-                        id,
+                        id: id.into(),
                         global_start,
                         global_end,
                         status
@@ -499,10 +499,10 @@ fn feedback() -> impl Strategy<Value = Feedback> {
                 )
                     .prop_map(|(kind, block, behaviour, names, times)| {
                         BehaviourPrediction {
-                            kind,
-                            block,
-                            behaviour,
-                            syncs: names.into_iter().map(str::to_string).zip(times).collect(),
+                            kind: kind.into(),
+                            block: block.into(),
+                            behaviour: behaviour.into(),
+                            syncs: names.into_iter().map(Into::into).zip(times).collect(),
                         }
                     }),
                 0..3

@@ -95,9 +95,12 @@ impl Session {
         self.fb()
             .iter()
             .filter_map(|f| match f {
-                Feedback::BlockProgress(p) => {
-                    Some((p.block.clone(), p.sync.clone(), p.global_time, p.status))
-                }
+                Feedback::BlockProgress(p) => Some((
+                    p.block.to_string(),
+                    p.sync.to_string(),
+                    p.global_time,
+                    p.status,
+                )),
                 _ => None,
             })
             .collect()

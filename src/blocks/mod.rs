@@ -243,14 +243,14 @@ impl BlockManager {
                 .iter()
                 .filter(|x| x.phase != Phase::Removed)
                 .map(|x| BehaviourPrediction {
-                    kind: b.source.behaviours[x.index].kind.element_name().to_string(),
-                    block: b.id.to_string(),
-                    behaviour: x.id.to_string(),
+                    kind: bml::Id::new(b.source.behaviours[x.index].kind.element_name()),
+                    block: b.id.clone(),
+                    behaviour: x.id.clone(),
                     syncs: x
                         .syncs
                         .iter()
                         .filter(|s| s.1.is_finite())
-                        .map(|(n, t)| (n.to_string(), *t))
+                        .map(|(n, t)| (n.clone(), *t))
                         .collect(),
                 })
                 .collect()
@@ -260,7 +260,7 @@ impl BlockManager {
         let fb = PredictionFeedback {
             character_id: self.character.clone(),
             blocks: vec![BlockPrediction {
-                id: b.id.to_string(),
+                id: b.id.clone(),
                 global_start: Some(b.start),
                 // unknown while scheduling (the harness waits for a known end)
                 global_end: end.filter(|e| e.is_finite() && b.status != BlockStatus::InPrep),
@@ -271,11 +271,11 @@ impl BlockManager {
         Feedback::Prediction(fb)
     }
 
-    fn progress(&mut self, block: &str, sync: &str, t: f64, status: BlockStatus) {
+    fn progress(&mut self, block: &bml::Id, sync: &'static str, t: f64, status: BlockStatus) {
         let character_id = self.character.clone();
         self.emit(Feedback::BlockProgress(BlockProgress {
-            block: block.to_string(),
-            sync: sync.to_string(),
+            block: block.clone(),
+            sync: bml::Id::new_static(sync),
             global_time: t,
             character_id,
             status: Some(status),
@@ -806,7 +806,7 @@ impl BlockManager {
         for x in &mut self.blocks[i].behaviours {
             if x.phase == Phase::Running {
                 for (name, _) in &x.syncs[x.next..] {
-                    reports.push((x.id.clone(), name.to_string()));
+                    reports.push((x.id.clone(), name.clone()));
                 }
                 x.next = x.syncs.len();
                 x.phase = Phase::Ended;
@@ -923,12 +923,19 @@ impl BlockManager {
         })
     }
 
-    fn sync_feedback(&mut self, block: &str, behaviour: &str, sync: &str, local: f64, t: f64) {
+    fn sync_feedback(
+        &mut self,
+        block: &bml::Id,
+        behaviour: &bml::Id,
+        sync: &bml::Id,
+        local: f64,
+        t: f64,
+    ) {
         let character_id = self.character.clone();
         self.emit(Feedback::SyncPointProgress(SyncPointProgress {
-            block: block.to_string(),
-            behaviour: behaviour.to_string(),
-            sync: sync.to_string(),
+            block: block.clone(),
+            behaviour: behaviour.clone(),
+            sync: sync.clone(),
             time: local,
             global_time: t,
             character_id,

@@ -218,7 +218,7 @@ pub fn diff(a: &Log, b: &Log, tolerance: f64) -> Vec<Difference> {
             }
         }
         if let Feedback::SyncPointProgress(p) = fa {
-            syncs.push((p.block.clone(), ia, ib, id));
+            syncs.push((p.block.to_string(), ia, ib, id));
         }
     }
     for (ib, (line, fb)) in b.messages.iter().enumerate() {

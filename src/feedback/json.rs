@@ -58,7 +58,7 @@ fn to_value(fb: &Feedback) -> Value {
                 .map(|b| {
                     let mut o = Map::new();
                     o.insert("feedback".into(), json!("bml"));
-                    o.insert("id".into(), json!(b.id));
+                    o.insert("id".into(), json!(b.id.as_str()));
                     put_opt(&mut o, "globalStart", b.global_start.map(time));
                     put_opt(&mut o, "globalEnd", b.global_end.map(time));
                     put_opt(&mut o, "bmla:status", b.status.map(|s| json!(s.as_str())));
@@ -70,10 +70,10 @@ fn to_value(fb: &Feedback) -> Value {
                 .iter()
                 .map(|b| {
                     let mut o = Map::new();
-                    o.insert("feedback".into(), json!(b.kind));
+                    o.insert("feedback".into(), json!(b.kind.as_str()));
                     o.insert("id".into(), json!(format!("{}:{}", b.block, b.behaviour)));
                     for (sync, t) in &b.syncs {
-                        o.insert(sync.clone(), time(*t));
+                        o.insert(sync.to_string(), time(*t));
                     }
                     Value::Object(o)
                 })
@@ -195,9 +195,9 @@ pub fn from_json(line: &str) -> Result<Feedback, FeedbackError> {
             let p = split_id(str_of(m, "id")?, 3, "syncPointProgress")?;
             let [block, behaviour, sync] = <[String; 3]>::try_from(p).expect("three parts");
             Ok(Feedback::SyncPointProgress(SyncPointProgress {
-                block,
-                behaviour,
-                sync,
+                block: block.into(),
+                behaviour: behaviour.into(),
+                sync: sync.into(),
                 time: num_of(m, "time")?,
                 global_time: num_of(m, "globalTime")?,
                 character_id,
@@ -233,7 +233,7 @@ pub fn from_json(line: &str) -> Result<Feedback, FeedbackError> {
                         let t = v.as_f64().ok_or_else(|| {
                             FeedbackError(format!("predicted time \"{k}\" should be a number"))
                         })?;
-                        syncs.push((k.clone(), t));
+                        syncs.push((k.as_str().into(), t));
                     }
                 }
                 let kind = str_of(b, "feedback")?;
@@ -245,8 +245,8 @@ pub fn from_json(line: &str) -> Result<Feedback, FeedbackError> {
                 }
                 p.behaviours.push(BehaviourPrediction {
                     kind: kind.into(),
-                    block,
-                    behaviour,
+                    block: block.into(),
+                    behaviour: behaviour.into(),
                     syncs,
                 });
             }

@@ -115,9 +115,9 @@ impl From<KnownWarning> for WarningType {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BlockProgress {
     /// Block id.
-    pub block: String,
+    pub block: crate::bml::Id,
     /// `start` or `end` (other block sync ids are accepted when reading).
-    pub sync: String,
+    pub sync: crate::bml::Id,
     /// Global time in seconds.
     pub global_time: f64,
     /// Character, if any.
@@ -132,11 +132,11 @@ pub struct BlockProgress {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SyncPointProgress {
     /// Block id.
-    pub block: String,
+    pub block: crate::bml::Id,
     /// Behaviour id.
-    pub behaviour: String,
+    pub behaviour: crate::bml::Id,
     /// Sync point id.
-    pub sync: String,
+    pub sync: crate::bml::Id,
     /// Time relative to the block start, seconds.
     pub time: f64,
     /// Global time in seconds.
@@ -151,7 +151,7 @@ pub struct SyncPointProgress {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BlockPrediction {
     /// Block id.
-    pub id: String,
+    pub id: crate::bml::Id,
     /// Predicted global start.
     pub global_start: Option<f64>,
     /// Predicted global end (absent while unknown).
@@ -165,13 +165,13 @@ pub struct BlockPrediction {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BehaviourPrediction {
     /// Behaviour element name, e.g. `gesture`.
-    pub kind: String,
+    pub kind: crate::bml::Id,
     /// Block id.
-    pub block: String,
+    pub block: crate::bml::Id,
     /// Behaviour id.
-    pub behaviour: String,
+    pub behaviour: crate::bml::Id,
     /// (sync id, predicted time) in sync order.
-    pub syncs: Vec<(String, f64)>,
+    pub syncs: Vec<(crate::bml::Id, f64)>,
 }
 
 /// `<predictionFeedback>`: predicted timing of blocks and behaviours.

@@ -224,8 +224,8 @@ pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
                         FeedbackError(format!("blockProgress id '{id}' should be block:sync"))
                     })?;
                 Ok(Feedback::BlockProgress(BlockProgress {
-                    block: block.to_string(),
-                    sync: sync.to_string(),
+                    block: block.into(),
+                    sync: sync.into(),
                     global_time: num(req(&a, "globalTime", &name)?, "globalTime")?,
                     character_id,
                     status: status(&a)?,
@@ -236,9 +236,9 @@ pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
                 let p = split_id(req(&a, "id", &name)?, 3, "syncPointProgress")?;
                 let [block, behaviour, sync] = <[String; 3]>::try_from(p).expect("three parts");
                 Ok(Feedback::SyncPointProgress(SyncPointProgress {
-                    block,
-                    behaviour,
-                    sync,
+                    block: block.into(),
+                    behaviour: behaviour.into(),
+                    sync: sync.into(),
                     time: num(req(&a, "time", &name)?, "time")?,
                     global_time: num(req(&a, "globalTime", &name)?, "globalTime")?,
                     character_id,
@@ -325,7 +325,7 @@ fn prediction_children(
         }
         if name == "bml" {
             p.blocks.push(BlockPrediction {
-                id: req(&a, "id", "bml")?.to_string(),
+                id: req(&a, "id", "bml")?.into(),
                 global_start: opt_num(&a, false, "globalStart")?,
                 global_end: opt_num(&a, false, "globalEnd")?,
                 status: status(&a)?,
@@ -337,13 +337,13 @@ fn prediction_children(
             for (bmla, n, v) in &a {
                 if !bmla && n != "id" {
                     check_name(n)?;
-                    syncs.push((n.clone(), num(v, n)?));
+                    syncs.push((n.as_str().into(), num(v, n)?));
                 }
             }
             p.behaviours.push(BehaviourPrediction {
-                kind: name,
-                block,
-                behaviour,
+                kind: name.into(),
+                block: block.into(),
+                behaviour: behaviour.into(),
                 syncs,
             });
         }
