@@ -360,3 +360,49 @@ fn run_bvh_records_frames_without_changing_the_feedback() {
     assert_eq!(code, 2);
     assert!(err.contains("leave out --realtime"), "{err}");
 }
+
+#[test]
+fn run_assets_extend_the_motion_data_and_report_bad_files() {
+    let dir = std::env::temp_dir().join(format!("bmlr-assets-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("units.json"),
+        r#"{"units": {"swing": {"keys": {"start": 0, "stroke": 0.5, "end": 1},
+            "duration": {"preferred": 1.5, "min": 0.5, "max": 3},
+            "rotations": {"r_shoulder": ["0", "0", "40 * sin(pi * t)"]}}}}"#,
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("gestures.json"),
+        r#"{"gestures": [{"lexeme": "SWING", "procedural": "swing"}]}"#,
+    )
+    .unwrap();
+    let block = "-";
+    let bml = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b"><bmlt:procanimation id="p" name="swing"/><gesture id="g" lexeme="SWING" start="p:end"/></bml>"#;
+    let assets = dir.to_str().unwrap();
+    let (code, out, err) = bmlr_stdin(
+        &["run", "--assets", assets, "--format", "jsonl", block],
+        bml,
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(!out.contains("warning"), "{out}");
+    // the unit's own timing: 1.5 s, then the gesture bound to it (1.5 s more)
+    assert!(out.contains(r#""id":"b:p:end","time":1.5"#), "{out}");
+    assert!(out.contains(r#""id":"b:g:end","time":3"#), "{out}");
+    // without the directory the unit is unknown
+    let (_, out, _) = bmlr_stdin(&["run", "--format", "jsonl", block], bml);
+    assert!(out.contains("no procedural unit 'swing'"), "{out}");
+    // a bad file: exit 2 naming it
+    std::fs::write(
+        dir.join("heads.json"),
+        r#"{"heads": [{"lexeme": "X", "axis": "q", "degrees": 1}]}"#,
+    )
+    .unwrap();
+    let (code, _, err) = bmlr_stdin(&["run", "--assets", assets, block], bml);
+    assert_eq!(code, 2);
+    assert!(err.contains("heads.json") && err.contains("axis"), "{err}");
+    let (code, _, err) = bmlr(&["run", "--assets", "no/such/dir", "-"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("not a directory"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

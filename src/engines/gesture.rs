@@ -122,6 +122,13 @@ impl Lexicon {
         Ok(Lexicon { bindings })
     }
 
+    /// `first`'s bindings, then this lexicon's: for a lexeme both bind, `first`'s win.
+    pub fn extended_by(mut self, first: Lexicon) -> Lexicon {
+        let mut bindings = first.bindings;
+        bindings.append(&mut self.bindings);
+        Lexicon { bindings }
+    }
+
     /// The keys of `lexeme` (its first binding without a filter, if that is keys).
     pub fn keys(&self, lexeme: &str) -> Option<&GestureKeys> {
         match &self

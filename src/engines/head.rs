@@ -91,6 +91,13 @@ impl HeadLexicon {
         Ok(HeadLexicon { motions })
     }
 
+    /// `first`'s lexemes, then these: for a lexeme both bind, `first`'s wins.
+    pub fn extended_by(mut self, first: HeadLexicon) -> HeadLexicon {
+        let mut motions = first.motions;
+        motions.append(&mut self.motions);
+        HeadLexicon { motions }
+    }
+
     /// The motion of `lexeme`, if bound.
     pub fn get(&self, lexeme: &str) -> Option<Motion> {
         self.motions.iter().find(|m| m.0 == lexeme).map(|m| m.1)

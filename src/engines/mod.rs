@@ -1,6 +1,7 @@
 //! The built-in engines and the default registry that maps every BML 1.0, BMLA and BMLT behaviour
 //! kind to one of them:
 //!
+//! - [`assets`]: the motion data (units and bindings), embedded or read from a directory;
 //! - [`control`]: `wait`, `interrupt`, `activate`, `parametervaluechange`;
 //! - [`speech`]: `speech` and `bmlt:text` with the headless speech timing model, `volume` settable
 //!   while speaking;
@@ -18,6 +19,7 @@
 //! - [`noise`]: BMLT Perlin noise on a joint, added on top of the other engines;
 //! - [`transition`]: BMLT transitions from the current pose to the predicted one (A54).
 
+pub mod assets;
 pub mod control;
 pub mod gaze;
 pub mod gesture;
@@ -53,8 +55,14 @@ fn keys(kinds: &[(&str, &str)]) -> Vec<KindKey> {
     kinds.iter().map(|(ns, n)| KindKey::new(ns, n)).collect()
 }
 
-/// A registry with every built-in engine, using `models` for timing.
+/// A registry with every built-in engine, using `models` for timing and the embedded motion data.
 pub fn default_registry(models: DefaultTimingModels) -> Registry {
+    registry_with(models, &assets::Assets::default())
+}
+
+/// A registry with every built-in engine, using `models` for timing and `assets` for the motion
+/// engines' units and bindings.
+pub fn registry_with(models: DefaultTimingModels, assets: &assets::Assets) -> Registry {
     let mut r = Registry::new();
     r.register(
         Box::new(control::ControlEngine::default()),
@@ -83,22 +91,22 @@ pub fn default_registry(models: DefaultTimingModels) -> Registry {
         &keys(&[(NS_BMLT, "keyframe")]),
     );
     r.register(
-        Box::new(procedural::ProceduralEngine::default()),
+        Box::new(procedural::ProceduralEngine::new(assets.units.clone())),
         &keys(&[
             (NS_BMLT, "procanimation"),
             (NS_BMLT, "procanimationgesture"),
         ]),
     );
     r.register(
-        Box::new(posture::PostureEngine::default()),
+        Box::new(posture::PostureEngine::new(assets.poses.clone())),
         &keys(&[(NS_BML, "posture"), (NS_BML, "postureShift")]),
     );
     r.register(
-        Box::new(gesture::GestureEngine::default()),
+        Box::new(gesture::GestureEngine::new(assets.gestures.clone())),
         &keys(&[(NS_BML, "gesture")]),
     );
     r.register(
-        Box::new(head::HeadEngine::default()),
+        Box::new(head::HeadEngine::new(assets.heads.clone())),
         &keys(&[(NS_BML, "head")]),
     );
     // noise adds to whatever the joint has

@@ -108,6 +108,13 @@ impl PoseBindings {
         Ok(PoseBindings { poses })
     }
 
+    /// `first`'s bindings, then these: for a pose both bind, `first`'s wins.
+    pub fn extended_by(mut self, first: PoseBindings) -> PoseBindings {
+        let mut poses = first.poses;
+        poses.append(&mut self.poses);
+        PoseBindings { poses }
+    }
+
     fn get(&self, part: PosePart, lexeme: &str) -> Result<HeldPose, String> {
         self.poses
             .iter()
@@ -146,9 +153,16 @@ pub struct PostureEngine {
 
 impl Default for PostureEngine {
     fn default() -> Self {
+        PostureEngine::new(PoseBindings::default_bindings())
+    }
+}
+
+impl PostureEngine {
+    /// A posture engine holding the poses of `bindings`.
+    pub fn new(bindings: PoseBindings) -> Self {
         PostureEngine {
             models: DefaultTimingModels::default(),
-            bindings: PoseBindings::default_bindings(),
+            bindings,
             units: Units::new(),
             rest: None,
         }

@@ -601,6 +601,13 @@ impl Library {
         Ok(Library { units })
     }
 
+    /// This library with the units of `other` added (a unit of the same name replaces this
+    /// library's).
+    pub fn extended(mut self, other: Library) -> Library {
+        self.units.extend(other.units);
+        self
+    }
+
     /// The unit called `name`.
     pub fn get(&self, name: &str) -> Option<&Arc<ProcUnit>> {
         self.units.get(name)

@@ -51,6 +51,11 @@ pub struct RunArgs {
     /// Character for blocks without a characterId.
     #[arg(long, value_name = "ID")]
     character: Option<String>,
+    /// A directory of motion data adding to the embedded defaults: any of units.json (procedural
+    /// units), gestures.json, poses.json and heads.json (bindings, which win over the embedded
+    /// ones for what they bind).
+    #[arg(long, value_name = "DIR")]
+    pub assets: Option<std::path::PathBuf>,
     /// Write the realized motion of the character (--character, else the default one) as BVH,
     /// one frame every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.bvh")]
@@ -61,12 +66,29 @@ pub struct RunArgs {
     items: Vec<String>,
 }
 
+/// `realizer` with the motion data of `dir` (units and bindings), if given.
+pub fn with_assets(realizer: Realizer, dir: Option<&Path>) -> Result<Realizer, String> {
+    let Some(dir) = dir else {
+        return Ok(realizer);
+    };
+    let assets = bml_realizer::engines::assets::Assets::from_dir(dir)?;
+    Ok(realizer.with_engines(move || {
+        bml_realizer::engines::registry_with(
+            bml_realizer::engine::timing::DefaultTimingModels::default(),
+            &assets,
+        )
+    }))
+}
+
 /// Arguments of `bmlr plan`.
 #[derive(Args)]
 pub struct PlanArgs {
     /// Character for blocks without a characterId.
     #[arg(long, value_name = "ID")]
     character: Option<String>,
+    /// A directory of motion data adding to the embedded defaults (see `bmlr run --assets`).
+    #[arg(long, value_name = "DIR")]
+    assets: Option<std::path::PathBuf>,
     /// Also draw the plan as a timeline picture (SVG) with the constraints as links.
     #[arg(long, value_name = "OUT.svg")]
     svg: Option<std::path::PathBuf>,
@@ -198,9 +220,15 @@ pub fn run(args: RunArgs) -> ExitCode {
         eprintln!("bmlr run: --fps must be a positive number");
         return ExitCode::from(2);
     }
-    let realizer = Realizer::new()
-        .with_default_character(args.character.clone())
-        .with_posix_time(args.realtime);
+    let realizer = match with_assets(Realizer::new(), args.assets.as_deref()) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("bmlr run: --assets {e}");
+            return ExitCode::from(2);
+        }
+    }
+    .with_default_character(args.character.clone())
+    .with_posix_time(args.realtime);
     if args.realtime && args.bvh.is_some() {
         eprintln!("bmlr run: --bvh records on the virtual clock; leave out --realtime");
         return ExitCode::from(2);
@@ -409,7 +437,13 @@ pub fn plan(args: PlanArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let mut realizer = Realizer::new().with_default_character(args.character);
+    let mut realizer = match with_assets(Realizer::new(), args.assets.as_deref()) {
+        Ok(r) => r.with_default_character(args.character),
+        Err(e) => {
+            eprintln!("bmlr plan: --assets {e}");
+            return ExitCode::from(2);
+        }
+    };
     let mut feedback = Vec::new();
     let mut blocks = Vec::new();
     for item in items {

@@ -11,7 +11,8 @@ use bml_realizer::bml::{BlockStream, StreamItem};
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::conformance::InProcess;
 use bml_realizer::engine::timing::{DefaultTimingModels, SpeechTiming};
-use bml_realizer::engines::default_registry;
+use bml_realizer::engines::assets::Assets;
+use bml_realizer::engines::registry_with;
 use bml_realizer::feedback::Format;
 use bml_realizer::realizer::Realizer;
 use clap::Args;
@@ -36,6 +37,9 @@ pub struct ServeArgs {
     /// Speech may change its rate to meet its constraints (an incremental TTS).
     #[arg(long)]
     retimable_speech: bool,
+    /// A directory of motion data adding to the embedded defaults (see `bmlr run --assets`).
+    #[arg(long, value_name = "DIR")]
+    assets: Option<std::path::PathBuf>,
 }
 
 /// `bmlr serve --stdio` (runs until stdin closes and nothing more is scheduled) or `--tcp`.
@@ -48,8 +52,15 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         retimable: args.retimable_speech,
         ..SpeechTiming::default()
     };
+    let assets = match args.assets.as_deref().map(Assets::from_dir).transpose() {
+        Ok(a) => a.unwrap_or_default(),
+        Err(e) => {
+            eprintln!("bmlr serve: --assets {e}");
+            return ExitCode::from(2);
+        }
+    };
     let mut realizer = Realizer::new()
-        .with_engines(move || default_registry(DefaultTimingModels { speech }))
+        .with_engines(move || registry_with(DefaultTimingModels { speech }, &assets))
         .with_posix_time(true);
     if let Some(addr) = &args.tcp {
         return crate::tcp::serve(addr, args.per_client, args.fps, realizer);

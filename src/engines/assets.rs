@@ -1,0 +1,77 @@
+//! The motion data the built-in engines read: the procedural unit library and the bindings of
+//! gesture lexemes, posture poses and head lexemes. The defaults are embedded in the crate
+//! (`fixtures/procedural/units.json`, `fixtures/bindings/{gestures,poses,heads}.json`); a
+//! directory with files of the same names adds to them: its units join the library (replacing
+//! units of the same name) and its bindings come before the embedded ones (so they win for the
+//! lexemes and poses they bind).
+
+use std::path::Path;
+
+use super::gesture::Lexicon;
+use super::head::HeadLexicon;
+use super::posture::PoseBindings;
+use super::procedural::Library;
+
+/// The data of the motion engines.
+#[derive(Debug, Clone)]
+pub struct Assets {
+    /// Procedural units (`units.json`).
+    pub units: Library,
+    /// Gesture bindings (`gestures.json`).
+    pub gestures: Lexicon,
+    /// Posture pose bindings (`poses.json`).
+    pub poses: PoseBindings,
+    /// Head lexemes (`heads.json`).
+    pub heads: HeadLexicon,
+}
+
+impl Default for Assets {
+    fn default() -> Self {
+        Assets {
+            units: Library::default_library(),
+            gestures: Lexicon::default_lexicon(),
+            poses: PoseBindings::default_bindings(),
+            heads: HeadLexicon::default_lexicon(),
+        }
+    }
+}
+
+impl Assets {
+    /// The defaults extended by each of `units.json`, `gestures.json`, `poses.json` and
+    /// `heads.json` that `dir` has (see the module documentation). The directory's bindings may
+    /// name its own units and the embedded ones. The error names the file and what is wrong.
+    pub fn from_dir(dir: &Path) -> Result<Assets, String> {
+        if !dir.is_dir() {
+            return Err(format!("{} is not a directory", dir.display()));
+        }
+        let read = |name: &str| -> Result<Option<(String, String)>, String> {
+            let path = dir.join(name);
+            if !path.exists() {
+                return Ok(None);
+            }
+            let text =
+                std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            Ok(Some((path.display().to_string(), text)))
+        };
+        let mut assets = Assets::default();
+        if let Some((path, text)) = read("units.json")? {
+            let units = Library::from_json(&text).map_err(|e| format!("{path}: {e}"))?;
+            assets.units = assets.units.extended(units);
+        }
+        if let Some((path, text)) = read("gestures.json")? {
+            let first =
+                Lexicon::from_json(&text, &assets.units).map_err(|e| format!("{path}: {e}"))?;
+            assets.gestures = assets.gestures.extended_by(first);
+        }
+        if let Some((path, text)) = read("poses.json")? {
+            let first = PoseBindings::from_json(&text, &assets.units)
+                .map_err(|e| format!("{path}: {e}"))?;
+            assets.poses = assets.poses.extended_by(first);
+        }
+        if let Some((path, text)) = read("heads.json")? {
+            let first = HeadLexicon::from_json(&text).map_err(|e| format!("{path}: {e}"))?;
+            assets.heads = assets.heads.extended_by(first);
+        }
+        Ok(assets)
+    }
+}
