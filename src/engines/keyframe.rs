@@ -200,10 +200,28 @@ impl Keys {
         how: Interpolation,
         controls: &[Vec<(Quat, Quat)>],
     ) -> (Vec3, Vec<Quat>) {
-        let k = &self.keys;
-        if how == Interpolation::Slerp || controls.len() + 1 != k.len() {
+        if how == Interpolation::Slerp || controls.len() + 1 != self.keys.len() {
             return self.sample(t);
         }
+        self.interpolate(t, |i, p, q, u| {
+            let (ca, cb) = controls[i][p];
+            bezier(q.0, ca, cb, q.1, u)
+        })
+    }
+
+    /// The root translation and rotations at key time `t` (clamped to the keys), slerped.
+    pub fn sample(&self, t: f64) -> (Vec3, Vec<Quat>) {
+        self.interpolate(t, |_, _, q, u| q.0.slerp(q.1, u))
+    }
+
+    /// The keys at `t`: a key's own values outside the keys, else the root lerped and every
+    /// part's rotation by `between(segment, part, (from, to), u)` within its segment.
+    fn interpolate(
+        &self,
+        t: f64,
+        between: impl Fn(usize, usize, (Quat, Quat), f32) -> Quat,
+    ) -> (Vec3, Vec<Quat>) {
+        let k = &self.keys;
         if t <= k[0].0 || k.len() == 1 {
             return (k[0].1, k[0].2.clone());
         }
@@ -217,26 +235,9 @@ impl Keys {
         let rotations =
             a.2.iter()
                 .zip(&b.2)
-                .zip(&controls[i])
-                .map(|((p, q), (ca, cb))| bezier(*p, *ca, *cb, *q, u))
+                .enumerate()
+                .map(|(p, (qa, qb))| between(i, p, (*qa, *qb), u))
                 .collect();
-        (a.1.lerp(b.1, u), rotations)
-    }
-
-    /// The root translation and rotations at key time `t` (clamped to the keys), slerped.
-    pub fn sample(&self, t: f64) -> (Vec3, Vec<Quat>) {
-        let k = &self.keys;
-        if t <= k[0].0 || k.len() == 1 {
-            return (k[0].1, k[0].2.clone());
-        }
-        let last = &k[k.len() - 1];
-        if t >= last.0 {
-            return (last.1, last.2.clone());
-        }
-        let i = k.partition_point(|key| key.0 <= t) - 1;
-        let (a, b) = (&k[i], &k[i + 1]);
-        let u = ((t - a.0) / (b.0 - a.0)) as f32;
-        let rotations = a.2.iter().zip(&b.2).map(|(p, q)| p.slerp(*q, u)).collect();
         (a.1.lerp(b.1, u), rotations)
     }
 }
