@@ -165,16 +165,24 @@ fn weights(u: &GazeUnit, syncs: &[(SyncName, f64)], t: f64, amplitude: f64) -> O
 impl GazeEngine {
     /// The point between the eyes in the rest pose.
     fn eyes_at_rest(&mut self, skeleton: &Skeleton) -> Vec3 {
-        *self.eyes_at_rest.get_or_insert_with(|| {
-            let rest = Pose::rest(skeleton).world(skeleton).positions;
-            match (
-                skeleton.joint("l_eyeball_joint"),
-                skeleton.joint("r_eyeball_joint"),
-            ) {
-                (Some(l), Some(r)) => (rest[l] + rest[r]) / 2.0,
-                _ => rest[0],
-            }
-        })
+        *self
+            .eyes_at_rest
+            .get_or_insert_with(|| eyes_at_rest(skeleton))
+    }
+}
+
+/// The point between the eyes in the rest pose of `skeleton` (the root without eyes): where gaze
+/// and head direction measure their aims from.
+pub(crate) fn eyes_at_rest(skeleton: &Skeleton) -> Vec3 {
+    let rest = Pose::rest(skeleton);
+    match (
+        skeleton.joint("l_eyeball_joint"),
+        skeleton.joint("r_eyeball_joint"),
+    ) {
+        (Some(l), Some(r)) => {
+            (rest.joint_world(skeleton, l).0 + rest.joint_world(skeleton, r).0) / 2.0
+        }
+        _ => rest.root,
     }
 }
 

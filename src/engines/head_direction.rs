@@ -13,7 +13,7 @@ use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
-use crate::engines::gaze::{donders, yaw_pitch};
+use crate::engines::gaze::{donders, eyes_at_rest, yaw_pitch};
 use crate::engines::motion::{envelope, finished_shift};
 use crate::world::World;
 
@@ -32,20 +32,8 @@ pub struct HeadDirectionEngine {
     units: Units<DirectionUnit>,
     /// The target the head faces when no shift runs.
     rest: Option<String>,
-}
-
-/// The point the head turns about's view: between the eyes in the rest pose.
-fn eyes(skeleton: &Skeleton) -> Vec3 {
-    let rest = Pose::rest(skeleton);
-    match (
-        skeleton.joint("l_eyeball_joint"),
-        skeleton.joint("r_eyeball_joint"),
-    ) {
-        (Some(l), Some(r)) => {
-            (rest.joint_world(skeleton, l).0 + rest.joint_world(skeleton, r).0) / 2.0
-        }
-        _ => rest.root,
-    }
+    /// The point between the eyes in the rest pose (the skeleton does not change).
+    eyes_at_rest: Option<Vec3>,
 }
 
 impl Engine for HeadDirectionEngine {
@@ -100,7 +88,9 @@ impl Engine for HeadDirectionEngine {
         if active.is_none() && self.rest.is_none() {
             return;
         }
-        let from = eyes(skeleton);
+        let from = *self
+            .eyes_at_rest
+            .get_or_insert_with(|| eyes_at_rest(skeleton));
         let aim = |target: Option<&String>| {
             target
                 .and_then(|t| world.get(t))

@@ -21,7 +21,10 @@ use glam::{EulerRot, Quat};
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, Steering, Unit, UnitKey, Units};
+use crate::engine::{
+    named_param, named_params, set_named_param, Engine, EngineError, Params, Steering, Unit,
+    UnitKey, Units,
+};
 use crate::engines::motion::min_jerk;
 use crate::engines::procedural::perlin;
 use crate::world::World;
@@ -42,16 +45,13 @@ const PARAMS: &[(&str, f64)] = &[
 #[derive(Debug, Clone)]
 struct NoiseUnit {
     joint: String,
-    /// Values of [`PARAMS`], in order.
-    values: [f64; 9],
+    /// [`PARAMS`] with the behaviour's values, in that order.
+    params: Params,
 }
 
 impl NoiseUnit {
     fn value(&self, name: &str) -> f64 {
-        PARAMS
-            .iter()
-            .position(|p| p.0 == name)
-            .map_or(0.0, |i| self.values[i])
+        named_param(&self.params, name).unwrap_or(0.0)
     }
 
     /// The rotation (degrees about x, y, z) `dt` seconds after the start.
@@ -60,14 +60,15 @@ impl NoiseUnit {
         let persistence = self.value("persistence");
         let mut out = [0.0; 3];
         // PARAMS: three frequencies, then three amplitudes
-        for (axis, (f, a)) in self.values[0..3].iter().zip(&self.values[3..6]).enumerate() {
+        for (axis, out) in out.iter_mut().enumerate() {
+            let (f, a) = (self.params[axis].1, self.params[axis + 3].1);
             let mut sum = 0.0;
             for k in 0..octaves {
                 let scale = 2f64.powi(k as i32);
                 sum += persistence.powi(k as i32)
                     * perlin(f * scale * dt, (axis * 8) as f64 + k as f64);
             }
-            out[axis] = a * sum;
+            *out = a * sum;
         }
         out
     }
@@ -121,42 +122,14 @@ impl Engine for NoiseEngine {
                 n.kind
             )));
         }
-        let mut values = [0.0; 9];
-        for (v, p) in values.iter_mut().zip(PARAMS) {
-            *v = p.1;
-        }
-        for p in &n.params {
-            let i = PARAMS
-                .iter()
-                .position(|x| x.0.eq_ignore_ascii_case(&p.name))
-                .ok_or_else(|| {
-                    let known: Vec<&str> = PARAMS.iter().map(|x| x.0).collect();
-                    fail(format!(
-                        "noise has no parameter '{}' (it has {known:?})",
-                        p.name
-                    ))
-                })?;
-            values[i] = p
-                .value
-                .trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    fail(format!(
-                        "parameter '{}' = '{}' is not a number",
-                        p.name, p.value
-                    ))
-                })?;
-        }
+        let params = named_params("noise", PARAMS.iter().copied(), &n.params).map_err(fail)?;
         let joint = n.joint.clone();
-        self.units.add(unit, NoiseUnit { joint, values });
+        self.units.add(unit, NoiseUnit { joint, params });
         Ok(())
     }
 
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
-        let u = self.units.get(key)?;
-        PARAMS.iter().any(|p| p.0 == name).then(|| u.value(name))
+        named_param(&self.units.get(key)?.params, name)
     }
 
     fn set_parameter(
@@ -166,21 +139,8 @@ impl Engine for NoiseEngine {
         value: f64,
         _now: f64,
     ) -> Result<Option<Vec<f64>>, EngineError> {
-        let (_, u) = self
-            .units
-            .get_mut(key)
-            .ok_or_else(|| EngineError(format!("{key} is not running")))?;
-        let i = PARAMS
-            .iter()
-            .position(|p| p.0 == name)
-            .ok_or_else(|| EngineError(format!("{key}: noise has no parameter '{name}'")))?;
-        if !value.is_finite() {
-            return Err(EngineError(format!(
-                "{key}: {name} = {value} is not finite"
-            )));
-        }
-        u.values[i] = value;
-        Ok(None)
+        let params = self.units.get_mut(key).map(|(_, u)| &mut u.params);
+        set_named_param(key, "noise", params, name, value)
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {

@@ -51,7 +51,10 @@ use crate::bml::{Behaviour, BehaviourKind, Id, Param};
 use crate::body::ik::{place_limb, LimbRoot, ARM_POLE, LEG_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
-use crate::engine::{Engine, EngineError, Steering, SyncTimes, Unit, UnitKey, Units};
+use crate::engine::{
+    named_param, named_params, set_named_param, Engine, EngineError, Steering, SyncTimes, Unit,
+    UnitKey, Units,
+};
 use crate::engines::motion::min_jerk;
 use crate::schedule::SyncName;
 use crate::world::World;
@@ -415,24 +418,11 @@ impl ProcUnit {
 
     /// Checks parameter overrides against the unit's parameters.
     pub fn parameters(&self, overrides: &[Param]) -> Result<Vec<(String, f64)>, String> {
-        let mut params = self.params.clone();
-        for p in overrides {
-            let Some(slot) = params.iter_mut().find(|x| x.0 == p.name) else {
-                let known: Vec<&str> = self.params.iter().map(|x| x.0.as_str()).collect();
-                return Err(format!(
-                    "unit '{}' has no parameter '{}' (it has {known:?})",
-                    self.name, p.name
-                ));
-            };
-            slot.1 = p
-                .value
-                .trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| format!("parameter '{}' = '{}' is not a number", p.name, p.value))?;
-        }
-        Ok(params)
+        named_params(
+            &format!("unit '{}'", self.name),
+            self.params.iter().cloned(),
+            overrides,
+        )
     }
 
     /// Its weight at global time `t` for a run from `start` to `end`: blending in after `start`
@@ -712,8 +702,7 @@ impl Engine for ProceduralEngine {
     }
 
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
-        let r = self.units.get(key)?;
-        r.params.iter().find(|p| p.0 == name).map(|p| p.1)
+        named_param(&self.units.get(key)?.params, name)
     }
 
     fn set_parameter(
@@ -723,23 +712,11 @@ impl Engine for ProceduralEngine {
         value: f64,
         _now: f64,
     ) -> Result<Option<Vec<f64>>, EngineError> {
-        let (_, r) = self
-            .units
-            .get_mut(key)
-            .ok_or_else(|| EngineError(format!("{key} is not running")))?;
-        match r.params.iter_mut().find(|p| p.0 == name) {
-            Some(p) if value.is_finite() => {
-                p.1 = value;
-                Ok(None)
-            }
-            Some(_) => Err(EngineError(format!(
-                "{key}: {name} = {value} is not finite"
-            ))),
-            None => Err(EngineError(format!(
-                "{key}: unit '{}' has no parameter '{name}'",
-                r.unit.name
-            ))),
-        }
+        let running = self.units.get_mut(key).map(|(_, r)| r);
+        let owner = running
+            .as_ref()
+            .map_or(String::new(), |r| format!("unit '{}'", r.unit.name));
+        set_named_param(key, &owner, running.map(|r| &mut r.params), name, value)
     }
 
     fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
