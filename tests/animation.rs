@@ -521,24 +521,22 @@ fn a_sitting_shift_folds_the_legs_and_stays_a_posture_returns() {
     );
 }
 
-/// What [`track`] records: per frame (time, joint position), the sync times, the warnings.
-struct Track {
-    positions: Vec<(f64, Vec3)>,
+/// A run recorded by [`record`]: every frame's (time, pose), the sync times
+/// ("block:behaviour:sync") and the warnings ("TYPE text").
+struct Recording {
+    frames: Vec<(f64, bml_realizer::body::Pose)>,
     syncs: Vec<(String, f64)>,
     warnings: Vec<String>,
 }
 
-/// Runs `bml` at 60 Hz and records the world position of `joint` every frame, with the sync
-/// times ("block:behaviour:sync") and warnings reported.
-fn track(bml: &str, joint: &str, until: f64) -> Track {
-    let skeleton = Skeleton::adult();
-    let j = skeleton.joint(joint).unwrap();
+/// Runs `bml` at 60 Hz from 0 to `until` and records it.
+fn record(bml: &str, until: f64) -> Recording {
     let mut r = Realizer::new();
     r.perform_bml(bml).unwrap();
-    let (mut out, mut syncs, mut warnings) = (Vec::new(), Vec::new(), Vec::new());
-    for i in 0..=(until * FPS).ceil() as u32 {
+    let (mut frames, mut syncs, mut warnings) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..=(until * FPS).round() as u32 {
         let t = f64::from(i) / FPS;
-        let frame = r.tick(t);
+        let mut frame = r.tick(t);
         for fb in &frame.feedback {
             match fb {
                 Feedback::SyncPointProgress(p) => syncs.push((
@@ -549,12 +547,52 @@ fn track(bml: &str, joint: &str, until: f64) -> Track {
                 _ => {}
             }
         }
-        out.push((t, frame.poses[0].pose.world(&skeleton).positions[j]));
+        frames.push((t, frame.poses.swap_remove(0).pose));
     }
-    Track {
-        positions: out,
+    Recording {
+        frames,
         syncs,
         warnings,
+    }
+}
+
+impl Recording {
+    /// The world position of `joint` (adult skeleton) every frame.
+    fn positions(&self, joint: &str) -> Vec<(f64, Vec3)> {
+        let skeleton = Skeleton::adult();
+        let j = skeleton.joint(joint).unwrap();
+        self.frames
+            .iter()
+            .map(|(t, p)| (*t, p.joint_world(&skeleton, j).0))
+            .collect()
+    }
+
+    /// The pose of the frame at time `t` (a multiple of 1/60 s).
+    fn at(&self, t: f64) -> &bml_realizer::body::Pose {
+        &self
+            .frames
+            .iter()
+            .find(|f| (f.0 - t).abs() < 1e-9)
+            .unwrap()
+            .1
+    }
+}
+
+/// What [`track`] records: per frame (time, joint position), the sync times, the warnings.
+struct Track {
+    positions: Vec<(f64, Vec3)>,
+    syncs: Vec<(String, f64)>,
+    warnings: Vec<String>,
+}
+
+/// Runs `bml` at 60 Hz and records the world position of `joint` every frame, with the sync
+/// times and warnings reported.
+fn track(bml: &str, joint: &str, until: f64) -> Track {
+    let r = record(bml, until);
+    Track {
+        positions: r.positions(joint),
+        syncs: r.syncs,
+        warnings: r.warnings,
     }
 }
 
@@ -686,20 +724,23 @@ fn a_procanimation_naming_a_unit_the_library_lacks_is_refused_with_the_reason() 
 
 #[test]
 fn noise_moves_its_joint_smoothly_within_its_amplitude_and_fades_in_and_out() {
-    let skeleton = Skeleton::adult();
-    let skull = skeleton.joint("skullbase").unwrap();
-    let mut r = Realizer::new();
-    r.perform_bml(&format!(
-        r#"<bml {BMLT} id="b"><bmlt:noise id="n" type="perlin" joint="skullbase" start="1" end="6"><bmlt:parameter name="baseamplitudex" value="3"/><bmlt:parameter name="basefreqx" value="0.7"/></bmlt:noise></bml>"#
-    ))
-    .unwrap();
-    let rest = glam::Quat::IDENTITY;
-    let mut angles = Vec::new();
-    for i in 0..=(7.0 * FPS) as u32 {
-        let t = f64::from(i) / FPS;
-        let q = r.tick(t).poses[0].pose.rotations[skull];
-        angles.push((t, q.angle_between(rest).to_degrees() as f64));
-    }
+    let skull = Skeleton::adult().joint("skullbase").unwrap();
+    let run = record(
+        &format!(
+            r#"<bml {BMLT} id="b"><bmlt:noise id="n" type="perlin" joint="skullbase" start="1" end="6"><bmlt:parameter name="baseamplitudex" value="3"/><bmlt:parameter name="basefreqx" value="0.7"/></bmlt:noise></bml>"#
+        ),
+        7.0,
+    );
+    let angles: Vec<(f64, f64)> = run
+        .frames
+        .iter()
+        .map(|(t, p)| {
+            (
+                *t,
+                f64::from(p.rotations[skull].angle_between(Quat::IDENTITY)).to_degrees(),
+            )
+        })
+        .collect();
     // bounded by the amplitudes over both octaves: (3 + 2) · (1 + 0.5) degrees
     assert!(angles.iter().all(|(_, a)| *a <= 7.5), "{angles:?}");
     let peak = angles.iter().map(|a| a.1).fold(0.0, f64::max);
@@ -730,34 +771,23 @@ fn noise_of_an_unknown_type_is_refused_with_the_reason() {
 
 #[test]
 fn s77_a_gesture_bound_to_a_procedural_unit_takes_its_timing_and_both_hands_mirror() {
-    let skeleton = Skeleton::adult();
-    let (l, r) = (
-        skeleton.joint("l_wrist").unwrap(),
-        skeleton.joint("r_wrist").unwrap(),
+    let run = record(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gesture id="g" lexeme="HELLO" mode="BOTH_HANDS" start="0.5"/></bml>"#,
+        3.0,
     );
-    let mut realizer = Realizer::new();
-    realizer
-        .perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gesture id="g" lexeme="HELLO" mode="BOTH_HANDS" start="0.5"/></bml>"#)
-        .unwrap();
-    let mut syncs = Vec::new();
+    let (left, right) = (run.positions("l_wrist"), run.positions("r_wrist"));
     let mut moved = 0.0f32;
-    let rest = bml_realizer::body::Pose::rest(&skeleton).world(&skeleton);
-    for i in 0..=(3.0 * FPS) as u32 {
-        let t = f64::from(i) / FPS;
-        let frame = realizer.tick(t);
-        for fb in &frame.feedback {
-            if let Feedback::SyncPointProgress(p) = fb {
-                syncs.push((p.sync.to_string(), p.global_time));
-            }
-        }
-        let w = frame.poses[0].pose.world(&skeleton);
-        let reflected = Vec3::new(-w.positions[r].x, w.positions[r].y, w.positions[r].z);
-        assert!((w.positions[l] - reflected).length() < 1e-3, "at {t}");
-        moved = moved.max((w.positions[r] - rest.positions[r]).length());
+    for ((t, l), (_, r)) in left.iter().zip(&right) {
+        assert!((*l - Vec3::new(-r.x, r.y, r.z)).length() < 1e-3, "at {t}");
+        moved = moved.max((*r - right[0].1).length());
     }
     // the procedural wave's timing: 2 s preferred, stroke at α 0.5
-    assert!((at(&syncs, "end") - 2.5).abs() < 1e-9, "{syncs:?}");
-    assert!((at(&syncs, "stroke") - 1.5).abs() < 1e-9);
+    assert!(
+        (at(&run.syncs, "b:g:end") - 2.5).abs() < 1e-9,
+        "{:?}",
+        run.syncs
+    );
+    assert!((at(&run.syncs, "b:g:stroke") - 1.5).abs() < 1e-9);
     assert!(moved > 0.1, "the arms wave ({moved} m)");
 }
 
@@ -791,37 +821,36 @@ fn a54_a_transition_starts_at_the_current_pose_and_ends_at_the_predicted_one() {
     );
     // a keyframe bends the arm until 1 s; the transition (1 s to 1.5 s) leads into the
     // procedural lift that starts at 1.5 s
-    let mut r = Realizer::new();
-    r.perform_bml(&format!(
-        r#"<bml {BMLT} id="b">
+    let run = record(
+        &format!(
+            r#"<bml {BMLT} id="b">
         <bmlt:keyframe id="kf" start="0" end="1"><SkeletonInterpolator rotationEncoding="quaternions" parts="r_shoulder r_elbow" encoding="R">
             0 1 0 0 0 1 0 0 0
             1 0.9239 0 0 0.3827 0.7071 0 0.7071 0
         </SkeletonInterpolator></bmlt:keyframe>
         <bmlt:transition id="tr" class="SlerpTransition" start="kf:end" end="p:start"><bmlt:parameter name="joints" value="r_shoulder r_elbow"/></bmlt:transition>
         <bmlt:procanimation id="p" name="lift" start="1.5" end="2.5"/></bml>"#
-    ))
-    .unwrap();
-    let mut frames = Vec::new();
-    for i in 0..=(2.6 * FPS).round() as u32 {
-        let t = f64::from(i) / FPS;
-        frames.push((t, r.tick(t).poses[0].pose.clone()));
-    }
-    let frame = |t: f64| &frames.iter().find(|f| (f.0 - t).abs() < 1e-9).unwrap().1;
+        ),
+        2.6,
+    );
     // its first frame is the pose the body had (the frame before)
-    let (before, first) = (frame(59.0 / FPS), frame(1.0));
+    let (before, first) = (run.at(59.0 / FPS), run.at(1.0));
     for j in [shoulder, elbow] {
         assert!(first.rotations[j].angle_between(before.rotations[j]) < 1e-4);
     }
     // its last frame is the lift's first pose: the wrist at the unit's start target
-    let last = frame(1.5).world(&skeleton);
+    let last = run.at(1.5).world(&skeleton);
     assert!(
         (last.positions[wrist] - Vec3::new(-0.3, 1.1, 0.2)).length() < 1e-3,
         "{}",
         last.positions[wrist]
     );
     // no jump anywhere from the keyframe through the transition into the lift
-    for w in frames.windows(2).filter(|w| w[0].0 >= 0.5 && w[1].0 <= 2.0) {
+    for w in run
+        .frames
+        .windows(2)
+        .filter(|w| w[0].0 >= 0.5 && w[1].0 <= 2.0)
+    {
         for j in [shoulder, elbow] {
             let step = w[1].1.rotations[j]
                 .angle_between(w[0].1.rotations[j])
@@ -850,33 +879,28 @@ fn a_hermite_keyframe_is_accepted_and_an_unknown_interpolation_refused() {
 
 #[test]
 fn a_posture_pose_holds_the_arms_akimbo_with_its_stance_and_lets_go_by_its_end() {
-    let skeleton = Skeleton::adult();
-    let (l, r) = (
-        skeleton.joint("l_wrist").unwrap(),
-        skeleton.joint("r_wrist").unwrap(),
+    let run = record(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><posture id="p" start="0" ready="0.5" relax="2" end="2.5"><stance type="STANDING"/><pose part="ARMS" lexeme="AKIMBO"/></posture></bml>"#,
+        2.5,
     );
-    let mut realizer = Realizer::new();
-    realizer
-        .perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><posture id="p" start="0" ready="0.5" relax="2" end="2.5"><stance type="STANDING"/><pose part="ARMS" lexeme="AKIMBO"/></posture></bml>"#)
-        .unwrap();
-    let rest = bml_realizer::body::Pose::rest(&skeleton).world(&skeleton);
-    let mut at = |t: f64| realizer.tick(t).poses[0].pose.world(&skeleton);
-    at(0.0);
+    let (left, right) = (run.positions("l_wrist"), run.positions("r_wrist"));
+    let at =
+        |series: &[(f64, Vec3)], t: f64| series.iter().find(|p| (p.0 - t).abs() < 1e-9).unwrap().1;
     for t in [0.5, 1.2, 2.0] {
-        let w = at(t);
+        let (l, r) = (at(&left, t), at(&right, t));
         assert!(
-            (w.positions[r] - Vec3::new(-0.24, 1.0, 0.02)).length() < 1e-3,
-            "{t}: {}",
-            w.positions[r]
+            (r - Vec3::new(-0.24, 1.0, 0.02)).length() < 1e-3,
+            "{t}: {r}"
         );
-        assert!(
-            (w.positions[l] - Vec3::new(0.24, 1.0, 0.02)).length() < 1e-3,
-            "{t}: {}",
-            w.positions[l]
-        );
+        assert!((l - Vec3::new(0.24, 1.0, 0.02)).length() < 1e-3, "{t}: {l}");
     }
-    let end = at(2.5);
-    assert!((end.positions[r] - rest.positions[r]).length() < 1e-4);
+    // back at rest by the end
+    let skeleton = Skeleton::adult();
+    let wrist = skeleton.joint("r_wrist").unwrap();
+    let rest = bml_realizer::body::Pose::rest(&skeleton)
+        .joint_world(&skeleton, wrist)
+        .0;
+    assert!((at(&right, 2.5) - rest).length() < 1e-4);
 }
 
 #[test]
