@@ -14,8 +14,8 @@ use crate::bml::{Behaviour, BehaviourKind, Mode, Param};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
-use crate::engines::motion::{hands, min_jerk};
-use crate::engines::procedural::{alpha_at, mirror_name, mirror_rotation, Library, ProcUnit};
+use crate::engines::motion::{hands, min_jerk, sides};
+use crate::engines::procedural::{mirror_name, mirror_rotation, Library, ProcUnit};
 use crate::schedule::SyncName;
 use crate::world::World;
 
@@ -338,11 +338,7 @@ impl Engine for GestureEngine {
         let BehaviourKind::Gesture(g) = &behaviour.kind else {
             return None;
         };
-        let sides: &[bool] = match g.mode {
-            Some(Mode::LeftHand) => &[true],
-            Some(Mode::BothHands) => &[false, true],
-            Some(Mode::RightHand) | None => &[false],
-        };
+        let sides = sides(g.mode);
         match self.lexicon.find(behaviour)? {
             Bound::Procedural(unit, _) => Some(unit.steering(skeleton, sides)),
             Bound::Keys(keys) => {
@@ -378,11 +374,7 @@ impl Engine for GestureEngine {
         };
         let right = match self.lexicon.find(unit.behaviour) {
             Some(Bound::Procedural(p, params)) => {
-                let sides: &'static [bool] = match g.mode {
-                    Some(Mode::LeftHand) => &[true],
-                    Some(Mode::BothHands) => &[false, true],
-                    Some(Mode::RightHand) | None => &[false],
-                };
+                let sides = sides(g.mode);
                 let (unit_data, params) = (p.clone(), params.clone());
                 self.units.add(
                     unit,
@@ -433,20 +425,7 @@ impl Engine for GestureEngine {
                     params,
                     sides,
                 } => {
-                    let (Some(start), Some(end)) =
-                        (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
-                    else {
-                        continue;
-                    };
-                    if now < start || now > end {
-                        continue;
-                    }
-                    let alpha = alpha_at(&unit.keys, syncs, now);
-                    let weight = unit.weight(start, end, now);
-                    for &mirrored in sides.iter() {
-                        // checked when the lexicon was read; a failing expression leaves the pose
-                        let _ = unit.apply(alpha, params, mirrored, weight, skeleton, pose);
-                    }
+                    unit.play(syncs, now, params, sides, skeleton, pose);
                 }
             }
         }

@@ -61,6 +61,16 @@ pub fn finished_shift<T>(units: &Units<T>, now: f64, is_shift: impl Fn(&T) -> bo
         .map(|(_, u)| u)
 }
 
+/// The sides a gesture authored for the right arm plays on for a mode: `false` as authored,
+/// `true` mirrored onto the left (the right hand when no mode is given).
+pub fn sides(mode: Option<Mode>) -> &'static [bool] {
+    match mode {
+        Some(Mode::LeftHand) => &[true],
+        Some(Mode::BothHands) => &[false, true],
+        Some(Mode::RightHand) | None => &[false],
+    }
+}
+
 /// The hands a gesture mode occupies (the right hand when none is given).
 pub fn hands(mode: Option<Mode>) -> &'static [&'static str] {
     match mode {

@@ -434,6 +434,34 @@ impl ProcUnit {
         min_jerk((t - start) / self.blend).min(min_jerk((end - t) / self.blend)) as f32
     }
 
+    /// Plays a run timed by `syncs` (its keys' global times) at `t` on `sides` (`false` as
+    /// authored, `true` mirrored): nothing outside `start..=end` (the end frame shows α = 1),
+    /// else α from the keys (A37) and the blend weight. Returns whether it was active. An
+    /// expression that fails at run time (a division by zero) leaves the pose as it is: the
+    /// parameters were checked when the unit was added and on every change.
+    pub fn play(
+        &self,
+        syncs: &[(SyncName, f64)],
+        t: f64,
+        params: &[(String, f64)],
+        sides: &[bool],
+        skeleton: &Skeleton,
+        pose: &mut Pose,
+    ) -> bool {
+        let (Some(start), Some(end)) = (syncs.first().map(|s| s.1), syncs.last().map(|s| s.1))
+        else {
+            return false;
+        };
+        if t < start || t > end {
+            return false;
+        }
+        let (alpha, weight) = (alpha_at(&self.keys, syncs, t), self.weight(start, end, t));
+        for &mirrored in sides {
+            let _ = self.apply(alpha, params, mirrored, weight, skeleton, pose);
+        }
+        true
+    }
+
     /// Applies the unit at `alpha` with `weight` to `pose`: rotations first, then effectors by
     /// IK. A weight below 1 slerps from what the joints have toward the unit's rotations (for an
     /// additive unit: from none of its rotation); `mirrored` swaps left and right and reflects in
@@ -756,13 +784,7 @@ impl Engine for ProceduralEngine {
             if replaced {
                 continue;
             }
-            let alpha = alpha_at(&r.unit.keys, syncs, now);
-            let weight = r.unit.weight(start, end, now);
-            // parameters were checked when the unit was added and on every change; an
-            // expression that still fails (a division by zero) leaves the pose as it is
-            let _ = r
-                .unit
-                .apply(alpha, &r.params, false, weight, skeleton, pose);
+            r.unit.play(syncs, now, &r.params, &[false], skeleton, pose);
         }
         !active.is_empty()
     }
