@@ -3,7 +3,7 @@
 
 use glam::{Quat, Vec3};
 
-use super::pose::{Pose, WorldPose};
+use super::pose::Pose;
 
 use super::skeleton::Skeleton;
 
@@ -18,7 +18,7 @@ pub fn arc(from: Vec3, to: Vec3) -> Quat {
 }
 
 /// The world frame of a limb's root joint: its position, its orientation and its parent's
-/// orientation (from [`Pose::world`] or [`Pose::joint_world`]).
+/// orientation ([`LimbRoot::chain`]).
 #[derive(Debug, Clone, Copy)]
 pub struct LimbRoot {
     /// Position of the root joint.
@@ -30,15 +30,6 @@ pub struct LimbRoot {
 }
 
 impl LimbRoot {
-    /// The frame of joint `root` in `world`; `None` for the skeleton's root.
-    pub fn of(skeleton: &Skeleton, world: &WorldPose, root: usize) -> Option<LimbRoot> {
-        Some(LimbRoot {
-            position: world.positions[root],
-            orientation: world.orientations[root],
-            parent: world.orientations[skeleton.joints()[root].parent?],
-        })
-    }
-
     /// The frame of joint `root` by forward kinematics along its ancestors only.
     pub fn chain(skeleton: &Skeleton, pose: &Pose, root: usize) -> Option<LimbRoot> {
         skeleton.joints()[root].parent?;

@@ -475,6 +475,9 @@ impl ProcUnit {
         skeleton: &Skeleton,
         pose: &mut Pose,
     ) -> Result<(), String> {
+        if weight <= 0.0 {
+            return Ok(()); // nothing of it shows (a pose blended fully out)
+        }
         let blend = |from: Quat, to: Quat| {
             if weight >= 1.0 {
                 to
