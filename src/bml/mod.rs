@@ -20,6 +20,7 @@ mod stream;
 mod syncref;
 mod validate;
 mod writer;
+mod xml;
 
 pub use constraints::{extract, Anchor, Constraint, Relation, Source};
 pub use diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos, Severity};

@@ -1,22 +1,15 @@
-//! The streaming BML parser (quick-xml): text → [`Block`], with every problem reported as a
+//! The streaming BML parser (over the tokenizer in `xml.rs`): text → [`Block`], with every problem reported as a
 //! [`Diagnostic`] at its line:column. Structure, attribute values and sync reference syntax are
 //! checked here; cross-references are checked by `validate.rs`.
 
 use std::borrow::Cow;
 use std::fmt;
 
-use quick_xml::events::Event;
-use quick_xml::name::ResolveResult;
-use quick_xml::NsReader;
-
 use super::diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos};
 use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
-use crate::xmlname::{is_forbidden_char, is_ncname};
-
-/// The namespace reserved for `xmlns` declarations; no element may be in it.
-const XMLNS_URI: &str = "http://www.w3.org/2000/xmlns/";
+use super::xml::{self, Event, Tag, Tokenizer, XmlError};
 
 /// A parsed block together with the warnings found while reading it.
 #[derive(Debug, Clone, PartialEq)]
@@ -68,18 +61,13 @@ enum Ns {
 }
 
 impl Ns {
-    fn from_uri(raw: &[u8]) -> Ns {
-        match raw {
-            b"http://www.bml-initiative.org/bml/bml-1.0" => Ns::Bml,
-            b"http://www.bml-initiative.org/bml/coreextensions-1.0" => Ns::CoreExt,
-            b"http://www.asap-project.org/bmla" => Ns::Bmla,
-            b"http://hmi.ewi.utwente.nl/bmlt" => Ns::Bmlt,
-            _ if raw.contains(&b'&') => match namespace_uri(raw) {
-                // written with character references: compare the resolved text
-                uri if uri.as_bytes() != raw => Ns::from_uri(uri.as_bytes()),
-                uri => Ns::Other(uri),
-            },
-            _ => Ns::Other(String::from_utf8_lossy(raw).into_owned()),
+    fn from_uri(uri: &str) -> Ns {
+        match uri {
+            NS_BML => Ns::Bml,
+            NS_CORE_EXT => Ns::CoreExt,
+            NS_BMLA => Ns::Bmla,
+            NS_BMLT => Ns::Bmlt,
+            _ => Ns::Other(uri.to_string()),
         }
     }
 
@@ -152,7 +140,7 @@ struct Fatal;
 
 struct Parser<'i> {
     src: &'i str,
-    reader: NsReader<&'i [u8]>,
+    tok: Tokenizer<'i>,
     lines: LineIndex,
     diags: Vec<Diagnostic>,
     pending: Option<Tok<'i>>,
@@ -189,11 +177,11 @@ impl<'i> Attrs<'i> {
 
 impl<'i> Parser<'i> {
     fn new(src: &'i str) -> Self {
-        // A byte-order mark is not content; quick-xml skips it, so offsets are relative to the rest.
+        // A byte-order mark is not content; offsets are relative to the rest.
         let src = src.strip_prefix('\u{feff}').unwrap_or(src);
         Parser {
             src,
-            reader: NsReader::from_str(src),
+            tok: Tokenizer::new(src),
             lines: LineIndex::new(src),
             diags: Vec::new(),
             pending: None,
@@ -214,33 +202,12 @@ impl<'i> Parser<'i> {
         self.diags.push(Diagnostic::warning(code, pos, msg));
     }
 
-    fn offset_in_src(&self, bytes: &[u8], fallback: usize) -> usize {
-        let base = self.src.as_ptr() as usize;
-        let p = bytes.as_ptr() as usize;
-        if p >= base && p <= base + self.src.len() {
-            p - base
-        } else {
-            fallback
-        }
-    }
-
-    /// The source text that `bytes` (a slice of the source handed out by quick-xml) covers,
-    /// borrowed; a copy if it is not a slice of the source.
-    fn text_of(&self, bytes: &[u8]) -> Str<'i> {
-        let src: &'i str = self.src;
-        let base = src.as_ptr() as usize;
-        let p = bytes.as_ptr() as usize;
-        if p >= base && p + bytes.len() <= base + src.len() {
-            if let Some(s) = src.get(p - base..p - base + bytes.len()) {
-                return Cow::Borrowed(s);
-            }
-        }
-        Cow::Owned(String::from_utf8_lossy(bytes).into_owned())
-    }
-
-    fn xml_error(&mut self, e: impl std::fmt::Display) -> Fatal {
-        let at = self.reader.error_position() as usize;
-        self.error(Code::NotXml, at, format!("not well-formed XML: {e}"));
+    fn xml_error(&mut self, e: XmlError) -> Fatal {
+        self.error(
+            Code::NotXml,
+            e.offset,
+            format!("not well-formed XML: {}", e.message),
+        );
         Fatal
     }
 
@@ -251,79 +218,15 @@ impl<'i> Parser<'i> {
         }
         let mut text: Option<(Str<'i>, usize)> = None;
         loop {
-            let before = self.reader.buffer_position() as usize;
-            let (ns, ev) = match self.reader.read_resolved_event() {
-                Ok((res, ev)) => {
-                    let ns = match res {
-                        ResolveResult::Bound(n) => Ok(Ns::from_uri(n.as_ref())),
-                        ResolveResult::Unbound => Ok(Ns::None),
-                        ResolveResult::Unknown(p) => Err(String::from_utf8_lossy(&p).into_owned()),
-                    };
-                    (ns, ev)
+            let tok = match self.tok.next() {
+                Ok(Event::Start(tag)) => Tok::Start(self.element(tag)?),
+                Ok(Event::End { offset, after }) => Tok::End { offset, after },
+                Ok(Event::Eof) => Tok::Eof,
+                Ok(Event::Text { text: t, offset }) => {
+                    push_text(&mut text, t, offset);
+                    continue;
                 }
                 Err(e) => return Err(self.xml_error(e)),
-            };
-            let tok = match ev {
-                Event::Start(e) => Tok::Start(self.element(e, false, ns, before)?),
-                Event::Empty(e) => Tok::Start(self.element(e, true, ns, before)?),
-                Event::End(_) => Tok::End {
-                    offset: before,
-                    after: self.reader.buffer_position() as usize,
-                },
-                Event::Eof => Tok::Eof,
-                Event::Text(t) => {
-                    let s = match self.text_of(&t) {
-                        // XML end-of-line handling: \r\n and lone \r read as \n
-                        s if s.contains('\r') => {
-                            Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n"))
-                        }
-                        s => s,
-                    };
-                    push_text(&mut text, s, before);
-                    continue;
-                }
-                Event::CData(c) => {
-                    let s = match c.decode() {
-                        Ok(s) => Cow::Owned(s.into_owned()),
-                        Err(e) => return Err(self.xml_error(e)),
-                    };
-                    push_text(&mut text, s, before);
-                    continue;
-                }
-                Event::GeneralRef(r) => {
-                    let resolved: Str<'i> = match r.resolve_char_ref() {
-                        Ok(Some(c)) if is_forbidden_char(c) => {
-                            self.error(
-                                Code::NotXml,
-                                before,
-                                format!(
-                                    "character reference to U+{:04X}, which XML does not allow",
-                                    c as u32
-                                ),
-                            );
-                            return Err(Fatal);
-                        }
-                        Ok(Some(c)) => c.to_string().into(),
-                        Ok(None) => {
-                            let name = r.decode().map(|n| n.into_owned()).unwrap_or_default();
-                            match quick_xml::escape::resolve_predefined_entity(&name) {
-                                Some(v) => v.into(),
-                                None => {
-                                    self.error(
-                                        Code::NotXml,
-                                        before,
-                                        format!("unknown entity '&{name};'"),
-                                    );
-                                    return Err(Fatal);
-                                }
-                            }
-                        }
-                        Err(e) => return Err(self.xml_error(e)),
-                    };
-                    push_text(&mut text, resolved, before);
-                    continue;
-                }
-                _ => continue, // comments, processing instructions, declarations, doctype
             };
             return Ok(match text {
                 Some((text, offset)) => {
@@ -335,148 +238,69 @@ impl<'i> Parser<'i> {
         }
     }
 
-    /// Turns a start (or empty-element) tag into an [`El`], resolving attribute namespaces while
-    /// the element's namespace scope is current.
-    fn element(
-        &mut self,
-        e: quick_xml::events::BytesStart<'i>,
-        empty: bool,
-        ns: Result<Ns, String>,
-        before: usize,
-    ) -> Result<El<'i>, Fatal> {
-        let qname = self.text_of(e.name().as_ref());
-        let (prefix, name) = split_qname(&qname);
-        let ns = match ns {
-            Ok(ns) => ns,
-            Err(prefix) => {
+    /// Turns a start (or empty-element) tag into an [`El`], resolving its namespaces and its
+    /// attributes' while the element's namespace scope is current.
+    fn element(&mut self, tag: Tag<'i>) -> Result<El<'i>, Fatal> {
+        let qname = tag.qname;
+        let (prefix, name) = split_qname(qname);
+        let ns = match self.tok.resolve(prefix) {
+            Ok(Some(uri)) => Ns::from_uri(uri),
+            Ok(None) => Ns::None,
+            Err(()) => {
+                let prefix = prefix.unwrap_or_default();
                 self.error(
                     Code::NotXml,
-                    before,
+                    tag.offset,
                     format!("namespace prefix '{prefix}' of <{qname}> is not declared"),
                 );
-                Ns::Other(prefix)
+                Ns::Other(prefix.to_string())
             }
         };
-        if !is_ncname(&name) || prefix.as_ref().is_some_and(|p| !is_ncname(p)) {
-            self.error(
-                Code::NotXml,
-                before,
-                format!("<{qname}> is not a valid qualified name"),
-            );
-            return Err(Fatal);
-        }
-        if matches!(&ns, Ns::Other(u) if u == XMLNS_URI) {
-            self.error(
-                Code::NotXml,
-                before,
-                format!("<{qname}>: the prefix xmlns is reserved for namespace declarations"),
-            );
-            return Err(Fatal);
-        }
-        let mut prefixes: Vec<Str<'i>> = prefix.into_iter().collect();
-        let mut attrs: Vec<Option<RawAttr<'i>>> = Vec::new();
-        // quick-xml's duplicate check allocates per element; duplicates are checked here instead:
-        // declarations by prefix, other attributes by (namespace, local name)
-        let mut declared: Vec<Str<'i>> = Vec::new();
-        for a in e.attributes().with_checks(false) {
-            let a = match a {
-                Ok(a) => a,
-                Err(err) => {
-                    self.error(
-                        Code::NotXml,
-                        before,
-                        format!("not well-formed XML in the attributes of <{qname}>: {err}"),
-                    );
-                    return Err(Fatal);
-                }
-            };
-            let key = a.key.as_ref();
-            let k = self.text_of(key);
-            if k == "xmlns" || k.starts_with("xmlns:") {
-                if declared.contains(&k) {
-                    let at = self.offset_in_src(key, before);
-                    self.error(
-                        Code::NotXml,
-                        at,
-                        format!("attribute '{k}' appears twice on <{qname}>"),
-                    );
-                    return Err(Fatal);
-                }
-                declared.push(k);
-                if let Err(err) = a.unescape_value() {
-                    let at = self.offset_in_src(key, before);
-                    self.error(
-                        Code::NotXml,
-                        at,
-                        format!(
-                            "namespace declaration has a bad character or entity reference: {err}"
-                        ),
-                    );
-                    return Err(Fatal);
-                }
-                continue;
+        let mut prefixes: Vec<Str<'i>> = prefix.map(Cow::Borrowed).into_iter().collect();
+        let n = self.tok.attrs().len();
+        let mut attrs: Vec<Option<RawAttr<'i>>> = Vec::with_capacity(n);
+        for i in 0..n {
+            let a = self.tok.attrs()[i];
+            if a.declares().is_some() {
+                continue; // in scope now; the tokenizer checked them
             }
-            let offset = self.offset_in_src(key, before);
-            let (aprefix, aname) = split_qname(&k);
-            if !is_ncname(&aname) || aprefix.as_ref().is_some_and(|p| !is_ncname(p)) {
-                self.error(
-                    Code::NotXml,
-                    offset,
-                    format!("attribute '{k}' is not a valid qualified name"),
-                );
-                return Err(Fatal);
-            }
-            let unprefixed = aprefix.is_none();
-            prefixes.extend(aprefix);
-            let ans = if unprefixed {
-                Ns::None // unprefixed attributes are in no namespace
-            } else {
-                match self.reader.resolve_attribute(a.key).0 {
-                    ResolveResult::Bound(n) => match Ns::from_uri(n.as_ref()) {
-                        Ns::Bml => Ns::None,
-                        other => other,
-                    },
-                    ResolveResult::Unbound => Ns::None,
-                    ResolveResult::Unknown(p) => {
-                        let p = String::from_utf8_lossy(&p).into_owned();
-                        self.error(
-                            Code::NotXml,
-                            offset,
-                            format!(
-                                "namespace prefix '{p}' of attribute '{}' is not declared",
-                                String::from_utf8_lossy(key)
-                            ),
-                        );
-                        Ns::Other(p)
+            let (aprefix, aname) = split_qname(a.key);
+            let ans = match aprefix {
+                None => Ns::None, // unprefixed attributes are in no namespace
+                Some(p) => {
+                    prefixes.push(Cow::Borrowed(p));
+                    match self.tok.resolve(Some(p)) {
+                        Ok(Some(uri)) => match Ns::from_uri(uri) {
+                            Ns::Bml => Ns::None,
+                            other => other,
+                        },
+                        Ok(None) => Ns::None,
+                        Err(()) => {
+                            self.error(
+                                Code::NotXml,
+                                a.offset,
+                                format!(
+                                    "namespace prefix '{p}' of attribute '{}' is not declared",
+                                    a.key
+                                ),
+                            );
+                            Ns::Other(p.to_string())
+                        }
                     }
                 }
             };
-            let raw = self.text_of(&a.value);
-            let unescaped = match raw {
-                // the common case: nothing to resolve, borrow the source
-                Cow::Borrowed(s) if !s.as_bytes().contains(&b'&') => Ok(Cow::Borrowed(s)),
-                _ => a.unescape_value().map(|v| Cow::Owned(v.into_owned())),
-            };
-            let value = match unescaped {
-                Ok(v) if v.chars().any(is_forbidden_char) => {
-                    self.error(
-                        Code::NotXml,
-                        offset,
-                        format!("attribute '{k}' refers to a character that XML does not allow"),
-                    );
-                    return Err(Fatal);
-                }
+            let value = match xml::unescape(a.raw, a.value_offset) {
                 Ok(v) => v,
-                Err(err) => {
+                Err(e) => {
                     self.error(
                         Code::NotXml,
-                        offset,
+                        a.offset,
                         format!(
-                            "attribute '{}' has a bad character or entity reference: {err}",
-                            String::from_utf8_lossy(key)
+                            "not well-formed XML: attribute '{}' has a bad character or entity reference: {}",
+                            a.key, e.message
                         ),
                     );
-                    Cow::Owned(String::from_utf8_lossy(&a.value).into_owned())
+                    return Err(Fatal);
                 }
             };
             if attrs
@@ -486,47 +310,33 @@ impl<'i> Parser<'i> {
             {
                 self.error(
                     Code::NotXml,
-                    offset,
-                    format!(
-                        "attribute '{}' appears twice on <{qname}>",
-                        String::from_utf8_lossy(key)
-                    ),
+                    a.offset,
+                    format!("attribute '{}' appears twice on <{qname}>", a.key),
                 );
                 return Err(Fatal);
             }
             attrs.push(Some(RawAttr {
                 ns: ans,
-                name: aname,
+                name: Cow::Borrowed(aname),
                 value,
-                offset,
+                offset: a.offset,
             }));
         }
-        let inner_start = self.reader.buffer_position() as usize;
         Ok(El {
             ns,
-            name,
-            qname,
+            name: Cow::Borrowed(name),
+            qname: Cow::Borrowed(qname),
             prefixes,
             attrs,
-            empty,
-            offset: before,
-            inner_start,
+            empty: tag.empty,
+            offset: tag.offset,
+            inner_start: tag.end,
         })
     }
 
     /// The prefixed namespace bindings in scope now (call right after reading a start tag).
     fn scope(&self) -> Vec<(String, String)> {
-        self.reader
-            .resolver()
-            .bindings()
-            .filter_map(|(decl, ns)| match decl {
-                quick_xml::name::PrefixDeclaration::Named(p) if p != b"xml" => Some((
-                    String::from_utf8_lossy(p).into_owned(),
-                    namespace_uri(ns.as_ref()),
-                )),
-                _ => None,
-            })
-            .collect()
+        self.tok.scope()
     }
 
     /// Skips the rest of an element whose start tag was just read, returning what it held.
@@ -1767,27 +1577,11 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
     }
 }
 
-/// Splits `prefix:local` at the first colon (what remains may still contain one: not a valid name).
-fn split_qname<'i>(q: &Str<'i>) -> (Option<Str<'i>>, Str<'i>) {
-    match q {
-        Cow::Borrowed(s) => match s.split_once(':') {
-            Some((p, l)) => (Some(Cow::Borrowed(p)), Cow::Borrowed(l)),
-            None => (None, Cow::Borrowed(s)),
-        },
-        Cow::Owned(s) => match s.split_once(':') {
-            Some((p, l)) => (Some(Cow::Owned(p.to_string())), Cow::Owned(l.to_string())),
-            None => (None, Cow::Owned(s.clone())),
-        },
-    }
-}
-
-/// A namespace URI as declared: the resolver hands it out as written, so resolve character
-/// references (declarations were checked to be well-formed when read).
-fn namespace_uri(raw: &[u8]) -> String {
-    let text = String::from_utf8_lossy(raw);
-    match quick_xml::escape::unescape(&text) {
-        Ok(u) => u.into_owned(),
-        Err(_) => text.into_owned(),
+/// Splits `prefix:local` at the colon (the tokenizer checked that there is at most one).
+fn split_qname(q: &str) -> (Option<&str>, &str) {
+    match q.split_once(':') {
+        Some((p, l)) => (Some(p), l),
+        None => (None, q),
     }
 }
 

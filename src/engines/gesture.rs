@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use glam::{EulerRot, Quat};
 
-use crate::bml::{Behaviour, BehaviourKind, Mode, Param};
+use crate::bml::{Behaviour, BehaviourKind, Param};
 use crate::body::{Pose, Skeleton};
 use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
@@ -29,8 +29,8 @@ pub type GestureKeys = Vec<(String, Vec<(String, Quat)>)>;
 /// with parameters.
 #[derive(Debug, Clone)]
 pub enum Bound {
-    /// Rotations at sync points.
-    Keys(GestureKeys),
+    /// Rotations at sync points (shared by every unit that plays them).
+    Keys(Arc<GestureKeys>),
     /// A unit of the procedural library and its parameters.
     Procedural(Arc<ProcUnit>, Vec<(String, f64)>),
 }
@@ -86,7 +86,7 @@ impl Lexicon {
                 }
             }
             let bound = match (g.get("keys"), g.get("procedural")) {
-                (Some(keys), None) => Bound::Keys(read_keys(lexeme, keys)?),
+                (Some(keys), None) => Bound::Keys(Arc::new(read_keys(lexeme, keys)?)),
                 (None, Some(name)) => {
                     let name = name
                         .as_str()
@@ -207,9 +207,12 @@ pub fn mirror(joint: &str, q: Quat) -> (String, Quat) {
 #[derive(Debug, Clone)]
 enum GestureUnit {
     Keys {
-        /// (sync, [(joint, rotation)]) for the arms it moves, in sync order.
-        keys: GestureKeys,
-        /// The keys resolved against the skeleton and the unit's syncs, made on first use.
+        /// (sync, [(right-arm joint, rotation)]), as bound.
+        keys: Arc<GestureKeys>,
+        /// Mirrorings to play: `[false]` right arm, `[true]` left arm, both for both hands.
+        sides: &'static [bool],
+        /// The keys resolved against the skeleton, the sides and the unit's syncs, made on first
+        /// use.
         compiled: Option<Compiled>,
     },
     Procedural {
@@ -228,9 +231,34 @@ struct Compiled {
     keys: Vec<(usize, Vec<Quat>)>,
 }
 
-fn compile(keys: &GestureKeys, skeleton: &Skeleton, syncs: &[(SyncName, f64)]) -> Compiled {
+fn compile(
+    keys: &GestureKeys,
+    sides: &[bool],
+    skeleton: &Skeleton,
+    syncs: &[(SyncName, f64)],
+) -> Compiled {
+    // the keys of the arms the unit moves: the right arm's as bound, the left's mirrored
+    let side_keys: Vec<Vec<(String, Quat)>> = keys
+        .iter()
+        .map(|(_, k)| {
+            sides
+                .iter()
+                .flat_map(|&left| {
+                    k.iter().map(
+                        move |(j, q)| {
+                            if left {
+                                mirror(j, *q)
+                            } else {
+                                (j.clone(), *q)
+                            }
+                        },
+                    )
+                })
+                .collect()
+        })
+        .collect();
     let mut names: Vec<&str> = Vec::new();
-    for (_, k) in keys {
+    for k in &side_keys {
         for (j, _) in k {
             if !names.contains(&j.as_str()) && skeleton.joint(j).is_some() {
                 names.push(j);
@@ -240,7 +268,8 @@ fn compile(keys: &GestureKeys, skeleton: &Skeleton, syncs: &[(SyncName, f64)]) -
     let joints = names.iter().filter_map(|n| skeleton.joint(n)).collect();
     let mut keys: Vec<(usize, Vec<Quat>)> = keys
         .iter()
-        .filter_map(|(sync, k)| {
+        .zip(&side_keys)
+        .filter_map(|((sync, _), k)| {
             let i = syncs.iter().position(|s| s.0 == *sync)?;
             let rot = names
                 .iter()
@@ -372,52 +401,37 @@ impl Engine for GestureEngine {
         let BehaviourKind::Gesture(g) = &unit.behaviour.kind else {
             return Err(EngineError("the gesture engine realizes <gesture>".into()));
         };
-        let right = match self.lexicon.find(unit.behaviour) {
-            Some(Bound::Procedural(p, params)) => {
-                let sides = sides(g.mode);
-                let (unit_data, params) = (p.clone(), params.clone());
-                self.units.add(
-                    unit,
-                    GestureUnit::Procedural {
-                        unit: unit_data,
-                        params,
-                        sides,
-                    },
-                );
-                return Ok(());
-            }
-            Some(Bound::Keys(k)) => k.clone(),
-            None => Vec::new(),
-        };
-        let keys = right
-            .into_iter()
-            .map(|(sync, joints)| {
-                let arms: Vec<(String, Quat)> = match g.mode {
-                    Some(Mode::LeftHand) => joints.iter().map(|(j, q)| mirror(j, *q)).collect(),
-                    Some(Mode::BothHands) => joints
-                        .iter()
-                        .flat_map(|(j, q)| [(j.clone(), *q), mirror(j, *q)])
-                        .collect(),
-                    Some(Mode::RightHand) | None => joints,
-                };
-                (sync, arms)
-            })
-            .collect();
-        self.units.add(
-            unit,
-            GestureUnit::Keys {
-                keys,
+        let sides = sides(g.mode);
+        let played = match self.lexicon.find(unit.behaviour) {
+            Some(Bound::Procedural(p, params)) => GestureUnit::Procedural {
+                unit: p.clone(),
+                params: params.clone(),
+                sides,
+            },
+            Some(Bound::Keys(k)) => GestureUnit::Keys {
+                keys: k.clone(),
+                sides,
                 compiled: None,
             },
-        );
+            None => GestureUnit::Keys {
+                keys: Arc::default(),
+                sides,
+                compiled: None,
+            },
+        };
+        self.units.add(unit, played);
         Ok(())
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         for (syncs, u) in self.units.all_mut() {
             match u {
-                GestureUnit::Keys { keys, compiled } => {
-                    let c = compiled.get_or_insert_with(|| compile(keys, skeleton, syncs));
+                GestureUnit::Keys {
+                    keys,
+                    sides,
+                    compiled,
+                } => {
+                    let c = compiled.get_or_insert_with(|| compile(keys, sides, skeleton, syncs));
                     play_keys(c, syncs, now, pose);
                 }
                 GestureUnit::Procedural {
@@ -435,6 +449,7 @@ impl Engine for GestureEngine {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bml::Mode;
     use glam::Vec3;
 
     #[test]

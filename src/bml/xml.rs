@@ -1,0 +1,663 @@
+//! The XML 1.0 + Namespaces tokenizer under the BML parser: start, end and text events over a
+//! `&str`, with names, attribute values and text borrowed from the input, character and entity
+//! references resolved, and the namespace scope kept on a stack. It checks well-formedness
+//! (names, tag nesting, quoting, references, declarations) and reports each problem at its byte
+//! offset. Made for short BML blocks: no allocation for a tag, its attributes or plain text.
+
+use std::borrow::Cow;
+
+use crate::xmlname::{is_forbidden_char, is_ncname};
+
+/// The namespace bound to the prefix `xml`.
+pub(crate) const XML_URI: &str = "http://www.w3.org/XML/1998/namespace";
+/// The namespace of `xmlns` declarations; no element or attribute may be in it.
+pub(crate) const XMLNS_URI: &str = "http://www.w3.org/2000/xmlns/";
+
+/// A well-formedness error: where it is (byte offset) and what is wrong.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct XmlError {
+    /// Byte offset of the offending construct.
+    pub offset: usize,
+    /// What is wrong, in a sentence without the position.
+    pub message: String,
+}
+
+fn err<T>(offset: usize, message: impl Into<String>) -> Result<T, XmlError> {
+    Err(XmlError {
+        offset,
+        message: message.into(),
+    })
+}
+
+/// One attribute of a start tag, as written (namespace declarations included).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Attr<'i> {
+    /// The qualified name (`prefix:local` or `local`).
+    pub key: &'i str,
+    /// Byte offset of the name.
+    pub offset: usize,
+    /// The value between the quotes, references not yet resolved (see [`unescape`]).
+    pub raw: &'i str,
+    /// Byte offset of the value's first character.
+    pub value_offset: usize,
+}
+
+impl<'i> Attr<'i> {
+    /// The prefix a namespace declaration binds: `Some("")` for `xmlns`, `Some(p)` for
+    /// `xmlns:p`, `None` for an ordinary attribute.
+    pub fn declares(&self) -> Option<&'i str> {
+        match self.key.strip_prefix("xmlns") {
+            Some("") => Some(""),
+            Some(rest) => rest.strip_prefix(':'),
+            None => None,
+        }
+    }
+}
+
+/// A start tag (or an empty-element tag).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Tag<'i> {
+    /// The qualified name.
+    pub qname: &'i str,
+    /// Whether it is an empty-element tag (`<x/>`).
+    pub empty: bool,
+    /// Byte offset of the `<`.
+    pub offset: usize,
+    /// Byte offset just after the `>`.
+    pub end: usize,
+}
+
+/// What the tokenizer reads.
+#[derive(Debug, Clone)]
+pub(crate) enum Event<'i> {
+    /// A start or empty-element tag; its attributes are in [`Tokenizer::attrs`] until the next
+    /// call to [`Tokenizer::next`], and its namespace declarations are in scope.
+    Start(Tag<'i>),
+    /// An end tag (already checked to close the open element).
+    End {
+        /// Byte offset of the `</`.
+        offset: usize,
+        /// Byte offset just after the `>`.
+        after: usize,
+    },
+    /// Character data (a run of text, a reference or a CDATA section), with references
+    /// resolved and line ends normalised to `\n`. Adjacent pieces are separate events.
+    Text {
+        /// The characters.
+        text: Cow<'i, str>,
+        /// Byte offset of the first one in the source.
+        offset: usize,
+    },
+    /// The end of the input.
+    Eof,
+}
+
+/// An open element: its name, and the length of the binding list before its declarations.
+struct Open<'i> {
+    qname: &'i str,
+    bindings: usize,
+}
+
+/// The tokenizer: a cursor over the input plus the open elements and namespace bindings.
+pub(crate) struct Tokenizer<'i> {
+    src: &'i str,
+    pos: usize,
+    open: Vec<Open<'i>>,
+    /// (prefix, namespace) in declaration order; `""` is the default namespace, and an empty
+    /// namespace undeclares it.
+    bindings: Vec<(&'i str, Cow<'i, str>)>,
+    /// The attributes of the last start tag.
+    attrs: Vec<Attr<'i>>,
+    /// The last event was an empty-element tag: its scope ends before the next event.
+    close_empty: Option<usize>,
+}
+
+impl<'i> Tokenizer<'i> {
+    /// A tokenizer at the start of `src`.
+    pub fn new(src: &'i str) -> Self {
+        Tokenizer {
+            src,
+            pos: 0,
+            open: Vec::new(),
+            bindings: Vec::new(),
+            attrs: Vec::new(),
+            close_empty: None,
+        }
+    }
+
+    /// The attributes of the last start tag, in source order.
+    pub fn attrs(&self) -> &[Attr<'i>] {
+        &self.attrs
+    }
+
+    /// The namespace a prefix is bound to here (`None` for no prefix: the default namespace);
+    /// `Ok(None)` when there is none, `Err(())` for a prefix that is not declared.
+    pub fn resolve(&self, prefix: Option<&str>) -> Result<Option<&str>, ()> {
+        let p = prefix.unwrap_or("");
+        match p {
+            "xml" => return Ok(Some(XML_URI)),
+            "xmlns" => return Ok(Some(XMLNS_URI)),
+            _ => {}
+        }
+        match self.bindings.iter().rev().find(|b| b.0 == p) {
+            Some((_, uri)) if uri.is_empty() => Ok(None),
+            Some((_, uri)) => Ok(Some(uri)),
+            None if p.is_empty() => Ok(None),
+            None => Err(()),
+        }
+    }
+
+    /// The prefixed bindings in scope (innermost first for each prefix), `xml` excluded.
+    pub fn scope(&self) -> Vec<(String, String)> {
+        let mut out: Vec<(String, String)> = Vec::new();
+        for (p, uri) in self.bindings.iter().rev() {
+            if !p.is_empty() && *p != "xml" && !out.iter().any(|(q, _)| q == p) {
+                out.push((p.to_string(), uri.to_string()));
+            }
+        }
+        out
+    }
+
+    fn bytes(&self) -> &'i [u8] {
+        self.src.as_bytes()
+    }
+
+    /// Reads the next event.
+    pub fn next(&mut self) -> Result<Event<'i>, XmlError> {
+        if let Some(mark) = self.close_empty.take() {
+            self.bindings.truncate(mark);
+        }
+        loop {
+            let b = self.bytes();
+            let start = self.pos;
+            if start >= b.len() {
+                return Ok(Event::Eof);
+            }
+            match b[start] {
+                b'<' => match b.get(start + 1) {
+                    Some(b'/') => return self.end_tag(start),
+                    Some(b'!') => {
+                        if let Some(text) = self.bang(start)? {
+                            return Ok(Event::Text {
+                                text: Cow::Borrowed(text),
+                                offset: start,
+                            });
+                        }
+                    }
+                    Some(b'?') => self.skip_to(start, "?>", "processing instruction")?,
+                    _ => return self.start_tag(start),
+                },
+                b'&' => {
+                    let (c, next) = reference(self.src, start)?;
+                    self.pos = next;
+                    return Ok(Event::Text {
+                        text: c,
+                        offset: start,
+                    });
+                }
+                _ => {
+                    let end =
+                        memchr::memchr2(b'<', b'&', &b[start..]).map_or(b.len(), |i| start + i);
+                    self.pos = end;
+                    let s = &self.src[start..end];
+                    let text = if memchr::memchr(b'\r', s.as_bytes()).is_some() {
+                        Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n"))
+                    } else {
+                        Cow::Borrowed(s)
+                    };
+                    return Ok(Event::Text {
+                        text,
+                        offset: start,
+                    });
+                }
+            }
+        }
+    }
+
+    /// Skips past `close`, or fails with an unclosed `what`.
+    fn skip_to(&mut self, start: usize, close: &str, what: &str) -> Result<(), XmlError> {
+        match memchr::memmem::find(&self.bytes()[start + 2..], close.as_bytes()) {
+            Some(i) => {
+                self.pos = start + 2 + i + close.len();
+                Ok(())
+            }
+            None => err(start, format!("the {what} is never closed")),
+        }
+    }
+
+    /// `<!`: a comment or a DOCTYPE (skipped) or a CDATA section (its text).
+    fn bang(&mut self, start: usize) -> Result<Option<&'i str>, XmlError> {
+        let rest = &self.src[start..];
+        if let Some(body) = rest.strip_prefix("<!--") {
+            match body.find("-->") {
+                Some(i) => self.pos = start + 4 + i + 3,
+                None => return err(start, "the comment is never closed"),
+            }
+            Ok(None)
+        } else if let Some(body) = rest.strip_prefix("<![CDATA[") {
+            match body.find("]]>") {
+                Some(i) => {
+                    self.pos = start + 9 + i + 3;
+                    Ok(Some(&body[..i]))
+                }
+                None => err(start, "the CDATA section is never closed"),
+            }
+        } else if rest.starts_with("<!DOCTYPE") {
+            // the internal subset may contain '>' inside brackets and quotes
+            let (mut depth, mut quote) = (0usize, None);
+            for (i, &c) in rest.as_bytes().iter().enumerate().skip(9) {
+                match (quote, c) {
+                    (Some(q), _) if c == q => quote = None,
+                    (Some(_), _) => {}
+                    (None, b'"' | b'\'') => quote = Some(c),
+                    (None, b'[') => depth += 1,
+                    (None, b']') => depth = depth.saturating_sub(1),
+                    (None, b'>') if depth == 0 => {
+                        self.pos = start + i + 1;
+                        return Ok(None);
+                    }
+                    _ => {}
+                }
+            }
+            err(start, "the DOCTYPE declaration is never closed")
+        } else {
+            err(
+                start,
+                "'<!' starts neither a comment, a CDATA section nor a DOCTYPE",
+            )
+        }
+    }
+
+    /// Scans a name from `at` up to whitespace, `/`, `>`, `=` or the end.
+    fn name_at(&self, at: usize) -> &'i str {
+        let b = self.bytes();
+        let mut i = at;
+        while i < b.len()
+            && !matches!(
+                b[i],
+                b' ' | b'\t' | b'\n' | b'\r' | b'/' | b'>' | b'=' | b'<'
+            )
+        {
+            i += 1;
+        }
+        &self.src[at..i]
+    }
+
+    fn skip_space(&mut self) {
+        let b = self.bytes();
+        while self.pos < b.len() && matches!(b[self.pos], b' ' | b'\t' | b'\n' | b'\r') {
+            self.pos += 1;
+        }
+    }
+
+    fn start_tag(&mut self, start: usize) -> Result<Event<'i>, XmlError> {
+        let qname = self.name_at(start + 1);
+        if !is_qname(qname) {
+            return err(start, format!("<{qname}> is not a valid qualified name"));
+        }
+        if qname.starts_with("xmlns:") {
+            return err(
+                start,
+                format!("<{qname}>: the prefix xmlns is reserved for namespace declarations"),
+            );
+        }
+        self.pos = start + 1 + qname.len();
+        self.attrs.clear();
+        let mark = self.bindings.len();
+        let b = self.bytes();
+        let empty = loop {
+            let before = self.pos;
+            self.skip_space();
+            match b.get(self.pos) {
+                None => return err(start, format!("the tag <{qname}> is never closed")),
+                Some(b'>') => {
+                    self.pos += 1;
+                    break false;
+                }
+                Some(b'/') => {
+                    if b.get(self.pos + 1) == Some(&b'>') {
+                        self.pos += 2;
+                        break true;
+                    }
+                    return err(
+                        self.pos,
+                        format!("'/' in the tag <{qname}> is not followed by '>'"),
+                    );
+                }
+                Some(_) if before == self.pos => {
+                    return err(
+                        self.pos,
+                        format!("attributes of <{qname}> must be separated by white space"),
+                    )
+                }
+                Some(_) => self.attribute(qname)?,
+            }
+        };
+        // namespace declarations take effect for the element and its attributes
+        for i in 0..self.attrs.len() {
+            let a = self.attrs[i];
+            if let Some(prefix) = a.declares() {
+                if self.bindings[mark..].iter().any(|(p, _)| *p == prefix) {
+                    return err(
+                        a.offset,
+                        format!("attribute '{}' appears twice on <{qname}>", a.key),
+                    );
+                }
+                let uri = unescape(a.raw, a.value_offset).map_err(|e| XmlError {
+                    offset: a.offset,
+                    message: format!(
+                        "namespace declaration has a bad character or entity reference: {}",
+                        e.message
+                    ),
+                })?;
+                if !prefix.is_empty() && uri.is_empty() {
+                    return err(
+                        a.offset,
+                        format!("'{}' cannot undeclare a prefix (XML 1.0 namespaces)", a.key),
+                    );
+                }
+                if matches!(prefix, "xml" | "xmlns") && uri != XML_URI {
+                    return err(a.offset, format!("the prefix {prefix} cannot be declared"));
+                }
+                self.bindings.push((prefix, uri));
+            }
+        }
+        let end = self.pos;
+        if empty {
+            self.close_empty = Some(mark);
+        } else {
+            self.open.push(Open {
+                qname,
+                bindings: mark,
+            });
+        }
+        Ok(Event::Start(Tag {
+            qname,
+            empty,
+            offset: start,
+            end,
+        }))
+    }
+
+    /// One `name = "value"` at the cursor.
+    fn attribute(&mut self, tag: &str) -> Result<(), XmlError> {
+        let b = self.bytes();
+        let offset = self.pos;
+        let key = self.name_at(offset);
+        if !is_qname(key) {
+            return err(
+                offset,
+                format!("attribute '{key}' of <{tag}> is not a valid qualified name"),
+            );
+        }
+        self.pos += key.len();
+        self.skip_space();
+        if b.get(self.pos) != Some(&b'=') {
+            return err(offset, format!("attribute '{key}' of <{tag}> has no value"));
+        }
+        self.pos += 1;
+        self.skip_space();
+        let quote = match b.get(self.pos) {
+            Some(&q @ (b'"' | b'\'')) => q,
+            _ => {
+                return err(
+                    self.pos,
+                    format!("the value of attribute '{key}' of <{tag}> is not in quotes"),
+                )
+            }
+        };
+        let value_offset = self.pos + 1;
+        let Some(len) = memchr::memchr(quote, &b[value_offset..]) else {
+            return err(
+                offset,
+                format!("the value of attribute '{key}' of <{tag}> is never closed"),
+            );
+        };
+        let raw = &self.src[value_offset..value_offset + len];
+        if let Some(i) = memchr::memchr(b'<', raw.as_bytes()) {
+            return err(
+                value_offset + i,
+                format!("'<' in the value of attribute '{key}'"),
+            );
+        }
+        self.pos = value_offset + len + 1;
+        self.attrs.push(Attr {
+            key,
+            offset,
+            raw,
+            value_offset,
+        });
+        Ok(())
+    }
+
+    fn end_tag(&mut self, start: usize) -> Result<Event<'i>, XmlError> {
+        let qname = self.name_at(start + 2);
+        self.pos = start + 2 + qname.len();
+        self.skip_space();
+        if self.bytes().get(self.pos) != Some(&b'>') {
+            return err(
+                start,
+                format!("the end tag </{qname}> is not closed by '>'"),
+            );
+        }
+        self.pos += 1;
+        match self.open.pop() {
+            Some(o) if o.qname == qname => {
+                self.bindings.truncate(o.bindings);
+                Ok(Event::End {
+                    offset: start,
+                    after: self.pos,
+                })
+            }
+            Some(o) => err(
+                start,
+                format!(
+                    "end tag </{qname}> does not match the start tag <{}>",
+                    o.qname
+                ),
+            ),
+            None => err(start, format!("end tag </{qname}> without a start tag")),
+        }
+    }
+}
+
+/// Whether `q` is `NCName` or `NCName:NCName`.
+fn is_qname(q: &str) -> bool {
+    match q.split_once(':') {
+        Some((p, l)) => is_ncname(p) && is_ncname(l),
+        None => is_ncname(q),
+    }
+}
+
+/// The character or entity reference starting at the `&` at `at` in `src`, and the offset just
+/// after its `;`.
+fn reference(src: &str, at: usize) -> Result<(Cow<'static, str>, usize), XmlError> {
+    let rest = &src[at + 1..];
+    let Some(semi) = rest.bytes().take(32).position(|c| c == b';') else {
+        return err(
+            at,
+            "'&' does not start a reference (write &amp; for an ampersand)",
+        );
+    };
+    let name = &rest[..semi];
+    let after = at + 1 + semi + 1;
+    let c = match name {
+        "lt" => "<",
+        "gt" => ">",
+        "amp" => "&",
+        "apos" => "'",
+        "quot" => "\"",
+        _ => {
+            let code = if let Some(hex) = name.strip_prefix("#x") {
+                u32::from_str_radix(hex, 16)
+                    .ok()
+                    .filter(|_| !hex.starts_with('+'))
+            } else if let Some(dec) = name.strip_prefix('#') {
+                dec.parse::<u32>().ok().filter(|_| !dec.starts_with('+'))
+            } else {
+                return err(at, format!("unknown entity '&{name};'"));
+            };
+            return match code.and_then(char::from_u32) {
+                Some(c) if is_forbidden_char(c) => err(
+                    at,
+                    format!(
+                        "character reference to U+{:04X}, which XML does not allow",
+                        c as u32
+                    ),
+                ),
+                Some(c) => Ok((Cow::Owned(c.to_string()), after)),
+                None => err(at, format!("'&{name};' is not a valid character reference")),
+            };
+        }
+    };
+    Ok((Cow::Borrowed(c), after))
+}
+
+/// Resolves the references in an attribute value (`raw` starts at byte `offset` of the source);
+/// borrowed when there are none.
+pub(crate) fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlError> {
+    let Some(first) = memchr::memchr(b'&', raw.as_bytes()) else {
+        return Ok(Cow::Borrowed(raw));
+    };
+    let mut out = String::with_capacity(raw.len());
+    out.push_str(&raw[..first]);
+    let mut i = first;
+    while i < raw.len() {
+        if raw.as_bytes()[i] == b'&' {
+            let (c, next) = reference(raw, i).map_err(|e| XmlError {
+                offset: offset + e.offset,
+                message: e.message,
+            })?;
+            out.push_str(&c);
+            i = next;
+        } else {
+            let end = memchr::memchr(b'&', &raw.as_bytes()[i..]).map_or(raw.len(), |j| i + j);
+            out.push_str(&raw[i..end]);
+            i = end;
+        }
+    }
+    Ok(Cow::Owned(out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every event of `src` as a short string, or the error as `!offset message`.
+    fn events(src: &str) -> Vec<String> {
+        let mut t = Tokenizer::new(src);
+        let mut out = Vec::new();
+        loop {
+            match t.next() {
+                Ok(Event::Eof) => return out,
+                Ok(Event::Start(tag)) => {
+                    let attrs: Vec<String> = t
+                        .attrs()
+                        .iter()
+                        .map(|a| format!("{}={}@{}", a.key, a.raw, a.offset))
+                        .collect();
+                    let ns = t.resolve(tag.qname.split_once(':').map(|p| p.0));
+                    out.push(format!(
+                        "<{}{} {}{:?}@{}",
+                        tag.qname,
+                        if tag.empty { "/" } else { "" },
+                        attrs.join(","),
+                        ns,
+                        tag.offset
+                    ));
+                }
+                Ok(Event::End { offset, after }) => out.push(format!("/{offset}-{after}")),
+                Ok(Event::Text { text, offset }) => out.push(format!("'{text}'@{offset}")),
+                Err(e) => {
+                    out.push(format!("!{} {}", e.offset, e.message));
+                    return out;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn tags_attributes_text_and_offsets() {
+        assert_eq!(
+            events(r#"<a x = "1" y='2'>hi<b/></a>"#),
+            [
+                "<a x=1@3,y=2@11Ok(None)@0",
+                "'hi'@17",
+                "<b/ Ok(None)@19",
+                "/23-27"
+            ]
+        );
+    }
+
+    #[test]
+    fn references_cdata_comments_and_line_ends() {
+        assert_eq!(
+            events("<?xml version=\"1.0\"?><!DOCTYPE a [<!ENTITY x \">\">]><a>1&lt;2&#x41;&#66;<!-- c --><![CDATA[<&>]]>\r\nz</a>"),
+            [
+                "<a Ok(None)@51",
+                "'1'@54",
+                "'<'@55",
+                "'2'@59",
+                "'A'@60",
+                "'B'@66",
+                "'<&>'@81",
+                "'\nz'@96",
+                "/99-103"
+            ]
+        );
+        assert_eq!(unescape("a&amp;b&quot;", 10).unwrap(), "a&b\"");
+        assert_eq!(unescape("a&bogus;", 10).unwrap_err().offset, 11);
+    }
+
+    #[test]
+    fn namespaces_follow_the_element_scope() {
+        let ev = events(
+            r#"<a xmlns="urn:d" xmlns:p="urn:p"><p:b xmlns:p="urn:q"/><p:c/><d xmlns=""/></a>"#,
+        );
+        assert_eq!(
+            ev[0],
+            r#"<a xmlns=urn:d@3,xmlns:p=urn:p@17Ok(Some("urn:d"))@0"#
+        );
+        assert!(ev[1].ends_with(r#"Ok(Some("urn:q"))@33"#), "{}", ev[1]);
+        assert!(ev[2].ends_with(r#"Ok(Some("urn:p"))@55"#), "{}", ev[2]);
+        assert!(ev[3].ends_with("Ok(None)@61"), "{}", ev[3]);
+        let mut t = Tokenizer::new(r#"<a xmlns:p="urn:p&amp;x"><b/></a>"#);
+        t.next().unwrap();
+        assert_eq!(t.resolve(Some("p")), Ok(Some("urn:p&x")));
+        assert_eq!(t.resolve(Some("q")), Err(()));
+        assert_eq!(t.scope(), [("p".to_string(), "urn:p&x".to_string())]);
+    }
+
+    #[test]
+    fn malformed_input_is_reported_where_it_is() {
+        for (src, offset, words) in [
+            ("<a><b></a>", 6, "does not match the start tag <b>"),
+            ("</a>", 0, "without a start tag"),
+            ("<a x=1/>", 5, "not in quotes"),
+            ("<a x/>", 3, "has no value"),
+            ("<a x='1'y='2'/>", 8, "separated by white space"),
+            ("<a x='<'/>", 6, "'<' in the value"),
+            ("<a x='1", 3, "never closed"),
+            ("<a", 0, "never closed"),
+            ("<a>&b</a>", 3, "does not start a reference"),
+            ("<a>&#1;</a>", 3, "U+0001"),
+            ("<a>&#xD800;</a>", 3, "not a valid character reference"),
+            ("<a><!-- x</a>", 3, "comment is never closed"),
+            ("<1a/>", 0, "not a valid qualified name"),
+            ("<p:/x/>", 0, "not a valid qualified name"),
+            ("<xmlns:x/>", 0, "reserved"),
+            ("<a xmlns:p='1' xmlns:p='2'/>", 15, "appears twice"),
+            ("<a xmlns:p=''/>", 3, "cannot undeclare"),
+            ("<a x:y:z='1'/>", 3, "not a valid qualified name"),
+            ("<a/ >", 2, "not followed by '>'"),
+            ("<!x>", 0, "neither a comment"),
+        ] {
+            let ev = events(src);
+            let last = ev.last().unwrap();
+            assert!(
+                last.starts_with(&format!("!{offset} ")) && last.contains(words),
+                "{src}: {last}"
+            );
+        }
+    }
+}
