@@ -21,17 +21,17 @@ use timing::TimingModel;
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct UnitKey {
     /// Block id.
-    pub block: String,
+    pub block: crate::bml::Id,
     /// Behaviour id.
-    pub behaviour: String,
+    pub behaviour: crate::bml::Id,
 }
 
 impl UnitKey {
     /// The key of `block:behaviour`.
     pub fn new(block: &str, behaviour: &str) -> Self {
         UnitKey {
-            block: block.to_string(),
-            behaviour: behaviour.to_string(),
+            block: block.into(),
+            behaviour: behaviour.into(),
         }
     }
 }

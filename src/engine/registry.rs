@@ -2,8 +2,6 @@
 //! several kinds; registering a kind again hands it to the newer engine. New kinds and engines
 //! register from outside the core (S76).
 
-use std::collections::HashMap;
-
 use super::timing::{TimingModel, TimingModels};
 use super::Engine;
 use crate::bml::Behaviour;
@@ -36,7 +34,9 @@ impl KindKey {
 #[derive(Default)]
 pub struct Registry {
     engines: Vec<Box<dyn Engine>>,
-    kinds: HashMap<KindKey, usize>,
+    /// (kind, engine index), sorted by name and namespace: found by binary search without
+    /// allocating.
+    kinds: Vec<(KindKey, usize)>,
 }
 
 impl Registry {
@@ -50,19 +50,25 @@ impl Registry {
         self.engines.push(engine);
         let index = self.engines.len() - 1;
         for k in kinds {
-            self.kinds.insert(k.clone(), index);
+            match self
+                .kinds
+                .binary_search_by(|(x, _)| (&x.name, &x.ns).cmp(&(&k.name, &k.ns)))
+            {
+                Ok(at) => self.kinds[at].1 = index,
+                Err(at) => self.kinds.insert(at, (k.clone(), index)),
+            }
         }
         index
     }
 
     /// The index of the engine that realizes `behaviour`'s kind.
     pub fn engine_for(&self, behaviour: &Behaviour) -> Option<usize> {
-        // a lookup without allocating a key: kinds are few, compare in place
-        let (ns, name) = (behaviour.kind.namespace(), behaviour.kind.element_name());
+        // by name first: names differ early, namespaces share long prefixes
+        let key = (behaviour.kind.element_name(), behaviour.kind.namespace());
         self.kinds
-            .iter()
-            .find(|(k, _)| k.name == name && k.ns == ns)
-            .map(|(_, &i)| i)
+            .binary_search_by(|(k, _)| (k.name.as_str(), k.ns.as_str()).cmp(&key))
+            .ok()
+            .map(|at| self.kinds[at].1)
     }
 
     /// Number of engines.
@@ -97,7 +103,7 @@ impl Registry {
 
     /// The registered kinds, sorted.
     pub fn kinds(&self) -> Vec<&KindKey> {
-        let mut v: Vec<&KindKey> = self.kinds.keys().collect();
+        let mut v: Vec<&KindKey> = self.kinds.iter().map(|(k, _)| k).collect();
         v.sort();
         v
     }

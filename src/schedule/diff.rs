@@ -12,8 +12,6 @@
 //! because the scheduler needs the cycle as constraint tags, lower bounds per variable, and no
 //! allocation beyond a few flat vectors per solve.
 
-use std::collections::VecDeque;
-
 use crate::bml::Relation;
 
 /// Improvements smaller than this (seconds) are not propagated: constraints hold within it, and
@@ -127,30 +125,41 @@ impl DiffSystem {
 
     /// The least solution with every variable at or above its lower bound, or a conflicting cycle.
     pub fn solve(&self) -> Result<Vec<f64>, Conflict> {
-        let n = self.len();
-        // adjacency in CSR form: edges grouped by `from`
-        let mut start = vec![0usize; n + 1];
+        let (n, m) = (self.len(), self.edges.len());
+        // one scratch allocation, split into: CSR offsets of the edges grouped by `from` (n + 1),
+        // a fill cursor per variable (n), the grouped edge indices (m), the length of the path
+        // that gave each variable its value (n), and a ring queue of variables (n) in which each
+        // variable is at most once (`queued`, n)
+        let mut scratch = vec![0usize; (n + 1) + n + m + 4 * n];
+        let (start, rest) = scratch.split_at_mut(n + 1);
+        let (fill, rest) = rest.split_at_mut(n);
+        let (out, rest) = rest.split_at_mut(m);
+        let (path_len, rest) = rest.split_at_mut(n);
+        let (ring, queued) = rest.split_at_mut(n);
         for e in &self.edges {
             start[e.from + 1] += 1;
         }
         for i in 0..n {
             start[i + 1] += start[i];
         }
-        let mut fill = start.clone();
-        let mut out = vec![0usize; self.edges.len()];
+        fill.copy_from_slice(&start[..n]);
         for (i, e) in self.edges.iter().enumerate() {
             out[fill[e.from]] = i;
             fill[e.from] += 1;
         }
 
         let mut x = self.lower.clone();
-        // edges on the path that gave each variable its value; a path longer than n edges repeats
-        // a variable, so it contains a positive cycle
-        let mut path_len = vec![0usize; n];
-        let mut queued = vec![true; n];
-        let mut queue: VecDeque<usize> = (0..n).collect();
-        while let Some(u) = queue.pop_front() {
-            queued[u] = false;
+        // a path longer than n edges repeats a variable, so it contains a positive cycle
+        for (i, r) in ring.iter_mut().enumerate() {
+            *r = i;
+        }
+        queued.fill(1);
+        let (mut head, mut len) = (0usize, n);
+        while len > 0 {
+            let u = ring[head];
+            head = if head + 1 == n { 0 } else { head + 1 };
+            len -= 1;
+            queued[u] = 0;
             for &ei in &out[start[u]..start[u + 1]] {
                 let e = &self.edges[ei];
                 let candidate = x[u] + e.weight;
@@ -160,9 +169,11 @@ impl DiffSystem {
                     if path_len[e.to] > n {
                         return Err(self.find_cycle());
                     }
-                    if !queued[e.to] {
-                        queued[e.to] = true;
-                        queue.push_back(e.to);
+                    if queued[e.to] == 0 {
+                        queued[e.to] = 1;
+                        let tail = (head + len) % n;
+                        ring[tail] = e.to;
+                        len += 1;
                     }
                 }
             }

@@ -146,10 +146,15 @@ pub(crate) fn resolve(
                     sync,
                 }) if *b == block.id => (behaviour, sync),
                 Anchor::Point(p) => {
-                    return external.time(p).map(|t| Some(Term::Fixed(t))).ok_or((
-                        KnownWarning::NoSuchTarget,
-                        format!("the time of {p} is not known"),
-                    ));
+                    return external
+                        .time(p)
+                        .map(|t| Some(Term::Fixed(t)))
+                        .ok_or_else(|| {
+                            (
+                                KnownWarning::NoSuchTarget,
+                                format!("the time of {p} is not known"),
+                            )
+                        });
                 }
             };
             let Some(i) = index.get(behaviour) else {

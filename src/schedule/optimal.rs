@@ -264,13 +264,14 @@ fn feasible(items: &[Item], links: &[Link], constraints: &[Constraint]) -> Resul
 fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
     let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
     let block = s.var(0.0);
-    let starts: Vec<usize> = items.iter().map(|_| s.var(f64::MIN / 4.0)).collect();
-    for (i, &v) in starts.iter().enumerate() {
+    // item i's start is variable i + 1
+    for i in 0..items.len() {
+        let v = s.var(f64::MIN / 4.0);
         s.at_least(v, block, 0.0, links.len() + i);
     }
     let var = |t: Term| -> (usize, f64) {
         match t {
-            Term::Key(i, k) => (starts[i], items[i].model.keys[k].at),
+            Term::Key(i, k) => (i + 1, items[i].model.keys[k].at),
             Term::Fixed(t) => (block, t),
         }
     };
@@ -286,11 +287,11 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
     Some(
         items
             .iter()
-            .zip(&starts)
-            .map(|(it, &v)| {
+            .enumerate()
+            .map(|(i, it)| {
                 it.model.keys[..it.len]
                     .iter()
-                    .map(|k| x[v] + k.at)
+                    .map(|k| x[i + 1] + k.at)
                     .collect()
             })
             .collect(),
