@@ -32,7 +32,8 @@ impl fmt::Display for Pos {
 pub struct LineIndex {
     starts: Vec<usize>,
     /// Per line, the offset of its first byte outside ASCII (or of its end): columns before it
-    /// are byte counts, so a long line does not make every position cost its length.
+    /// are byte counts, so a long line does not make every position cost its length. Empty when
+    /// the whole text is ASCII.
     ascii_until: Vec<usize>,
 }
 
@@ -40,12 +41,12 @@ impl LineIndex {
     /// Index the line starts of `src`.
     pub fn new(src: &str) -> Self {
         let bytes = src.as_bytes();
-        let lines = memchr::memchr_iter(b'\n', bytes).count();
-        let mut starts = Vec::with_capacity(lines + 1);
+        let mut starts = Vec::with_capacity(bytes.len() / 32 + 1);
         starts.push(0);
         starts.extend(memchr::memchr_iter(b'\n', bytes).map(|i| i + 1));
+        // an ASCII text (nearly every block) needs no second table: columns are byte counts
         let ascii_until = if src.is_ascii() {
-            starts.iter().skip(1).copied().chain([src.len()]).collect()
+            Vec::new()
         } else {
             let ends = starts.iter().skip(1).copied().chain([src.len()]);
             starts
@@ -70,7 +71,11 @@ impl LineIndex {
         let offset = offset.min(src.len());
         let line = self.starts.partition_point(|&s| s <= offset) - 1;
         let start = self.starts[line];
-        let ascii = self.ascii_until.get(line).copied().unwrap_or(start);
+        let ascii = if self.ascii_until.is_empty() {
+            offset // an ASCII text
+        } else {
+            self.ascii_until.get(line).copied().unwrap_or(start)
+        };
         let col = if offset <= ascii {
             offset - start
         } else {

@@ -118,9 +118,9 @@ impl<'i> Tokenizer<'i> {
         Tokenizer {
             src,
             pos: 0,
-            open: Vec::new(),
-            bindings: Vec::new(),
-            attrs: Vec::new(),
+            open: Vec::with_capacity(8),
+            bindings: Vec::with_capacity(4),
+            attrs: Vec::with_capacity(8),
             close_empty: None,
         }
     }
@@ -229,13 +229,13 @@ impl<'i> Tokenizer<'i> {
     fn bang(&mut self, start: usize) -> Result<Option<&'i str>, XmlError> {
         let rest = &self.src[start..];
         if let Some(body) = rest.strip_prefix("<!--") {
-            match body.find("-->") {
+            match memchr::memmem::find(body.as_bytes(), b"-->") {
                 Some(i) => self.pos = start + 4 + i + 3,
                 None => return err(start, "the comment is never closed"),
             }
             Ok(None)
         } else if let Some(body) = rest.strip_prefix("<![CDATA[") {
-            match body.find("]]>") {
+            match memchr::memmem::find(body.as_bytes(), b"]]>") {
                 Some(i) => {
                     self.pos = start + 9 + i + 3;
                     Ok(Some(&body[..i]))
@@ -268,19 +268,35 @@ impl<'i> Tokenizer<'i> {
         }
     }
 
-    /// Scans a name from `at` up to whitespace, `/`, `>`, `=` or the end.
-    fn name_at(&self, at: usize) -> &'i str {
+    /// Scans a name from `at` up to whitespace, `/`, `>`, `=`, `<` or the end; with whether it
+    /// is a qualified name (`NCName` or `NCName:NCName`).
+    fn name_at(&self, at: usize) -> (&'i str, bool) {
         let b = self.bytes();
+        // the common case in one pass: ASCII letters, digits, '_', '-', '.' and at most one ':'
+        // not at either end, starting with a letter or '_'
         let mut i = at;
-        while i < b.len()
-            && !matches!(
-                b[i],
-                b' ' | b'\t' | b'\n' | b'\r' | b'/' | b'>' | b'=' | b'<'
-            )
-        {
+        let mut colon = None;
+        let mut ascii = true;
+        while i < b.len() {
+            match b[i] {
+                b' ' | b'\t' | b'\n' | b'\r' | b'/' | b'>' | b'=' | b'<' => break,
+                b':' if colon.is_none() => colon = Some(i),
+                c if c.is_ascii_alphanumeric() || matches!(c, b'_' | b'-' | b'.') => {}
+                _ => ascii = false,
+            }
             i += 1;
         }
-        &self.src[at..i]
+        let name = &self.src[at..i];
+        let starts = |j: usize| j < i && (b[j].is_ascii_alphabetic() || b[j] == b'_');
+        let valid = if ascii {
+            match colon {
+                Some(c) => starts(at) && starts(c + 1),
+                None => starts(at),
+            }
+        } else {
+            is_qname(name)
+        };
+        (name, valid)
     }
 
     fn skip_space(&mut self) {
@@ -291,8 +307,8 @@ impl<'i> Tokenizer<'i> {
     }
 
     fn start_tag(&mut self, start: usize) -> Result<Event<'i>, XmlError> {
-        let qname = self.name_at(start + 1);
-        if !is_qname(qname) {
+        let (qname, valid) = self.name_at(start + 1);
+        if !valid {
             return err(start, format!("<{qname}> is not a valid qualified name"));
         }
         if qname.starts_with("xmlns:") {
@@ -383,8 +399,8 @@ impl<'i> Tokenizer<'i> {
     fn attribute(&mut self, tag: &str) -> Result<(), XmlError> {
         let b = self.bytes();
         let offset = self.pos;
-        let key = self.name_at(offset);
-        if !is_qname(key) {
+        let (key, valid) = self.name_at(offset);
+        if !valid {
             return err(
                 offset,
                 format!("attribute '{key}' of <{tag}> is not a valid qualified name"),
@@ -407,14 +423,15 @@ impl<'i> Tokenizer<'i> {
             }
         };
         let value_offset = self.pos + 1;
-        let Some(len) = memchr::memchr(quote, &b[value_offset..]) else {
+        // values are short: a plain loop beats a vectorised search's setup
+        let Some(len) = b[value_offset..].iter().position(|&c| c == quote) else {
             return err(
                 offset,
                 format!("the value of attribute '{key}' of <{tag}> is never closed"),
             );
         };
         let raw = &self.src[value_offset..value_offset + len];
-        if let Some(i) = memchr::memchr(b'<', raw.as_bytes()) {
+        if let Some(i) = raw.bytes().position(|c| c == b'<') {
             return err(
                 value_offset + i,
                 format!("'<' in the value of attribute '{key}'"),
@@ -431,7 +448,7 @@ impl<'i> Tokenizer<'i> {
     }
 
     fn end_tag(&mut self, start: usize) -> Result<Event<'i>, XmlError> {
-        let qname = self.name_at(start + 2);
+        let (qname, _) = self.name_at(start + 2);
         self.pos = start + 2 + qname.len();
         self.skip_space();
         if self.bytes().get(self.pos) != Some(&b'>') {
@@ -516,7 +533,7 @@ fn reference(src: &str, at: usize) -> Result<(Cow<'static, str>, usize), XmlErro
 /// Resolves the references in an attribute value (`raw` starts at byte `offset` of the source);
 /// borrowed when there are none.
 pub(crate) fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlError> {
-    let Some(first) = memchr::memchr(b'&', raw.as_bytes()) else {
+    let Some(first) = raw.bytes().position(|c| c == b'&') else {
         return Ok(Cow::Borrowed(raw));
     };
     let mut out = String::with_capacity(raw.len());
