@@ -171,10 +171,21 @@ impl TimingModel {
                 ));
             }
         }
+        // names read once (a few keys: pairwise is cheapest), on the stack for the usual counts
+        let mut small = [""; 16];
+        let mut large = Vec::new();
+        let names: &mut [&str] = if self.keys.len() <= small.len() {
+            &mut small[..self.keys.len()]
+        } else {
+            large.resize(self.keys.len(), "");
+            &mut large
+        };
         for (i, k) in self.keys.iter().enumerate() {
-            if self.keys[..i].iter().any(|e| e.name == k.name) {
-                return Err(format!("key {} appears twice", k.name));
+            let name = k.name.as_str();
+            if names[..i].contains(&name) {
+                return Err(format!("key {name} appears twice"));
             }
+            names[i] = name;
         }
         Ok(())
     }
@@ -234,8 +245,9 @@ pub fn syllables(word: &str) -> usize {
 
 const OTHER: u8 = 0;
 const SPACE: u8 = 1;
-const LETTER: u8 = 2;
+const CONSONANT: u8 = 2;
 const DIGIT: u8 = 3;
+const VOWEL: u8 = 4;
 
 /// The class of each ASCII byte for the one-pass syllable count.
 static ASCII_CLASS: [u8; 256] = {
@@ -245,8 +257,10 @@ static ASCII_CLASS: [u8; 256] = {
         let c = b as u8;
         t[b] = if c.is_ascii_whitespace() {
             SPACE
+        } else if Syllables::vowel(c.to_ascii_lowercase()) {
+            VOWEL
         } else if c.is_ascii_alphabetic() {
-            LETTER
+            CONSONANT
         } else if c.is_ascii_digit() {
             DIGIT
         } else {
@@ -269,13 +283,17 @@ struct Syllables {
 }
 
 impl Syllables {
-    fn vowel(c: u8) -> bool {
+    const fn vowel(c: u8) -> bool {
         matches!(c, b'a' | b'e' | b'i' | b'o' | b'u' | b'y')
     }
 
     /// One letter, lower-cased (0 for a letter outside ASCII).
     fn letter(&mut self, c: u8) {
-        let v = Self::vowel(c);
+        self.letter_of(c, Self::vowel(c));
+    }
+
+    /// One lower-cased letter already known to be a vowel or not.
+    fn letter_of(&mut self, c: u8, v: bool) {
         self.any = true;
         self.letters += 1;
         self.groups += usize::from(v && !self.prev_vowel);
@@ -317,26 +335,40 @@ impl SpeechTiming {
                 .map(|w| self.word(syllables(w), w.chars().last().unwrap_or(' ')))
                 .sum();
         }
-        // one pass over the bytes with a class table, no splitting (nearly every text)
-        let (mut total, mut word, mut last) = (0.0, Syllables::default(), None);
+        // one pass over the bytes with a class table, no splitting (nearly every text); the
+        // syllables and pauses are counted, and timed once at the end
+        let (mut syllables, mut sentences, mut commas) = (0usize, 0usize, 0usize);
+        let mut word = Syllables::default();
+        let mut last = None;
+        let mut finish = |word: Syllables, last: u8| {
+            syllables += word.total();
+            match last {
+                b'.' | b'!' | b'?' => sentences += 1,
+                b',' | b';' | b':' => commas += 1,
+                _ => {}
+            }
+        };
         for &b in text.as_bytes() {
             match ASCII_CLASS[usize::from(b)] {
                 SPACE => {
                     if let Some(l) = last.take() {
-                        total += self.word(std::mem::take(&mut word).total(), char::from(l));
+                        finish(std::mem::take(&mut word), l);
                     }
                     continue;
                 }
-                LETTER => word.letter(b | 0x20),
+                VOWEL => word.letter_of(b | 0x20, true),
+                CONSONANT => word.letter_of(b | 0x20, false),
                 DIGIT => word.any = true,
                 _ => {}
             }
             last = Some(b);
         }
         if let Some(l) = last {
-            total += self.word(word.total(), char::from(l));
+            finish(word, l);
         }
-        total
+        syllables as f64 * self.syllable_seconds
+            + sentences as f64 * self.sentence_pause
+            + commas as f64 * self.comma_pause
     }
 
     /// The rigid timing of a speech: `start`, each inline sync at the boundary where it is written,
@@ -697,5 +729,19 @@ mod tests {
         ])
         .contains("comes before"));
         assert!(bad(&[("start", 0.0), ("a", 0.2), ("a", 0.3), ("end", 1.0)]).contains("twice"));
+        // more keys than the names kept on the stack
+        const MANY: [&str; 20] = [
+            "start", "k1", "k2", "k3", "k4", "k5", "k6", "k7", "k8", "k9", "k10", "k11", "k12",
+            "k13", "k14", "k15", "k16", "k17", "k3", "end",
+        ];
+        let keys: Vec<(&'static str, f64)> = MANY
+            .iter()
+            .enumerate()
+            .map(|(i, &n)| (n, i as f64))
+            .collect();
+        assert!(bad(&keys).contains("key k3 appears twice"));
+        let mut unique = keys.clone();
+        unique[18].0 = "k18";
+        TimingModel::stretchable(&unique).check().unwrap();
     }
 }

@@ -302,38 +302,49 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
 /// distances `at` constraints already fix; all others keep their preferred timing. `None` if some
 /// behaviour's constrained keys are not fixed relative to each other (the LP decides then).
 fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
-    // anchored keys per item, in key order
-    let mut anchors: Vec<Vec<usize>> = vec![Vec::new(); items.len()];
+    // anchored (item, key) pairs, sorted: item i's anchors are `pairs[first[i]..first[i + 1]]`
+    let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(2 * links.len());
     for l in links {
         for t in [l.left, l.right] {
             if let Term::Key(i, k) = t {
-                if !anchors[i].contains(&k) {
-                    anchors[i].push(k);
-                }
+                pairs.push((i, k));
             }
         }
     }
-    for a in &mut anchors {
-        a.sort_unstable();
+    pairs.sort_unstable();
+    pairs.dedup();
+    // per item: first anchor, first node, and (for a stretched item) its scale, in one vector
+    let m = items.len();
+    let mut first = vec![0usize; 2 * m + 1];
+    for &(i, _) in &pairs {
+        first[i + 1] += 1;
     }
-    let multi = |i: usize| {
-        matches!(items[i].model.flexibility, Flexibility::Stretchable { .. })
-            && anchors[i].len() >= 2
+    for i in 0..m {
+        first[i + 1] += first[i];
+    }
+    let stretches = |i: usize, count: usize| {
+        matches!(items[i].model.flexibility, Flexibility::Stretchable { .. }) && count >= 2
     };
     // nodes: 0 = block; one per anchor of a multi-anchor item, one (its start) for any other item
-    let mut node_of: Vec<Vec<usize>> = Vec::with_capacity(items.len());
     let mut n = 1;
-    for (i, a) in anchors.iter().enumerate() {
-        let count = if multi(i) { a.len() } else { 1 };
-        node_of.push((n..n + count).collect());
-        n += count;
+    for i in 0..m {
+        let count = first[i + 1] - first[i];
+        first[m + 1 + i] = n;
+        n += if stretches(i, count) { count } else { 1 };
     }
+    let (first, base) = first.split_at(m + 1);
+    let anchor = |i: usize, j: usize| pairs[first[i] + j].1;
+    let anchors = |i: usize| first[i + 1] - first[i];
+    let multi = |i: usize| stretches(i, anchors(i));
     let node = |i: usize, k: usize| -> (usize, f64) {
         if multi(i) {
-            let j = anchors[i].iter().position(|&a| a == k).unwrap_or(0);
-            (node_of[i][j], 0.0)
+            let j = pairs[first[i]..first[i + 1]]
+                .iter()
+                .position(|&(_, a)| a == k)
+                .unwrap_or(0);
+            (base[i] + j, 0.0)
         } else {
-            (node_of[i][0], items[i].model.keys[k].at)
+            (base[i], items[i].model.keys[k].at)
         }
     };
     let term = |t: Term| match t {
@@ -347,31 +358,27 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
         offsets.join(a, b, ob + l.offset - oa);
     }
     // the uniform scale of each multi-anchor item, from its fixed anchor distances
-    let mut scale = vec![1.0; items.len()];
-    for i in (0..items.len()).filter(|&i| multi(i)) {
+    let mut scale = vec![1.0; m];
+    for i in (0..m).filter(|&i| multi(i)) {
         let keys = &items[i].model.keys;
-        let (first, last) = (anchors[i][0], anchors[i][anchors[i].len() - 1]);
-        let (r0, o0) = offsets.find(node_of[i][0]);
-        for &v in &node_of[i][1..] {
-            if offsets.find(v).0 != r0 {
-                return None;
-            }
-        }
-        // anchors fixed out of order cannot be a uniform stretch (nor any valid timing)
+        let count = anchors(i);
+        let (fst, lst) = (anchor(i, 0), anchor(i, count - 1));
+        let (r0, o0) = offsets.find(base[i]);
+        // every anchor fixed relative to the first, and in order (anchors fixed out of order
+        // cannot be a uniform stretch, nor any valid timing)
         let mut prev = o0;
-        for &v in &node_of[i][1..] {
-            let o = offsets.find(v).1;
-            if o < prev - EPSILON {
+        for v in base[i] + 1..base[i] + count {
+            let (r, o) = offsets.find(v);
+            if r != r0 || o < prev - EPSILON {
                 return None;
             }
             prev = o;
         }
-        let (_, o1) = offsets.find(node_of[i][node_of[i].len() - 1]);
-        let span = keys[last].at - keys[first].at;
+        let span = keys[lst].at - keys[fst].at;
         if span <= 0.0 {
             return None;
         }
-        scale[i] = (o1 - o0) / span;
+        scale[i] = (prev - o0) / span;
         let duration = scale[i] * items[i].model.preferred_duration();
         if let Flexibility::Stretchable {
             min_duration,
@@ -387,7 +394,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
         }
     }
     // least solution over the nodes
-    let mut s = DiffSystem::with_capacity(n, 2 * links.len() + items.len());
+    let mut s = DiffSystem::with_capacity(n, 2 * links.len() + m);
     for v in 0..n {
         s.var(if v == 0 { 0.0 } else { f64::MIN / 4.0 });
     }
@@ -396,15 +403,15 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
         let offset = l.offset + ob - oa;
         s.relate(a, l.relation, b, offset, tag);
     }
-    for i in 0..items.len() {
+    for i in 0..m {
         let tag = links.len() + i;
         // nothing before the block: for a stretched item, its extrapolated start
         let lead = if multi(i) {
-            scale[i] * items[i].model.keys[anchors[i][0]].at
+            scale[i] * items[i].model.keys[anchor(i, 0)].at
         } else {
             0.0
         };
-        s.at_least(node_of[i][0], 0, lead, tag);
+        s.at_least(base[i], 0, lead, tag);
     }
     let x = s.solve().ok()?;
     if x[0] > EPSILON {
@@ -416,22 +423,22 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
         .map(|(i, it)| {
             let keys = &it.model.keys[..it.len];
             if !multi(i) {
-                let start = x[node_of[i][0]];
+                let start = x[base[i]];
                 return keys.iter().map(|k| start + k.at).collect();
             }
-            let a = &anchors[i];
-            let (last, at) = (a.len() - 1, |j: usize| x[node_of[i][j]]);
-            let p = |j: usize| it.model.keys[a[j]].at;
+            let last = anchors(i) - 1;
+            let at = |j: usize| x[base[i] + j];
+            let p = |j: usize| it.model.keys[anchor(i, j)].at;
             keys.iter()
                 .enumerate()
                 .map(|(k, key)| {
-                    if k <= a[0] {
+                    if k <= anchor(i, 0) {
                         at(0) - scale[i] * (p(0) - key.at)
-                    } else if k >= a[last] {
+                    } else if k >= anchor(i, last) {
                         at(last) + scale[i] * (key.at - p(last))
                     } else {
                         // linear between the surrounding anchors (S49)
-                        let j = a.iter().rposition(|&x| x <= k).unwrap_or(0);
+                        let j = (0..last).rev().find(|&j| anchor(i, j) <= k).unwrap_or(0);
                         let (p0, p1) = (p(j), p(j + 1));
                         if p1 > p0 {
                             at(j) + (key.at - p0) / (p1 - p0) * (at(j + 1) - at(j))
