@@ -255,7 +255,8 @@ static ASCII_CLASS: [u8; 256] = {
     let mut b = 0;
     while b < 128 {
         let c = b as u8;
-        t[b] = if c.is_ascii_whitespace() {
+        // white space as `split_whitespace` has it (ASCII's, and the vertical tab)
+        t[b] = if c.is_ascii_whitespace() || c == 0x0b {
             SPACE
         } else if Syllables::vowel(c.to_ascii_lowercase()) {
             VOWEL
@@ -561,6 +562,23 @@ mod tests {
                 .map(|w| sp.word(syllables(w), w.chars().last().unwrap()))
                 .sum();
             assert!((sp.text(text) - by_word).abs() < 1e-12, "{text:?}");
+        }
+        // and on random ASCII texts of letters, digits, punctuation and white space
+        const ALPHABET: &[u8] = b"aeiouyAEYbcdklmnrstzBKT09.,;:!?'-() \t\n\r\x0b\x0c";
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..3000 {
+            let mut text = String::new();
+            for _ in 0..(seed % 40) {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                text.push(char::from(ALPHABET[(seed % ALPHABET.len() as u64) as usize]));
+            }
+            let by_word: f64 = text
+                .split_whitespace()
+                .map(|w| sp.word(syllables(w), w.chars().last().unwrap()))
+                .sum();
+            assert!((sp.text(&text) - by_word).abs() < 1e-9, "{text:?}");
         }
     }
 
