@@ -213,7 +213,17 @@ impl SyncRef {
                 "empty sync reference: expected a time in seconds or behaviour:sync".into(),
             ));
         }
-        if !t.contains(':') {
+        // the colons, found in one pass over the bytes (ids are short: no searcher set-up)
+        let (mut colons, mut count) = ([0usize; 2], 0usize);
+        for (i, &c) in t.as_bytes().iter().enumerate() {
+            if c == b':' {
+                if count < 2 {
+                    colons[count] = i;
+                }
+                count += 1;
+            }
+        }
+        if count == 0 {
             return parse_seconds(t).map(SyncRef::Time).ok_or_else(|| {
                 err(
                     Code::MalformedSyncRef,
@@ -223,17 +233,25 @@ impl SyncRef {
                 )
             });
         }
-        let mut split = t.split(':').map(str::trim_ascii);
-        let parts: [Option<&str>; 3] = [split.next(), split.next(), split.next()];
-        if split.next().is_some() {
+        if count > 2 {
             return Err(err(
                 Code::MalformedSyncRef,
                 format!(
                     "sync reference '{t}' has {} parts; expected behaviour:sync, block:behaviour:sync or anticipators:id:sync",
-                    t.split(':').count()
+                    count + 1
                 ),
             ));
         }
+        let parts: [Option<&str>; 3] = if count == 1 {
+            [Some(&t[..colons[0]]), Some(&t[colons[0] + 1..]), None]
+        } else {
+            [
+                Some(&t[..colons[0]]),
+                Some(&t[colons[0] + 1..colons[1]]),
+                Some(&t[colons[1] + 1..]),
+            ]
+        }
+        .map(|p| p.map(str::trim_ascii));
         let n = parts.iter().flatten().count();
         let part = |i: usize| parts[i].unwrap_or_default();
         let last = part(n - 1);

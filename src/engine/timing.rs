@@ -572,7 +572,9 @@ mod tests {
                 seed ^= seed << 13;
                 seed ^= seed >> 7;
                 seed ^= seed << 17;
-                text.push(char::from(ALPHABET[(seed % ALPHABET.len() as u64) as usize]));
+                text.push(char::from(
+                    ALPHABET[(seed % ALPHABET.len() as u64) as usize],
+                ));
             }
             let by_word: f64 = text
                 .split_whitespace()

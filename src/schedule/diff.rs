@@ -125,6 +125,12 @@ impl DiffSystem {
 
     /// The least solution with every variable at or above its lower bound, or a conflicting cycle.
     pub fn solve(&self) -> Result<Vec<f64>, Conflict> {
+        self.least().ok_or_else(|| self.find_cycle())
+    }
+
+    /// The least solution, or `None` when the system is infeasible (without finding out why:
+    /// for callers that only try).
+    pub fn least(&self) -> Option<Vec<f64>> {
         let (n, m) = (self.len(), self.edges.len());
         // one scratch allocation, split into: CSR offsets of the edges grouped by `from` (n + 1),
         // a fill cursor per variable (n), the grouped edge indices (m), the length of the path
@@ -167,7 +173,7 @@ impl DiffSystem {
                     x[e.to] = candidate;
                     path_len[e.to] = path_len[u] + 1;
                     if path_len[e.to] > n {
-                        return Err(self.find_cycle());
+                        return None;
                     }
                     if queued[e.to] == 0 {
                         queued[e.to] = 1;
@@ -178,7 +184,7 @@ impl DiffSystem {
                 }
             }
         }
-        Ok(x)
+        Some(x)
     }
 
     /// Finds a positive cycle (the system is known to be infeasible) with classic Bellman–Ford:

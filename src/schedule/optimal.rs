@@ -280,7 +280,7 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
         let offset = l.offset + bo - ao;
         s.relate(a, l.relation, b, offset, tag);
     }
-    let x = s.solve().ok()?;
+    let x = s.least()?;
     if x[block] > EPSILON {
         return None;
     }
@@ -413,7 +413,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
         };
         s.at_least(base[i], 0, lead, tag);
     }
-    let x = s.solve().ok()?;
+    let x = s.least()?;
     if x[0] > EPSILON {
         return None;
     }
