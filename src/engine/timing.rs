@@ -245,9 +245,11 @@ pub fn syllables(word: &str) -> usize {
 
 const OTHER: u8 = 0;
 const SPACE: u8 = 1;
-const CONSONANT: u8 = 2;
-const DIGIT: u8 = 3;
-const VOWEL: u8 = 4;
+const DIGIT: u8 = 2;
+/// Bit of both letter classes.
+const LETTER: u8 = 4;
+const CONSONANT: u8 = LETTER;
+const VOWEL: u8 = LETTER | 8;
 
 /// The class of each ASCII byte for the one-pass syllable count.
 static ASCII_CLASS: [u8; 256] = {
@@ -290,17 +292,25 @@ impl Syllables {
 
     /// One letter, lower-cased (0 for a letter outside ASCII).
     fn letter(&mut self, c: u8) {
-        self.letter_of(c, Self::vowel(c));
-    }
-
-    /// One lower-cased letter already known to be a vowel or not.
-    fn letter_of(&mut self, c: u8, v: bool) {
+        let v = Self::vowel(c);
         self.any = true;
         self.letters += 1;
         self.groups += usize::from(v && !self.prev_vowel);
         self.prev_vowel = v;
         self.before_last = self.last;
         self.last = c;
+    }
+
+    /// One byte of an ASCII word and its class (not white space), without branches.
+    fn byte(&mut self, b: u8, class: u8) {
+        let letter = class & LETTER != 0;
+        let v = class == VOWEL;
+        self.any |= class != OTHER;
+        self.letters += usize::from(letter);
+        self.groups += usize::from(v && !self.prev_vowel);
+        self.prev_vowel = if letter { v } else { self.prev_vowel };
+        self.before_last = if letter { self.last } else { self.before_last };
+        self.last = if letter { b | 0x20 } else { self.last };
     }
 
     fn total(self) -> usize {
@@ -337,35 +347,29 @@ impl SpeechTiming {
                 .sum();
         }
         // one pass over the bytes with a class table, no splitting (nearly every text); the
-        // syllables and pauses are counted, and timed once at the end
+        // syllables and pauses are counted, and timed once at the end. Inside a word the state
+        // is updated without branches (a branch per letter class mispredicts on real text).
         let (mut syllables, mut sentences, mut commas) = (0usize, 0usize, 0usize);
         let mut word = Syllables::default();
-        let mut last = None;
-        let mut finish = |word: Syllables, last: u8| {
-            syllables += word.total();
-            match last {
-                b'.' | b'!' | b'?' => sentences += 1,
-                b',' | b';' | b':' => commas += 1,
-                _ => {}
-            }
-        };
+        let mut last = 0u8; // the word's last byte; 0 between words
         for &b in text.as_bytes() {
-            match ASCII_CLASS[usize::from(b)] {
-                SPACE => {
-                    if let Some(l) = last.take() {
-                        finish(std::mem::take(&mut word), l);
-                    }
-                    continue;
+            let class = ASCII_CLASS[usize::from(b)];
+            if class == SPACE {
+                if last != 0 {
+                    syllables += std::mem::take(&mut word).total();
+                    sentences += usize::from(matches!(last, b'.' | b'!' | b'?'));
+                    commas += usize::from(matches!(last, b',' | b';' | b':'));
+                    last = 0;
                 }
-                VOWEL => word.letter_of(b | 0x20, true),
-                CONSONANT => word.letter_of(b | 0x20, false),
-                DIGIT => word.any = true,
-                _ => {}
+                continue;
             }
-            last = Some(b);
+            word.byte(b, class);
+            last = b;
         }
-        if let Some(l) = last {
-            finish(word, l);
+        if last != 0 {
+            syllables += word.total();
+            sentences += usize::from(matches!(last, b'.' | b'!' | b'?'));
+            commas += usize::from(matches!(last, b',' | b';' | b':'));
         }
         syllables as f64 * self.syllable_seconds
             + sentences as f64 * self.sentence_pause
