@@ -34,8 +34,8 @@ impl KindKey {
 #[derive(Default)]
 pub struct Registry {
     engines: Vec<Box<dyn Engine>>,
-    /// (kind, engine index), sorted by name and namespace: found by binary search without
-    /// allocating.
+    /// (kind, engine index), sorted by name length, name and namespace: a lookup finds the few
+    /// names of its length by integer comparisons, then compares bytes only with those.
     kinds: Vec<(KindKey, usize)>,
 }
 
@@ -50,10 +50,9 @@ impl Registry {
         self.engines.push(engine);
         let index = self.engines.len() - 1;
         for k in kinds {
-            match self
-                .kinds
-                .binary_search_by(|(x, _)| (&x.name, &x.ns).cmp(&(&k.name, &k.ns)))
-            {
+            match self.kinds.binary_search_by(|(x, _)| {
+                (x.name.len(), &x.name, &x.ns).cmp(&(k.name.len(), &k.name, &k.ns))
+            }) {
                 Ok(at) => self.kinds[at].1 = index,
                 Err(at) => self.kinds.insert(at, (k.clone(), index)),
             }
@@ -63,12 +62,15 @@ impl Registry {
 
     /// The index of the engine that realizes `behaviour`'s kind.
     pub fn engine_for(&self, behaviour: &Behaviour) -> Option<usize> {
-        // by name first: names differ early, namespaces share long prefixes
-        let key = (behaviour.kind.element_name(), behaviour.kind.namespace());
-        self.kinds
-            .binary_search_by(|(k, _)| (k.name.as_str(), k.ns.as_str()).cmp(&key))
-            .ok()
-            .map(|at| self.kinds[at].1)
+        let (name, ns) = (behaviour.kind.element_name(), behaviour.kind.namespace());
+        let from = self
+            .kinds
+            .partition_point(|(k, _)| k.name.len() < name.len());
+        self.kinds[from..]
+            .iter()
+            .take_while(|(k, _)| k.name.len() == name.len())
+            .find(|(k, _)| k.name == name && k.ns == ns)
+            .map(|&(_, i)| i)
     }
 
     /// Number of engines.
@@ -114,5 +116,47 @@ impl TimingModels for Registry {
     fn model(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         self.engine_for(behaviour)
             .and_then(|i| self.engines[i].timing(behaviour))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bml::{NS_BML, NS_BMLT};
+    use crate::engine::timing::DefaultTimingModels;
+    use crate::engines::timing_only::TimingOnlyEngine;
+
+    #[test]
+    fn kinds_are_found_by_name_and_namespace_and_the_newest_registration_wins() {
+        let models = DefaultTimingModels::default();
+        let mut r = Registry::new();
+        let engine = || Box::new(TimingOnlyEngine::motion(models));
+        // names of equal length ("gesture", "posture", "x:gesture") and one name in two namespaces
+        let a = r.register(
+            engine(),
+            &[
+                KindKey::new(NS_BML, "gesture"),
+                KindKey::new(NS_BML, "posture"),
+                KindKey::new(NS_BML, "head"),
+            ],
+        );
+        let b = r.register(
+            engine(),
+            &[
+                KindKey::new("urn:x", "gesture"),
+                KindKey::new(NS_BMLT, "keyframe"),
+            ],
+        );
+        let c = r.register(engine(), &[KindKey::new(NS_BML, "posture")]);
+        let block = crate::bml::load(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:x="urn:x" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b">
+                <gesture id="g" lexeme="BEAT"/><posture id="p"><stance type="STANDING"/><pose part="WHOLEBODY" lexeme="NEUTRAL"/></posture>
+                <head id="h" lexeme="NOD"/><x:gesture id="xg"/><bmlt:keyframe id="k"/><gaze id="z" target="t"/></bml>"#,
+        )
+        .unwrap()
+        .block;
+        let found: Vec<Option<usize>> = block.behaviours.iter().map(|b| r.engine_for(b)).collect();
+        assert_eq!(found, [Some(a), Some(c), Some(a), Some(b), Some(b), None]);
+        assert_eq!(r.kinds().len(), 5);
     }
 }
