@@ -12,7 +12,10 @@
 mod anticipation;
 mod live;
 
-use std::collections::{HashMap, HashSet, VecDeque};
+use std::collections::VecDeque;
+
+// block ids come from the host: a fast hash (rustc's) instead of SipHash for the block index
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use crate::bml::{self, Diagnostic, SyncPoint};
 use crate::body::{Pose, Skeleton};
@@ -126,10 +129,10 @@ impl BlockManager {
             strategy,
             character,
             blocks: Vec::new(),
-            index: HashMap::new(),
+            index: HashMap::default(),
             lurking: 0,
             finished: VecDeque::new(),
-            finished_set: HashSet::new(),
+            finished_set: HashSet::default(),
             changes: Vec::new(),
             anticipators: Vec::new(),
             retiring: Vec::new(),
