@@ -278,10 +278,10 @@ impl<'i> Tokenizer<'i> {
         let mut colon = None;
         let mut ascii = true;
         while i < b.len() {
-            match b[i] {
-                b' ' | b'\t' | b'\n' | b'\r' | b'/' | b'>' | b'=' | b'<' => break,
-                b':' if colon.is_none() => colon = Some(i),
-                c if c.is_ascii_alphanumeric() || matches!(c, b'_' | b'-' | b'.') => {}
+            match NAME_CLASS[usize::from(b[i])] {
+                NAME_CHAR => {}
+                NAME_END => break,
+                COLON if colon.is_none() => colon = Some(i),
                 _ => ascii = false,
             }
             i += 1;
@@ -477,6 +477,31 @@ impl<'i> Tokenizer<'i> {
         }
     }
 }
+
+const NAME_OTHER: u8 = 0;
+const NAME_CHAR: u8 = 1;
+const NAME_END: u8 = 2;
+const COLON: u8 = 3;
+
+/// Bytes in and after a name: ASCII name characters (letters, digits, `_`, `-`, `.`), the
+/// bytes that end a name (white space, `/`, `>`, `=`, `<`), the colon, and the rest (checked by
+/// the general rule).
+static NAME_CLASS: [u8; 256] = {
+    let mut t = [NAME_OTHER; 256];
+    let mut b = 0;
+    while b < 128 {
+        let c = b as u8;
+        t[b] = match c {
+            b' ' | b'\t' | b'\n' | b'\r' | b'/' | b'>' | b'=' | b'<' => NAME_END,
+            b':' => COLON,
+            b'_' | b'-' | b'.' => NAME_CHAR,
+            _ if c.is_ascii_alphanumeric() => NAME_CHAR,
+            _ => NAME_OTHER,
+        };
+        b += 1;
+    }
+    t
+};
 
 /// Whether `q` is `NCName` or `NCName:NCName`.
 fn is_qname(q: &str) -> bool {
