@@ -177,7 +177,11 @@ impl DiffSystem {
                     }
                     if queued[e.to] == 0 {
                         queued[e.to] = 1;
-                        let tail = (head + len) % n;
+                        let tail = if head + len >= n {
+                            head + len - n
+                        } else {
+                            head + len
+                        };
                         ring[tail] = e.to;
                         len += 1;
                     }
