@@ -62,6 +62,8 @@ pub struct BlockManager {
     character: Option<String>,
     /// Live blocks in arrival order (so sorted by `seq`).
     blocks: Vec<LiveBlock>,
+    /// The blocks' `seq`s, in the same order: searched instead of the large blocks themselves.
+    seqs: Vec<u64>,
     /// Block id → seq, to find a block without scanning.
     index: HashMap<bml::Id, u64>,
     /// How many blocks are LURKING (nothing to check when none is).
@@ -84,15 +86,16 @@ pub struct BlockManager {
 /// Times of other blocks' syncs relative to the start of a block being scheduled.
 struct OtherBlocks<'a> {
     blocks: &'a [LiveBlock],
+    seqs: &'a [u64],
     index: &'a HashMap<bml::Id, u64>,
     anticipators: &'a [Box<dyn Anticipator>],
     start: f64,
 }
 
-/// Where block `id` is in `blocks` (sorted by seq).
-fn position(blocks: &[LiveBlock], index: &HashMap<bml::Id, u64>, id: &str) -> Option<usize> {
+/// Where block `id` is among the blocks whose `seq`s are `seqs` (sorted).
+fn position(seqs: &[u64], index: &HashMap<bml::Id, u64>, id: &str) -> Option<usize> {
     let seq = *index.get(id)?;
-    blocks.binary_search_by_key(&seq, |b| b.seq).ok()
+    seqs.binary_search(&seq).ok()
 }
 
 impl ExternalTimes for OtherBlocks<'_> {
@@ -103,7 +106,7 @@ impl ExternalTimes for OtherBlocks<'_> {
                 behaviour,
                 sync,
             } => {
-                let b = &self.blocks[position(self.blocks, self.index, block)?];
+                let b = &self.blocks[position(self.seqs, self.index, block)?];
                 let local = b.behaviour(behaviour)?.time(sync)?;
                 Some(b.start + local - self.start)
             }
@@ -129,6 +132,7 @@ impl BlockManager {
             strategy,
             character,
             blocks: Vec::new(),
+            seqs: Vec::new(),
             index: HashMap::default(),
             lurking: 0,
             finished: VecDeque::new(),
@@ -246,7 +250,7 @@ impl BlockManager {
                 .iter()
                 .filter(|x| x.phase != Phase::Removed)
                 .map(|x| BehaviourPrediction {
-                    kind: bml::Id::new(b.source.behaviours[x.index].kind.element_name()),
+                    kind: b.source.behaviours[x.index].kind.element_id(),
                     block: b.id.clone(),
                     behaviour: x.id.clone(),
                     syncs: x
@@ -415,6 +419,7 @@ impl BlockManager {
         let schedule = {
             let external = OtherBlocks {
                 blocks: &self.blocks,
+                seqs: &self.seqs,
                 index: &self.index,
                 anticipators: &self.anticipators,
                 start,
@@ -503,6 +508,7 @@ impl BlockManager {
         live.status = BlockStatus::Pending;
         live.preplan = ext.preplan;
         self.index.insert(live.id.clone(), live.seq);
+        self.seqs.push(live.seq);
         self.blocks.push(live);
         let i = self.blocks.len() - 1;
         self.predict(i, true);
@@ -560,7 +566,7 @@ impl BlockManager {
 
     /// Where block `id` is in `self.blocks`.
     fn pos(&self, id: &str) -> Option<usize> {
-        position(&self.blocks, &self.index, id)
+        position(&self.seqs, &self.index, id)
     }
 
     /// A PENDING block that may run: it starts now if nothing holds it back, else it is LURKING
@@ -638,7 +644,10 @@ impl BlockManager {
                 .iter_mut()
                 .filter(|x| x.phase == Phase::Planned)
             {
-                let key = UnitKey::new(&b.id, &x.id);
+                let key = UnitKey {
+                    block: b.id.clone(),
+                    behaviour: x.id.clone(),
+                };
                 let global = x.global(t);
                 let unit = Unit {
                     key: &key,
@@ -745,6 +754,7 @@ impl BlockManager {
     /// Removes block `i` from the plan with end feedback of `status`, then starts what waited.
     fn end_block(&mut self, i: usize, t: f64, status: BlockStatus) {
         let b = self.blocks.remove(i);
+        self.seqs.remove(i);
         self.index.remove(&b.id);
         if b.status == BlockStatus::Lurking {
             self.lurking -= 1;

@@ -5,6 +5,7 @@
 use std::fmt;
 
 use super::diagnostic::Pos;
+use super::model::Id;
 use super::model::{Block, ConstraintItem, ConstraintSync};
 use super::syncref::{fmt_seconds, SyncPoint, SyncRef};
 
@@ -173,7 +174,11 @@ pub fn extract(block: &Block) -> Vec<Constraint> {
     let mut out = Vec::with_capacity(attributes + block.constraints.len());
     for (index, b) in block.behaviours.iter().enumerate() {
         for s in &b.syncs {
-            let own = Anchor::Point(SyncPoint::local(&b.id, s.sync));
+            // the behaviour's id is shared, the standard sync name is static: nothing copied
+            let own = Anchor::Point(SyncPoint::Local {
+                behaviour: b.id.clone(),
+                sync: Id::new_static(s.sync),
+            });
             out.push(Constraint::between(
                 (own, 0.0),
                 Relation::At,

@@ -69,6 +69,22 @@ impl BehaviourKind {
     /// The element's local name.
     pub fn element_name(&self) -> &str {
         match self {
+            BehaviourKind::Unknown(u) => &u.name,
+            k => k.builtin_name(),
+        }
+    }
+
+    /// [`Self::element_name`] as an id: static for the built-in kinds (nothing copied).
+    pub fn element_id(&self) -> super::Id {
+        match self {
+            BehaviourKind::Unknown(u) => super::Id::new(&u.name),
+            k => super::Id::new_static(k.builtin_name()),
+        }
+    }
+
+    /// The local name of a built-in kind (`""` for an unknown extension).
+    fn builtin_name(&self) -> &'static str {
+        match self {
             BehaviourKind::Speech(_) => "speech",
             BehaviourKind::Gesture(_) => "gesture",
             BehaviourKind::Pointing(_) => "pointing",
@@ -96,7 +112,7 @@ impl BehaviourKind {
             BehaviourKind::FaceMorph(_) => "facemorph",
             BehaviourKind::Transition(_) => "transition",
             BehaviourKind::Text(_) => "text",
-            BehaviourKind::Unknown(u) => &u.name,
+            BehaviourKind::Unknown(_) => "",
         }
     }
 
