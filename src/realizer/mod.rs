@@ -141,6 +141,10 @@ impl Realizer {
     fn manager(&mut self, character: Option<String>) -> &mut BlockManager {
         let character = character.or_else(|| self.default_character.clone());
         let key = character.clone().unwrap_or_default();
+        if self.characters.contains_key(&key) {
+            // the usual case: no entry to build
+            return self.characters.get_mut(&key).expect("just found");
+        }
         let now = self.now;
         let (engines, strategy, skeleton, world) =
             (&self.engines, &self.strategy, &self.skeleton, &self.world);
