@@ -98,7 +98,7 @@ type Str<'i> = Cow<'i, str>;
 #[derive(Debug, Clone)]
 struct RawAttr<'i> {
     ns: Ns,
-    name: Str<'i>,
+    name: &'i str,
     value: Str<'i>,
     offset: usize,
 }
@@ -106,10 +106,10 @@ struct RawAttr<'i> {
 #[derive(Debug)]
 struct El<'i> {
     ns: Ns,
-    name: Str<'i>,
-    qname: Str<'i>,
+    name: &'i str,
+    qname: &'i str,
     /// Namespace prefixes used by the tag (element and attribute names).
-    prefixes: Vec<Str<'i>>,
+    prefixes: Vec<&'i str>,
     /// Attributes (xmlns declarations excluded); `Option` so that they can be taken one by one.
     attrs: Vec<Option<RawAttr<'i>>>,
     empty: bool,
@@ -132,7 +132,7 @@ struct Skipped<'i> {
     /// Offset just after the end tag.
     after: usize,
     /// Namespace prefixes used by the tags inside.
-    prefixes: Vec<Str<'i>>,
+    prefixes: Vec<&'i str>,
 }
 
 /// Fatal XML error: parsing stops.
@@ -166,7 +166,7 @@ impl<'i> Attrs<'i> {
     fn take_ext(&mut self, names: &[&str]) -> Option<RawAttr<'i>> {
         self.items
             .iter_mut()
-            .find(|a| matches!(a, Some(a) if a.ns.is_ext() && names.contains(&a.name.as_ref())))
+            .find(|a| matches!(a, Some(a) if a.ns.is_ext() && names.contains(&a.name)))
             .and_then(Option::take)
     }
 
@@ -256,7 +256,7 @@ impl<'i> Parser<'i> {
                 Ns::Other(prefix.to_string())
             }
         };
-        let mut prefixes: Vec<Str<'i>> = prefix.map(Cow::Borrowed).into_iter().collect();
+        let mut prefixes: Vec<&'i str> = prefix.into_iter().collect();
         let n = self.tok.attrs().len();
         let mut attrs: Vec<Option<RawAttr<'i>>> = Vec::with_capacity(n);
         for i in 0..n {
@@ -268,7 +268,7 @@ impl<'i> Parser<'i> {
             let ans = match aprefix {
                 None => Ns::None, // unprefixed attributes are in no namespace
                 Some(p) => {
-                    prefixes.push(Cow::Borrowed(p));
+                    prefixes.push(p);
                     match self.tok.resolve(Some(p)) {
                         Ok(Some(uri)) => match Ns::from_uri(uri) {
                             Ns::Bml => Ns::None,
@@ -317,15 +317,15 @@ impl<'i> Parser<'i> {
             }
             attrs.push(Some(RawAttr {
                 ns: ans,
-                name: Cow::Borrowed(aname),
+                name: aname,
                 value,
                 offset: a.offset,
             }));
         }
         Ok(El {
             ns,
-            name: Cow::Borrowed(name),
-            qname: Cow::Borrowed(qname),
+            name,
+            qname,
             prefixes,
             attrs,
             empty: tag.empty,
@@ -630,7 +630,7 @@ impl<'i> Parser<'i> {
                 );
                 kept.push(ForeignAttr {
                     ns: a.ns.uri().to_string(),
-                    name: a.name.into_owned(),
+                    name: a.name.to_owned(),
                     value: a.value.into_owned(),
                 });
             }
@@ -698,7 +698,7 @@ impl<'i> Parser<'i> {
         let mut items = Vec::new();
         let mut ok = true;
         self.children(&el, |p, mut item| {
-            let kind = match (item.ns.is_core(), item.name.as_ref()) {
+            let kind = match (item.ns.is_core(), item.name) {
                 (true, k @ ("synchronize" | "before" | "after")) => k.to_string(),
                 _ => {
                     p.error(
@@ -789,7 +789,7 @@ impl<'i> Parser<'i> {
 
     fn behaviour(&mut self, mut el: El<'i>, required: bool) -> Result<Option<Behaviour>, Fatal> {
         let core = el.ns.is_core();
-        let name = el.name.as_ref();
+        let name = el.name;
         let known = (core && CORE_BEHAVIOURS.contains(&name))
             || (el.ns == Ns::CoreExt && name == "faceFacs")
             || (el.ns.is_ext() && CONTROL_BEHAVIOURS.contains(&name))
@@ -828,9 +828,9 @@ impl<'i> Parser<'i> {
                 None
             }
         };
-        let qname = el.qname.clone();
+        let qname = el.qname;
         let on = On {
-            qname: &qname,
+            qname,
             id: id.as_deref(),
         };
         if !known {
@@ -852,7 +852,7 @@ impl<'i> Parser<'i> {
                     .rest()
                     .map(|a| ForeignAttr {
                         ns: a.ns.uri().to_string(),
-                        name: a.name.into_owned(),
+                        name: a.name.to_owned(),
                         value: a.value.into_owned(),
                     })
                     .collect(),
@@ -931,7 +931,7 @@ impl<'i> Parser<'i> {
         let mut saw_trajectory = false;
         self.children(el, |p, mut c| {
             let core = c.ns.is_core();
-            match (&mut *kind, c.name.as_ref()) {
+            match (&mut *kind, c.name) {
                 (_, "description") if core => {
                     let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
                     let priority = attrs.take("priority").and_then(|a| {
@@ -1399,7 +1399,7 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
             stance: StanceType::Standing,
             poses: Vec::new(),
         };
-        Some(match self.el.name.as_ref() {
+        Some(match self.el.name {
             "speech" => BehaviourKind::Speech(Speech::default()),
             "text" => BehaviourKind::Text(Speech::default()),
             "gesture" => {
@@ -1589,7 +1589,7 @@ fn split_qname(q: &str) -> (Option<&str>, &str) {
 /// content keeps these so that the writer can declare them again.
 fn used_prefixes(
     scope: Vec<(String, String)>,
-    used: &[Str],
+    used: &[&str],
     known: &[(String, String)],
 ) -> Vec<(String, String)> {
     let mut out: Vec<(String, String)> = known.to_vec();
