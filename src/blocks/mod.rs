@@ -393,7 +393,9 @@ impl BlockManager {
         let chunk_after = self.existing(&block.ext.chunk_after, &block.id);
         let mut start = self.predicted_start(now, &waits_for, &chunk_after);
         // a block tied to another block's sync point that passed a moment ago starts then
+        let mut on_anticipators = false;
         for p in referenced_points(&block) {
+            on_anticipators |= matches!(p, SyncPoint::Anticipator { .. });
             if let SyncPoint::External {
                 block: b,
                 behaviour,
@@ -442,7 +444,11 @@ impl BlockManager {
                 d.reason.clone(),
             );
         }
-        let refs = anticipator_refs(&live.source);
+        let refs = if on_anticipators {
+            anticipator_refs(&live.source)
+        } else {
+            Vec::new()
+        };
         if !refs.is_empty() {
             // its own peg board: anticipator moves retime it without rescheduling (S56)
             let (mut board, mut anticipators) = (PegBoard::new(), Anticipators::default());

@@ -182,7 +182,11 @@ impl TimingModel {
         };
         for (i, k) in self.keys.iter().enumerate() {
             let name = k.name.as_str();
-            if names[..i].contains(&name) {
+            // short names: an inline byte comparison, not a call to memcmp per pair
+            if names[..i]
+                .iter()
+                .any(|n| n.len() == name.len() && n.bytes().eq(name.bytes()))
+            {
                 return Err(format!("key {name} appears twice"));
             }
             names[i] = name;
