@@ -43,15 +43,10 @@ pub(crate) struct LiveBehaviour {
 impl LiveBehaviour {
     /// (sync, global time) for a block that starts at `start`.
     pub(crate) fn global(&self, start: f64) -> Vec<(SyncName, f64)> {
-        let mut out = Vec::with_capacity(self.syncs.len());
-        self.global_into(start, &mut out);
-        out
-    }
-
-    /// [`Self::global`] into `out` (cleared first), to reuse one buffer for many behaviours.
-    pub(crate) fn global_into(&self, start: f64, out: &mut Vec<(SyncName, f64)>) {
-        out.clear();
-        out.extend(self.syncs.iter().map(|(n, l)| (n.clone(), start + l)));
+        self.syncs
+            .iter()
+            .map(|(n, l)| (n.clone(), start + l))
+            .collect()
     }
 
     /// Block-local time of `sync`.

@@ -645,8 +645,6 @@ impl BlockManager {
         let mut failed = Vec::new();
         {
             let b = &mut self.blocks[i];
-            // one buffer for every unit's global sync times (engines copy what they keep)
-            let mut global = Vec::new();
             for x in b
                 .behaviours
                 .iter_mut()
@@ -656,7 +654,7 @@ impl BlockManager {
                     block: b.id.clone(),
                     behaviour: x.id.clone(),
                 };
-                x.global_into(t, &mut global);
+                let global = x.global(t);
                 let unit = Unit {
                     key: &key,
                     behaviour: &b.source.behaviours[x.index],
