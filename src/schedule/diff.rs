@@ -136,7 +136,15 @@ impl DiffSystem {
         // a fill cursor per variable (n), the grouped edge indices (m), the length of the path
         // that gave each variable its value (n), and a ring queue of variables (n) in which each
         // variable is at most once (`queued`, n)
-        let mut scratch = vec![0usize; (n + 1) + n + m + 4 * n];
+        let need = (n + 1) + n + m + 4 * n;
+        // most blocks are small: their scratch lives on the stack
+        let (mut small, mut large) = ([0usize; 128], Vec::new());
+        let scratch: &mut [usize] = if need <= small.len() {
+            &mut small[..need]
+        } else {
+            large.resize(need, 0);
+            &mut large
+        };
         let (start, rest) = scratch.split_at_mut(n + 1);
         let (fill, rest) = rest.split_at_mut(n);
         let (out, rest) = rest.split_at_mut(m);
