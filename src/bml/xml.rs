@@ -216,7 +216,7 @@ impl<'i> Tokenizer<'i> {
 
     /// Skips past `close`, or fails with an unclosed `what`.
     fn skip_to(&mut self, start: usize, close: &str, what: &str) -> Result<(), XmlError> {
-        match memchr::memmem::find(&self.bytes()[start + 2..], close.as_bytes()) {
+        match find(&self.bytes()[start + 2..], close.as_bytes()) {
             Some(i) => {
                 self.pos = start + 2 + i + close.len();
                 Ok(())
@@ -229,13 +229,13 @@ impl<'i> Tokenizer<'i> {
     fn bang(&mut self, start: usize) -> Result<Option<&'i str>, XmlError> {
         let rest = &self.src[start..];
         if let Some(body) = rest.strip_prefix("<!--") {
-            match memchr::memmem::find(body.as_bytes(), b"-->") {
+            match find(body.as_bytes(), b"-->") {
                 Some(i) => self.pos = start + 4 + i + 3,
                 None => return err(start, "the comment is never closed"),
             }
             Ok(None)
         } else if let Some(body) = rest.strip_prefix("<![CDATA[") {
-            match memchr::memmem::find(body.as_bytes(), b"]]>") {
+            match find(body.as_bytes(), b"]]>") {
                 Some(i) => {
                     self.pos = start + 9 + i + 3;
                     Ok(Some(&body[..i]))
@@ -503,6 +503,20 @@ static NAME_CLASS: [u8; 256] = {
     t
 };
 
+/// The first occurrence of `needle` (a short closing delimiter) in `haystack`: a search for its
+/// first byte, then a comparison (no searcher to build for a comment of a few hundred bytes).
+fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
+    let mut from = 0;
+    while let Some(i) = memchr::memchr(needle[0], &haystack[from..]) {
+        let at = from + i;
+        if haystack[at..].starts_with(needle) {
+            return Some(at);
+        }
+        from = at + 1;
+    }
+    None
+}
+
 /// Whether `q` is `NCName` or `NCName:NCName`.
 fn is_qname(q: &str) -> bool {
     match q.split_once(':') {
@@ -649,6 +663,16 @@ mod tests {
         );
         assert_eq!(unescape("a&amp;b&quot;", 10).unwrap(), "a&b\"");
         assert_eq!(unescape("a&bogus;", 10).unwrap_err().offset, 11);
+    }
+
+    #[test]
+    fn closing_delimiters_are_found_after_partial_matches() {
+        assert_eq!(find(b"a - b -- c --->", b"-->"), Some(12));
+        assert_eq!(find(b"x]]]>", b"]]>"), Some(2));
+        assert_eq!(find(b"no end -- here", b"-->"), None);
+        assert_eq!(find(b"ends with --", b"-->"), None);
+        assert_eq!(find(b"", b"?>"), None);
+        assert_eq!(events("<a><!-- - -- ---><b/></a>")[1], "<b/ Ok(None)@17");
     }
 
     #[test]
