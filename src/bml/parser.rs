@@ -1,6 +1,6 @@
-//! The streaming BML parser (over the tokenizer in `xml.rs`): text → [`Block`], with every problem reported as a
-//! [`Diagnostic`] at its line:column. Structure, attribute values and sync reference syntax are
-//! checked here; cross-references are checked by `validate.rs`.
+//! The streaming BML parser (over the tokenizer in `xml.rs`): text → [`Block`], with every
+//! problem reported as a [`Diagnostic`] at its line:column. Structure, attribute values and sync
+//! reference syntax are checked here; cross-references are checked by `validate.rs`.
 
 use std::borrow::Cow;
 use std::fmt;
