@@ -1,10 +1,19 @@
 //! XML name rules (the NCName production of Namespaces in XML), shared by the BML parser and the
-//! feedback codecs.
+//! feedback codecs, and the comparison of short names used in lookups.
 
 /// Whether `c` is outside XML 1.0's `Char` production (C0 controls but tab, LF, CR; U+FFFE, U+FFFF),
 /// i.e. may appear in an XML document neither literally nor as a character reference.
 pub(crate) fn is_forbidden_char(c: char) -> bool {
     ((c as u32) < 0x20 && !matches!(c, '\t' | '\n' | '\r')) || c == '\u{FFFE}' || c == '\u{FFFF}'
+}
+
+/// Whether two short names (ids, sync names, element names) are equal: length and first byte
+/// first, then the bytes inline. Most candidates in a lookup differ there, and no call to
+/// `memcmp` is made per candidate.
+#[inline]
+pub(crate) fn same_name(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    a.len() == b.len() && a.first() == b.first() && a.iter().zip(b).all(|(x, y)| x == y)
 }
 
 /// Whether `s` is an XML name without colons (the NCName production of Namespaces in XML).
@@ -36,6 +45,23 @@ pub(crate) fn is_ncname(s: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::is_ncname;
+
+    #[test]
+    fn same_names() {
+        use super::same_name;
+        for (a, b, same) in [
+            ("start", "start", true),
+            ("start", "stArt", false),
+            ("start", "ready", false),
+            ("stroke", "strokeEnd", false),
+            ("", "", true),
+            ("é", "é", true),
+            ("é", "è", false),
+        ] {
+            assert_eq!(same_name(a, b), same, "{a} {b}");
+            assert_eq!(same_name(a, b), a == b);
+        }
+    }
 
     #[test]
     fn ncnames() {

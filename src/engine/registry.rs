@@ -69,7 +69,7 @@ impl Registry {
         self.kinds[from..]
             .iter()
             .take_while(|(k, _)| k.name.len() == name.len())
-            .find(|(k, _)| k.name == name && k.ns == ns)
+            .find(|(k, _)| crate::xmlname::same_name(&k.name, name) && k.ns == ns)
             .map(|&(_, i)| i)
     }
 

@@ -142,7 +142,9 @@ impl TimingModel {
 
     /// Index of the key named `name`.
     pub fn key(&self, name: &str) -> Option<usize> {
-        self.keys.iter().position(|k| k.name == name)
+        self.keys
+            .iter()
+            .position(|k| crate::xmlname::same_name(&k.name, name))
     }
 
     /// Checks the model's invariants: at least `start` and `end`, `start` first at 0, `end` last and
@@ -182,10 +184,9 @@ impl TimingModel {
         };
         for (i, k) in self.keys.iter().enumerate() {
             let name = k.name.as_str();
-            // short names: an inline byte comparison, not a call to memcmp per pair
             if names[..i]
                 .iter()
-                .any(|n| n.len() == name.len() && n.bytes().eq(name.bytes()))
+                .any(|n| crate::xmlname::same_name(n, name))
             {
                 return Err(format!("key {name} appears twice"));
             }
