@@ -7,6 +7,7 @@ use crate::feedback::BlockStatus;
 use crate::plan::pegs::PegBoard;
 use crate::schedule::to_pegs::{Anticipators, PlannedBlock};
 use crate::schedule::{BlockSchedule, SyncName};
+use crate::xmlname::same_name;
 
 /// Where a behaviour is in its life.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -183,7 +184,12 @@ impl LiveBlock {
     /// Takes the scheduled behaviours (in document order) and their engines.
     pub(crate) fn set_schedule(&mut self, schedule: BlockSchedule, registry: &Registry) {
         for s in schedule.behaviours {
-            let Some(index) = self.source.behaviours.iter().position(|b| b.id == s.id) else {
+            let Some(index) = self
+                .source
+                .behaviours
+                .iter()
+                .position(|b| same_name(&b.id, &s.id))
+            else {
                 continue;
             };
             let Some(engine) = registry.engine_for(&self.source.behaviours[index]) else {
@@ -236,7 +242,7 @@ impl LiveBlock {
     }
 
     pub(crate) fn behaviour(&self, id: &str) -> Option<&LiveBehaviour> {
-        self.behaviours.iter().find(|b| b.id == id)
+        self.behaviours.iter().find(|b| same_name(&b.id, id))
     }
 
     /// Whether the block has started (IN_EXEC or SUBSIDING).

@@ -10,6 +10,7 @@ use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
 use super::xml::{self, Event, Tag, Tokenizer, XmlError};
+use crate::xmlname::same_name;
 
 /// A parsed block together with the warnings found while reading it.
 #[derive(Debug, Clone, PartialEq)]
@@ -159,7 +160,7 @@ impl<'i> Attrs<'i> {
     fn take(&mut self, name: &str) -> Option<RawAttr<'i>> {
         self.items
             .iter_mut()
-            .find(|a| matches!(a, Some(a) if a.ns == Ns::None && a.name == name))
+            .find(|a| matches!(a, Some(a) if a.ns == Ns::None && same_name(a.name, name)))
             .and_then(Option::take)
     }
 
@@ -901,7 +902,7 @@ impl<'i> Parser<'i> {
         for slot in attrs.items.iter_mut() {
             let Some(name) = slot.as_ref().and_then(|a| {
                 (a.ns == Ns::None)
-                    .then(|| names.iter().find(|n| **n == a.name).copied())
+                    .then(|| names.iter().find(|n| same_name(n, a.name)).copied())
                     .flatten()
             }) else {
                 continue;

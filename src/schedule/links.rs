@@ -108,7 +108,10 @@ impl<'a> IdIndex<'a> {
             let at = self.ids.partition_point(|(k, _)| *k < id);
             self.ids.get(at).filter(|(k, _)| *k == id).map(|(_, i)| *i)
         } else {
-            self.ids.iter().find(|(k, _)| *k == id).map(|(_, i)| *i)
+            self.ids
+                .iter()
+                .find(|(k, _)| crate::xmlname::same_name(k, id))
+                .map(|(_, i)| *i)
         }
     }
 }
