@@ -286,8 +286,8 @@ struct Syllables {
     letters: usize,
     any: bool,
     prev_vowel: bool,
-    last: u8,
-    before_last: u8,
+    /// The last letter is an `e` after a letter that is not a vowel ("make").
+    e_end: bool,
 }
 
 impl Syllables {
@@ -301,9 +301,8 @@ impl Syllables {
         self.any = true;
         self.letters += 1;
         self.groups += usize::from(v && !self.prev_vowel);
+        self.e_end = c == b'e' && !self.prev_vowel;
         self.prev_vowel = v;
-        self.before_last = self.last;
-        self.last = c;
     }
 
     /// One byte of an ASCII word and its class (not white space), without branches.
@@ -313,9 +312,9 @@ impl Syllables {
         self.any |= class != OTHER;
         self.letters += usize::from(letter);
         self.groups += usize::from(v && !self.prev_vowel);
+        let e_end = b | 0x20 == b'e' && !self.prev_vowel;
+        self.e_end = if letter { e_end } else { self.e_end };
         self.prev_vowel = if letter { v } else { self.prev_vowel };
-        self.before_last = if letter { self.last } else { self.before_last };
-        self.last = if letter { b | 0x20 } else { self.last };
     }
 
     fn total(self) -> usize {
@@ -323,10 +322,7 @@ impl Syllables {
             return 0;
         }
         // a silent final e ("make") does not count
-        let silent_e = self.letters > 2
-            && self.last == b'e'
-            && !Self::vowel(self.before_last)
-            && self.groups > 1;
+        let silent_e = self.letters > 2 && self.e_end && self.groups > 1;
         (self.groups - usize::from(silent_e)).max(1)
     }
 }
