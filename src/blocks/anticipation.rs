@@ -140,7 +140,7 @@ impl BlockManager {
                 }
             }
             if matches!(x.phase, Phase::Added | Phase::Running) {
-                let key = UnitKey::new(&block_id, &x.id);
+                let key = UnitKey::new(block_id.clone(), x.id.clone());
                 self.registry
                     .engine_mut(x.engine)
                     .retime(&key, &x.global(start));
@@ -154,7 +154,7 @@ impl BlockManager {
                 self.interrupt_unit(i, xi, t);
             } else {
                 if x.phase == Phase::Added {
-                    let key = UnitKey::new(&block_id, &x.id);
+                    let key = UnitKey::new(block_id.clone(), x.id.clone());
                     self.registry.engine_mut(x.engine).remove(&key);
                 }
                 self.blocks[i].behaviours[xi].phase = Phase::Removed;

@@ -650,10 +650,7 @@ impl BlockManager {
                 .iter_mut()
                 .filter(|x| x.phase == Phase::Planned)
             {
-                let key = UnitKey {
-                    block: b.id.clone(),
-                    behaviour: x.id.clone(),
-                };
+                let key = UnitKey::new(b.id.clone(), x.id.clone());
                 let global = x.global(t);
                 let unit = Unit {
                     key: &key,
@@ -766,7 +763,7 @@ impl BlockManager {
             self.lurking -= 1;
         }
         for x in &b.behaviours {
-            let key = UnitKey::new(&b.id, &x.id);
+            let key = UnitKey::new(b.id.clone(), x.id.clone());
             match x.phase {
                 // it reached its end: it shows its last moment in this frame, then goes
                 Phase::Ended => self.retiring.push((x.engine, key)),
@@ -842,7 +839,7 @@ impl BlockManager {
     fn interrupt_unit(&mut self, bi: usize, xi: usize, t: f64) {
         let b = &self.blocks[bi];
         let (start, x) = (b.start, &b.behaviours[xi]);
-        let key = UnitKey::new(&b.id, &x.id);
+        let key = UnitKey::new(b.id.clone(), x.id.clone());
         let times = self
             .registry
             .engine_mut(x.engine)
@@ -883,7 +880,7 @@ impl BlockManager {
             match x.phase {
                 Phase::Planned => self.blocks[i].behaviours[xi].phase = Phase::Removed,
                 Phase::Added => {
-                    let key = UnitKey::new(&self.blocks[i].id, &x.id);
+                    let key = UnitKey::new(self.blocks[i].id.clone(), x.id.clone());
                     self.registry.engine_mut(x.engine).remove(&key);
                     self.blocks[i].behaviours[xi].phase = Phase::Removed;
                 }
@@ -1056,7 +1053,7 @@ impl BlockManager {
             )
         };
         self.sync_feedback(&block_id, &beh_id, &sync, local, t);
-        let key = UnitKey::new(&block_id, &beh_id);
+        let key = UnitKey::new(block_id.clone(), beh_id.clone());
         let mut actions = Vec::new();
         self.registry
             .engine_mut(engine)

@@ -27,8 +27,8 @@ pub struct UnitKey {
 }
 
 impl UnitKey {
-    /// The key of `block:behaviour`.
-    pub fn new(block: &str, behaviour: &str) -> Self {
+    /// The key of `block:behaviour` (ids are shared, not copied, when given as `bml::Id`s).
+    pub fn new(block: impl Into<crate::bml::Id>, behaviour: impl Into<crate::bml::Id>) -> Self {
         UnitKey {
             block: block.into(),
             behaviour: behaviour.into(),

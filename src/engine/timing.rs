@@ -173,24 +173,15 @@ impl TimingModel {
                 ));
             }
         }
-        // names read once (a few keys: pairwise is cheapest), on the stack for the usual counts
-        let mut small = [""; 16];
-        let mut large = Vec::new();
-        let names: &mut [&str] = if self.keys.len() <= small.len() {
-            &mut small[..self.keys.len()]
-        } else {
-            large.resize(self.keys.len(), "");
-            &mut large
-        };
+        // unique names: a few keys, so pairwise is cheapest
         for (i, k) in self.keys.iter().enumerate() {
             let name = k.name.as_str();
-            if names[..i]
+            if self.keys[..i]
                 .iter()
-                .any(|n| crate::xmlname::same_name(n, name))
+                .any(|e| crate::xmlname::same_name(&e.name, name))
             {
                 return Err(format!("key {name} appears twice"));
             }
-            names[i] = name;
         }
         Ok(())
     }
@@ -297,12 +288,7 @@ impl Syllables {
 
     /// One letter, lower-cased (0 for a letter outside ASCII).
     fn letter(&mut self, c: u8) {
-        let v = Self::vowel(c);
-        self.any = true;
-        self.letters += 1;
-        self.groups += usize::from(v && !self.prev_vowel);
-        self.e_end = c == b'e' && !self.prev_vowel;
-        self.prev_vowel = v;
+        self.byte(c, if Self::vowel(c) { VOWEL } else { CONSONANT });
     }
 
     /// One byte of an ASCII word and its class (not white space), without branches.
