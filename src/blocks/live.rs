@@ -183,6 +183,7 @@ impl LiveBlock {
 
     /// Takes the scheduled behaviours (in document order) and their engines.
     pub(crate) fn set_schedule(&mut self, schedule: BlockSchedule, registry: &Registry) {
+        self.behaviours.reserve_exact(schedule.behaviours.len());
         for s in schedule.behaviours {
             let Some(index) = self
                 .source

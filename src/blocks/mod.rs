@@ -181,6 +181,12 @@ impl BlockManager {
         std::mem::take(&mut self.out)
     }
 
+    /// Moves the feedback produced so far to the end of `to`; the manager keeps its list's
+    /// capacity for the next messages.
+    pub fn move_feedback(&mut self, to: &mut Vec<Feedback>) {
+        to.append(&mut self.out);
+    }
+
     /// What the manager holds.
     pub fn sizes(&self) -> Sizes {
         Sizes {
@@ -651,11 +657,10 @@ impl BlockManager {
                 .filter(|x| x.phase == Phase::Planned)
             {
                 let key = UnitKey::new(b.id.clone(), x.id.clone());
-                let global = x.global(t);
                 let unit = Unit {
                     key: &key,
                     behaviour: &b.source.behaviours[x.index],
-                    syncs: &global,
+                    syncs: x.global(t),
                     world: &self.world,
                 };
                 match self.registry.engine_mut(x.engine).add(unit) {

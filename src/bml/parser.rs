@@ -897,14 +897,21 @@ impl<'i> Parser<'i> {
         names: &[&'static str],
         on: &dyn fmt::Display,
     ) -> Vec<SyncAttr> {
-        // in document order
-        let mut out = Vec::new();
+        let sync_name = |a: &RawAttr| {
+            (a.ns == Ns::None)
+                .then(|| names.iter().find(|n| same_name(n, a.name)).copied())
+                .flatten()
+        };
+        // in document order; the list is kept with the behaviour, so it gets its exact size
+        let count = attrs
+            .items
+            .iter()
+            .flatten()
+            .filter(|a| sync_name(a).is_some())
+            .count();
+        let mut out = Vec::with_capacity(count);
         for slot in attrs.items.iter_mut() {
-            let Some(name) = slot.as_ref().and_then(|a| {
-                (a.ns == Ns::None)
-                    .then(|| names.iter().find(|n| same_name(n, a.name)).copied())
-                    .flatten()
-            }) else {
+            let Some(name) = slot.as_ref().and_then(sync_name) else {
                 continue;
             };
             let Some(a) = slot.take() else { continue };

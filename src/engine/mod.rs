@@ -144,14 +144,15 @@ pub fn named_param(params: &[(String, f64)], name: &str) -> Option<f64> {
 
 /// A scheduled behaviour handed to its engine: the behaviour and its sync points' global times
 /// (in sync order; a persistent end is infinite).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Unit<'a> {
     /// Which unit.
     pub key: &'a UnitKey,
     /// The behaviour as written.
     pub behaviour: &'a Behaviour,
-    /// (sync name, global time) in sync order.
-    pub syncs: &'a [(SyncName, f64)],
+    /// (sync name, global time) in sync order; the unit's own list, which [`Units::add`] keeps
+    /// without copying it.
+    pub syncs: SyncTimes,
     /// The world as it is when the unit is added (targets).
     pub world: &'a World,
 }
@@ -410,7 +411,7 @@ impl<T> Units<T> {
     /// Adds a unit with the engine's own data `data`.
     pub fn add(&mut self, unit: Unit<'_>, data: T) {
         self.units
-            .push((Arc::new(unit.key.clone()), unit.syncs.to_vec(), data));
+            .push((Arc::new(unit.key.clone()), unit.syncs, data));
     }
 
     /// Forgets a unit.

@@ -366,10 +366,16 @@ impl SpeechTiming {
     /// The rigid timing of a speech: `start`, each inline sync at the boundary where it is written,
     /// `end` after the last word. An empty text lasts one syllable.
     pub fn model(&self, speech: &Speech) -> TimingModel {
-        let mut keys = vec![SyncKey {
+        let syncs = speech
+            .text
+            .iter()
+            .filter(|p| matches!(p, TextPart::Sync(_)))
+            .count();
+        let mut keys = Vec::with_capacity(syncs + 2);
+        keys.push(SyncKey {
             name: crate::bml::Id::new_static("start"),
             at: 0.0,
-        }];
+        });
         let mut t = 0.0;
         for part in &speech.text {
             match part {

@@ -934,7 +934,7 @@ mod tests {
             e.add(Unit {
                 key: &key,
                 behaviour: &block.behaviours[0],
-                syncs: &syncs,
+                syncs,
                 world: &world,
             })
             .unwrap();

@@ -172,11 +172,15 @@ impl Realizer {
         match block {
             Some(block) if errors.is_empty() => {
                 let world = self.world.clone();
+                // the manager's feedback moves straight into the frame's list (no list per block)
+                let mut unframed = std::mem::take(&mut self.unframed);
+                let from = unframed.len();
                 let m = self.manager(block.character_id.clone());
                 m.set_world(&world);
                 m.submit(block, &diagnostics);
-                let fb = m.take_feedback();
-                self.deliver(fb);
+                m.move_feedback(&mut unframed);
+                self.unframed = unframed;
+                self.deliver(from);
                 Ok(())
             }
             block => {
@@ -194,7 +198,7 @@ impl Realizer {
                     .map(|d| format!("{}:{}: {}", d.pos.line, d.pos.col, d.message))
                     .collect::<Vec<_>>()
                     .join("; ");
-                self.deliver(vec![Feedback::Warning(WarningFeedback {
+                self.unframed.push(Feedback::Warning(WarningFeedback {
                     id,
                     kind: KnownWarning::ParsingFailure.into(),
                     character_id,
@@ -203,7 +207,8 @@ impl Realizer {
                     } else {
                         text
                     },
-                })]);
+                }));
+                self.deliver(self.unframed.len() - 1);
                 let mut diagnostics = diagnostics;
                 diagnostics.retain(Diagnostic::is_error);
                 Err(BmlError(diagnostics))
@@ -216,12 +221,14 @@ impl Realizer {
         self.listeners.push(listener);
     }
 
-    fn deliver(&mut self, mut feedback: Vec<Feedback>) {
+    /// Stamps and hands to the listeners the feedback from `unframed[from..]`, which is new.
+    fn deliver(&mut self, from: usize) {
+        let feedback = &mut self.unframed[from..];
         if self.posix_time {
             let ms = SystemTime::now()
                 .duration_since(UNIX_EPOCH)
                 .map_or(0, |d| d.as_millis() as u64);
-            for fb in &mut feedback {
+            for fb in feedback.iter_mut() {
                 match fb {
                     Feedback::BlockProgress(p) => p.posix_time = Some(ms),
                     Feedback::SyncPointProgress(p) => p.posix_time = Some(ms),
@@ -229,12 +236,11 @@ impl Realizer {
                 }
             }
         }
-        for fb in &feedback {
+        for fb in feedback.iter() {
             for l in &mut self.listeners {
                 l.feedback(fb);
             }
         }
-        self.unframed.extend(feedback);
     }
 
     /// Moves time to `now` (never backwards): every character passes the sync points up to then
@@ -251,12 +257,12 @@ impl Realizer {
             time: now,
             ..Frame::default()
         };
-        let mut feedback = Vec::new();
+        let from = self.unframed.len();
         for m in self.characters.values_mut() {
             m.advance(now, &self.world, &mut frame);
-            feedback.extend(m.take_feedback());
+            m.move_feedback(&mut self.unframed);
         }
-        self.deliver(feedback);
+        self.deliver(from);
         frame.feedback = std::mem::take(&mut self.unframed);
         frame
     }
