@@ -1,6 +1,7 @@
 //! Diagnostics for BML input: source positions, severities, the stable diagnostic codes and the
 //! error type returned when a block cannot be accepted.
 
+use std::cell::Cell;
 use std::fmt;
 
 /// A position in the source text: 1-based line and column (column counted in characters).
@@ -37,11 +38,34 @@ pub struct LineIndex {
     ascii_until: Vec<usize>,
 }
 
+thread_local! {
+    /// Line starts of an index that is gone, kept for the next one on this thread: indexing one
+    /// small block after another allocates nothing.
+    static SPARE_STARTS: Cell<Vec<usize>> = const { Cell::new(Vec::new()) };
+}
+
+/// Longer lists of line starts are not kept.
+const SPARE_LINES: usize = 4096;
+
+impl Drop for LineIndex {
+    fn drop(&mut self) {
+        if self.starts.capacity() <= SPARE_LINES {
+            let starts = std::mem::take(&mut self.starts);
+            let _ = SPARE_STARTS.try_with(|s| s.set(starts));
+        }
+    }
+}
+
 impl LineIndex {
     /// Index the line starts of `src`.
     pub fn new(src: &str) -> Self {
         let bytes = src.as_bytes();
-        let mut starts = Vec::with_capacity(bytes.len() / 32 + 1);
+        let mut starts = SPARE_STARTS
+            .try_with(Cell::take)
+            .ok()
+            .filter(|v| v.capacity() > 0)
+            .unwrap_or_else(|| Vec::with_capacity(bytes.len() / 32 + 1));
+        starts.clear();
         starts.push(0);
         starts.extend(memchr::memchr_iter(b'\n', bytes).map(|i| i + 1));
         // an ASCII text (nearly every block) needs no second table: columns are byte counts

@@ -3,6 +3,7 @@
 //! reference syntax are checked here; cross-references are checked by `validate.rs`.
 
 use std::borrow::Cow;
+use std::cell::Cell;
 use std::fmt;
 
 use super::diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos};
@@ -39,6 +40,10 @@ pub fn parse(src: &str) -> Result<Parsed, BmlError> {
 pub fn parse_with_diagnostics(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
     let mut p = Parser::new(src);
     let block = p.document();
+    let spare = std::mem::take(&mut p.spare_attrs);
+    if spare.capacity() <= SPARE_ATTRS_MAX {
+        let _ = SPARE_ATTRS.try_with(|s| s.set(xml::recycle(spare)));
+    }
     let mut diags = p.diags;
     diags.sort_by_key(|d| (d.pos.line, d.pos.col));
     (block, diags)
@@ -145,7 +150,17 @@ struct Parser<'i> {
     lines: LineIndex,
     diags: Vec<Diagnostic>,
     pending: Option<Tok<'i>>,
+    /// An emptied attribute list, for the next element (one list serves a whole block).
+    spare_attrs: Vec<Option<RawAttr<'i>>>,
 }
+
+thread_local! {
+    /// The attribute list of the last parse on this thread, for the next one.
+    static SPARE_ATTRS: Cell<Vec<Option<RawAttr<'static>>>> = const { Cell::new(Vec::new()) };
+}
+
+/// Longer attribute lists are not kept between parses.
+const SPARE_ATTRS_MAX: usize = 64;
 
 /// Remaining attributes of an element, taken one by one by name.
 struct Attrs<'i> {
@@ -186,6 +201,10 @@ impl<'i> Parser<'i> {
             lines: LineIndex::new(src),
             diags: Vec::new(),
             pending: None,
+            spare_attrs: SPARE_ATTRS
+                .try_with(Cell::take)
+                .map(xml::recycle)
+                .unwrap_or_default(),
         }
     }
 
@@ -259,7 +278,8 @@ impl<'i> Parser<'i> {
         };
         let mut prefixes: Vec<&'i str> = prefix.into_iter().collect();
         let n = self.tok.attrs().len();
-        let mut attrs: Vec<Option<RawAttr<'i>>> = Vec::with_capacity(n);
+        let mut attrs = std::mem::take(&mut self.spare_attrs);
+        attrs.reserve(n);
         for i in 0..n {
             let a = self.tok.attrs()[i];
             if a.declares().is_some() {
@@ -612,7 +632,8 @@ impl<'i> Parser<'i> {
     /// Reports leftover attributes: unprefixed ones are errors, extension ones warnings (kept).
     fn leftover_attrs(&mut self, attrs: Attrs<'i>, on: &dyn fmt::Display) -> Vec<ForeignAttr> {
         let mut kept = Vec::new();
-        for a in attrs.rest() {
+        let mut items = attrs.items;
+        for a in items.drain(..).flatten() {
             if a.ns == Ns::None {
                 self.error(
                     Code::UnknownAttribute,
@@ -636,6 +657,8 @@ impl<'i> Parser<'i> {
                 });
             }
         }
+        // the emptied list serves the next element
+        self.spare_attrs = items;
         kept
     }
 

@@ -5,6 +5,7 @@
 //! offset. Made for short BML blocks: no allocation for a tag, its attributes or plain text.
 
 use std::borrow::Cow;
+use std::cell::Cell;
 
 use crate::xmlname::{is_forbidden_char, is_ncname};
 
@@ -98,6 +99,30 @@ struct Open<'i> {
     bindings: usize,
 }
 
+/// The tokenizer's lists, kept between tokenizers on one thread, so that parsing one small block
+/// after another allocates no scratch space.
+struct Spare {
+    open: Vec<Open<'static>>,
+    bindings: Vec<(&'static str, Cow<'static, str>)>,
+    attrs: Vec<Attr<'static>>,
+}
+
+/// Lists longer than this are not kept (a rare huge block should not pin its memory).
+const SPARE_MAX: usize = 64;
+
+thread_local! {
+    static SPARE: Cell<Option<Spare>> = const { Cell::new(None) };
+}
+
+/// `v` emptied and retyped (here: only its lifetime), keeping its allocation: collecting a
+/// by-value iterator into elements of the same size and alignment reuses the buffer.
+pub(crate) fn recycle<T, U>(mut v: Vec<T>) -> Vec<U> {
+    v.clear();
+    v.into_iter()
+        .map(|_| unreachable!("the list is empty"))
+        .collect()
+}
+
 /// The tokenizer: a cursor over the input plus the open elements and namespace bindings.
 pub(crate) struct Tokenizer<'i> {
     src: &'i str,
@@ -112,17 +137,59 @@ pub(crate) struct Tokenizer<'i> {
     close_empty: Option<usize>,
 }
 
+impl Drop for Tokenizer<'_> {
+    /// Leaves the lists to the next tokenizer on this thread.
+    fn drop(&mut self) {
+        let (open, bindings, attrs) = (
+            std::mem::take(&mut self.open),
+            std::mem::take(&mut self.bindings),
+            std::mem::take(&mut self.attrs),
+        );
+        if open
+            .capacity()
+            .max(bindings.capacity())
+            .max(attrs.capacity())
+            <= SPARE_MAX
+        {
+            let spare = Spare {
+                open: recycle(open),
+                bindings: recycle(bindings),
+                attrs: recycle(attrs),
+            };
+            let _ = SPARE.try_with(|s| s.set(Some(spare)));
+        }
+    }
+}
+
 impl<'i> Tokenizer<'i> {
     /// A tokenizer at the start of `src`.
     pub fn new(src: &'i str) -> Self {
         Tokenizer {
             src,
             pos: 0,
-            open: Vec::with_capacity(8),
-            bindings: Vec::with_capacity(4),
-            attrs: Vec::with_capacity(8),
+            open: Vec::new(),
+            bindings: Vec::new(),
+            attrs: Vec::new(),
             close_empty: None,
         }
+        .with_spare_lists()
+    }
+
+    /// Takes this thread's spare lists, or allocates new ones.
+    fn with_spare_lists(mut self) -> Self {
+        match SPARE.try_with(Cell::take).ok().flatten() {
+            Some(spare) => {
+                self.open = recycle(spare.open);
+                self.bindings = recycle(spare.bindings);
+                self.attrs = recycle(spare.attrs);
+            }
+            None => {
+                self.open = Vec::with_capacity(8);
+                self.bindings = Vec::with_capacity(4);
+                self.attrs = Vec::with_capacity(8);
+            }
+        }
+        self
     }
 
     /// The attributes of the last start tag, in source order.
@@ -275,6 +342,10 @@ impl<'i> Tokenizer<'i> {
         // the common case in one pass: ASCII letters, digits, '_', '-', '.' and at most one ':'
         // not at either end, starting with a letter or '_'
         let mut i = at;
+        // plain name characters (nearly every byte of every name) in a tight loop first
+        while i < b.len() && NAME_CLASS[usize::from(b[i])] == NAME_CHAR {
+            i += 1;
+        }
         let mut colon = None;
         let mut ascii = true;
         while i < b.len() {

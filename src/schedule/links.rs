@@ -1,6 +1,8 @@
 //! Behaviours and constraints prepared for a strategy: each behaviour with its timing model, and
 //! each normalised constraint resolved to sync keys of those behaviours or to known times.
 
+use smallvec::SmallVec;
+
 use super::strategy::{Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour};
 use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
 use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
@@ -83,18 +85,23 @@ pub(crate) fn items<'b>(
     items
 }
 
+/// Up to this many ids are searched one by one (see [`IdIndex`]).
+const ID_INDEX_LINEAR: usize = 16;
+
 /// Positions of ids in a list: a linear scan for the few behaviours of a typical block, a binary
 /// search over a sorted copy for large ones (cheaper than hashing either way).
 pub(crate) struct IdIndex<'a> {
-    ids: Vec<(&'a str, usize)>,
+    /// Inline for a typical block: building the index allocates nothing.
+    ids: SmallVec<[(&'a str, usize); ID_INDEX_LINEAR]>,
     sorted: bool,
 }
 
 impl<'a> IdIndex<'a> {
-    const LINEAR: usize = 16;
+    const LINEAR: usize = ID_INDEX_LINEAR;
 
     pub(crate) fn new(ids: impl Iterator<Item = &'a str>) -> Self {
-        let mut ids: Vec<(&str, usize)> = ids.enumerate().map(|(i, id)| (id, i)).collect();
+        let mut ids: SmallVec<[(&str, usize); ID_INDEX_LINEAR]> =
+            ids.enumerate().map(|(i, id)| (id, i)).collect();
         let sorted = ids.len() > Self::LINEAR;
         if sorted {
             ids.sort_unstable();

@@ -72,10 +72,15 @@ impl SchedulingStrategy for Optimal {
                     }
                 },
             };
+            // `times` holds each item's key times one item after the other
+            let mut rest = times.as_slice();
             let mut behaviours: Vec<ScheduledBehaviour> = items
                 .into_iter()
-                .zip(times)
-                .map(|(it, t)| scheduled(it, &t, 0.0))
+                .map(|it| {
+                    let (t, after) = rest.split_at(it.len);
+                    rest = after;
+                    scheduled(it, t, 0.0)
+                })
                 .collect();
             // document order
             let pos = IdIndex::new(block.behaviours.iter().map(|b| b.id.as_str()));
@@ -260,8 +265,9 @@ fn feasible(items: &[Item], links: &[Link], constraints: &[Constraint]) -> Resul
 }
 
 /// Every behaviour at its preferred timing: one variable per behaviour start. `None` if the
-/// constraints need some behaviour to stretch.
-fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
+/// constraints need some behaviour to stretch. The times of each item's keys, item after item
+/// (as from all the strategies below).
+fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
     let block = s.var(0.0);
     // item i's start is variable i + 1
@@ -284,24 +290,17 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
     if x[block] > EPSILON {
         return None;
     }
-    Some(
-        items
-            .iter()
-            .enumerate()
-            .map(|(i, it)| {
-                it.model.keys[..it.len]
-                    .iter()
-                    .map(|k| x[i + 1] + k.at)
-                    .collect()
-            })
-            .collect(),
-    )
+    let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
+    for (i, it) in items.iter().enumerate() {
+        times.extend(it.model.keys[..it.len].iter().map(|k| x[i + 1] + k.at));
+    }
+    Some(times)
 }
 
 /// Every behaviour constrained at two or more keys stretches uniformly between keys whose
 /// distances `at` constraints already fix; all others keep their preferred timing. `None` if some
 /// behaviour's constrained keys are not fixed relative to each other (the LP decides then).
-fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
+fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     // anchored (item, key) pairs, sorted: item i's anchors are `pairs[first[i]..first[i + 1]]`
     let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(2 * links.len());
     for l in links {
@@ -417,44 +416,39 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<Vec<f64>>> {
     if x[0] > EPSILON {
         return None;
     }
-    let times = items
-        .iter()
-        .enumerate()
-        .map(|(i, it)| {
-            let keys = &it.model.keys[..it.len];
-            if !multi(i) {
-                let start = x[base[i]];
-                return keys.iter().map(|k| start + k.at).collect();
+    let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
+    for (i, it) in items.iter().enumerate() {
+        let keys = &it.model.keys[..it.len];
+        if !multi(i) {
+            let start = x[base[i]];
+            times.extend(keys.iter().map(|k| start + k.at));
+            continue;
+        }
+        let last = anchors(i) - 1;
+        let at = |j: usize| x[base[i] + j];
+        let p = |j: usize| it.model.keys[anchor(i, j)].at;
+        times.extend(keys.iter().enumerate().map(|(k, key)| {
+            if k <= anchor(i, 0) {
+                at(0) - scale[i] * (p(0) - key.at)
+            } else if k >= anchor(i, last) {
+                at(last) + scale[i] * (key.at - p(last))
+            } else {
+                // linear between the surrounding anchors (S49)
+                let j = (0..last).rev().find(|&j| anchor(i, j) <= k).unwrap_or(0);
+                let (p0, p1) = (p(j), p(j + 1));
+                if p1 > p0 {
+                    at(j) + (key.at - p0) / (p1 - p0) * (at(j + 1) - at(j))
+                } else {
+                    at(j)
+                }
             }
-            let last = anchors(i) - 1;
-            let at = |j: usize| x[base[i] + j];
-            let p = |j: usize| it.model.keys[anchor(i, j)].at;
-            keys.iter()
-                .enumerate()
-                .map(|(k, key)| {
-                    if k <= anchor(i, 0) {
-                        at(0) - scale[i] * (p(0) - key.at)
-                    } else if k >= anchor(i, last) {
-                        at(last) + scale[i] * (key.at - p(last))
-                    } else {
-                        // linear between the surrounding anchors (S49)
-                        let j = (0..last).rev().find(|&j| anchor(i, j) <= k).unwrap_or(0);
-                        let (p0, p1) = (p(j), p(j + 1));
-                        if p1 > p0 {
-                            at(j) + (key.at - p0) / (p1 - p0) * (at(j + 1) - at(j))
-                        } else {
-                            at(j)
-                        }
-                    }
-                })
-                .collect()
-        })
-        .collect();
+        }));
+    }
     Some(times)
 }
 
 /// The two-stage linear program for blocks where some behaviour must stretch.
-fn optimise(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
+fn optimise(items: &[Item], links: &[Link]) -> Vec<f64> {
     let build = |deviation_bound: Option<f64>| {
         let mut vars = ProblemVariables::new();
         let t: Vec<Vec<Variable>> = items
@@ -528,10 +522,7 @@ fn optimise(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
         }
         let solution = problem.solve().ok()?;
         let value = solution.eval(&objective);
-        let times = t
-            .iter()
-            .map(|row| row.iter().map(|&v| solution.value(v)).collect())
-            .collect();
+        let times = t.iter().flatten().map(|&v| solution.value(v)).collect();
         Some((value, times))
     };
     // the hard system is feasible, so both stages have solutions; fall back to the earliest
@@ -546,17 +537,13 @@ fn optimise(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
 }
 
 /// The least solution of the hard system (every key as early as possible).
-fn earliest(items: &[Item], links: &[Link]) -> Vec<Vec<f64>> {
+fn earliest(items: &[Item], links: &[Link]) -> Vec<f64> {
     let (s, base) = hard_system(items, links);
     let x = s.solve().unwrap_or_default();
     items
         .iter()
         .zip(&base)
-        .map(|(it, &b)| {
-            (0..it.len)
-                .map(|k| x.get(b + k).copied().unwrap_or(0.0))
-                .collect()
-        })
+        .flat_map(|(it, &b)| (b..b + it.len).map(|v| x.get(v).copied().unwrap_or(0.0)))
         .collect()
 }
 
@@ -611,7 +598,8 @@ mod tests {
             );
             let fast = uniform(&items, &links).unwrap_or_else(|| panic!("{file}: no fast path"));
             let lp = optimise(&items, &links);
-            for (a, b) in fast.iter().flatten().zip(lp.iter().flatten()) {
+            assert_eq!(fast.len(), lp.len(), "{file}");
+            for (a, b) in fast.iter().zip(&lp) {
                 assert!((a - b).abs() < 1e-6, "{file}: {fast:?} vs {lp:?}");
             }
         }
