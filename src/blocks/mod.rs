@@ -251,22 +251,22 @@ impl BlockManager {
 
     fn prediction(&self, b: &LiveBlock, with_behaviours: bool) -> Feedback {
         let end = b.predicted_end();
+        // the feedback is kept until the host takes it: every list gets its exact size
         let behaviours = if with_behaviours {
-            b.behaviours
-                .iter()
-                .filter(|x| x.phase != Phase::Removed)
-                .map(|x| BehaviourPrediction {
+            let live = || b.behaviours.iter().filter(|x| x.phase != Phase::Removed);
+            let mut v = Vec::with_capacity(live().count());
+            v.extend(live().map(|x| {
+                let known = || x.syncs.iter().filter(|s| s.1.is_finite());
+                let mut syncs = Vec::with_capacity(known().count());
+                syncs.extend(known().map(|(n, t)| (n.clone(), *t)));
+                BehaviourPrediction {
                     kind: b.source.behaviours[x.index].kind.element_id(),
                     block: b.id.clone(),
                     behaviour: x.id.clone(),
-                    syncs: x
-                        .syncs
-                        .iter()
-                        .filter(|s| s.1.is_finite())
-                        .map(|(n, t)| (n.clone(), *t))
-                        .collect(),
-                })
-                .collect()
+                    syncs,
+                }
+            }));
+            v
         } else {
             Vec::new()
         };

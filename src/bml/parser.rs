@@ -619,7 +619,9 @@ impl<'i> Parser<'i> {
         }
         block.foreign_attrs = self.leftover_attrs(attrs, &"<bml>");
 
-        let mut behaviours = Vec::new();
+        // kept as long as the block runs: room for two behaviours to start with (most blocks
+        // have one or two), growing as usual after that
+        let mut behaviours = Vec::with_capacity(2);
         let mut constraints = Vec::new();
         self.children(&el, |p, child| {
             p.block_child(child, false, &mut behaviours, &mut constraints)
@@ -1193,7 +1195,13 @@ impl<'i> Parser<'i> {
             match self.next()? {
                 Tok::Text { text, .. } => match out.last_mut() {
                     Some(TextPart::Text(t)) => t.push_str(&text),
-                    _ => out.push(TextPart::Text(text.into_owned())),
+                    _ => {
+                        // the parts are kept with the block; most texts are one part
+                        if out.capacity() == 0 {
+                            out.reserve_exact(1);
+                        }
+                        out.push(TextPart::Text(text.into_owned()))
+                    }
                 },
                 Tok::Start(mut c) => {
                     if c.ns.is_core() && c.name == "sync" {
