@@ -256,9 +256,12 @@ impl BlockManager {
             let live = || b.behaviours.iter().filter(|x| x.phase != Phase::Removed);
             let mut v = Vec::with_capacity(live().count());
             v.extend(live().map(|x| {
-                let known = || x.syncs.iter().filter(|s| s.1.is_finite());
-                let mut syncs = Vec::with_capacity(known().count());
-                syncs.extend(known().map(|(n, t)| (n.clone(), *t)));
+                // (a persistent behaviour's end is infinite: not a prediction)
+                let syncs = if x.syncs.iter().all(|s| s.1.is_finite()) {
+                    x.syncs.clone()
+                } else {
+                    x.syncs.iter().filter(|s| s.1.is_finite()).cloned().collect()
+                };
                 BehaviourPrediction {
                     kind: b.source.behaviours[x.index].kind.element_id(),
                     block: b.id.clone(),

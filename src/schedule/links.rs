@@ -63,12 +63,14 @@ pub(crate) fn items<'b>(
             }),
             Some((model, Ok(()))) => {
                 // a persistent behaviour has no end unless a constraint names it
-                let end_named = constraints.iter().any(|c| {
-                    [&c.left, &c.right].iter().any(|a| {
-                        matches!(a, Anchor::Point(SyncPoint::Local { behaviour, sync }) if *behaviour == beh.id && sync == "end")
+                let end_named = || {
+                    constraints.iter().any(|c| {
+                        [&c.left, &c.right].iter().any(|a| {
+                            matches!(a, Anchor::Point(SyncPoint::Local { behaviour, sync }) if *behaviour == beh.id && sync == "end")
+                        })
                     })
-                });
-                let len = if model.persistent && !end_named {
+                };
+                let len = if model.persistent && !end_named() {
                     model.keys.len() - 1
                 } else {
                     model.keys.len()
