@@ -260,7 +260,11 @@ impl BlockManager {
                 let syncs = if x.syncs.iter().all(|s| s.1.is_finite()) {
                     x.syncs.clone()
                 } else {
-                    x.syncs.iter().filter(|s| s.1.is_finite()).cloned().collect()
+                    x.syncs
+                        .iter()
+                        .filter(|s| s.1.is_finite())
+                        .cloned()
+                        .collect()
                 };
                 BehaviourPrediction {
                     kind: b.source.behaviours[x.index].kind.element_id(),
