@@ -296,3 +296,34 @@ proptest! {
         let _ = bml::check(&text);
     }
 }
+
+/// The parser keeps its scratch lists (tokenizer stacks, line starts, attribute list) on the
+/// thread between parses. A parse must not depend on what the thread parsed before, including a
+/// parse that stopped half-way with elements open and namespaces bound.
+#[test]
+fn a_parse_does_not_depend_on_earlier_parses_on_the_thread() {
+    let inputs = [
+        block(r#"<speech id="s1"><text>One <sync id="a"/> two.</text></speech>"#),
+        // stops inside nested elements with a prefix bound
+        format!(
+            "<bml {NS} xmlns:x=\"urn:x\" id=\"b2\">\n<speech id=\"s\" x:y=\"1\"><text>hi</speech>"
+        ),
+        "<!-- a comment\nover lines -->\n".to_string()
+            + &block(r#"<gesture id="g" lexeme="BEAT" start="1" x:q="2"/>"#),
+        format!("<bml {NS} xmlns:p=\"urn:p\" id=\"b4\" p:a=\"&amp;1\"><head id=\"h\" lexeme=\"NOD\"/></bml>"),
+        block(r#"<head id="h1" lexeme="NOD" start="0" end="5"/>"#),
+    ];
+    let seen = |src: &str| format!("{:?}", bml::check(src));
+    // each on a thread of its own: nothing kept from before
+    let alone: Vec<String> = inputs
+        .iter()
+        .map(|src| {
+            let src = src.clone();
+            std::thread::spawn(move || seen(&src)).join().unwrap()
+        })
+        .collect();
+    // all on this thread, forwards and backwards
+    for (i, src) in inputs.iter().enumerate().chain(inputs.iter().enumerate().rev()) {
+        assert_eq!(seen(src), alone[i], "input {i} parsed after others");
+    }
+}

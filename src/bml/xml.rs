@@ -670,6 +670,20 @@ pub(crate) fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlErro
 mod tests {
     use super::*;
 
+    /// The kept lists are reused, not reallocated: `recycle` keeps the buffer.
+    #[test]
+    fn recycle_keeps_the_allocation() {
+        let mut v: Vec<Open<'_>> = Vec::with_capacity(8);
+        v.push(Open {
+            qname: "bml",
+            bindings: 0,
+        });
+        let (ptr, cap) = (v.as_ptr() as usize, v.capacity());
+        let w: Vec<Open<'static>> = recycle(v);
+        assert!(w.is_empty());
+        assert_eq!((w.as_ptr() as usize, w.capacity()), (ptr, cap));
+    }
+
     /// Every event of `src` as a short string, or the error as `!offset message`.
     fn events(src: &str) -> Vec<String> {
         let mut t = Tokenizer::new(src);
