@@ -65,6 +65,38 @@ pub const BMLT_BEHAVIOURS: &[&str] = &[
     "text",
 ];
 
+/// Every built-in kind's element name and the namespace it is written in, in the order of
+/// [`BehaviourKind::builtin_slot`] (the control behaviours are also read in BMLT).
+pub const BUILTIN_KINDS: [(&str, &str); 27] = [
+    ("speech", NS_BML),
+    ("gesture", NS_BML),
+    ("pointing", NS_BML),
+    ("head", NS_BML),
+    ("headDirectionShift", NS_BML),
+    ("gaze", NS_BML),
+    ("gazeShift", NS_BML),
+    ("face", NS_BML),
+    ("faceLexeme", NS_BML),
+    ("faceFacs", NS_CORE_EXT),
+    ("faceShift", NS_BML),
+    ("posture", NS_BML),
+    ("postureShift", NS_BML),
+    ("locomotion", NS_BML),
+    ("wait", NS_BML),
+    ("interrupt", NS_BMLA),
+    ("activate", NS_BMLA),
+    ("parametervaluechange", NS_BMLA),
+    ("procanimation", NS_BMLT),
+    ("procanimationgesture", NS_BMLT),
+    ("keyframe", NS_BMLT),
+    ("controller", NS_BMLT),
+    ("audiofile", NS_BMLT),
+    ("noise", NS_BMLT),
+    ("facemorph", NS_BMLT),
+    ("transition", NS_BMLT),
+    ("text", NS_BMLT),
+];
+
 impl BehaviourKind {
     /// The element's local name.
     pub fn element_name(&self) -> &str {
@@ -82,58 +114,51 @@ impl BehaviourKind {
         }
     }
 
+    /// The position of a built-in kind in [`BUILTIN_KINDS`] (`None` for an unknown extension):
+    /// a number that registries can index by.
+    pub fn builtin_slot(&self) -> Option<usize> {
+        Some(match self {
+            BehaviourKind::Speech(_) => 0,
+            BehaviourKind::Gesture(_) => 1,
+            BehaviourKind::Pointing(_) => 2,
+            BehaviourKind::Head(_) => 3,
+            BehaviourKind::HeadDirectionShift { .. } => 4,
+            BehaviourKind::Gaze(_) => 5,
+            BehaviourKind::GazeShift(_) => 6,
+            BehaviourKind::Face(_) => 7,
+            BehaviourKind::FaceLexeme(_) => 8,
+            BehaviourKind::FaceFacs(_) => 9,
+            BehaviourKind::FaceShift(_) => 10,
+            BehaviourKind::Posture(_) => 11,
+            BehaviourKind::PostureShift(_) => 12,
+            BehaviourKind::Locomotion(_) => 13,
+            BehaviourKind::Wait(_) => 14,
+            BehaviourKind::Interrupt(_) => 15,
+            BehaviourKind::Activate(_) => 16,
+            BehaviourKind::ParameterValueChange(_) => 17,
+            BehaviourKind::ProcAnimation(_) => 18,
+            BehaviourKind::ProcAnimationGesture(_) => 19,
+            BehaviourKind::Keyframe(_) => 20,
+            BehaviourKind::Controller(_) => 21,
+            BehaviourKind::AudioFile { .. } => 22,
+            BehaviourKind::Noise(_) => 23,
+            BehaviourKind::FaceMorph(_) => 24,
+            BehaviourKind::Transition(_) => 25,
+            BehaviourKind::Text(_) => 26,
+            BehaviourKind::Unknown(_) => return None,
+        })
+    }
+
     /// The local name of a built-in kind (`""` for an unknown extension).
     fn builtin_name(&self) -> &'static str {
-        match self {
-            BehaviourKind::Speech(_) => "speech",
-            BehaviourKind::Gesture(_) => "gesture",
-            BehaviourKind::Pointing(_) => "pointing",
-            BehaviourKind::Head(_) => "head",
-            BehaviourKind::HeadDirectionShift { .. } => "headDirectionShift",
-            BehaviourKind::Gaze(_) => "gaze",
-            BehaviourKind::GazeShift(_) => "gazeShift",
-            BehaviourKind::Face(_) => "face",
-            BehaviourKind::FaceLexeme(_) => "faceLexeme",
-            BehaviourKind::FaceFacs(_) => "faceFacs",
-            BehaviourKind::FaceShift(_) => "faceShift",
-            BehaviourKind::Posture(_) => "posture",
-            BehaviourKind::PostureShift(_) => "postureShift",
-            BehaviourKind::Locomotion(_) => "locomotion",
-            BehaviourKind::Wait(_) => "wait",
-            BehaviourKind::Interrupt(_) => "interrupt",
-            BehaviourKind::Activate(_) => "activate",
-            BehaviourKind::ParameterValueChange(_) => "parametervaluechange",
-            BehaviourKind::ProcAnimation(_) => "procanimation",
-            BehaviourKind::ProcAnimationGesture(_) => "procanimationgesture",
-            BehaviourKind::Keyframe(_) => "keyframe",
-            BehaviourKind::Controller(_) => "controller",
-            BehaviourKind::AudioFile { .. } => "audiofile",
-            BehaviourKind::Noise(_) => "noise",
-            BehaviourKind::FaceMorph(_) => "facemorph",
-            BehaviourKind::Transition(_) => "transition",
-            BehaviourKind::Text(_) => "text",
-            BehaviourKind::Unknown(_) => "",
-        }
+        self.builtin_slot().map_or("", |s| BUILTIN_KINDS[s].0)
     }
 
     /// The namespace the writer puts the element in.
     pub fn namespace(&self) -> &str {
         match self {
-            BehaviourKind::FaceFacs(_) => NS_CORE_EXT,
-            BehaviourKind::Interrupt(_)
-            | BehaviourKind::Activate(_)
-            | BehaviourKind::ParameterValueChange(_) => NS_BMLA,
-            BehaviourKind::ProcAnimation(_)
-            | BehaviourKind::ProcAnimationGesture(_)
-            | BehaviourKind::Keyframe(_)
-            | BehaviourKind::Controller(_)
-            | BehaviourKind::AudioFile { .. }
-            | BehaviourKind::Noise(_)
-            | BehaviourKind::FaceMorph(_)
-            | BehaviourKind::Transition(_)
-            | BehaviourKind::Text(_) => NS_BMLT,
             BehaviourKind::Unknown(u) => &u.ns,
-            _ => NS_BML,
+            k => k.builtin_slot().map_or("", |s| BUILTIN_KINDS[s].1),
         }
     }
 
@@ -199,5 +224,26 @@ impl Behaviour {
             }
             k => k.has_open_syncs() || k.standard_syncs().contains(&sync),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The slot table names exactly the elements the parser accepts, each in the namespace the
+    /// writer uses for it.
+    #[test]
+    fn builtin_kinds_are_the_accepted_elements_in_their_namespaces() {
+        let mut expected: Vec<(&str, &str)> = CORE_BEHAVIOURS
+            .iter()
+            .map(|&n| (n, if n == "faceFacs" { NS_CORE_EXT } else { NS_BML }))
+            .chain(CONTROL_BEHAVIOURS.iter().map(|&n| (n, NS_BMLA)))
+            .chain(BMLT_BEHAVIOURS.iter().map(|&n| (n, NS_BMLT)))
+            .collect();
+        let mut table = BUILTIN_KINDS.to_vec();
+        expected.sort();
+        table.sort();
+        assert_eq!(table, expected);
     }
 }

@@ -25,8 +25,8 @@ mod xml;
 pub use constraints::{extract, Anchor, Constraint, Relation, Source};
 pub use diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos, Severity};
 pub use kinds::{
-    ALL_STANDARD_SYNCS, BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS, FACE_SYNCS,
-    GAZE_SYNCS, GESTURE_SYNCS, START_END,
+    ALL_STANDARD_SYNCS, BMLT_BEHAVIOURS, BUILTIN_KINDS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS,
+    FACE_SYNCS, GAZE_SYNCS, GESTURE_SYNCS, START_END,
 };
 pub use model::*;
 pub use parser::{parse, parse_with_diagnostics, Parsed};

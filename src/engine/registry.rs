@@ -4,7 +4,7 @@
 
 use super::timing::{TimingModel, TimingModels};
 use super::Engine;
-use crate::bml::Behaviour;
+use crate::bml::{Behaviour, BUILTIN_KINDS};
 
 /// A behaviour kind as written: namespace URI and element name.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -37,6 +37,9 @@ pub struct Registry {
     /// (kind, engine index), sorted by name length, name and namespace: a lookup finds the few
     /// names of its length by integer comparisons, then compares bytes only with those.
     kinds: Vec<(KindKey, usize)>,
+    /// The engine of each built-in kind, by [`BehaviourKind::builtin_slot`]: found without
+    /// comparing names.
+    builtin: [Option<usize>; BUILTIN_KINDS.len()],
 }
 
 impl Registry {
@@ -50,6 +53,12 @@ impl Registry {
         self.engines.push(engine);
         let index = self.engines.len() - 1;
         for k in kinds {
+            if let Some(slot) = BUILTIN_KINDS
+                .iter()
+                .position(|&(name, ns)| name == k.name && ns == k.ns)
+            {
+                self.builtin[slot] = Some(index);
+            }
             match self.kinds.binary_search_by(|(x, _)| {
                 (x.name.len(), &x.name, &x.ns).cmp(&(k.name.len(), &k.name, &k.ns))
             }) {
@@ -62,6 +71,9 @@ impl Registry {
 
     /// The index of the engine that realizes `behaviour`'s kind.
     pub fn engine_for(&self, behaviour: &Behaviour) -> Option<usize> {
+        if let Some(slot) = behaviour.kind.builtin_slot() {
+            return self.builtin[slot];
+        }
         let (name, ns) = (behaviour.kind.element_name(), behaviour.kind.namespace());
         let from = self
             .kinds
