@@ -323,7 +323,11 @@ fn a_parse_does_not_depend_on_earlier_parses_on_the_thread() {
         })
         .collect();
     // all on this thread, forwards and backwards
-    for (i, src) in inputs.iter().enumerate().chain(inputs.iter().enumerate().rev()) {
+    for (i, src) in inputs
+        .iter()
+        .enumerate()
+        .chain(inputs.iter().enumerate().rev())
+    {
         assert_eq!(seen(src), alone[i], "input {i} parsed after others");
     }
 }
