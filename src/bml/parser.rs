@@ -1618,8 +1618,9 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
 
 /// Splits `prefix:local` at the colon (the tokenizer checked that there is at most one).
 fn split_qname(q: &str) -> (Option<&str>, &str) {
-    match q.split_once(':') {
-        Some((p, l)) => (Some(p), l),
+    // a plain byte loop: names are a few bytes, too short for a searcher to pay off
+    match q.bytes().position(|b| b == b':') {
+        Some(i) => (Some(&q[..i]), &q[i + 1..]),
         None => (None, q),
     }
 }
