@@ -24,6 +24,8 @@ use good_lp::{
     constraint, microlp, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
 };
 
+use smallvec::SmallVec;
+
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
 use super::offsets::Offsets;
@@ -268,6 +270,9 @@ fn feasible(items: &[Item], links: &[Link], constraints: &[Constraint]) -> Resul
 /// constraints need some behaviour to stretch. The times of each item's keys, item after item
 /// (as from all the strategies below).
 fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
+    if pinned_apart(items, links) {
+        return None;
+    }
     let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
     let block = s.var(0.0);
     // item i's start is variable i + 1
@@ -295,6 +300,31 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         times.extend(it.model.keys[..it.len].iter().map(|k| x[i + 1] + k.at));
     }
     Some(times)
+}
+
+/// Whether some behaviour has two keys set `at` fixed times that its preferred timing cannot
+/// meet (the usual `start="0" end="5"`): then it must stretch, and [`preferred`] has no answer.
+/// An exact shortcut, found without building a difference system.
+fn pinned_apart(items: &[Item], links: &[Link]) -> bool {
+    // (item, the start that the fixed time implies for it)
+    let mut starts: SmallVec<[(usize, f64); 8]> = SmallVec::new();
+    for l in links.iter().filter(|l| l.relation == Relation::At) {
+        // left = right + offset
+        let implied = match (l.left, l.right) {
+            (Term::Key(i, k), Term::Fixed(t)) => (i, k, t + l.offset),
+            (Term::Fixed(t), Term::Key(i, k)) => (i, k, t - l.offset),
+            _ => continue,
+        };
+        let (i, k, at) = implied;
+        starts.push((i, at - items[i].model.keys[k].at));
+    }
+    if starts.len() < 2 {
+        return false;
+    }
+    starts.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    starts
+        .windows(2)
+        .any(|w| w[0].0 == w[1].0 && w[1].1 - w[0].1 > EPSILON)
 }
 
 /// Every behaviour constrained at two or more keys stretches uniformly between keys whose
@@ -565,6 +595,63 @@ mod tests {
         (models, block)
     }
 
+    /// Items and links of a one-block source, as `Optimal` prepares them.
+    fn linked(block: &Block, models: Vec<TimingModel>) -> (Vec<Item<'_>>, Vec<Link>) {
+        let items: Vec<Item> = block
+            .behaviours
+            .iter()
+            .zip(models)
+            .map(|(beh, model)| Item {
+                beh,
+                len: model.keys.len(),
+                model,
+            })
+            .collect();
+        let (links, unusable) = resolve(block, &items, &extract(block), &NoExternal);
+        assert!(unusable.is_none());
+        (items, links)
+    }
+
+    /// The shortcut says "must stretch" exactly when two fixed times disagree with the preferred
+    /// timing, and then the preferred-timing system has no solution either.
+    #[test]
+    fn pinned_apart_only_when_fixed_times_disagree_with_preferred_timing() {
+        let ns = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+        let head =
+            |syncs: &str| format!(r#"<bml {ns} id="b"><head id="h" lexeme="NOD" {syncs}/></bml>"#);
+        let (models, _) = prepared(&head(""));
+        let d = models[0].preferred_duration();
+        let stroke = models[0].keys[models[0].key("stroke").unwrap()].at;
+        for (syncs, apart) in [
+            (String::from(r#"start="0" end="5""#), true),
+            (format!(r#"start="1" end="{}""#, 1.0 + d), false),
+            (format!(r#"start="1" stroke="{}""#, 1.0 + stroke), false),
+            (format!(r#"start="1" stroke="{}""#, 1.5 + stroke), true),
+            (String::from(r#"start="1""#), false),
+            (String::from(r#"end="2""#), false),
+        ] {
+            let (models, block) = prepared(&head(&syncs));
+            let (items, links) = linked(&block, models);
+            assert_eq!(pinned_apart(&items, &links), apart, "{syncs}");
+            // the shortcut never hides a preferred-timing answer
+            if apart {
+                let mut s = DiffSystem::new();
+                let b = s.var(0.0);
+                let v = s.var(f64::MIN / 4.0);
+                s.at_least(v, b, 0.0, links.len());
+                for (tag, l) in links.iter().enumerate() {
+                    let side = |t: Term| match t {
+                        Term::Key(_, k) => (v, items[0].model.keys[k].at),
+                        Term::Fixed(t) => (b, t),
+                    };
+                    let ((x, xo), (y, yo)) = (side(l.left), side(l.right));
+                    s.relate(x, l.relation, y, l.offset + yo - xo, tag);
+                }
+                assert!(s.least().is_none_or(|x| x[b] > EPSILON), "{syncs}");
+            }
+        }
+    }
+
     /// Where both apply, the uniform-stretch fast path and the LP agree.
     #[test]
     fn uniform_fast_path_matches_the_linear_program() {
@@ -580,18 +667,7 @@ mod tests {
         ] {
             let (models, block) =
                 prepared(&std::fs::read_to_string(format!("{dir}{file}")).unwrap());
-            let items: Vec<Item> = block
-                .behaviours
-                .iter()
-                .zip(models)
-                .map(|(beh, model)| Item {
-                    beh,
-                    len: model.keys.len(),
-                    model,
-                })
-                .collect();
-            let (links, unusable) = resolve(&block, &items, &extract(&block), &NoExternal);
-            assert!(unusable.is_none());
+            let (items, links) = linked(&block, models);
             assert!(
                 preferred(&items, &links).is_none(),
                 "{file} needs stretching"
