@@ -16,6 +16,15 @@ pub(crate) fn same_name(a: &str, b: &str) -> bool {
     a.len() == b.len() && a.first() == b.first() && a.iter().zip(b).all(|(x, y)| x == y)
 }
 
+/// Splits a qualified name `prefix:local` at its first colon (`None` for an unprefixed name). A
+/// plain byte loop: names are a few bytes, too short for a searcher to pay off.
+pub(crate) fn split_qname(q: &str) -> (Option<&str>, &str) {
+    match q.bytes().position(|b| b == b':') {
+        Some(i) => (Some(&q[..i]), &q[i + 1..]),
+        None => (None, q),
+    }
+}
+
 /// Whether `s` is an XML name without colons (the NCName production of Namespaces in XML).
 pub(crate) fn is_ncname(s: &str) -> bool {
     // fast path: ASCII letters, digits, '_', '-', '.'
@@ -61,6 +70,15 @@ mod tests {
             assert_eq!(same_name(a, b), same, "{a} {b}");
             assert_eq!(same_name(a, b), a == b);
         }
+    }
+
+    #[test]
+    fn qualified_names_split_at_their_first_colon() {
+        use super::split_qname;
+        assert_eq!(split_qname("bmlt:keyframe"), (Some("bmlt"), "keyframe"));
+        assert_eq!(split_qname("speech"), (None, "speech"));
+        assert_eq!(split_qname(":x"), (Some(""), "x"));
+        assert_eq!(split_qname("a:b:c"), (Some("a"), "b:c"));
     }
 
     #[test]

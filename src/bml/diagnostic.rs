@@ -1,7 +1,6 @@
 //! Diagnostics for BML input: source positions, severities, the stable diagnostic codes and the
 //! error type returned when a block cannot be accepted.
 
-use std::cell::Cell;
 use std::fmt;
 
 /// A position in the source text: 1-based line and column (column counted in characters).
@@ -38,33 +37,16 @@ pub struct LineIndex {
     ascii_until: Vec<usize>,
 }
 
-thread_local! {
-    /// Line starts of an index that is gone, kept for the next one on this thread: indexing one
-    /// small block after another allocates nothing.
-    static SPARE_STARTS: Cell<Vec<usize>> = const { Cell::new(Vec::new()) };
-}
-
-/// Longer lists of line starts are not kept.
-const SPARE_LINES: usize = 4096;
-
-impl Drop for LineIndex {
-    fn drop(&mut self) {
-        if self.starts.capacity() <= SPARE_LINES {
-            let starts = std::mem::take(&mut self.starts);
-            let _ = SPARE_STARTS.try_with(|s| s.set(starts));
-        }
-    }
-}
-
 impl LineIndex {
     /// Index the line starts of `src`.
     pub fn new(src: &str) -> Self {
+        Self::with_starts(src, Vec::with_capacity(src.len() / 32 + 1))
+    }
+
+    /// Like [`Self::new`], with the line starts written into `starts` (emptied first; from
+    /// [`Self::into_starts`]), so that indexing one block after another need not allocate.
+    pub(crate) fn with_starts(src: &str, mut starts: Vec<usize>) -> Self {
         let bytes = src.as_bytes();
-        let mut starts = SPARE_STARTS
-            .try_with(Cell::take)
-            .ok()
-            .filter(|v| v.capacity() > 0)
-            .unwrap_or_else(|| Vec::with_capacity(bytes.len() / 32 + 1));
         starts.clear();
         starts.push(0);
         starts.extend(memchr::memchr_iter(b'\n', bytes).map(|i| i + 1));
@@ -88,6 +70,11 @@ impl LineIndex {
             starts,
             ascii_until,
         }
+    }
+
+    /// The list of line starts, for another index.
+    pub(crate) fn into_starts(self) -> Vec<usize> {
+        self.starts
     }
 
     /// The position of byte offset `offset` in `src` (the text this index was built from).

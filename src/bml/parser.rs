@@ -11,7 +11,7 @@ use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
 use super::xml::{self, Event, Tag, Tokenizer, XmlError};
-use crate::xmlname::same_name;
+use crate::xmlname::{same_name, split_qname};
 
 /// A parsed block together with the warnings found while reading it.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,11 +40,8 @@ pub fn parse(src: &str) -> Result<Parsed, BmlError> {
 pub fn parse_with_diagnostics(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
     let mut p = Parser::new(src);
     let block = p.document();
-    let spare = std::mem::take(&mut p.spare_attrs);
-    if spare.capacity() <= SPARE_ATTRS_MAX {
-        let _ = SPARE_ATTRS.try_with(|s| s.set(xml::recycle(spare)));
-    }
-    let mut diags = p.diags;
+    let mut diags = std::mem::take(&mut p.diags);
+    p.keep_scratch();
     diags.sort_by_key(|d| (d.pos.line, d.pos.col));
     (block, diags)
 }
@@ -154,13 +151,22 @@ struct Parser<'i> {
     spare_attrs: Vec<Option<RawAttr<'i>>>,
 }
 
-thread_local! {
-    /// The attribute list of the last parse on this thread, for the next one.
-    static SPARE_ATTRS: Cell<Vec<Option<RawAttr<'static>>>> = const { Cell::new(Vec::new()) };
+/// The scratch lists of a parse (the tokenizer's, the line starts, the attribute list), kept on
+/// the thread for the next parse: parsing one small block after another allocates no scratch
+/// space.
+#[derive(Default)]
+struct Scratch {
+    tokens: xml::Lists,
+    lines: Vec<usize>,
+    attrs: Vec<Option<RawAttr<'static>>>,
 }
 
-/// Longer attribute lists are not kept between parses.
-const SPARE_ATTRS_MAX: usize = 64;
+thread_local! {
+    static SCRATCH: Cell<Option<Scratch>> = const { Cell::new(None) };
+}
+
+/// Scratch lists longer than this are not kept (a rare huge block should not pin its memory).
+const SCRATCH_MAX: usize = 4096;
 
 /// Remaining attributes of an element, taken one by one by name.
 struct Attrs<'i> {
@@ -195,16 +201,35 @@ impl<'i> Parser<'i> {
     fn new(src: &'i str) -> Self {
         // A byte-order mark is not content; offsets are relative to the rest.
         let src = src.strip_prefix('\u{feff}').unwrap_or(src);
+        let scratch = SCRATCH
+            .try_with(Cell::take)
+            .ok()
+            .flatten()
+            .unwrap_or_default();
         Parser {
             src,
-            tok: Tokenizer::new(src),
-            lines: LineIndex::new(src),
+            tok: Tokenizer::with_lists(src, scratch.tokens),
+            lines: LineIndex::with_starts(src, scratch.lines),
             diags: Vec::new(),
             pending: None,
-            spare_attrs: SPARE_ATTRS
-                .try_with(Cell::take)
-                .map(xml::recycle)
-                .unwrap_or_default(),
+            spare_attrs: xml::recycle(scratch.attrs),
+        }
+    }
+
+    /// Leaves the scratch lists to the next parse on this thread.
+    fn keep_scratch(self) {
+        let scratch = Scratch {
+            tokens: self.tok.into_lists(),
+            lines: self.lines.into_starts(),
+            attrs: xml::recycle(self.spare_attrs),
+        };
+        let longest = scratch
+            .tokens
+            .longest()
+            .max(scratch.lines.capacity())
+            .max(scratch.attrs.capacity());
+        if longest <= SCRATCH_MAX {
+            let _ = SCRATCH.try_with(|s| s.set(Some(scratch)));
         }
     }
 
@@ -258,24 +283,30 @@ impl<'i> Parser<'i> {
         }
     }
 
-    /// Turns a start (or empty-element) tag into an [`El`], resolving its namespaces and its
-    /// attributes' while the element's namespace scope is current.
-    fn element(&mut self, tag: Tag<'i>) -> Result<El<'i>, Fatal> {
-        let qname = tag.qname;
-        let (prefix, name) = split_qname(qname);
-        let ns = match self.tok.resolve(prefix) {
+    /// The namespace `prefix` is bound to where the tokenizer is (`None`: the default one); an
+    /// undeclared prefix is an error on `what`, at `offset`.
+    fn namespace(&mut self, prefix: Option<&str>, offset: usize, what: &dyn fmt::Display) -> Ns {
+        match self.tok.resolve(prefix) {
             Ok(Some(uri)) => Ns::from_uri(uri),
             Ok(None) => Ns::None,
             Err(()) => {
                 let prefix = prefix.unwrap_or_default();
                 self.error(
                     Code::NotXml,
-                    tag.offset,
-                    format!("namespace prefix '{prefix}' of <{qname}> is not declared"),
+                    offset,
+                    format!("namespace prefix '{prefix}' of {what} is not declared"),
                 );
                 Ns::Other(prefix.to_string())
             }
-        };
+        }
+    }
+
+    /// Turns a start (or empty-element) tag into an [`El`], resolving its namespaces and its
+    /// attributes' while the element's namespace scope is current.
+    fn element(&mut self, tag: Tag<'i>) -> Result<El<'i>, Fatal> {
+        let qname = tag.qname;
+        let (prefix, name) = split_qname(qname);
+        let ns = self.namespace(prefix, tag.offset, &format_args!("<{qname}>"));
         let mut prefixes: Vec<&'i str> = prefix.into_iter().collect();
         let n = self.tok.attrs().len();
         let mut attrs = std::mem::take(&mut self.spare_attrs);
@@ -290,23 +321,10 @@ impl<'i> Parser<'i> {
                 None => Ns::None, // unprefixed attributes are in no namespace
                 Some(p) => {
                     prefixes.push(p);
-                    match self.tok.resolve(Some(p)) {
-                        Ok(Some(uri)) => match Ns::from_uri(uri) {
-                            Ns::Bml => Ns::None,
-                            other => other,
-                        },
-                        Ok(None) => Ns::None,
-                        Err(()) => {
-                            self.error(
-                                Code::NotXml,
-                                a.offset,
-                                format!(
-                                    "namespace prefix '{p}' of attribute '{}' is not declared",
-                                    a.key
-                                ),
-                            );
-                            Ns::Other(p.to_string())
-                        }
+                    let what = format_args!("attribute '{}'", a.key);
+                    match self.namespace(Some(p), a.offset, &what) {
+                        Ns::Bml => Ns::None,
+                        other => other,
                     }
                 }
             };
@@ -1613,15 +1631,6 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
             }),
             _ => return None,
         })
-    }
-}
-
-/// Splits `prefix:local` at the colon (the tokenizer checked that there is at most one).
-fn split_qname(q: &str) -> (Option<&str>, &str) {
-    // a plain byte loop: names are a few bytes, too short for a searcher to pay off
-    match q.bytes().position(|b| b == b':') {
-        Some(i) => (Some(&q[..i]), &q[i + 1..]),
-        None => (None, q),
     }
 }
 

@@ -5,9 +5,8 @@
 //! offset. Made for short BML blocks: no allocation for a tag, its attributes or plain text.
 
 use std::borrow::Cow;
-use std::cell::Cell;
 
-use crate::xmlname::{is_forbidden_char, is_ncname};
+use crate::xmlname::{is_forbidden_char, is_ncname, split_qname};
 
 /// The namespace bound to the prefix `xml`.
 pub(crate) const XML_URI: &str = "http://www.w3.org/XML/1998/namespace";
@@ -99,19 +98,24 @@ struct Open<'i> {
     bindings: usize,
 }
 
-/// The tokenizer's lists, kept between tokenizers on one thread, so that parsing one small block
-/// after another allocates no scratch space.
-struct Spare {
+/// A tokenizer's lists, emptied, for building another one (see [`Tokenizer::into_lists`]): the
+/// parser keeps them between blocks, so parsing one small block after another allocates no
+/// scratch space.
+#[derive(Default)]
+pub(crate) struct Lists {
     open: Vec<Open<'static>>,
     bindings: Vec<(&'static str, Cow<'static, str>)>,
     attrs: Vec<Attr<'static>>,
 }
 
-/// Lists longer than this are not kept (a rare huge block should not pin its memory).
-const SPARE_MAX: usize = 64;
-
-thread_local! {
-    static SPARE: Cell<Option<Spare>> = const { Cell::new(None) };
+impl Lists {
+    /// The longest of the lists.
+    pub fn longest(&self) -> usize {
+        self.open
+            .capacity()
+            .max(self.bindings.capacity())
+            .max(self.attrs.capacity())
+    }
 }
 
 /// `v` emptied and retyped (here: only its lifetime), keeping its allocation: collecting a
@@ -137,59 +141,27 @@ pub(crate) struct Tokenizer<'i> {
     close_empty: Option<usize>,
 }
 
-impl Drop for Tokenizer<'_> {
-    /// Leaves the lists to the next tokenizer on this thread.
-    fn drop(&mut self) {
-        let (open, bindings, attrs) = (
-            std::mem::take(&mut self.open),
-            std::mem::take(&mut self.bindings),
-            std::mem::take(&mut self.attrs),
-        );
-        if open
-            .capacity()
-            .max(bindings.capacity())
-            .max(attrs.capacity())
-            <= SPARE_MAX
-        {
-            let spare = Spare {
-                open: recycle(open),
-                bindings: recycle(bindings),
-                attrs: recycle(attrs),
-            };
-            let _ = SPARE.try_with(|s| s.set(Some(spare)));
-        }
-    }
-}
-
 impl<'i> Tokenizer<'i> {
-    /// A tokenizer at the start of `src`.
-    pub fn new(src: &'i str) -> Self {
+    /// A tokenizer at the start of `src` that uses `lists` (new ones, or from
+    /// [`Self::into_lists`]).
+    pub fn with_lists(src: &'i str, lists: Lists) -> Self {
         Tokenizer {
             src,
             pos: 0,
-            open: Vec::new(),
-            bindings: Vec::new(),
-            attrs: Vec::new(),
+            open: recycle(lists.open),
+            bindings: recycle(lists.bindings),
+            attrs: recycle(lists.attrs),
             close_empty: None,
         }
-        .with_spare_lists()
     }
 
-    /// Takes this thread's spare lists, or allocates new ones.
-    fn with_spare_lists(mut self) -> Self {
-        match SPARE.try_with(Cell::take).ok().flatten() {
-            Some(spare) => {
-                self.open = recycle(spare.open);
-                self.bindings = recycle(spare.bindings);
-                self.attrs = recycle(spare.attrs);
-            }
-            None => {
-                self.open = Vec::with_capacity(8);
-                self.bindings = Vec::with_capacity(4);
-                self.attrs = Vec::with_capacity(8);
-            }
+    /// The lists, emptied, for the next tokenizer.
+    pub fn into_lists(self) -> Lists {
+        Lists {
+            open: recycle(self.open),
+            bindings: recycle(self.bindings),
+            attrs: recycle(self.attrs),
         }
-        self
     }
 
     /// The attributes of the last start tag, in source order.
@@ -590,9 +562,9 @@ fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
 
 /// Whether `q` is `NCName` or `NCName:NCName`.
 fn is_qname(q: &str) -> bool {
-    match q.split_once(':') {
-        Some((p, l)) => is_ncname(p) && is_ncname(l),
-        None => is_ncname(q),
+    match split_qname(q) {
+        (Some(p), l) => is_ncname(p) && is_ncname(l),
+        (None, l) => is_ncname(l),
     }
 }
 
@@ -686,7 +658,7 @@ mod tests {
 
     /// Every event of `src` as a short string, or the error as `!offset message`.
     fn events(src: &str) -> Vec<String> {
-        let mut t = Tokenizer::new(src);
+        let mut t = Tokenizer::with_lists(src, Lists::default());
         let mut out = Vec::new();
         loop {
             match t.next() {
@@ -697,7 +669,7 @@ mod tests {
                         .iter()
                         .map(|a| format!("{}={}@{}", a.key, a.raw, a.offset))
                         .collect();
-                    let ns = t.resolve(tag.qname.split_once(':').map(|p| p.0));
+                    let ns = t.resolve(split_qname(tag.qname).0);
                     out.push(format!(
                         "<{}{} {}{:?}@{}",
                         tag.qname,
@@ -772,7 +744,7 @@ mod tests {
         assert!(ev[1].ends_with(r#"Ok(Some("urn:q"))@33"#), "{}", ev[1]);
         assert!(ev[2].ends_with(r#"Ok(Some("urn:p"))@55"#), "{}", ev[2]);
         assert!(ev[3].ends_with("Ok(None)@61"), "{}", ev[3]);
-        let mut t = Tokenizer::new(r#"<a xmlns:p="urn:p&amp;x"><b/></a>"#);
+        let mut t = Tokenizer::with_lists(r#"<a xmlns:p="urn:p&amp;x"><b/></a>"#, Lists::default());
         t.next().unwrap();
         assert_eq!(t.resolve(Some("p")), Ok(Some("urn:p&x")));
         assert_eq!(t.resolve(Some("q")), Err(()));

@@ -34,8 +34,7 @@ impl KindKey {
 #[derive(Default)]
 pub struct Registry {
     engines: Vec<Box<dyn Engine>>,
-    /// (kind, engine index), sorted by name length, name and namespace: a lookup finds the few
-    /// names of its length by integer comparisons, then compares bytes only with those.
+    /// (kind, engine index) for every registered kind, in registration order.
     kinds: Vec<(KindKey, usize)>,
     /// The engine of each built-in kind, by [`BehaviourKind::builtin_slot`]: found without
     /// comparing names.
@@ -59,11 +58,9 @@ impl Registry {
             {
                 self.builtin[slot] = Some(index);
             }
-            match self.kinds.binary_search_by(|(x, _)| {
-                (x.name.len(), &x.name, &x.ns).cmp(&(k.name.len(), &k.name, &k.ns))
-            }) {
-                Ok(at) => self.kinds[at].1 = index,
-                Err(at) => self.kinds.insert(at, (k.clone(), index)),
+            match self.kinds.iter_mut().find(|(x, _)| x == k) {
+                Some(known) => known.1 = index,
+                None => self.kinds.push((k.clone(), index)),
             }
         }
         index
@@ -74,14 +71,11 @@ impl Registry {
         if let Some(slot) = behaviour.kind.builtin_slot() {
             return self.builtin[slot];
         }
+        // an extension kind: the few registered kinds compared in place
         let (name, ns) = (behaviour.kind.element_name(), behaviour.kind.namespace());
-        let from = self
-            .kinds
-            .partition_point(|(k, _)| k.name.len() < name.len());
-        self.kinds[from..]
+        self.kinds
             .iter()
-            .take_while(|(k, _)| k.name.len() == name.len())
-            .find(|(k, _)| crate::xmlname::same_name(&k.name, name) && k.ns == ns)
+            .find(|(k, _)| k.name == name && k.ns == ns)
             .map(|&(_, i)| i)
     }
 
@@ -169,6 +163,11 @@ mod tests {
         .block;
         let found: Vec<Option<usize>> = block.behaviours.iter().map(|b| r.engine_for(b)).collect();
         assert_eq!(found, [Some(a), Some(c), Some(a), Some(b), Some(b), None]);
+        assert_eq!(r.kinds().len(), 5);
+        // an extension kind registered again goes to the newer engine too
+        let d = r.register(engine(), &[KindKey::new("urn:x", "gesture")]);
+        assert_eq!(r.engine_for(&block.behaviours[3]), Some(d));
+        assert_eq!(r.engine_for(&block.behaviours[4]), Some(b));
         assert_eq!(r.kinds().len(), 5);
     }
 }

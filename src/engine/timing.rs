@@ -313,15 +313,21 @@ impl Syllables {
     }
 }
 
+/// The pause after a word ending in `last`: 1 for a sentence end (`.`, `!`, `?`), 2 for a comma
+/// (`,`, `;`, `:`), 0 for none.
+fn pause_after(last: char) -> usize {
+    match last {
+        '.' | '!' | '?' => 1,
+        ',' | ';' | ':' => 2,
+        _ => 0,
+    }
+}
+
 impl SpeechTiming {
     /// Time of a word of `syllables` whose last character is `last`, including the pause its
     /// trailing punctuation asks for.
     fn word(&self, syllables: usize, last: char) -> f64 {
-        let pause = match last {
-            '.' | '!' | '?' => self.sentence_pause,
-            ',' | ';' | ':' => self.comma_pause,
-            _ => 0.0,
-        };
+        let pause = [0.0, self.sentence_pause, self.comma_pause][pause_after(last)];
         syllables as f64 * self.syllable_seconds + pause
     }
 
@@ -336,16 +342,19 @@ impl SpeechTiming {
         // one pass over the bytes with a class table, no splitting (nearly every text); the
         // syllables and pauses are counted, and timed once at the end. Inside a word the state
         // is updated without branches (a branch per letter class mispredicts on real text).
-        let (mut syllables, mut sentences, mut commas) = (0usize, 0usize, 0usize);
+        let mut syllables = 0usize;
+        let mut pauses = [0usize; 3]; // words by `pause_after` their last byte
+        let mut end_word = |word: &mut Syllables, last: u8| {
+            syllables += std::mem::take(word).total();
+            pauses[pause_after(char::from(last))] += 1;
+        };
         let mut word = Syllables::default();
         let mut last = 0u8; // the word's last byte; 0 between words
         for &b in text.as_bytes() {
             let class = ASCII_CLASS[usize::from(b)];
             if class == SPACE {
                 if last != 0 {
-                    syllables += std::mem::take(&mut word).total();
-                    sentences += usize::from(matches!(last, b'.' | b'!' | b'?'));
-                    commas += usize::from(matches!(last, b',' | b';' | b':'));
+                    end_word(&mut word, last);
                     last = 0;
                 }
                 continue;
@@ -354,13 +363,11 @@ impl SpeechTiming {
             last = b;
         }
         if last != 0 {
-            syllables += word.total();
-            sentences += usize::from(matches!(last, b'.' | b'!' | b'?'));
-            commas += usize::from(matches!(last, b',' | b';' | b':'));
+            end_word(&mut word, last);
         }
         syllables as f64 * self.syllable_seconds
-            + sentences as f64 * self.sentence_pause
-            + commas as f64 * self.comma_pause
+            + pauses[1] as f64 * self.sentence_pause
+            + pauses[2] as f64 * self.comma_pause
     }
 
     /// The rigid timing of a speech: `start`, each inline sync at the boundary where it is written,

@@ -136,7 +136,7 @@ impl DiffSystem {
         // a fill cursor per variable (n), the grouped edge indices (m), the length of the path
         // that gave each variable its value (n), and a ring queue of variables (n) in which each
         // variable is at most once (`queued`, n)
-        let need = (n + 1) + n + m + 4 * n;
+        let need = (n + 1) + n + m + 3 * n;
         // most blocks are small: their scratch lives on the stack
         let (mut small, mut large) = ([0usize; 128], Vec::new());
         let scratch: &mut [usize] = if need <= small.len() {

@@ -94,26 +94,23 @@ const ID_INDEX_LINEAR: usize = 16;
 /// search over a sorted copy for large ones (cheaper than hashing either way).
 pub(crate) struct IdIndex<'a> {
     /// Inline for a typical block: building the index allocates nothing.
+    /// Sorted when there are more than [`ID_INDEX_LINEAR`].
     ids: SmallVec<[(&'a str, usize); ID_INDEX_LINEAR]>,
-    sorted: bool,
 }
 
 impl<'a> IdIndex<'a> {
-    const LINEAR: usize = ID_INDEX_LINEAR;
-
     pub(crate) fn new(ids: impl Iterator<Item = &'a str>) -> Self {
         let mut ids: SmallVec<[(&str, usize); ID_INDEX_LINEAR]> =
             ids.enumerate().map(|(i, id)| (id, i)).collect();
-        let sorted = ids.len() > Self::LINEAR;
-        if sorted {
+        if ids.len() > ID_INDEX_LINEAR {
             ids.sort_unstable();
         }
-        IdIndex { ids, sorted }
+        IdIndex { ids }
     }
 
     /// The position of `id` (the first, if it occurs twice).
     pub(crate) fn get(&self, id: &str) -> Option<usize> {
-        if self.sorted {
+        if self.ids.len() > ID_INDEX_LINEAR {
             let at = self.ids.partition_point(|(k, _)| *k < id);
             self.ids.get(at).filter(|(k, _)| *k == id).map(|(_, i)| *i)
         } else {
@@ -249,5 +246,27 @@ pub(crate) fn resolve_all(
             reason,
         });
         items.remove(i);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::IdIndex;
+
+    /// Both ways of looking up (a scan for a few ids, a binary search for many) give the position
+    /// of the first occurrence, and nothing for an id that is not there.
+    #[test]
+    fn id_index_finds_the_first_position_for_few_and_many_ids() {
+        for n in [3usize, 16, 17, 40] {
+            let mut ids: Vec<String> = (0..n).map(|i| format!("b{}", n - i)).collect();
+            ids.push("b2".into()); // a second "b2", after the first
+            let index = IdIndex::new(ids.iter().map(String::as_str));
+            for (i, id) in ids.iter().enumerate().take(n) {
+                assert_eq!(index.get(id), Some(i), "{id} of {n}");
+            }
+            assert_eq!(index.get("b2"), Some(n - 2), "first b2 of {n}");
+            assert_eq!(index.get("b0"), None);
+            assert_eq!(index.get("c1"), None);
+        }
     }
 }
