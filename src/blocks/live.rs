@@ -8,6 +8,7 @@ use crate::plan::pegs::PegBoard;
 use crate::schedule::to_pegs::{Anticipators, PlannedBlock};
 use crate::schedule::{BlockSchedule, SyncName};
 use crate::xmlname::same_name;
+use smallvec::SmallVec;
 
 /// Where a behaviour is in its life.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,8 +113,8 @@ pub(crate) struct BlockPegs {
 
 /// Every sync point that a sync reference of `block` names (attributes and `<constraint>`s), each
 /// once, in document order.
-pub(crate) fn referenced_points(block: &bml::Block) -> Vec<&SyncPoint> {
-    let mut out: Vec<&SyncPoint> = Vec::new();
+pub(crate) fn referenced_points(block: &bml::Block) -> SmallVec<[&SyncPoint; 8]> {
+    let mut out: SmallVec<[&SyncPoint; 8]> = SmallVec::new();
     let refs = block
         .behaviours
         .iter()

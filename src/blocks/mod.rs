@@ -498,7 +498,7 @@ impl BlockManager {
         }
         // chunkBefore / prependBefore: make other blocks wait for this one
         let id = live.id.clone();
-        let ext = live.source.ext.clone();
+        let ext = &live.source.ext;
         for (targets, chunk) in [(&ext.chunk_before, true), (&ext.prepend_before, false)] {
             for t in targets {
                 match self.pos(t).map(|i| &mut self.blocks[i]) {
@@ -524,14 +524,15 @@ impl BlockManager {
             }
         }
         // S26, S27
+        let preplan = ext.preplan;
         live.status = BlockStatus::Pending;
-        live.preplan = ext.preplan;
+        live.preplan = preplan;
         self.index.insert(live.id.clone(), live.seq);
         self.seqs.push(live.seq);
         self.blocks.push(live);
         let i = self.blocks.len() - 1;
         self.predict(i, true);
-        if !ext.preplan {
+        if !preplan {
             if self.ready(i) {
                 // at its planned start: now, or a moment ago (LATE_START)
                 let t = self.blocks[i].start.min(now);

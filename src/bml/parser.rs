@@ -677,9 +677,17 @@ impl<'i> Parser<'i> {
                 });
             }
         }
-        // the emptied list serves the next element
-        self.spare_attrs = items;
+        self.give_back(items);
         kept
+    }
+
+    /// Keeps an element's attribute list, emptied, for the next element (the larger one, if
+    /// there is a spare already).
+    fn give_back(&mut self, mut items: Vec<Option<RawAttr<'i>>>) {
+        if items.capacity() > self.spare_attrs.capacity() {
+            items.clear();
+            self.spare_attrs = items;
+        }
     }
 
     fn block_child(
@@ -1038,6 +1046,7 @@ impl<'i> Parser<'i> {
                         );
                     }
                     p.speech_text(&c, &mut s.text)?;
+                    p.give_back(c.attrs);
                 }
                 (BehaviourKind::Posture(post) | BehaviourKind::PostureShift(post), "stance")
                     if core =>

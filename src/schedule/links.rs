@@ -44,9 +44,9 @@ pub(crate) fn items<'b>(
     constraints: &[Constraint],
     dropped: &mut Vec<Dropped>,
 ) -> Vec<Item<'b>> {
-    let mut order: Vec<&Behaviour> = block.behaviours.iter().collect();
+    let mut order: SmallVec<[&Behaviour; 8]> = block.behaviours.iter().collect();
     order.sort_by(|a, b| a.id.cmp(&b.id));
-    let mut items = Vec::new();
+    let mut items = Vec::with_capacity(order.len());
     for beh in order {
         let model = models.model(beh).map(|m| {
             let valid = m.check();
@@ -142,7 +142,7 @@ pub(crate) fn resolve(
     external: &dyn ExternalTimes,
 ) -> (Vec<Link>, Option<(usize, KnownWarning, String)>) {
     let index = IdIndex::new(items.iter().map(|it| it.beh.id.as_str()));
-    let mut links = Vec::new();
+    let mut links = Vec::with_capacity(constraints.len());
     for (ci, c) in constraints.iter().enumerate() {
         let mut owner = None;
         let mut term = |a: &Anchor| -> Result<Option<Term>, (KnownWarning, String)> {

@@ -29,9 +29,7 @@ use smallvec::SmallVec;
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
 use super::offsets::Offsets;
-use super::strategy::{
-    BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
-};
+use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
 use crate::bml::{extract, Block, Constraint, Relation};
 use crate::engine::timing::{Flexibility, TimingModels, MIN_DURATION};
 use crate::feedback::KnownWarning;
@@ -75,15 +73,14 @@ impl SchedulingStrategy for Optimal {
                 },
             };
             // `times` holds each item's key times one item after the other
+            // (into a list of its own: collecting in place would shrink the items' allocation)
             let mut rest = times.as_slice();
-            let mut behaviours: Vec<ScheduledBehaviour> = items
-                .into_iter()
-                .map(|it| {
-                    let (t, after) = rest.split_at(it.len);
-                    rest = after;
-                    scheduled(it, t, 0.0)
-                })
-                .collect();
+            let mut behaviours = Vec::with_capacity(items.len());
+            for it in items {
+                let (t, after) = rest.split_at(it.len);
+                rest = after;
+                behaviours.push(scheduled(it, t, 0.0));
+            }
             // document order
             let pos = IdIndex::new(block.behaviours.iter().map(|b| b.id.as_str()));
             behaviours.sort_by_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
