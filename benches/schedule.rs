@@ -118,6 +118,23 @@ fn anticipator_move(c: &mut Criterion) {
     });
 }
 
+/// N blocks, each tied to the one before: its speech starts when the previous block's speech
+/// ends, with a beat gesture on its own speech's end.
+fn chain_texts(n: usize) -> Vec<String> {
+    (0..n)
+        .map(|i| {
+            let start = if i == 0 {
+                String::new()
+            } else {
+                format!(r#" start="b{}:s:end""#, i - 1)
+            };
+            format!(
+                r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b{i}"><speech id="s"{start}><text>One two three.</text></speech><gesture id="g" lexeme="BEAT" stroke="s:end"/></bml>"#
+            )
+        })
+        .collect()
+}
+
 /// N blocks sent at once, each tied to the one before by an external reference (its speech
 /// starts when the previous block's speech ends, a beat gesture on its end): parse + schedule +
 /// plan of every block through the runtime, the shape of AsapRealizer's chained-block bench.
@@ -126,18 +143,7 @@ fn chained_blocks(c: &mut Criterion) {
     let mut g = c.benchmark_group("schedule/chained-blocks");
     g.sample_size(10);
     for n in [10usize, 100, 1000, 10_000] {
-        let blocks: Vec<String> = (0..n)
-            .map(|i| {
-                let start = if i == 0 {
-                    String::new()
-                } else {
-                    format!(r#" start="b{}:s:end""#, i - 1)
-                };
-                format!(
-                    r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b{i}"><speech id="s"{start}><text>One two three.</text></speech><gesture id="g" lexeme="BEAT" stroke="s:end"/></bml>"#
-                )
-            })
-            .collect();
+        let blocks = chain_texts(n);
         // a fresh realizer per iteration (built outside the timing: it loads the skeleton and
         // the gesture lexicon); dropping it afterwards is not timed either
         g.bench_function(BenchmarkId::from_parameter(n), |b| {
@@ -149,6 +155,65 @@ fn chained_blocks(c: &mut Criterion) {
                     }
                     r
                 },
+                BatchSize::PerIteration,
+            )
+        });
+    }
+    g.finish();
+}
+
+/// The same chain through the scheduler core alone, the scope of AsapRealizer's number: parse
+/// and `Optimal` schedule of each block with the default timing models, the previous blocks'
+/// times known to the next (all blocks at start 0, so block-local times are global). No block
+/// lifecycle, engines or feedback.
+fn chained_core(c: &mut Criterion) {
+    use bml_realizer::bml::SyncPoint;
+    use bml_realizer::schedule::{BlockSchedule, ExternalTimes};
+    use std::collections::HashMap;
+
+    /// The schedules so far, by block id.
+    struct Known(HashMap<bml::Id, BlockSchedule>);
+    impl ExternalTimes for Known {
+        fn time(&self, point: &SyncPoint) -> Option<f64> {
+            let SyncPoint::External {
+                block,
+                behaviour,
+                sync,
+            } = point
+            else {
+                return None;
+            };
+            let schedule = self.0.get(block)?;
+            schedule
+                .behaviours
+                .iter()
+                .find(|b| b.id == *behaviour)?
+                .time(sync)
+        }
+    }
+
+    let models = DefaultTimingModels::default();
+    let mut g = c.benchmark_group("schedule/chained-core");
+    g.sample_size(10);
+    for n in [10usize, 100, 1000, 10_000] {
+        let blocks = chain_texts(n);
+        let run = |mut known: Known| {
+            for text in &blocks {
+                let block = bml::load(text).unwrap().block;
+                let schedule = Optimal.schedule(&block, &models, &known).unwrap();
+                known.0.insert(block.id, schedule);
+            }
+            known
+        };
+        // each block really follows the one before (a missed reference would drop its speech)
+        let known = run(Known(HashMap::new()));
+        let last = &known.0[format!("b{}", n - 1).as_str()];
+        assert_eq!(last.behaviours.len(), 2);
+        assert!(last.behaviours.iter().all(|b| b.syncs[0].1 > 0.0));
+        g.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter_batched(
+                || Known(HashMap::with_capacity(n)),
+                run,
                 BatchSize::PerIteration,
             )
         });
@@ -213,6 +278,7 @@ criterion_group!(
     optimal,
     anticipator_move,
     chained_blocks,
+    chained_core,
     after_large_block
 );
 criterion_main!(benches);
