@@ -40,18 +40,50 @@ pub struct LineIndex {
 impl LineIndex {
     /// Index the line starts of `src`.
     pub fn new(src: &str) -> Self {
-        Self::with_starts(src, Vec::with_capacity(src.len() / 32 + 1))
+        Self::scan(src, Vec::with_capacity(src.len() / 32 + 1)).0
     }
 
-    /// Like [`Self::new`], with the line starts written into `starts` (emptied first; from
-    /// [`Self::into_starts`]), so that indexing one block after another need not allocate.
-    pub(crate) fn with_starts(src: &str, mut starts: Vec<usize>) -> Self {
+    /// The index of `src`, with the line starts written into `starts` (emptied first; from
+    /// [`Self::into_starts`], so that indexing one block after another need not allocate), and
+    /// found in the same pass over the text, the offset of its first C0 control character other
+    /// than tab, line feed and carriage return (XML 1.0 forbids them).
+    pub(crate) fn scan(src: &str, mut starts: Vec<usize>) -> (Self, Option<usize>) {
         let bytes = src.as_bytes();
         starts.clear();
         starts.push(0);
-        starts.extend(memchr::memchr_iter(b'\n', bytes).map(|i| i + 1));
+        let (mut ascii, mut forbidden) = (true, None);
+        let mut byte = |at: usize, b: u8| match b {
+            b'\n' => starts.push(at + 1),
+            b'\t' | b'\r' => {}
+            0..=0x1f => {
+                forbidden.get_or_insert(at);
+            }
+            0x80.. => ascii = false,
+            _ => {}
+        };
+        // eight bytes at a time: most words of a block hold neither a byte below 0x20 (line
+        // ends, tabs, control characters) nor one above 0x7F, and need no closer look
+        const ONES: u64 = 0x0101_0101_0101_0101;
+        const HIGH: u64 = 0x8080_8080_8080_8080;
+        let mut words = bytes.chunks_exact(8);
+        let mut at = 0;
+        for w in &mut words {
+            let x = u64::from_le_bytes(w.try_into().expect("eight bytes"));
+            // a byte's high bit after subtracting 0x20 is set if it is below 0x20 or at least
+            // 0xA0, and every non-ASCII character starts with a byte of at least 0xC2 (a
+            // borrow into the next byte only comes from a byte that is itself below 0x20)
+            if x.wrapping_sub(ONES * 0x20) & HIGH != 0 {
+                for (i, &b) in w.iter().enumerate() {
+                    byte(at + i, b);
+                }
+            }
+            at += 8;
+        }
+        for (i, &b) in words.remainder().iter().enumerate() {
+            byte(at + i, b);
+        }
         // an ASCII text (nearly every block) needs no second table: columns are byte counts
-        let ascii_until = if src.is_ascii() {
+        let ascii_until = if ascii {
             Vec::new()
         } else {
             let ends = starts.iter().skip(1).copied().chain([src.len()]);
@@ -66,10 +98,11 @@ impl LineIndex {
                 })
                 .collect()
         };
-        LineIndex {
+        let index = LineIndex {
             starts,
             ascii_until,
-        }
+        };
+        (index, forbidden)
     }
 
     /// The list of line starts, for another index.
@@ -281,6 +314,42 @@ impl BmlError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The eight-bytes-at-a-time scan finds what a byte-by-byte reading finds: every line start,
+    /// the first forbidden control character, and whether the text is ASCII (through the
+    /// columns), wherever in a word those bytes fall.
+    #[test]
+    fn one_pass_scan_agrees_with_byte_by_byte_reading() {
+        let pieces = [
+            "a", "bc", "\n", "\t", "\r\n", "\u{1}", "\u{1f}", " ", "é", "€", "~", "\u{7f}",
+        ];
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..3000 {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            let len = (seed % 40) as usize;
+            let src: String = (0..len)
+                .map(|j| pieces[((seed >> (j % 60)) as usize + j * 7) % pieces.len()])
+                .collect();
+            let (index, forbidden) = LineIndex::scan(&src, Vec::new());
+            let starts: Vec<usize> = [0]
+                .into_iter()
+                .chain(src.match_indices('\n').map(|(i, _)| i + 1))
+                .collect();
+            assert_eq!(index.starts, starts, "{src:?}");
+            let first = src
+                .bytes()
+                .position(|b| b < 0x20 && !matches!(b, b'\t' | b'\n' | b'\r'));
+            assert_eq!(forbidden, first, "{src:?}");
+            assert_eq!(index.ascii_until.is_empty(), src.is_ascii(), "{src:?}");
+            for (o, _) in src.char_indices() {
+                let line_start = src[..o].rfind('\n').map_or(0, |i| i + 1);
+                let col = src[line_start..o].chars().count() as u32 + 1;
+                assert_eq!(index.pos(&src, o).col, col, "{src:?} at {o}");
+            }
+        }
+    }
 
     #[test]
     fn line_index_maps_offsets_to_line_and_char_column() {

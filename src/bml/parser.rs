@@ -145,6 +145,8 @@ struct Parser<'i> {
     src: &'i str,
     tok: Tokenizer<'i>,
     lines: LineIndex,
+    /// Offset of the first control character XML forbids (found while indexing the lines).
+    forbidden: Option<usize>,
     diags: Vec<Diagnostic>,
     pending: Option<Tok<'i>>,
     /// An emptied attribute list, for the next element (one list serves a whole block).
@@ -206,10 +208,12 @@ impl<'i> Parser<'i> {
             .ok()
             .flatten()
             .unwrap_or_default();
+        let (lines, forbidden) = LineIndex::scan(src, scratch.lines);
         Parser {
             src,
             tok: Tokenizer::with_lists(src, scratch.tokens),
-            lines: LineIndex::with_starts(src, scratch.lines),
+            lines,
+            forbidden,
             diags: Vec::new(),
             pending: None,
             spare_attrs: xml::recycle(scratch.attrs),
@@ -461,10 +465,7 @@ impl<'i> Parser<'i> {
 
     fn document_inner(&mut self) -> Result<Option<Block>, Fatal> {
         // XML 1.0 forbids most C0 control characters anywhere in a document.
-        let forbidden = |b: u8| b < 0x20 && !matches!(b, b'\t' | b'\n' | b'\r');
-        // branch-free pass first (vectorises); locate only when something is there
-        let any = self.src.bytes().fold(false, |acc, b| acc | forbidden(b));
-        if let Some(at) = any.then(|| self.src.bytes().position(forbidden)).flatten() {
+        if let Some(at) = self.forbidden {
             let c = self.src.as_bytes()[at];
             self.error(
                 Code::NotXml,
