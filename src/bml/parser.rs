@@ -332,7 +332,7 @@ impl<'i> Parser<'i> {
                     }
                 }
             };
-            let value = match xml::unescape(a.raw, a.value_offset) {
+            let value = match a.value() {
                 Ok(v) => v,
                 Err(e) => {
                     self.error(

@@ -40,9 +40,20 @@ pub(crate) struct Attr<'i> {
     pub raw: &'i str,
     /// Byte offset of the value's first character.
     pub value_offset: usize,
+    /// Whether the value holds a reference (`&`), so that [`Attr::value`] must resolve it.
+    pub references: bool,
 }
 
 impl<'i> Attr<'i> {
+    /// The value with its references resolved (borrowed when it has none).
+    pub fn value(&self) -> Result<Cow<'i, str>, XmlError> {
+        if self.references {
+            unescape(self.raw, self.value_offset)
+        } else {
+            Ok(Cow::Borrowed(self.raw))
+        }
+    }
+
     /// The prefix a namespace declaration binds: `Some("")` for `xmlns`, `Some(p)` for
     /// `xmlns:p`, `None` for an ordinary attribute.
     pub fn declares(&self) -> Option<&'i str> {
@@ -402,7 +413,7 @@ impl<'i> Tokenizer<'i> {
                         format!("attribute '{}' appears twice on <{qname}>", a.key),
                     );
                 }
-                let uri = unescape(a.raw, a.value_offset).map_err(|e| XmlError {
+                let uri = a.value().map_err(|e| XmlError {
                     offset: a.offset,
                     message: format!(
                         "namespace declaration has a bad character or entity reference: {}",
@@ -466,26 +477,36 @@ impl<'i> Tokenizer<'i> {
             }
         };
         let value_offset = self.pos + 1;
-        // values are short: a plain loop beats a vectorised search's setup
-        let Some(len) = b[value_offset..].iter().position(|&c| c == quote) else {
-            return err(
-                offset,
-                format!("the value of attribute '{key}' of <{tag}> is never closed"),
-            );
-        };
-        let raw = &self.src[value_offset..value_offset + len];
-        if let Some(i) = raw.bytes().position(|c| c == b'<') {
-            return err(
-                value_offset + i,
-                format!("'<' in the value of attribute '{key}'"),
-            );
+        // one search for the closing quote, a '<' (not allowed) or a reference
+        let (mut end, mut references) = (value_offset, false);
+        loop {
+            match memchr::memchr3(quote, b'<', b'&', &b[end..]).map(|i| end + i) {
+                None => {
+                    return err(
+                        offset,
+                        format!("the value of attribute '{key}' of <{tag}> is never closed"),
+                    )
+                }
+                Some(i) if b[i] == quote => {
+                    end = i;
+                    break;
+                }
+                Some(i) if b[i] == b'<' => {
+                    return err(i, format!("'<' in the value of attribute '{key}'"))
+                }
+                Some(i) => {
+                    references = true;
+                    end = i + 1;
+                }
+            }
         }
-        self.pos = value_offset + len + 1;
+        self.pos = end + 1;
         self.attrs.push(Attr {
             key,
             offset,
-            raw,
+            raw: &self.src[value_offset..end],
             value_offset,
+            references,
         });
         Ok(())
     }
