@@ -92,10 +92,18 @@ struct OtherBlocks<'a> {
     start: f64,
 }
 
-/// Where block `id` is among the blocks whose `seq`s are `seqs` (sorted).
+/// Where block `id` is among the blocks whose `seq`s are `seqs` (increasing).
 fn position(seqs: &[u64], index: &HashMap<bml::Id, u64>, id: &str) -> Option<usize> {
     let seq = *index.get(id)?;
-    seqs.binary_search(&seq).ok()
+    // where it is if no block after it has left (the usual case: blocks mostly end in order,
+    // and references go to recent blocks), else a binary search
+    let guess = seqs
+        .len()
+        .checked_sub(1 + usize::try_from(seqs.last()?.checked_sub(seq)?).ok()?);
+    match guess {
+        Some(i) if seqs[i] == seq => Some(i),
+        _ => seqs.binary_search(&seq).ok(),
+    }
 }
 
 impl ExternalTimes for OtherBlocks<'_> {
