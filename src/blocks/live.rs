@@ -99,8 +99,8 @@ pub(crate) struct LiveBlock {
     /// Waiting for an activation.
     pub(crate) preplan: bool,
     /// The block's own peg board, for blocks tied to anticipators: moving an anticipator's peg
-    /// retimes what hangs on it (S56).
-    pub(crate) pegs: Option<BlockPegs>,
+    /// retimes what hangs on it (S56). Boxed: few blocks have one, and every block is kept.
+    pub(crate) pegs: Option<Box<BlockPegs>>,
 }
 
 /// A block on its own peg board (only blocks that refer to anticipators have one).

@@ -287,7 +287,7 @@ impl BlockManager {
         };
         let fb = PredictionFeedback {
             character_id: self.character.clone(),
-            blocks: vec![BlockPrediction {
+            blocks: smallvec::smallvec![BlockPrediction {
                 id: b.id.clone(),
                 global_start: Some(b.start),
                 // unknown while scheduling (the harness waits for a known end)
@@ -490,11 +490,11 @@ impl BlockManager {
                 &schedule,
                 start,
             );
-            live.pegs = Some(BlockPegs {
+            live.pegs = Some(Box::new(BlockPegs {
                 board,
                 anticipators,
                 plan,
-            });
+            }));
         }
         live.set_schedule(schedule, &self.registry);
         for (beh, reason) in live.resolve_exclusive_ties(&self.registry) {

@@ -8,6 +8,8 @@ mod xml;
 
 use std::fmt;
 
+pub use smallvec::SmallVec;
+
 pub use json::{from_json, to_json};
 pub use xml::{from_xml, to_xml};
 
@@ -179,8 +181,9 @@ pub struct BehaviourPrediction {
 pub struct PredictionFeedback {
     /// Character, if any.
     pub character_id: Option<String>,
-    /// Block predictions.
-    pub blocks: Vec<BlockPrediction>,
+    /// Block predictions: in practice one (the realizer sends one per block), so it is kept
+    /// inline.
+    pub blocks: SmallVec<[BlockPrediction; 1]>,
     /// Behaviour predictions.
     pub behaviours: Vec<BehaviourPrediction>,
 }
