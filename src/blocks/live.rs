@@ -1,6 +1,8 @@
 //! One block in the running plan and its behaviours: block-local sync times from the schedule,
 //! how far each behaviour has got, and the derived block predictions (end, subsiding time).
 
+use smallvec::SmallVec;
+
 use crate::bml::{self, ConstraintItem, SyncPoint, SyncRef};
 use crate::engine::Registry;
 use crate::feedback::BlockStatus;
@@ -8,7 +10,6 @@ use crate::plan::pegs::PegBoard;
 use crate::schedule::to_pegs::{Anticipators, PlannedBlock};
 use crate::schedule::{BlockSchedule, SyncName};
 use crate::xmlname::same_name;
-use smallvec::SmallVec;
 
 /// Where a behaviour is in its life.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

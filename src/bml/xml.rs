@@ -773,6 +773,46 @@ mod tests {
     }
 
     #[test]
+    fn attribute_values_are_resolved_only_when_they_hold_references() {
+        let src = r#"<a x="plain" y='a&amp;b&lt;' z="&quot;" w="'"/>"#;
+        let mut t = Tokenizer::with_lists(src, Lists::default());
+        assert!(matches!(t.next(), Ok(Event::Start(_))));
+        let got: Vec<(&str, bool, String, bool)> = t
+            .attrs()
+            .iter()
+            .map(|a| {
+                let v = a.value().unwrap();
+                let borrowed = matches!(v, Cow::Borrowed(_));
+                (a.key, a.references, v.into_owned(), borrowed)
+            })
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("x", false, "plain".to_string(), true),
+                ("y", true, "a&b<".to_string(), false),
+                ("z", true, "\"".to_string(), false),
+                ("w", false, "'".to_string(), true),
+            ]
+        );
+        // a bad reference is found when the value is asked for, at its offset
+        let mut t = Tokenizer::with_lists("<a x='1&bogus;'/>", Lists::default());
+        assert!(matches!(t.next(), Ok(Event::Start(_))));
+        assert_eq!(t.attrs()[0].value().unwrap_err().offset, 7);
+        // a '<' after a reference, and a value left open after one, are still found
+        for (src, offset, words) in [
+            ("<a x='&amp;<'/>", 11, "'<' in the value"),
+            ("<a x='&amp;", 3, "never closed"),
+        ] {
+            let last = events(src).pop().unwrap();
+            assert!(
+                last.starts_with(&format!("!{offset} ")) && last.contains(words),
+                "{src}: {last}"
+            );
+        }
+    }
+
+    #[test]
     fn malformed_input_is_reported_where_it_is() {
         for (src, offset, words) in [
             ("<a><b></a>", 6, "does not match the start tag <b>"),

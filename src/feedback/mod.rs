@@ -8,6 +8,7 @@ mod xml;
 
 use std::fmt;
 
+/// The list type of [`PredictionFeedback::blocks`] (inline for one block).
 pub use smallvec::SmallVec;
 
 pub use json::{from_json, to_json};
