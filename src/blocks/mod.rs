@@ -184,11 +184,6 @@ impl BlockManager {
         &self.registry
     }
 
-    /// Takes the feedback produced so far.
-    pub fn take_feedback(&mut self) -> Vec<Feedback> {
-        std::mem::take(&mut self.out)
-    }
-
     /// Moves the feedback produced so far to the end of `to`; the manager keeps its list's
     /// capacity for the next messages.
     pub fn move_feedback(&mut self, to: &mut Vec<Feedback>) {

@@ -635,7 +635,7 @@ fn reference(src: &str, at: usize) -> Result<(Cow<'static, str>, usize), XmlErro
 
 /// Resolves the references in an attribute value (`raw` starts at byte `offset` of the source);
 /// borrowed when there are none.
-pub(crate) fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlError> {
+fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlError> {
     let Some(first) = raw.bytes().position(|c| c == b'&') else {
         return Ok(Cow::Borrowed(raw));
     };

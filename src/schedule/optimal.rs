@@ -72,8 +72,8 @@ impl SchedulingStrategy for Optimal {
                     }
                 },
             };
-            // `times` holds each item's key times one item after the other
-            // (into a list of its own: collecting in place would shrink the items' allocation)
+            // `times` holds each item's key times one item after the other; the results go into
+            // a list of their own (collecting in place would shrink the items' allocation)
             let mut rest = times.as_slice();
             let mut behaviours = Vec::with_capacity(items.len());
             for it in items {
