@@ -39,7 +39,12 @@ pub fn parse(src: &str) -> Result<Parsed, BmlError> {
 /// diagnostics, errors included.
 pub fn parse_with_diagnostics(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
     let mut p = Parser::new(src);
-    let block = p.document();
+    // filled in place: a block is a few hundred bytes, and it is not copied up the parser's
+    // return values
+    let mut block = None;
+    if p.document(&mut block).is_err() {
+        block = None;
+    }
     let mut diags = std::mem::take(&mut p.diags);
     p.keep_scratch();
     diags.sort_by_key(|d| (d.pos.line, d.pos.col));
@@ -459,11 +464,9 @@ impl<'i> Parser<'i> {
         }
     }
 
-    fn document(&mut self) -> Option<Block> {
-        self.document_inner().ok().flatten()
-    }
-
-    fn document_inner(&mut self) -> Result<Option<Block>, Fatal> {
+    /// Reads the document; `out` gets the block when the root is `<bml>` (only partly filled if
+    /// a fatal error stops the parse, which the caller discards then).
+    fn document(&mut self, out: &mut Option<Block>) -> Result<(), Fatal> {
         // XML 1.0 forbids most C0 control characters anywhere in a document.
         if let Some(at) = self.forbidden {
             let c = self.src.as_bytes()[at];
@@ -514,9 +517,9 @@ impl<'i> Parser<'i> {
                     root.qname
                 ),
             );
-            return Ok(None);
+            return Ok(());
         }
-        let block = self.block(root)?;
+        self.block(root, out.insert(Block::default()))?;
         loop {
             match self.next()? {
                 Tok::Eof => break,
@@ -542,7 +545,7 @@ impl<'i> Parser<'i> {
                 _ => {}
             }
         }
-        Ok(Some(block))
+        Ok(())
     }
 
     fn bool_attr(&mut self, a: &RawAttr<'i>) -> bool {
@@ -563,11 +566,9 @@ impl<'i> Parser<'i> {
         }
     }
 
-    fn block(&mut self, mut el: El<'i>) -> Result<Block, Fatal> {
-        let mut block = Block {
-            pos: self.pos(el.offset),
-            ..Block::default()
-        };
+    /// Reads the `<bml>` element `el` into `block` (a default one).
+    fn block(&mut self, mut el: El<'i>, block: &mut Block) -> Result<(), Fatal> {
+        block.pos = self.pos(el.offset);
         let mut attrs = Attrs::new(std::mem::take(&mut el.attrs));
         match attrs.take("id") {
             Some(a) if !a.value.trim_ascii().is_empty() => {
@@ -647,7 +648,7 @@ impl<'i> Parser<'i> {
         })?;
         block.behaviours = behaviours;
         block.constraints = constraints;
-        Ok(block)
+        Ok(())
     }
 
     /// Reports leftover attributes: unprefixed ones are errors, extension ones warnings (kept).

@@ -1,11 +1,13 @@
 //! Weighted union-find over numbered nodes: which nodes `at`-constraints tie together, and at what
 //! fixed distance from each other (`value(node) = value(root) + offset(node)`).
 
-/// Nodes joined by fixed distances.
+use smallvec::SmallVec;
+
+/// Nodes joined by fixed distances (those of a typical block on the stack).
 #[derive(Debug, Clone)]
 pub(crate) struct Offsets {
-    parent: Vec<usize>,
-    offset: Vec<f64>,
+    parent: SmallVec<[usize; 16]>,
+    offset: SmallVec<[f64; 16]>,
 }
 
 impl Offsets {
@@ -13,7 +15,7 @@ impl Offsets {
     pub(crate) fn new(n: usize) -> Self {
         Offsets {
             parent: (0..n).collect(),
-            offset: vec![0.0; n],
+            offset: smallvec::smallvec![0.0; n],
         }
     }
 

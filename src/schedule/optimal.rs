@@ -334,7 +334,8 @@ fn pinned_apart(items: &[Item], links: &[Link]) -> bool {
 /// behaviour's constrained keys are not fixed relative to each other (the LP decides then).
 fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     // anchored (item, key) pairs, sorted: item i's anchors are `pairs[first[i]..first[i + 1]]`
-    let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(2 * links.len());
+    // (the lists of a typical block fit on the stack)
+    let mut pairs: SmallVec<[(usize, usize); 16]> = SmallVec::with_capacity(2 * links.len());
     for l in links {
         for t in [l.left, l.right] {
             if let Term::Key(i, k) = t {
@@ -346,7 +347,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     pairs.dedup();
     // per item: first anchor, first node, and (for a stretched item) its scale, in one vector
     let m = items.len();
-    let mut first = vec![0usize; 2 * m + 1];
+    let mut first: SmallVec<[usize; 17]> = smallvec::smallvec![0usize; 2 * m + 1];
     for &(i, _) in &pairs {
         first[i + 1] += 1;
     }
@@ -389,7 +390,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         offsets.join(a, b, ob + l.offset - oa);
     }
     // the uniform scale of each multi-anchor item, from its fixed anchor distances
-    let mut scale = vec![1.0; m];
+    let mut scale: SmallVec<[f64; 8]> = smallvec::smallvec![1.0; m];
     for i in (0..m).filter(|&i| multi(i)) {
         let keys = &items[i].model.keys;
         let count = anchors(i);
