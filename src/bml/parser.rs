@@ -721,8 +721,8 @@ impl<'i> Parser<'i> {
             self.children(&child, |p, c| {
                 p.block_child(c, true, behaviours, constraints)
             })?;
-        } else if let Some(b) = self.behaviour(child, required)? {
-            behaviours.push(b);
+        } else {
+            self.behaviour(child, required, behaviours)?;
         }
         Ok(())
     }
@@ -841,7 +841,14 @@ impl<'i> Parser<'i> {
         }))
     }
 
-    fn behaviour(&mut self, mut el: El<'i>, required: bool) -> Result<Option<Behaviour>, Fatal> {
+    /// Reads a behaviour element into `out` (nothing is added for one that cannot be kept; the
+    /// behaviour is built in its place in the list, not copied up a return value).
+    fn behaviour(
+        &mut self,
+        mut el: El<'i>,
+        required: bool,
+        out: &mut Vec<Behaviour>,
+    ) -> Result<(), Fatal> {
         let core = el.ns.is_core();
         let name = el.name;
         let known = (core && CORE_BEHAVIOURS.contains(&name))
@@ -855,7 +862,7 @@ impl<'i> Parser<'i> {
                 format!("<{}> is not a BML 1.0 behaviour or block element", el.qname),
             );
             self.skip(&el)?;
-            return Ok(None);
+            return Ok(());
         }
         let mut attrs = Attrs::new(std::mem::take(&mut el.attrs));
         let id = match attrs.take("id") {
@@ -913,35 +920,41 @@ impl<'i> Parser<'i> {
                 content,
                 namespaces,
             });
-            return Ok(id.map(|id| Behaviour {
-                id,
-                kind,
-                syncs,
-                required,
-                descriptions: Vec::new(),
-                foreign_attrs: Vec::new(),
-                pos: self.pos(el.offset),
-            }));
+            if let Some(id) = id {
+                out.push(Behaviour {
+                    id,
+                    kind,
+                    syncs,
+                    required,
+                    descriptions: Vec::new(),
+                    foreign_attrs: Vec::new(),
+                    pos: self.pos(el.offset),
+                });
+            }
+            return Ok(());
         }
 
         let mut kb = KindBuilder::new(self, &mut attrs, &on, &el);
         let kind = kb.build();
         let Some(mut kind) = kind else {
             self.skip(&el)?;
-            return Ok(None);
+            return Ok(());
         };
         let syncs = self.sync_attrs(&mut attrs, kind.standard_syncs(), &on);
         let foreign_attrs = self.leftover_attrs(attrs, &on);
         let descriptions = self.behaviour_children(&el, &mut kind, &on)?;
-        Ok(id.map(|id| Behaviour {
-            id,
-            kind,
-            syncs,
-            required,
-            descriptions,
-            foreign_attrs,
-            pos: self.pos(el.offset),
-        }))
+        if let Some(id) = id {
+            out.push(Behaviour {
+                id,
+                kind,
+                syncs,
+                required,
+                descriptions,
+                foreign_attrs,
+                pos: self.pos(el.offset),
+            });
+        }
+        Ok(())
     }
 
     fn sync_attrs(
