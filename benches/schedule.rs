@@ -272,10 +272,46 @@ fn after_large_block(c: &mut Criterion) {
     g.finish();
 }
 
+/// Every RealizerTester core file (the per-file bar: AsapRealizer's scheduler core
+/// took 21–40 µs for each single-behaviour file): parse + `Optimal` schedule with the default
+/// timing models, file by file. A file that is not a valid block (`bmlnoid.xml` tests the
+/// missing-id error) is left out.
+fn core_files(c: &mut Criterion) {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/fixtures/realizertester/bml-1/core"
+    );
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .expect("the core fixtures")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
+        .collect();
+    files.sort();
+    let models = DefaultTimingModels::default();
+    let mut g = c.benchmark_group("schedule/core-file");
+    g.warm_up_time(std::time::Duration::from_millis(300));
+    g.measurement_time(std::time::Duration::from_secs(1));
+    for path in files {
+        let text = std::fs::read_to_string(&path).unwrap();
+        if bml::load(&text).is_err() {
+            continue;
+        }
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let block = bml::load(black_box(&text)).unwrap().block;
+                black_box(Optimal.schedule(&block, &models, &NoExternal).unwrap())
+            })
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
     solve,
     optimal,
+    core_files,
     anticipator_move,
     chained_blocks,
     chained_core,
