@@ -72,10 +72,13 @@ impl LineIndex {
             // a byte's high bit after subtracting 0x20 is set if it is below 0x20 or at least
             // 0xA0, and every non-ASCII character starts with a byte of at least 0xC2 (a
             // borrow into the next byte only comes from a byte that is itself below 0x20)
-            if x.wrapping_sub(ONES * 0x20) & HIGH != 0 {
-                for (i, &b) in w.iter().enumerate() {
-                    byte(at + i, b);
-                }
+            // (the flagged bytes are looked at one by one, the others not at all: a flag can
+            // also fall on the byte after one below 0x20, which the look sorts out)
+            let mut flagged = x.wrapping_sub(ONES * 0x20) & HIGH;
+            while flagged != 0 {
+                let i = flagged.trailing_zeros() as usize / 8;
+                byte(at + i, w[i]);
+                flagged &= flagged - 1;
             }
             at += 8;
         }
