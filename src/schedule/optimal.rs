@@ -345,10 +345,12 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     }
     pairs.sort_unstable();
     pairs.dedup();
+    // read as a slice from here on: no inline-or-heap check per access
+    let pairs = pairs.as_slice();
     // per item: first anchor, first node, and (for a stretched item) its scale, in one vector
     let m = items.len();
     let mut first: SmallVec<[usize; 17]> = smallvec::smallvec![0usize; 2 * m + 1];
-    for &(i, _) in &pairs {
+    for &(i, _) in pairs {
         first[i + 1] += 1;
     }
     for i in 0..m {
@@ -425,6 +427,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
             }
         }
     }
+    let scale = scale.as_slice();
     // least solution over the nodes
     let mut s = DiffSystem::with_capacity(n, 2 * links.len() + m);
     for v in 0..n {
