@@ -331,3 +331,34 @@ fn a_parse_does_not_depend_on_earlier_parses_on_the_thread() {
         assert_eq!(seen(src), alone[i], "input {i} parsed after others");
     }
 }
+
+/// White space between elements is passed over (also when written as a character reference),
+/// text that is not blank is reported once where it starts (also when a reference splits it), and
+/// a speech's text keeps its own white space, around inline syncs too.
+#[test]
+fn blank_text_between_elements_is_skipped_and_speech_text_is_kept() {
+    let blank = "\n\t<!-- c -->\n<bml xmlns=\"http://www.bml-initiative.org/bml/bml-1.0\" id=\"b\">\n\t&#32;\t<head id=\"h\" lexeme=\"NOD\"/>&#x20;\n</bml>\n";
+    let parsed = bml::load(blank).expect("blank text between elements is fine");
+    assert!(parsed.warnings.is_empty(), "{:?}", parsed.warnings);
+    assert_eq!(parsed.block.behaviours.len(), 1);
+    let split = block("<head id=\"h\" lexeme=\"NOD\"/>\n  a&#32;b <wait id=\"w\"/>");
+    // `a` is on line 3 (the block's second body line), after the two spaces that open it
+    assert_eq!(errors(&split), vec![(Code::UnexpectedText, 3, 3)]);
+    let speech = block(
+        "<speech id=\"s\">\n<text> Hey punk <sync id=\"x\"/> <sync id=\"y\"/>what? </text>\n</speech>",
+    );
+    let parsed = bml::load(&speech).unwrap().block;
+    let bml::BehaviourKind::Speech(s) = &parsed.behaviours[0].kind else {
+        panic!("a speech");
+    };
+    assert_eq!(
+        s.text,
+        vec![
+            bml::TextPart::Text(" Hey punk ".into()),
+            bml::TextPart::Sync("x".into()),
+            bml::TextPart::Text(" ".into()),
+            bml::TextPart::Sync("y".into()),
+            bml::TextPart::Text("what? ".into()),
+        ]
+    );
+}

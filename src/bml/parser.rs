@@ -267,6 +267,16 @@ impl<'i> Parser<'i> {
 
     /// Reads the next token, merging adjacent text, character references and CDATA.
     fn next(&mut self) -> Result<Tok<'i>, Fatal> {
+        self.token(true)
+    }
+
+    /// [`Self::next`] where text that is only white space does not matter (between elements):
+    /// such a run of text is passed over, not returned (and the token after it is not parked).
+    fn next_markup(&mut self) -> Result<Tok<'i>, Fatal> {
+        self.token(false)
+    }
+
+    fn token(&mut self, blank_text: bool) -> Result<Tok<'i>, Fatal> {
         if let Some(t) = self.pending.take() {
             return Ok(t);
         }
@@ -283,6 +293,7 @@ impl<'i> Parser<'i> {
                 Err(e) => return Err(self.xml_error(e)),
             };
             return Ok(match text {
+                Some((text, _)) if !blank_text && text.trim_ascii().is_empty() => tok,
                 Some((text, offset)) => {
                     self.pending = Some(tok);
                     Tok::Text { text, offset }
@@ -399,7 +410,7 @@ impl<'i> Parser<'i> {
         }
         let mut depth = 0usize;
         loop {
-            match self.next()? {
+            match self.next_markup()? {
                 Tok::Start(e) => {
                     prefixes.extend(e.prefixes);
                     if !e.empty {
@@ -442,7 +453,7 @@ impl<'i> Parser<'i> {
             return Ok(el.inner_start);
         }
         loop {
-            match self.next()? {
+            match self.next_markup()? {
                 Tok::Start(child) => on_child(self, child)?,
                 Tok::End { after, .. } => return Ok(after),
                 Tok::Text { text, offset } => {
@@ -478,7 +489,7 @@ impl<'i> Parser<'i> {
             return Err(Fatal);
         }
         let root = loop {
-            match self.next()? {
+            match self.next_markup()? {
                 Tok::Start(el) => break el,
                 Tok::Text { text, offset } if !text.trim_ascii().is_empty() => {
                     self.error(
@@ -521,7 +532,7 @@ impl<'i> Parser<'i> {
         }
         self.block(root, out.insert(Block::default()))?;
         loop {
-            match self.next()? {
+            match self.next_markup()? {
                 Tok::Eof => break,
                 Tok::Text { text, offset } if !text.trim_ascii().is_empty() => {
                     self.error(
