@@ -81,9 +81,11 @@ impl SchedulingStrategy for Optimal {
                 rest = after;
                 behaviours.push(scheduled(it, t, 0.0));
             }
-            // document order
-            let pos = IdIndex::new(block.behaviours.iter().map(|b| b.id.as_str()));
-            behaviours.sort_by_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
+            // document order (nothing to sort for one behaviour)
+            if behaviours.len() > 1 {
+                let pos = IdIndex::new(block.behaviours.iter().map(|b| b.id.as_str()));
+                behaviours.sort_by_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
+            }
             return Ok(BlockSchedule {
                 behaviours,
                 dropped,
