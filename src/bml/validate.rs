@@ -1,6 +1,8 @@
 //! Static validation of a parsed block: ids (missing, duplicate, unusable), references to unknown
 //! behaviours and unknown sync points, constraints that relate nothing, lexemes outside BML 1.0.
 
+use smallvec::SmallVec;
+
 use super::constraints::{extract_elements, Anchor, Relation};
 use super::diagnostic::{Code, Diagnostic, Pos};
 use super::model::{BehaviourKind, Block, ConstraintItem, TextPart, FACE_LEXEMES, HEAD_LEXEMES};
@@ -9,8 +11,9 @@ use super::syncref::{SyncPoint, SyncRef};
 /// Checks a block's cross-references; returns errors and warnings in source order.
 pub fn validate(block: &Block) -> Vec<Diagnostic> {
     let mut diags = Vec::new();
-    // duplicate ids: sort (id, index) pairs once instead of hashing every id
-    let mut ids: Vec<(&str, usize)> = block
+    // duplicate ids: sort (id, index) pairs once instead of hashing every id (those of a
+    // typical block on the stack)
+    let mut ids: SmallVec<[(&str, usize); 16]> = block
         .behaviours
         .iter()
         .enumerate()
