@@ -905,7 +905,7 @@ impl<'i> Parser<'i> {
             qname,
             id: id.as_deref(),
         };
-        if !known {
+        let (kind, syncs, descriptions, foreign_attrs) = if !known {
             self.warn(
                 Code::UnsupportedExtension,
                 el.offset,
@@ -931,29 +931,19 @@ impl<'i> Parser<'i> {
                 content,
                 namespaces,
             });
-            if let Some(id) = id {
-                out.push(Behaviour {
-                    id,
-                    kind,
-                    syncs,
-                    required,
-                    descriptions: Vec::new(),
-                    foreign_attrs: Vec::new(),
-                    pos: self.pos(el.offset),
-                });
-            }
-            return Ok(());
-        }
-
-        let mut kb = KindBuilder::new(self, &mut attrs, &on, &el);
-        let kind = kb.build();
-        let Some(mut kind) = kind else {
-            self.skip(&el)?;
-            return Ok(());
+            (kind, syncs, Vec::new(), Vec::new())
+        } else {
+            let mut kb = KindBuilder::new(self, &mut attrs, &on, &el);
+            let kind = kb.build();
+            let Some(mut kind) = kind else {
+                self.skip(&el)?;
+                return Ok(());
+            };
+            let syncs = self.sync_attrs(&mut attrs, kind.standard_syncs(), &on);
+            let foreign_attrs = self.leftover_attrs(attrs, &on);
+            let descriptions = self.behaviour_children(&el, &mut kind, &on)?;
+            (kind, syncs, descriptions, foreign_attrs)
         };
-        let syncs = self.sync_attrs(&mut attrs, kind.standard_syncs(), &on);
-        let foreign_attrs = self.leftover_attrs(attrs, &on);
-        let descriptions = self.behaviour_children(&el, &mut kind, &on)?;
         if let Some(id) = id {
             out.push(Behaviour {
                 id,
