@@ -4,6 +4,8 @@
 //!
 //! Run: `cargo bench --bench schedule`
 
+mod common;
+
 use std::hint::black_box;
 
 use bml_realizer::bml;
@@ -118,23 +120,6 @@ fn anticipator_move(c: &mut Criterion) {
     });
 }
 
-/// N blocks, each tied to the one before: its speech starts when the previous block's speech
-/// ends, with a beat gesture on its own speech's end.
-fn chain_texts(n: usize) -> Vec<String> {
-    (0..n)
-        .map(|i| {
-            let start = if i == 0 {
-                String::new()
-            } else {
-                format!(r#" start="b{}:s:end""#, i - 1)
-            };
-            format!(
-                r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b{i}"><speech id="s"{start}><text>One two three.</text></speech><gesture id="g" lexeme="BEAT" stroke="s:end"/></bml>"#
-            )
-        })
-        .collect()
-}
-
 /// N blocks sent at once, each tied to the one before by an external reference (its speech
 /// starts when the previous block's speech ends, a beat gesture on its end): parse + schedule +
 /// plan of every block through the runtime, the shape of AsapRealizer's chained-block bench.
@@ -143,7 +128,7 @@ fn chained_blocks(c: &mut Criterion) {
     let mut g = c.benchmark_group("schedule/chained-blocks");
     g.sample_size(10);
     for n in [10usize, 100, 1000, 10_000] {
-        let blocks = chain_texts(n);
+        let blocks = common::chain_texts(n);
         // a fresh realizer per iteration (built outside the timing: it loads the skeleton and
         // the gesture lexicon); dropping it afterwards is not timed either
         g.bench_function(BenchmarkId::from_parameter(n), |b| {
@@ -196,7 +181,7 @@ fn chained_core(c: &mut Criterion) {
     let mut g = c.benchmark_group("schedule/chained-core");
     g.sample_size(10);
     for n in [10usize, 100, 1000, 10_000] {
-        let blocks = chain_texts(n);
+        let blocks = common::chain_texts(n);
         let run = |mut known: Known| {
             for text in &blocks {
                 let block = bml::load(text).unwrap().block;
@@ -274,29 +259,13 @@ fn after_large_block(c: &mut Criterion) {
 
 /// Every RealizerTester core file (the issue's per-file bar: AsapRealizer's scheduler core
 /// took 21–40 µs for each single-behaviour file): parse + `Optimal` schedule with the default
-/// timing models, file by file. A file that is not a valid block (`bmlnoid.xml` tests the
-/// missing-id error) is left out.
+/// timing models, file by file (the valid blocks among them).
 fn core_files(c: &mut Criterion) {
-    let dir = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/fixtures/realizertester/bml-1/core"
-    );
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .expect("the core fixtures")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
-        .collect();
-    files.sort();
     let models = DefaultTimingModels::default();
     let mut g = c.benchmark_group("schedule/core-file");
     g.warm_up_time(std::time::Duration::from_millis(300));
     g.measurement_time(std::time::Duration::from_secs(1));
-    for path in files {
-        let text = std::fs::read_to_string(&path).unwrap();
-        if bml::load(&text).is_err() {
-            continue;
-        }
-        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+    for (name, text) in common::core_files() {
         g.bench_function(name, |b| {
             b.iter(|| {
                 let block = bml::load(black_box(&text)).unwrap().block;

@@ -12,6 +12,8 @@
 //!
 //! Run: `cargo bench --bench undisturbed` (an argument filters by name).
 
+mod common;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -25,50 +27,17 @@ fn best(batches: usize, mut run: impl FnMut() -> Duration) -> Duration {
     (0..batches).map(|_| run()).min().unwrap_or_default()
 }
 
-/// N blocks, each tied to the one before (the text of `schedule/chained-blocks`).
-fn chain_texts(n: usize) -> Vec<String> {
-    (0..n)
-        .map(|i| {
-            let start = if i == 0 {
-                String::new()
-            } else {
-                format!(r#" start="b{}:s:end""#, i - 1)
-            };
-            format!(
-                r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b{i}"><speech id="s"{start}><text>One two three.</text></speech><gesture id="g" lexeme="BEAT" stroke="s:end"/></bml>"#
-            )
-        })
-        .collect()
-}
-
 fn main() {
     // `cargo bench` passes `--bench`; any other argument filters the lines by name
     let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with("--"));
     let wanted = |name: &str| filter.as_deref().is_none_or(|f| name.contains(f));
 
-    let dir = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/fixtures/realizertester/bml-1/core"
-    );
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .expect("the core fixtures")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
-        .collect();
-    files.sort();
     let models = DefaultTimingModels::default();
-    let mut core: Vec<(String, String, Duration)> = Vec::new();
-    for path in files {
-        let name = format!(
-            "core-file/{}",
-            path.file_stem().unwrap_or_default().to_string_lossy()
-        );
-        let text = std::fs::read_to_string(&path).expect("a core file");
-        // a file that is not a valid block (bmlnoid.xml tests the missing-id error) is left out
-        if wanted(&name) && bml::load(&text).is_ok() {
-            core.push((name, text, Duration::MAX));
-        }
-    }
+    let mut core: Vec<(String, String, Duration)> = common::core_files()
+        .into_iter()
+        .map(|(stem, text)| (format!("core-file/{stem}"), text, Duration::MAX))
+        .filter(|(name, _, _)| wanted(name))
+        .collect();
     // the files take turns, five rounds of 20 batches each: a slow spell of the machine (it can
     // last seconds) then costs a file some of its batches, not all of them
     const ITERATIONS: u32 = 2000;
@@ -78,7 +47,7 @@ fn main() {
                 let start = Instant::now();
                 for _ in 0..ITERATIONS {
                     let block = bml::load(black_box(text.as_str()))
-                        .expect("checked above")
+                        .expect("core_files keeps valid blocks only")
                         .block;
                     black_box(
                         Optimal
@@ -101,7 +70,7 @@ fn main() {
         if !wanted(&name) {
             continue;
         }
-        let blocks = chain_texts(n);
+        let blocks = common::chain_texts(n);
         let t = best(runs, || {
             let mut r = Realizer::new();
             let start = Instant::now();
