@@ -70,10 +70,9 @@ impl LineIndex {
         for w in &mut words {
             let x = u64::from_le_bytes(w.try_into().expect("eight bytes"));
             // a byte's high bit after subtracting 0x20 is set if it is below 0x20 or at least
-            // 0xA0, and every non-ASCII character starts with a byte of at least 0xC2 (a
-            // borrow into the next byte only comes from a byte that is itself below 0x20)
-            // (the flagged bytes are looked at one by one, the others not at all: a flag can
-            // also fall on the byte after one below 0x20, which the look sorts out)
+            // 0xA0, and every non-ASCII character starts with a byte of at least 0xC2; only the
+            // flagged bytes are looked at (a borrow, which only a byte below 0x20 makes, can
+            // also flag the byte after it: the look sorts that out)
             let mut flagged = x.wrapping_sub(ONES * 0x20) & HIGH;
             while flagged != 0 {
                 let i = flagged.trailing_zeros() as usize / 8;

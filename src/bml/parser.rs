@@ -276,6 +276,7 @@ impl<'i> Parser<'i> {
         self.token(false)
     }
 
+    /// The next token; a run of blank text is returned only if `blank_text`.
     fn token(&mut self, blank_text: bool) -> Result<Tok<'i>, Fatal> {
         if let Some(t) = self.pending.take() {
             return Ok(t);

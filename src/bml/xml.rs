@@ -246,15 +246,10 @@ impl<'i> Tokenizer<'i> {
                     });
                 }
                 _ => {
-                    let end = find_near(&b[start..], [b'<', b'&'], |h| {
-                        memchr::memchr2(b'<', b'&', h)
-                    })
-                    .map_or(b.len(), |i| start + i);
+                    let end = find_near(&b[start..], [b'<', b'&']).map_or(b.len(), |i| start + i);
                     self.pos = end;
                     let s = &self.src[start..end];
-                    let text = if find_near(s.as_bytes(), [b'\r'], |h| memchr::memchr(b'\r', h))
-                        .is_some()
-                    {
+                    let text = if find_near(s.as_bytes(), [b'\r']).is_some() {
                         Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n"))
                     } else {
                         Cow::Borrowed(s)
@@ -484,12 +479,7 @@ impl<'i> Tokenizer<'i> {
         // one search for the closing quote, a '<' (not allowed) or a reference
         let (mut end, mut references) = (value_offset, false);
         loop {
-            let rest = &b[end..];
-            match find_near(rest, [quote, b'<', b'&'], |h| {
-                memchr::memchr3(quote, b'<', b'&', h)
-            })
-            .map(|i| end + i)
-            {
+            match find_near(&b[end..], [quote, b'<', b'&']).map(|i| end + i) {
                 None => {
                     return err(
                         offset,
@@ -579,13 +569,9 @@ static NAME_CLASS: [u8; 256] = {
 /// The first byte of `hay` that is one of `needles`. Matches in a BML document are mostly a few
 /// bytes away (the end of an attribute value, the next tag after white space), where a call into
 /// `memchr` costs more than the search itself; so the first [`NEAR`] bytes are searched here,
-/// eight at a time, and only the rest by `far` (`memchr`'s vector search for the same bytes).
+/// eight at a time, and only the rest by `memchr`'s vector search (for one to three needles).
 #[inline]
-fn find_near<const K: usize>(
-    hay: &[u8],
-    needles: [u8; K],
-    far: impl FnOnce(&[u8]) -> Option<usize>,
-) -> Option<usize> {
+fn find_near<const K: usize>(hay: &[u8], needles: [u8; K]) -> Option<usize> {
     const ONES: u64 = 0x0101_0101_0101_0101;
     const HIGH: u64 = 0x8080_8080_8080_8080;
     let near = hay.len().min(NEAR);
@@ -611,7 +597,14 @@ fn find_near<const K: usize>(
     if hay.len() <= NEAR {
         return None;
     }
-    far(&hay[NEAR..]).map(|i| NEAR + i)
+    let far = &hay[NEAR..];
+    match needles.as_slice() {
+        &[a] => memchr::memchr(a, far),
+        &[a, b] => memchr::memchr2(a, b, far),
+        &[a, b, c] => memchr::memchr3(a, b, c, far),
+        _ => far.iter().position(|b| needles.contains(b)),
+    }
+    .map(|i| NEAR + i)
 }
 
 /// How many bytes [`find_near`] searches itself.
@@ -713,7 +706,6 @@ fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlError> {
 mod tests {
     use super::*;
 
-    /// The kept lists are reused, not reallocated: `recycle` keeps the buffer.
     /// The short search finds the same first match as `memchr` for every length around its
     /// word and near-window edges, with needles and other bytes at every place.
     #[test]
@@ -738,16 +730,17 @@ mod tests {
                         }
                     })
                     .collect();
-                let three = super::find_near(&hay, [b'"', b'<', b'&'], |h| {
-                    memchr::memchr3(b'"', b'<', b'&', h)
-                });
+                let three = super::find_near(&hay, [b'"', b'<', b'&']);
                 assert_eq!(three, memchr::memchr3(b'"', b'<', b'&', &hay), "{hay:?}");
-                let one = super::find_near(&hay, [0u8], |h| memchr::memchr(0, h));
+                let one = super::find_near(&hay, [0u8]);
                 assert_eq!(one, memchr::memchr(0, &hay), "{hay:?}");
+                let two = super::find_near(&hay, [b'<', 0xFF]);
+                assert_eq!(two, memchr::memchr2(b'<', 0xFF, &hay), "{hay:?}");
             }
         }
     }
 
+    /// The kept lists are reused, not reallocated: `recycle` keeps the buffer.
     #[test]
     fn recycle_keeps_the_allocation() {
         let mut v: Vec<Open<'_>> = Vec::with_capacity(8);
