@@ -598,10 +598,10 @@ fn find_near<const K: usize>(hay: &[u8], needles: [u8; K]) -> Option<usize> {
         return None;
     }
     let far = &hay[NEAR..];
-    match needles.as_slice() {
-        &[a] => memchr::memchr(a, far),
-        &[a, b] => memchr::memchr2(a, b, far),
-        &[a, b, c] => memchr::memchr3(a, b, c, far),
+    match *needles.as_slice() {
+        [a] => memchr::memchr(a, far),
+        [a, b] => memchr::memchr2(a, b, far),
+        [a, b, c] => memchr::memchr3(a, b, c, far),
         _ => far.iter().position(|b| needles.contains(b)),
     }
     .map(|i| NEAR + i)
