@@ -37,7 +37,8 @@ pub use writer::write;
 
 /// Parses and validates one block: the block plus warnings, or every diagnostic if any is an error.
 pub fn load(src: &str) -> Result<Parsed, BmlError> {
-    let (block, mut diags) = check(src);
+    let mut block = None;
+    let mut diags = check_into(src, &mut block);
     match block {
         Some(block) if !diags.iter().any(Diagnostic::is_error) => Ok(Parsed {
             block,
@@ -53,10 +54,18 @@ pub fn load(src: &str) -> Result<Parsed, BmlError> {
 /// Parses and validates as far as possible, returning the block (if the text is a `<bml>`
 /// document) and every diagnostic in source order.
 pub fn check(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
-    let (block, mut diags) = parse_with_diagnostics(src);
-    if let Some(b) = &block {
+    let mut block = None;
+    let diags = check_into(src, &mut block);
+    (block, diags)
+}
+
+/// [`check`] with the block written into `block` (`None` before): the block is not copied up
+/// the return values.
+fn check_into(src: &str, block: &mut Option<Block>) -> Vec<Diagnostic> {
+    let mut diags = parser::parse_into(src, block);
+    if let Some(b) = block {
         diags.extend(validate(b));
         diags.sort_by_key(|d| (d.pos.line, d.pos.col));
     }
-    (block, diags)
+    diags
 }

@@ -38,17 +38,22 @@ pub fn parse(src: &str) -> Result<Parsed, BmlError> {
 /// Parses as far as possible: the block (unless the text is not a `<bml>` document at all) and all
 /// diagnostics, errors included.
 pub fn parse_with_diagnostics(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
-    let mut p = Parser::new(src);
-    // filled in place: a block is a few hundred bytes, and it is not copied up the parser's
-    // return values
     let mut block = None;
-    if p.document(&mut block).is_err() {
-        block = None;
+    let diags = parse_into(src, &mut block);
+    (block, diags)
+}
+
+/// [`parse_with_diagnostics`] with the block written into `block` (which must be `None`): a
+/// block is a few hundred bytes, and it is not copied up the parser's return values.
+pub(crate) fn parse_into(src: &str, block: &mut Option<Block>) -> Vec<Diagnostic> {
+    let mut p = Parser::new(src);
+    if p.document(block).is_err() {
+        *block = None;
     }
     let mut diags = std::mem::take(&mut p.diags);
     p.keep_scratch();
     diags.sort_by_key(|d| (d.pos.line, d.pos.col));
-    (block, diags)
+    diags
 }
 
 /// The namespace of an element or attribute, as far as this parser cares.

@@ -13,12 +13,15 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
     let mut diags = Vec::new();
     // duplicate ids: sort (id, index) pairs once instead of hashing every id (those of a
     // typical block on the stack)
-    let mut ids: SmallVec<[(&str, usize); 16]> = block
-        .behaviours
-        .iter()
-        .enumerate()
-        .map(|(i, b)| (b.id.as_str(), i))
-        .collect();
+    // (extended in place: collecting would copy the inline list once more)
+    let mut ids: SmallVec<[(&str, usize); 16]> = SmallVec::new();
+    ids.extend(
+        block
+            .behaviours
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.id.as_str(), i)),
+    );
     ids.sort_unstable();
     for pair in ids.windows(2) {
         let [(id, first), (next, dup)] = [pair[0], pair[1]];

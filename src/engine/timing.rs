@@ -153,13 +153,17 @@ impl TimingModel {
         let (Some(first), Some(last)) = (self.keys.first(), self.keys.last()) else {
             return Err("a timing model needs at least start and end".into());
         };
-        if first.name != "start" || first.at != 0.0 {
+        // every name read once (a short name lives inside its `Id`, behind a branch per read)
+        let mut names: smallvec::SmallVec<[&str; 16]> = smallvec::SmallVec::new();
+        names.extend(self.keys.iter().map(|k| k.name.as_str()));
+        let same = crate::xmlname::same_name;
+        if !same(names[0], "start") || first.at != 0.0 {
             return Err(format!(
                 "the first key must be start at 0, not {} at {}",
                 first.name, first.at
             ));
         }
-        if last.name != "end" || self.keys.len() < 2 || last.at <= 0.0 {
+        if !same(names[names.len() - 1], "end") || self.keys.len() < 2 || last.at <= 0.0 {
             return Err(format!(
                 "the last key must be end after start, not {} at {}",
                 last.name, last.at
@@ -174,12 +178,8 @@ impl TimingModel {
             }
         }
         // unique names: a few keys, so pairwise is cheapest
-        for (i, k) in self.keys.iter().enumerate() {
-            let name = k.name.as_str();
-            if self.keys[..i]
-                .iter()
-                .any(|e| crate::xmlname::same_name(&e.name, name))
-            {
+        for (i, &name) in names.iter().enumerate() {
+            if names[..i].iter().any(|e| same(e, name)) {
                 return Err(format!("key {name} appears twice"));
             }
         }

@@ -131,7 +131,20 @@ impl DiffSystem {
     /// The least solution, or `None` when the system is infeasible (without finding out why:
     /// for callers that only try).
     pub fn least(&self) -> Option<Vec<f64>> {
-        let (n, m) = (self.len(), self.edges.len());
+        let mut x = self.lower.clone();
+        self.raise(&mut x).then_some(x)
+    }
+
+    /// [`Self::least`] for a system that is not needed afterwards: the solution is written over
+    /// the lower bounds (no second list).
+    pub fn into_least(mut self) -> Option<Vec<f64>> {
+        let mut x = std::mem::take(&mut self.lower);
+        self.raise(&mut x).then_some(x)
+    }
+
+    /// Raises `x` (the lower bounds) to the least solution; `false` if the system is infeasible.
+    fn raise(&self, x: &mut [f64]) -> bool {
+        let (n, m) = (x.len(), self.edges.len());
         // one scratch allocation, split into: CSR offsets of the edges grouped by `from` (n + 1),
         // a fill cursor per variable (n), the grouped edge indices (m), the length of the path
         // that gave each variable its value (n), and a ring queue of variables (n) in which each
@@ -162,7 +175,6 @@ impl DiffSystem {
             fill[e.from] += 1;
         }
 
-        let mut x = self.lower.clone();
         // a path longer than n edges repeats a variable, so it contains a positive cycle
         for (i, r) in ring.iter_mut().enumerate() {
             *r = i;
@@ -181,7 +193,7 @@ impl DiffSystem {
                     x[e.to] = candidate;
                     path_len[e.to] = path_len[u] + 1;
                     if path_len[e.to] > n {
-                        return None;
+                        return false;
                     }
                     if queued[e.to] == 0 {
                         queued[e.to] = 1;
@@ -196,7 +208,7 @@ impl DiffSystem {
                 }
             }
         }
-        Some(x)
+        true
     }
 
     /// Finds a positive cycle (the system is known to be infeasible) with classic Bellman–Ford:
@@ -257,6 +269,8 @@ mod tests {
         s.equal(b, a, 1.5, 1); // b = a + 1.5
         s.at_most(a, b, -1.5, 2); // consistent with the equality
         assert_eq!(s.solve().unwrap(), vec![0.0, 2.0, 3.5]);
+        // written over the lower bounds, the same answer
+        assert_eq!(s.into_least(), Some(vec![0.0, 2.0, 3.5]));
     }
 
     #[test]
@@ -277,6 +291,7 @@ mod tests {
         s.equal(b, c, 1.0, 11);
         s.at_least(c, a, 0.0, 12);
         let conflict = s.solve().unwrap_err();
+        assert_eq!(s.clone().into_least(), None);
         let mut tags: Vec<usize> = conflict.tags().collect();
         tags.sort();
         assert_eq!(tags, vec![10, 11, 12]);

@@ -44,7 +44,8 @@ pub(crate) fn items<'b>(
     constraints: &[Constraint],
     dropped: &mut Vec<Dropped>,
 ) -> Vec<Item<'b>> {
-    let mut order: SmallVec<[&Behaviour; 8]> = block.behaviours.iter().collect();
+    let mut order: SmallVec<[&Behaviour; 8]> = SmallVec::new();
+    order.extend(&block.behaviours);
     order.sort_by(|a, b| a.id.cmp(&b.id));
     let mut items = Vec::with_capacity(order.len());
     for beh in order {
@@ -92,6 +93,7 @@ const ID_INDEX_LINEAR: usize = 16;
 
 /// Positions of ids in a list: a linear scan for the few behaviours of a typical block, a binary
 /// search over a sorted copy for large ones (cheaper than hashing either way).
+#[derive(Default)]
 pub(crate) struct IdIndex<'a> {
     /// Inline for a typical block: building the index allocates nothing.
     /// Sorted when there are more than [`ID_INDEX_LINEAR`].
@@ -99,13 +101,14 @@ pub(crate) struct IdIndex<'a> {
 }
 
 impl<'a> IdIndex<'a> {
-    pub(crate) fn new(ids: impl Iterator<Item = &'a str>) -> Self {
-        let mut ids: SmallVec<[(&str, usize); ID_INDEX_LINEAR]> =
-            ids.enumerate().map(|(i, id)| (id, i)).collect();
-        if ids.len() > ID_INDEX_LINEAR {
-            ids.sort_unstable();
+    /// Indexes `ids` (replacing what was indexed). (Filled in place: a constructor that
+    /// returned the index would copy its inline list.)
+    pub(crate) fn fill(&mut self, ids: impl Iterator<Item = &'a str>) {
+        self.ids.clear();
+        self.ids.extend(ids.enumerate().map(|(i, id)| (id, i)));
+        if self.ids.len() > ID_INDEX_LINEAR {
+            self.ids.sort_unstable();
         }
-        IdIndex { ids }
     }
 
     /// The position of `id` (the first, if it occurs twice).
@@ -141,7 +144,8 @@ pub(crate) fn resolve(
     constraints: &[Constraint],
     external: &dyn ExternalTimes,
 ) -> (Vec<Link>, Option<(usize, KnownWarning, String)>) {
-    let index = IdIndex::new(items.iter().map(|it| it.beh.id.as_str()));
+    let mut index = IdIndex::default();
+    index.fill(items.iter().map(|it| it.beh.id.as_str()));
     let mut links = Vec::with_capacity(constraints.len());
     for (ci, c) in constraints.iter().enumerate() {
         let mut owner = None;
@@ -260,7 +264,8 @@ mod tests {
         for n in [3usize, 16, 17, 40] {
             let mut ids: Vec<String> = (0..n).map(|i| format!("b{}", n - i)).collect();
             ids.push("b2".into()); // a second "b2", after the first
-            let index = IdIndex::new(ids.iter().map(String::as_str));
+            let mut index = IdIndex::default();
+            index.fill(ids.iter().map(String::as_str));
             for (i, id) in ids.iter().enumerate().take(n) {
                 assert_eq!(index.get(id), Some(i), "{id} of {n}");
             }

@@ -4,7 +4,7 @@
 use smallvec::SmallVec;
 
 /// Nodes joined by fixed distances (those of a typical block on the stack).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Offsets {
     parent: SmallVec<[usize; 16]>,
     offset: SmallVec<[f64; 16]>,
@@ -12,11 +12,20 @@ pub(crate) struct Offsets {
 
 impl Offsets {
     /// `n` separate nodes.
+    #[cfg(test)]
     pub(crate) fn new(n: usize) -> Self {
-        Offsets {
-            parent: (0..n).collect(),
-            offset: smallvec::smallvec![0.0; n],
-        }
+        let mut o = Self::default();
+        o.reset(n);
+        o
+    }
+
+    /// Makes this `n` separate nodes. (Filling a list in place: a constructor that returned
+    /// one would copy its inline storage.)
+    pub(crate) fn reset(&mut self, n: usize) {
+        self.parent.clear();
+        self.parent.extend(0..n);
+        self.offset.clear();
+        self.offset.resize(n, 0.0);
     }
 
     /// The node's root and its offset from it.

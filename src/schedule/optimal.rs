@@ -83,7 +83,8 @@ impl SchedulingStrategy for Optimal {
             }
             // document order (nothing to sort for one behaviour)
             if behaviours.len() > 1 {
-                let pos = IdIndex::new(block.behaviours.iter().map(|b| b.id.as_str()));
+                let mut pos = IdIndex::default();
+                pos.fill(block.behaviours.iter().map(|b| b.id.as_str()));
                 behaviours.sort_by_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
             }
             return Ok(BlockSchedule {
@@ -295,7 +296,7 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         let offset = l.offset + bo - ao;
         s.relate(a, l.relation, b, offset, tag);
     }
-    let x = s.least()?;
+    let x = s.into_least()?;
     if x[block] > EPSILON {
         return None;
     }
@@ -337,7 +338,10 @@ fn pinned_apart(items: &[Item], links: &[Link]) -> bool {
 fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     // anchored (item, key) pairs, sorted: item i's anchors are `pairs[first[i]..first[i + 1]]`
     // (the lists of a typical block fit on the stack)
-    let mut pairs: SmallVec<[(usize, usize); 16]> = SmallVec::with_capacity(2 * links.len());
+    // (lists on the stack start empty and are filled in place: a constructor that returns one
+    // would copy it)
+    let mut pairs: SmallVec<[(usize, usize); 16]> = SmallVec::new();
+    pairs.reserve(2 * links.len());
     for l in links {
         for t in [l.left, l.right] {
             if let Term::Key(i, k) = t {
@@ -351,7 +355,8 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     let pairs = pairs.as_slice();
     // per item: first anchor, first node, and (for a stretched item) its scale, in one vector
     let m = items.len();
-    let mut first: SmallVec<[usize; 17]> = smallvec::smallvec![0usize; 2 * m + 1];
+    let mut first: SmallVec<[usize; 17]> = SmallVec::new();
+    first.resize(2 * m + 1, 0);
     for &(i, _) in pairs {
         first[i + 1] += 1;
     }
@@ -387,14 +392,16 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         Term::Key(i, k) => node(i, k),
         Term::Fixed(v) => (0, v),
     };
-    let mut offsets = Offsets::new(n);
+    let mut offsets = Offsets::default();
+    offsets.reset(n);
     for l in links.iter().filter(|l| l.relation == Relation::At) {
         // left = right + offset  =>  value(a) + oa = value(b) + ob + offset
         let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
         offsets.join(a, b, ob + l.offset - oa);
     }
     // the uniform scale of each multi-anchor item, from its fixed anchor distances
-    let mut scale: SmallVec<[f64; 8]> = smallvec::smallvec![1.0; m];
+    let mut scale: SmallVec<[f64; 8]> = SmallVec::new();
+    scale.resize(m, 1.0);
     for i in (0..m).filter(|&i| multi(i)) {
         let keys = &items[i].model.keys;
         let count = anchors(i);
@@ -450,7 +457,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         };
         s.at_least(base[i], 0, lead, tag);
     }
-    let x = s.least()?;
+    let x = s.into_least()?;
     if x[0] > EPSILON {
         return None;
     }

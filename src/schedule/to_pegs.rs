@@ -156,7 +156,8 @@ pub fn plan_block(
         }
     }
     let n = times.len();
-    let mut joined = Offsets::new(n);
+    let mut joined = Offsets::default();
+    joined.reset(n);
     let mut named = vec![false; n];
     let mut on_anticipator: Vec<Option<(Id, Id, f64)>> = vec![None; n];
     let mut orders = Vec::new();
