@@ -44,7 +44,7 @@ impl LineIndex {
     }
 
     /// The index of `src`, with the line starts written into `starts` (emptied first; from
-    /// [`Self::into_starts`], so that indexing one block after another need not allocate), and
+    /// [`Self::take_starts`], so that indexing one block after another need not allocate), and
     /// found in the same pass over the text, the offset of its first C0 control character other
     /// than tab, line feed and carriage return (XML 1.0 forbids them).
     pub(crate) fn scan(src: &str, mut starts: Vec<usize>) -> (Self, Option<usize>) {
@@ -108,8 +108,8 @@ impl LineIndex {
     }
 
     /// The list of line starts, for another index.
-    pub(crate) fn into_starts(self) -> Vec<usize> {
-        self.starts
+    pub(crate) fn take_starts(&mut self) -> Vec<usize> {
+        std::mem::take(&mut self.starts)
     }
 
     /// The position of byte offset `offset` in `src` (the text this index was built from).

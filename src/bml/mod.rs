@@ -40,8 +40,9 @@ pub fn load(src: &str) -> Result<Parsed, BmlError> {
     let mut block = None;
     let mut diags = check_into(src, &mut block);
     match block {
-        Some(block) if !diags.iter().any(Diagnostic::is_error) => Ok(Parsed {
-            block,
+        // moved once, from the option straight into the result
+        Some(_) if !diags.iter().any(Diagnostic::is_error) => Ok(Parsed {
+            block: block.expect("matched"),
             warnings: diags,
         }),
         _ => {

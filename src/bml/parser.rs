@@ -231,11 +231,12 @@ impl<'i> Parser<'i> {
     }
 
     /// Leaves the scratch lists to the next parse on this thread.
-    fn keep_scratch(self) {
+    /// (Through a reference: the parser is a few hundred bytes, and it is not copied.)
+    fn keep_scratch(&mut self) {
         let scratch = Scratch {
-            tokens: self.tok.into_lists(),
-            lines: self.lines.into_starts(),
-            attrs: xml::recycle(self.spare_attrs),
+            tokens: self.tok.take_lists(),
+            lines: self.lines.take_starts(),
+            attrs: xml::recycle(std::mem::take(&mut self.spare_attrs)),
         };
         let longest = scratch
             .tokens

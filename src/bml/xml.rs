@@ -109,7 +109,7 @@ struct Open<'i> {
     bindings: usize,
 }
 
-/// A tokenizer's lists, emptied, for building another one (see [`Tokenizer::into_lists`]): the
+/// A tokenizer's lists, emptied, for building another one (see [`Tokenizer::take_lists`]): the
 /// parser keeps them between blocks, so parsing one small block after another allocates no
 /// scratch space.
 #[derive(Default)]
@@ -154,7 +154,7 @@ pub(crate) struct Tokenizer<'i> {
 
 impl<'i> Tokenizer<'i> {
     /// A tokenizer at the start of `src` that uses `lists` (new ones, or from
-    /// [`Self::into_lists`]).
+    /// [`Self::take_lists`]).
     pub fn with_lists(src: &'i str, lists: Lists) -> Self {
         Tokenizer {
             src,
@@ -166,12 +166,13 @@ impl<'i> Tokenizer<'i> {
         }
     }
 
-    /// The lists, emptied, for the next tokenizer.
-    pub fn into_lists(self) -> Lists {
+    /// The lists, emptied, for the next tokenizer (this one is done with them; taken through
+    /// a reference, so that the tokenizer itself is not copied).
+    pub fn take_lists(&mut self) -> Lists {
         Lists {
-            open: recycle(self.open),
-            bindings: recycle(self.bindings),
-            attrs: recycle(self.attrs),
+            open: recycle(std::mem::take(&mut self.open)),
+            bindings: recycle(std::mem::take(&mut self.bindings)),
+            attrs: recycle(std::mem::take(&mut self.attrs)),
         }
     }
 
