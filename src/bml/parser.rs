@@ -1246,9 +1246,15 @@ impl<'i> Parser<'i> {
                 Tok::Text { text, .. } => match out.last_mut() {
                     Some(TextPart::Text(t)) => t.push_str(&text),
                     _ => {
-                        // the parts are kept with the block; most texts are one part
+                        // the parts are kept with the block: most texts are one part (the
+                        // token after it, parked, ends the text); one with syncs has three or
+                        // more, and gets room for them at once (no reallocation)
                         if out.capacity() == 0 {
-                            out.reserve_exact(1);
+                            if matches!(self.pending, Some(Tok::Start(_))) {
+                                out.reserve_exact(4);
+                            } else {
+                                out.reserve_exact(1);
+                            }
                         }
                         out.push(TextPart::Text(text.into_owned()))
                     }
