@@ -977,18 +977,18 @@ impl<'i> Parser<'i> {
                 .flatten()
         };
         // in document order; the list is kept with the behaviour, so it gets its exact size
-        let count = attrs
-            .items
-            .iter()
-            .flatten()
-            .filter(|a| sync_name(a).is_some())
-            .count();
-        let mut out = Vec::with_capacity(count);
-        for slot in attrs.items.iter_mut() {
-            let Some(name) = slot.as_ref().and_then(sync_name) else {
+        // (each attribute's name is looked up once: where the sync attributes are is noted)
+        let mut found: smallvec::SmallVec<[(usize, &'static str); 8]> = smallvec::SmallVec::new();
+        for (i, slot) in attrs.items.iter().enumerate() {
+            if let Some(name) = slot.as_ref().and_then(sync_name) {
+                found.push((i, name));
+            }
+        }
+        let mut out = Vec::with_capacity(found.len());
+        for &(i, name) in &found {
+            let Some(a) = attrs.items[i].take() else {
                 continue;
             };
-            let Some(a) = slot.take() else { continue };
             if let Some(value) = self.sync_ref(&a, on) {
                 out.push(SyncAttr {
                     sync: name,
