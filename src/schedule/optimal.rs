@@ -296,7 +296,10 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         let offset = l.offset + bo - ao;
         s.relate(a, l.relation, b, offset, tag);
     }
-    let x = s.into_least()?;
+    if !s.raise_to_least() {
+        return None;
+    }
+    let x = s.lower_bounds();
     if x[block] > EPSILON {
         return None;
     }
@@ -457,7 +460,10 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         };
         s.at_least(base[i], 0, lead, tag);
     }
-    let x = s.into_least()?;
+    if !s.raise_to_least() {
+        return None;
+    }
+    let x = s.lower_bounds();
     if x[0] > EPSILON {
         return None;
     }
