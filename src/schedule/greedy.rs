@@ -51,7 +51,15 @@ impl SchedulingStrategy for SortedGreedy {
         }
         let mut dropped = Vec::new();
         let mut items = items(block, models, &constraints, &mut dropped);
-        let links = resolve_all(block, &mut items, &constraints, external, &mut dropped)?;
+        let mut links = Vec::new();
+        resolve_all(
+            block,
+            &mut items,
+            &constraints,
+            external,
+            &mut dropped,
+            &mut links,
+        )?;
         let doc = |beh: &Behaviour| {
             block
                 .behaviours
