@@ -170,16 +170,8 @@ impl fmt::Display for Constraint {
 /// Extracts the normalised constraints of a block: first the shorthand attributes (behaviour by
 /// behaviour, in document order), then the `<constraint>` elements.
 pub fn extract(block: &Block) -> Vec<Constraint> {
-    let mut out = Vec::new();
-    extract_into(block, &mut out);
-    out
-}
-
-/// [`extract`] into `out` (emptied first; a list kept from a block before need not allocate).
-pub(crate) fn extract_into(block: &Block, out: &mut Vec<Constraint>) {
-    out.clear();
     let attributes: usize = block.behaviours.iter().map(|b| b.syncs.len()).sum();
-    out.reserve_exact(attributes + block.constraints.len());
+    let mut out = Vec::with_capacity(attributes + block.constraints.len());
     for (index, b) in block.behaviours.iter().enumerate() {
         for s in &b.syncs {
             // the behaviour's id is shared, the standard sync name is static: nothing copied
@@ -200,7 +192,8 @@ pub(crate) fn extract_into(block: &Block, out: &mut Vec<Constraint>) {
             ));
         }
     }
-    extract_elements_into(block, out);
+    extract_elements_into(block, &mut out);
+    out
 }
 
 /// The constraints of the `<constraint>` elements only.

@@ -22,7 +22,6 @@ mod validate;
 mod writer;
 mod xml;
 
-pub(crate) use constraints::extract_into;
 pub use constraints::{extract, Anchor, Constraint, Relation, Source};
 pub use diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos, Severity};
 pub use kinds::{

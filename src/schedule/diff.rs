@@ -12,8 +12,6 @@
 //! because the scheduler needs the cycle as constraint tags, lower bounds per variable, and no
 //! allocation beyond a few flat vectors per solve.
 
-use std::cell::Cell;
-
 use crate::bml::Relation;
 
 /// Improvements smaller than this (seconds) are not propagated: constraints hold within it, and
@@ -38,31 +36,6 @@ pub struct Edge {
 pub struct DiffSystem {
     lower: Vec<f64>,
     edges: Vec<Edge>,
-}
-
-thread_local! {
-    /// The emptied lists of the last system dropped on this thread, for the next one made with
-    /// [`DiffSystem::with_capacity`]: a scheduler that solves one small block after another
-    /// allocates nothing for its systems.
-    static SPARE: Cell<Option<(Vec<f64>, Vec<Edge>)>> = const { Cell::new(None) };
-}
-
-/// Lists longer than this are not kept for the next system (a rare huge block should not pin
-/// its memory).
-const SPARE_MAX: usize = 4096;
-
-impl Drop for DiffSystem {
-    fn drop(&mut self) {
-        let (mut lower, mut edges) = (
-            std::mem::take(&mut self.lower),
-            std::mem::take(&mut self.edges),
-        );
-        if edges.capacity() > 0 && lower.capacity().max(edges.capacity()) <= SPARE_MAX {
-            lower.clear();
-            edges.clear();
-            let _ = SPARE.try_with(|s| s.set(Some((lower, edges))));
-        }
-    }
 }
 
 /// The constraints that cannot hold together: a positive cycle of edges.
@@ -90,19 +63,11 @@ impl DiffSystem {
         Self::default()
     }
 
-    /// An empty system with room for `vars` variables and `edges` edges (in the lists a
-    /// system dropped before on this thread left, if they are large enough).
+    /// An empty system with room for `vars` variables and `edges` edges.
     pub fn with_capacity(vars: usize, edges: usize) -> Self {
-        let (mut lower, mut spare_edges) = SPARE
-            .try_with(Cell::take)
-            .ok()
-            .flatten()
-            .unwrap_or_default();
-        lower.reserve(vars);
-        spare_edges.reserve(edges);
         DiffSystem {
-            lower,
-            edges: spare_edges,
+            lower: Vec::with_capacity(vars),
+            edges: Vec::with_capacity(edges),
         }
     }
 
@@ -170,19 +135,11 @@ impl DiffSystem {
         self.raise(&mut x).then_some(x)
     }
 
-    /// [`Self::least`] written over the lower bounds (no second list): `false` if the system
-    /// is infeasible. The solution is then [`Self::lower_bounds`]; the system is not needed
-    /// again.
-    pub fn raise_to_least(&mut self) -> bool {
+    /// [`Self::least`] for a system that is not needed afterwards: the solution is written over
+    /// the lower bounds (no second list).
+    pub fn into_least(mut self) -> Option<Vec<f64>> {
         let mut x = std::mem::take(&mut self.lower);
-        let feasible = self.raise(&mut x);
-        self.lower = x;
-        feasible
-    }
-
-    /// Each variable's lower bound (the solution after [`Self::raise_to_least`]).
-    pub fn lower_bounds(&self) -> &[f64] {
-        &self.lower
+        self.raise(&mut x).then_some(x)
     }
 
     /// Raises `x` (the lower bounds) to the least solution; `false` if the system is infeasible.
@@ -313,25 +270,7 @@ mod tests {
         s.at_most(a, b, -1.5, 2); // consistent with the equality
         assert_eq!(s.solve().unwrap(), vec![0.0, 2.0, 3.5]);
         // written over the lower bounds, the same answer
-        assert!(s.raise_to_least());
-        assert_eq!(s.lower_bounds(), [0.0, 2.0, 3.5]);
-    }
-
-    /// A system made after another was dropped starts empty (it only reuses the lists).
-    #[test]
-    fn a_new_system_keeps_nothing_of_a_dropped_one() {
-        let mut s = DiffSystem::with_capacity(3, 4);
-        let (a, b) = (s.var(1.0), s.var(0.0));
-        s.at_least(b, a, 5.0, 7);
-        assert!(s.raise_to_least());
-        assert_eq!(s.lower_bounds(), [1.0, 6.0]);
-        drop(s);
-        let mut t = DiffSystem::with_capacity(1, 1);
-        assert!(t.is_empty() && t.edges().is_empty());
-        let c = t.var(2.0);
-        assert!(t.raise_to_least());
-        assert_eq!(t.lower_bounds(), [2.0]);
-        assert_eq!(c, 0);
+        assert_eq!(s.into_least(), Some(vec![0.0, 2.0, 3.5]));
     }
 
     #[test]
@@ -352,7 +291,7 @@ mod tests {
         s.equal(b, c, 1.0, 11);
         s.at_least(c, a, 0.0, 12);
         let conflict = s.solve().unwrap_err();
-        assert!(!s.clone().raise_to_least());
+        assert_eq!(s.clone().into_least(), None);
         let mut tags: Vec<usize> = conflict.tags().collect();
         tags.sort();
         assert_eq!(tags, vec![10, 11, 12]);

@@ -51,15 +51,7 @@ impl SchedulingStrategy for SortedGreedy {
         }
         let mut dropped = Vec::new();
         let mut items = items(block, models, &constraints, &mut dropped);
-        let mut links = Vec::new();
-        resolve_all(
-            block,
-            &mut items,
-            &constraints,
-            external,
-            &mut dropped,
-            &mut links,
-        )?;
+        let links = resolve_all(block, &mut items, &constraints, external, &mut dropped)?;
         let doc = |beh: &Behaviour| {
             block
                 .behaviours

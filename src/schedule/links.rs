@@ -136,20 +136,17 @@ pub(crate) fn is_required(item: &Item, constraints: &[Constraint]) -> bool {
         })
 }
 
-/// Resolves constraints to terms, into `links` (emptied first). Returns the first behaviour that
-/// cannot be scheduled because a constraint names a sync it lacks or an external time that is
-/// unknown.
+/// Resolves constraints to terms. Returns the first behaviour that cannot be scheduled because a
+/// constraint names a sync it lacks or an external time that is unknown.
 pub(crate) fn resolve(
     block: &Block,
     items: &[Item],
     constraints: &[Constraint],
     external: &dyn ExternalTimes,
-    links: &mut Vec<Link>,
-) -> Option<(usize, KnownWarning, String)> {
+) -> (Vec<Link>, Option<(usize, KnownWarning, String)>) {
     let mut index = IdIndex::default();
     index.fill(items.iter().map(|it| it.beh.id.as_str()));
-    links.clear();
-    links.reserve(constraints.len());
+    let mut links = Vec::with_capacity(constraints.len());
     for (ci, c) in constraints.iter().enumerate() {
         let mut owner = None;
         let mut term = |a: &Anchor| -> Result<Option<Term>, (KnownWarning, String)> {
@@ -205,13 +202,13 @@ pub(crate) fn resolve(
             (Err((w, why)), _) | (_, Err((w, why))) => {
                 let reason = format!("constraint '{c}': {why}");
                 if let Some(i) = owner {
-                    return Some((i, w, reason));
+                    return (links, Some((i, w, reason)));
                 }
             }
             _ => {}
         }
     }
-    None
+    (links, None)
 }
 
 /// The result for one item: its keys' times (block-local, minus `shift`); keys without a time (a
@@ -230,19 +227,19 @@ pub(crate) fn scheduled(item: Item, times: &[f64], shift: f64) -> ScheduledBehav
     }
 }
 
-/// Resolves the constraints into `links`, dropping each behaviour that names a sync it lacks or
-/// an unknown external time (the block fails if that behaviour is required).
+/// Resolves the constraints, dropping each behaviour that names a sync it lacks or an unknown
+/// external time (the block fails if that behaviour is required).
 pub(crate) fn resolve_all(
     block: &Block,
     items: &mut Vec<Item>,
     constraints: &[Constraint],
     external: &dyn ExternalTimes,
     dropped: &mut Vec<Dropped>,
-    links: &mut Vec<Link>,
-) -> Result<(), ScheduleError> {
+) -> Result<Vec<Link>, ScheduleError> {
     loop {
-        let Some((i, warning, reason)) = resolve(block, items, constraints, external, links) else {
-            return Ok(());
+        let (links, unusable) = resolve(block, items, constraints, external);
+        let Some((i, warning, reason)) = unusable else {
+            return Ok(links);
         };
         if is_required(&items[i], constraints) {
             return Err(ScheduleError { reason });

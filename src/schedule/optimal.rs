@@ -24,15 +24,13 @@ use good_lp::{
     constraint, microlp, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
 };
 
-use std::cell::Cell;
-
 use smallvec::SmallVec;
 
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
 use super::offsets::Offsets;
 use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
-use crate::bml::{extract_into, Block, Constraint, Relation};
+use crate::bml::{extract, Block, Constraint, Relation};
 use crate::engine::timing::{Flexibility, TimingModels, MIN_DURATION};
 use crate::feedback::KnownWarning;
 
@@ -56,92 +54,44 @@ impl SchedulingStrategy for Optimal {
         models: &dyn TimingModels,
         external: &dyn ExternalTimes,
     ) -> Result<BlockSchedule, ScheduleError> {
-        let mut scratch = SCRATCH
-            .try_with(Cell::take)
-            .ok()
-            .flatten()
-            .unwrap_or_default();
-        let result = schedule_with(block, models, external, &mut scratch);
-        let Scratch { constraints, links } = &mut scratch;
-        if constraints.capacity().max(links.capacity()) <= SCRATCH_MAX {
-            constraints.clear();
-            links.clear();
-            let _ = SCRATCH.try_with(|s| s.set(Some(scratch)));
+        let mut dropped = Vec::new();
+        let constraints = extract(block);
+        let mut items = items(block, models, &constraints, &mut dropped);
+        loop {
+            let links = resolve_all(block, &mut items, &constraints, external, &mut dropped)?;
+            // a fast-path answer satisfies every hard constraint, so feasibility is only checked
+            // (and conflicts only resolved) when neither fast path applies
+            let fast = preferred(&items, &links).or_else(|| uniform(&items, &links));
+            let times = match fast {
+                Some(times) => times,
+                None => match feasible(&items, &links, &constraints) {
+                    Ok(()) => optimise(&items, &links),
+                    Err(involved) => {
+                        drop_one(&mut items, &involved, &constraints, &mut dropped)?;
+                        continue;
+                    }
+                },
+            };
+            // `times` holds each item's key times one item after the other; the results go into
+            // a list of their own (collecting in place would shrink the items' allocation)
+            let mut rest = times.as_slice();
+            let mut behaviours = Vec::with_capacity(items.len());
+            for it in items {
+                let (t, after) = rest.split_at(it.len);
+                rest = after;
+                behaviours.push(scheduled(it, t, 0.0));
+            }
+            // document order (nothing to sort for one behaviour)
+            if behaviours.len() > 1 {
+                let mut pos = IdIndex::default();
+                pos.fill(block.behaviours.iter().map(|b| b.id.as_str()));
+                behaviours.sort_by_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
+            }
+            return Ok(BlockSchedule {
+                behaviours,
+                dropped,
+            });
         }
-        result
-    }
-}
-
-/// The lists one schedule needs only while it runs (the block's constraints and their resolved
-/// links), kept on the thread for the next one: scheduling one small block after another
-/// allocates little beyond what its result keeps.
-#[derive(Default)]
-struct Scratch {
-    constraints: Vec<Constraint>,
-    links: Vec<Link>,
-}
-
-thread_local! {
-    static SCRATCH: Cell<Option<Scratch>> = const { Cell::new(None) };
-}
-
-/// Lists longer than this are not kept (a rare huge block should not pin its memory).
-const SCRATCH_MAX: usize = 4096;
-
-/// [`Optimal`]'s schedule, with the lists of `scratch`.
-fn schedule_with(
-    block: &Block,
-    models: &dyn TimingModels,
-    external: &dyn ExternalTimes,
-    scratch: &mut Scratch,
-) -> Result<BlockSchedule, ScheduleError> {
-    let Scratch { constraints, links } = scratch;
-    let mut dropped = Vec::new();
-    extract_into(block, constraints);
-    let constraints: &[Constraint] = constraints;
-    let mut items = items(block, models, constraints, &mut dropped);
-    loop {
-        resolve_all(
-            block,
-            &mut items,
-            constraints,
-            external,
-            &mut dropped,
-            links,
-        )?;
-        let links: &[Link] = links;
-        // a fast-path answer satisfies every hard constraint, so feasibility is only checked
-        // (and conflicts only resolved) when neither fast path applies
-        let fast = preferred(&items, links).or_else(|| uniform(&items, links));
-        let times = match fast {
-            Some(times) => times,
-            None => match feasible(&items, links, constraints) {
-                Ok(()) => optimise(&items, links),
-                Err(involved) => {
-                    drop_one(&mut items, &involved, constraints, &mut dropped)?;
-                    continue;
-                }
-            },
-        };
-        // `times` holds each item's key times one item after the other; the results go into
-        // a list of their own (collecting in place would shrink the items' allocation)
-        let mut rest = times.as_slice();
-        let mut behaviours = Vec::with_capacity(items.len());
-        for it in items {
-            let (t, after) = rest.split_at(it.len);
-            rest = after;
-            behaviours.push(scheduled(it, t, 0.0));
-        }
-        // document order (nothing to sort for one behaviour)
-        if behaviours.len() > 1 {
-            let mut pos = IdIndex::default();
-            pos.fill(block.behaviours.iter().map(|b| b.id.as_str()));
-            behaviours.sort_by_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
-        }
-        return Ok(BlockSchedule {
-            behaviours,
-            dropped,
-        });
     }
 }
 
@@ -346,10 +296,7 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         let offset = l.offset + bo - ao;
         s.relate(a, l.relation, b, offset, tag);
     }
-    if !s.raise_to_least() {
-        return None;
-    }
-    let x = s.lower_bounds();
+    let x = s.into_least()?;
     if x[block] > EPSILON {
         return None;
     }
@@ -510,10 +457,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         };
         s.at_least(base[i], 0, lead, tag);
     }
-    if !s.raise_to_least() {
-        return None;
-    }
-    let x = s.lower_bounds();
+    let x = s.into_least()?;
     if x[0] > EPSILON {
         return None;
     }
@@ -651,7 +595,7 @@ fn earliest(items: &[Item], links: &[Link]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bml::{self, extract};
+    use crate::bml;
     use crate::engine::timing::{DefaultTimingModels, TimingModel};
     use crate::schedule::links::resolve;
     use crate::schedule::strategy::NoExternal;
@@ -678,8 +622,7 @@ mod tests {
                 model,
             })
             .collect();
-        let mut links = Vec::new();
-        let unusable = resolve(block, &items, &extract(block), &NoExternal, &mut links);
+        let (links, unusable) = resolve(block, &items, &extract(block), &NoExternal);
         assert!(unusable.is_none());
         (items, links)
     }
@@ -710,29 +653,6 @@ mod tests {
                 assert_eq!(at_preferred_timing(&items, &links), None, "{syncs}");
             }
         }
-    }
-
-    /// The lists kept between schedules carry nothing over: a block scheduled right after a
-    /// larger one gets the answer a fresh thread gives it.
-    #[test]
-    fn a_schedule_keeps_nothing_of_the_one_before() {
-        let ns = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
-        let big = format!(
-            r#"<bml {ns} id="a"><head id="h" lexeme="NOD" start="1" end="4"/><gesture id="g" lexeme="BEAT" stroke="h:stroke"/><constraint id="c"><before ref="h:end"><sync ref="g:end"/></before></constraint></bml>"#
-        );
-        // (the same behaviour id: a constraint left over from the block before would apply)
-        let small = format!(r#"<bml {ns} id="b"><head id="h" lexeme="SHAKE" start="0.5"/></bml>"#);
-        let run = |src: &str| {
-            let block = bml::load(src).unwrap().block;
-            Optimal
-                .schedule(&block, &DefaultTimingModels::default(), &NoExternal)
-                .unwrap()
-        };
-        let fresh = std::thread::scope(|t| t.spawn(|| run(&small)).join().unwrap());
-        run(&big);
-        let after = run(&small);
-        assert_eq!(after, fresh);
-        assert_eq!(after.behaviours[0].time("start"), Some(0.5));
     }
 
     /// Where both apply, the uniform-stretch fast path and the LP agree.
