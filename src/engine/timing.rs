@@ -306,8 +306,8 @@ static WORD_STEP: [u8; 256] = {
             if letter {
                 let letters = state >> LETTERS_SHIFT;
                 let letters = if letters < 3 { letters + 1 } else { 3 };
-                next = (next & (ANY | E_END)) | (letters << LETTERS_SHIFT);
-                next &= !E_END;
+                // a letter sets the letter state anew: only ANY is kept
+                next = (next & ANY) | (letters << LETTERS_SHIFT);
                 if class == E && !prev_vowel {
                     next |= E_END;
                 }
@@ -337,7 +337,7 @@ impl Syllables {
     fn step(&mut self, class: u8) {
         let e = WORD_STEP[usize::from(self.state) * 8 + usize::from(class)];
         self.state = e & (GROUP - 1);
-        self.groups += usize::from(e >> 5);
+        self.groups += usize::from(e / GROUP);
     }
 
     fn total(self) -> usize {
