@@ -28,6 +28,8 @@ pub mod feedback;
 pub mod plan;
 pub mod realizer;
 pub mod schedule;
+#[cfg(test)]
+mod testrand;
 pub mod timeline;
 pub mod world;
 mod xmlname;

@@ -63,8 +63,7 @@ impl LineIndex {
         };
         // eight bytes at a time: most words of a block hold neither a byte below 0x20 (line
         // ends, tabs, control characters) nor one above 0x7F, and need no closer look
-        const ONES: u64 = 0x0101_0101_0101_0101;
-        const HIGH: u64 = 0x8080_8080_8080_8080;
+        use super::xml::{HIGH, ONES};
         let mut words = bytes.chunks_exact(8);
         let mut at = 0;
         for w in &mut words {
@@ -325,11 +324,9 @@ mod tests {
         let pieces = [
             "a", "bc", "\n", "\t", "\r\n", "\u{1}", "\u{1f}", " ", "é", "€", "~", "\u{7f}",
         ];
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = crate::testrand::XorShift(0x9e37_79b9_7f4a_7c15);
         for _ in 0..3000 {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
+            let seed = rng.next_u64();
             let len = (seed % 40) as usize;
             let src: String = (0..len)
                 .map(|j| pieces[((seed >> (j % 60)) as usize + j * 7) % pieces.len()])

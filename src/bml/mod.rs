@@ -38,18 +38,8 @@ pub use writer::write;
 /// Parses and validates one block: the block plus warnings, or every diagnostic if any is an error.
 pub fn load(src: &str) -> Result<Parsed, BmlError> {
     let mut block = None;
-    let mut diags = check_into(src, &mut block);
-    match block {
-        // moved once, from the option straight into the result
-        Some(_) if !diags.iter().any(Diagnostic::is_error) => Ok(Parsed {
-            block: block.expect("matched"),
-            warnings: diags,
-        }),
-        _ => {
-            diags.sort_by_key(|d| (d.pos.line, d.pos.col));
-            Err(BmlError(diags))
-        }
-    }
+    let diags = check_into(src, &mut block);
+    parser::parsed(&mut block, diags)
 }
 
 /// Parses and validates as far as possible, returning the block (if the text is a `<bml>`
@@ -61,7 +51,7 @@ pub fn check(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
 }
 
 /// [`check`] with the block written into `block` (`None` before): the block is not copied up
-/// the return values.
+/// the return values. The diagnostics come sorted by position either way.
 fn check_into(src: &str, block: &mut Option<Block>) -> Vec<Diagnostic> {
     let mut diags = parser::parse_into(src, block);
     if let Some(b) = block {

@@ -25,10 +25,20 @@ pub struct Parsed {
 /// Parses one `<bml>` block. Returns every diagnostic as an error if any of them is an error.
 /// Cross-reference checks are not done here: use [`super::load`] for parse + validation.
 pub fn parse(src: &str) -> Result<Parsed, BmlError> {
-    let (block, diags) = parse_with_diagnostics(src);
+    let mut block = None;
+    let diags = parse_into(src, &mut block);
+    parsed(&mut block, diags)
+}
+
+/// The block with its warnings, or every diagnostic (sorted) if any is an error or there is no
+/// block. The block is moved once, from the option straight into the result.
+pub(crate) fn parsed(
+    block: &mut Option<Block>,
+    diags: Vec<Diagnostic>,
+) -> Result<Parsed, BmlError> {
     match block {
-        Some(block) if !diags.iter().any(Diagnostic::is_error) => Ok(Parsed {
-            block,
+        Some(_) if !diags.iter().any(Diagnostic::is_error) => Ok(Parsed {
+            block: block.take().expect("matched"),
             warnings: diags,
         }),
         _ => Err(BmlError(diags)),
@@ -1248,7 +1258,8 @@ impl<'i> Parser<'i> {
                     _ => {
                         // the parts are kept with the block: most texts are one part (the
                         // token after it, parked, ends the text); one with syncs has three or
-                        // more, and gets room for them at once (no reallocation)
+                        // more, and gets room for them at once (no reallocation). Two calls
+                        // with constants: a computed amount takes the general, slower path.
                         if out.capacity() == 0 {
                             if matches!(self.pending, Some(Tok::Start(_))) {
                                 out.reserve_exact(4);

@@ -573,8 +573,6 @@ static NAME_CLASS: [u8; 256] = {
 /// eight at a time, and only the rest by `memchr`'s vector search (for one to three needles).
 #[inline]
 fn find_near<const K: usize>(hay: &[u8], needles: [u8; K]) -> Option<usize> {
-    const ONES: u64 = 0x0101_0101_0101_0101;
-    const HIGH: u64 = 0x8080_8080_8080_8080;
     let near = hay.len().min(NEAR);
     let mut words = hay[..near].chunks_exact(8);
     let mut at = 0;
@@ -607,6 +605,12 @@ fn find_near<const K: usize>(hay: &[u8], needles: [u8; K]) -> Option<usize> {
     }
     .map(|i| NEAR + i)
 }
+
+/// A byte of 1 in every lane of a word read eight bytes at a time (this search, and the line
+/// index's scan).
+pub(super) const ONES: u64 = 0x0101_0101_0101_0101;
+/// The high bit of every lane of such a word.
+pub(super) const HIGH: u64 = 0x8080_8080_8080_8080;
 
 /// How many bytes [`find_near`] searches itself.
 const NEAR: usize = 64;
@@ -711,14 +715,12 @@ mod tests {
     /// word and near-window edges, with needles and other bytes at every place.
     #[test]
     fn short_search_agrees_with_memchr() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rng = crate::testrand::XorShift(0x2545_f491_4f6c_dd1d);
         for len in 0..150 {
             for _ in 0..40 {
                 let hay: Vec<u8> = (0..len)
                     .map(|_| {
-                        seed ^= seed << 13;
-                        seed ^= seed >> 7;
-                        seed ^= seed << 17;
+                        let seed = rng.next_u64();
                         // mostly ordinary bytes, sometimes a needle, a zero or a high byte
                         match seed % 40 {
                             0 => b'"',

@@ -622,17 +622,11 @@ mod tests {
             'a', 'e', 'i', 'o', 'u', 'y', 'E', 'A', 'Y', 'b', 'k', 'm', 'r', 't', 'z', 'K', '0',
             '7', '\'', '-', '.', '!', ',', 'é', 'ß', '٣', '€',
         ];
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |below: usize| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % below as u64) as usize
-        };
+        let mut rng = crate::testrand::XorShift(0x2545_f491_4f6c_dd1d);
         let mut silent_e = 0;
         for _ in 0..20_000 {
-            let word: String = (0..next(9))
-                .map(|_| ALPHABET[next(ALPHABET.len())])
+            let word: String = (0..rng.below(9))
+                .map(|_| ALPHABET[rng.below(ALPHABET.len())])
                 .collect();
             let n = syllables_by_rule(&word);
             assert_eq!(syllables(&word), n, "{word:?}");
@@ -661,17 +655,11 @@ mod tests {
         // and on random ASCII texts of letters, digits, punctuation and white space
         const ALPHABET: &[u8] = b"aeiouyAEYbcdklmnrstzBKT09.,;:!?'-() \t\n\r\x0b\x0c";
         // (the generator steps for every text: a length of 0 must not stop it)
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = |below: usize| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % below as u64) as usize
-        };
+        let mut rng = crate::testrand::XorShift(0x9e37_79b9_7f4a_7c15);
         let mut words = 0;
         for _ in 0..3000 {
-            let text: String = (0..next(40))
-                .map(|_| char::from(ALPHABET[next(ALPHABET.len())]))
+            let text: String = (0..rng.below(40))
+                .map(|_| char::from(ALPHABET[rng.below(ALPHABET.len())]))
                 .collect();
             let by_word: f64 = text
                 .split_whitespace()
