@@ -3,6 +3,8 @@
 
 use smallvec::SmallVec;
 
+use super::diff::EPSILON;
+
 /// Nodes joined by fixed distances (those of a typical block on the stack).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Offsets {
@@ -40,20 +42,159 @@ impl Offsets {
         (root, self.offset[v])
     }
 
-    /// Records `value(a) = value(b) + d` (ignored if `a` and `b` are already joined).
-    pub(crate) fn join(&mut self, a: usize, b: usize, d: f64) {
+    /// Records `value(a) = value(b) + d`. Returns whether that is consistent: `false` if `a` and
+    /// `b` are already joined at a distance more than [`EPSILON`] away from `d` (the record is
+    /// then left as it was).
+    pub(crate) fn join(&mut self, a: usize, b: usize, d: f64) -> bool {
         let ((ra, oa), (rb, ob)) = (self.find(a), self.find(b));
-        if ra != rb {
-            // value(ra) = value(a) - oa = value(b) + d - oa = value(rb) + ob + d - oa
-            self.parent[ra] = rb;
-            self.offset[ra] = ob + d - oa;
+        if ra == rb {
+            return (oa - (ob + d)).abs() <= EPSILON;
         }
+        // value(ra) = value(a) - oa = value(b) + d - oa = value(rb) + ob + d - oa
+        self.parent[ra] = rb;
+        self.offset[ra] = ob + d - oa;
+        true
+    }
+
+    /// The least values of all nodes when the joins are the only ties between them: node 0 is
+    /// at 0, and `value(v) >= bound` for each `(v, bound)` of `bounds`. Every group of joined
+    /// nodes sits as early as its bounds allow, node 0's group where node 0 is at 0; `None` if a
+    /// bound in node 0's group does not hold there (more than [`EPSILON`] short). Every node
+    /// must be in node 0's group or in a group with a bound.
+    ///
+    /// This is the least solution of the difference system with the joins as equalities and the
+    /// bounds as constraints from node 0 (without a search over its edges).
+    pub(crate) fn least(&mut self, bounds: impl Iterator<Item = (usize, f64)>) -> Option<Vec<f64>> {
+        let n = self.parent.len();
+        // every node straight under its root, at its distance from it
+        for v in 0..n {
+            self.find(v);
+        }
+        let (parent, offset) = (self.parent.as_slice(), self.offset.as_slice());
+        // where each group's root must be for every bound in the group to hold
+        let mut root_at: SmallVec<[f64; 16]> = SmallVec::new();
+        root_at.resize(n, f64::NEG_INFINITY);
+        for (v, bound) in bounds {
+            let r = parent[v];
+            root_at[r] = root_at[r].max(bound - offset[v]);
+        }
+        let r0 = parent[0];
+        let fixed = -offset[0];
+        if root_at[r0] > fixed + EPSILON {
+            return None;
+        }
+        root_at[r0] = fixed;
+        debug_assert!(root_at
+            .iter()
+            .enumerate()
+            .all(|(r, t)| parent[r] != r || t.is_finite()));
+        Some((0..n).map(|v| offset[v] + root_at[parent[v]]).collect())
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::Offsets;
+    use crate::bml::Relation;
+    use crate::schedule::diff::{DiffSystem, EPSILON};
+    use proptest::prelude::*;
+
+    /// A system of joins and bounds over `n` nodes, with times in eighths of a second (exact in
+    /// binary, so a bound either holds exactly or misses by at least 1/8).
+    #[derive(Debug, Clone)]
+    struct Ties {
+        n: usize,
+        /// `(a, b, d)`: value(a) = value(b) + d.
+        joins: Vec<(usize, usize, f64)>,
+        bounds: Vec<(usize, f64)>,
+    }
+
+    fn ties() -> impl Strategy<Value = Ties> {
+        (2usize..12).prop_flat_map(|n| {
+            let eighths = |lo: i32, hi: i32| (lo..hi).prop_map(|e| f64::from(e) / 8.0);
+            (
+                proptest::collection::vec(eighths(-16, 64), n),
+                proptest::collection::vec((0..n, 0..n, prop::bool::weighted(0.1)), 0..2 * n),
+                proptest::collection::vec((0..n, eighths(-16, 64)), 0..n),
+            )
+                .prop_map(move |(x, pairs, mut bounds)| {
+                    // joins at the distances of a known assignment; one in ten off by 1/2
+                    let joins = pairs
+                        .into_iter()
+                        .map(|(a, b, off)| (a, b, x[a] - x[b] + if off { 0.5 } else { 0.0 }))
+                        .collect::<Vec<_>>();
+                    // a bound in every group away from node 0 (the scheduler bounds every item)
+                    let mut o = Offsets::new(n);
+                    for &(a, b, d) in &joins {
+                        o.join(a, b, d);
+                    }
+                    for (v, &xv) in x.iter().enumerate().skip(1) {
+                        let r = o.find(v).0;
+                        let bounded = bounds.iter().any(|&(w, _)| o.find(w).0 == r);
+                        if r != o.find(0).0 && !bounded {
+                            bounds.push((v, xv - 1.0));
+                        }
+                    }
+                    Ties { n, joins, bounds }
+                })
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(600))]
+
+        /// S43: the joined groups give the same least solution as the difference system with
+        /// the joins as `at` constraints and the bounds as constraints from node 0, and both
+        /// refuse the same systems (contradicting joins, a bound node 0's group cannot meet).
+        #[test]
+        fn least_by_groups_is_the_least_solution_of_the_difference_system(t in ties()) {
+            let mut s = DiffSystem::new();
+            for v in 0..t.n {
+                s.var(if v == 0 { 0.0 } else { f64::MIN / 4.0 });
+            }
+            let mut o = Offsets::new(t.n);
+            let mut consistent = true;
+            for (tag, &(a, b, d)) in t.joins.iter().enumerate() {
+                s.relate(a, Relation::At, b, d, tag);
+                consistent &= o.join(a, b, d);
+            }
+            for &(v, bound) in &t.bounds {
+                s.at_least(v, 0, bound, 0);
+            }
+            let expected = s.into_least().filter(|x| x[0] <= EPSILON);
+            let got = if consistent { o.least(t.bounds.iter().copied()) } else { None };
+            match (expected, got) {
+                (None, None) => {}
+                (Some(x), Some(y)) => {
+                    for (v, (a, b)) in x.iter().zip(&y).enumerate() {
+                        prop_assert!((a - b).abs() <= 1e-9, "node {v}: {a} vs {b} ({x:?} vs {y:?})");
+                    }
+                }
+                (x, y) => prop_assert!(false, "difference system {x:?}, groups {y:?}"),
+            }
+        }
+    }
+
+    /// A join that repeats a known distance is consistent; one that contradicts it is refused
+    /// and changes nothing.
+    #[test]
+    fn a_join_against_a_known_distance_reports_whether_it_agrees() {
+        let mut o = Offsets::new(3);
+        assert!(o.join(1, 0, 2.0));
+        assert!(o.join(2, 1, 1.0));
+        assert!(o.join(2, 0, 3.0), "the same distance again");
+        assert!(!o.join(2, 0, 3.5), "half a second off");
+        assert_eq!(o.find(2).1 - o.find(0).1, 3.0);
+        assert_eq!(o.least([(1, 0.0)].into_iter()), Some(vec![0.0, 2.0, 3.0]));
+        // a bound that node 0's group cannot meet; elsewhere, groups move up to their bounds
+        assert_eq!(o.least([(1, 2.5)].into_iter()), None);
+        let mut apart = Offsets::new(3);
+        apart.join(2, 1, 1.0);
+        assert_eq!(
+            apart.least([(2, 4.0), (1, 0.5)].into_iter()),
+            Some(vec![0.0, 3.0, 4.0])
+        );
+    }
 
     #[test]
     fn distances_compose_through_joins() {

@@ -276,30 +276,46 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     at_preferred_timing(items, links)
 }
 
-/// [`preferred`] by its difference system (no shortcut).
+/// [`preferred`] without the shortcut: the least solution over the block start (variable 0) and
+/// each item's start (item i's is variable i + 1).
 fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
-    let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
-    let block = s.var(0.0);
-    // item i's start is variable i + 1
-    for i in 0..items.len() {
-        let v = s.var(f64::MIN / 4.0);
-        s.at_least(v, block, 0.0, links.len() + i);
-    }
+    let block = 0;
     let var = |t: Term| -> (usize, f64) {
         match t {
             Term::Key(i, k) => (i + 1, items[i].model.keys[k].at),
             Term::Fixed(t) => (block, t),
         }
     };
-    for (tag, l) in links.iter().enumerate() {
-        let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
-        let offset = l.offset + bo - ao;
-        s.relate(a, l.relation, b, offset, tag);
-    }
-    let x = s.into_least()?;
-    if x[block] > EPSILON {
-        return None;
-    }
+    let x = if links.iter().all(|l| l.relation == Relation::At) {
+        // only `at` constraints: the joined groups hold the least solution
+        let mut offsets = Offsets::default();
+        offsets.reset(items.len() + 1);
+        for l in links {
+            // left = right + offset  =>  value(a) + ao = value(b) + bo + offset
+            let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
+            if !offsets.join(a, b, l.offset + bo - ao) {
+                return None;
+            }
+        }
+        offsets.least((1..=items.len()).map(|v| (v, 0.0)))?
+    } else {
+        let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
+        s.var(0.0);
+        for i in 0..items.len() {
+            let v = s.var(f64::MIN / 4.0);
+            s.at_least(v, block, 0.0, links.len() + i);
+        }
+        for (tag, l) in links.iter().enumerate() {
+            let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
+            let offset = l.offset + bo - ao;
+            s.relate(a, l.relation, b, offset, tag);
+        }
+        let x = s.into_least()?;
+        if x[block] > EPSILON {
+            return None;
+        }
+        x
+    };
     let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
     for (i, it) in items.iter().enumerate() {
         times.extend(it.model.keys[..it.len].iter().map(|k| x[i + 1] + k.at));
@@ -397,7 +413,9 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     for l in links.iter().filter(|l| l.relation == Relation::At) {
         // left = right + offset  =>  value(a) + oa = value(b) + ob + offset
         let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
-        offsets.join(a, b, ob + l.offset - oa);
+        if !offsets.join(a, b, ob + l.offset - oa) {
+            return None; // `at` constraints that contradict each other
+        }
     }
     // the uniform scale of each multi-anchor item, from its fixed anchor distances
     let mut scale: SmallVec<[f64; 8]> = SmallVec::new();
@@ -437,30 +455,37 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         }
     }
     let scale = scale.as_slice();
-    // least solution over the nodes
-    let mut s = DiffSystem::with_capacity(n, 2 * links.len() + m);
-    for v in 0..n {
-        s.var(if v == 0 { 0.0 } else { f64::MIN / 4.0 });
-    }
-    for (tag, l) in links.iter().enumerate() {
-        let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
-        let offset = l.offset + ob - oa;
-        s.relate(a, l.relation, b, offset, tag);
-    }
-    for i in 0..m {
-        let tag = links.len() + i;
-        // nothing before the block: for a stretched item, its extrapolated start
-        let lead = if multi(i) {
+    // nothing before the block: for a stretched item, its extrapolated start
+    let lead = |i: usize| {
+        if multi(i) {
             scale[i] * items[i].model.keys[anchor(i, 0)].at
         } else {
             0.0
-        };
-        s.at_least(base[i], 0, lead, tag);
-    }
-    let x = s.into_least()?;
-    if x[0] > EPSILON {
-        return None;
-    }
+        }
+    };
+    // least solution over the nodes: with only `at` constraints, the joined groups already
+    // hold it (each as early as its items allow)
+    let x = if links.iter().all(|l| l.relation == Relation::At) {
+        offsets.least((0..m).map(|i| (base[i], lead(i))))?
+    } else {
+        let mut s = DiffSystem::with_capacity(n, 2 * links.len() + m);
+        for v in 0..n {
+            s.var(if v == 0 { 0.0 } else { f64::MIN / 4.0 });
+        }
+        for (tag, l) in links.iter().enumerate() {
+            let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
+            let offset = l.offset + ob - oa;
+            s.relate(a, l.relation, b, offset, tag);
+        }
+        for (i, &b) in base.iter().enumerate() {
+            s.at_least(b, 0, lead(i), links.len() + i);
+        }
+        let x = s.into_least()?;
+        if x[0] > EPSILON {
+            return None;
+        }
+        x
+    };
     let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
     for (i, it) in items.iter().enumerate() {
         let keys = &it.model.keys[..it.len];
