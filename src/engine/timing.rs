@@ -153,9 +153,19 @@ impl TimingModel {
         let (Some(first), Some(last)) = (self.keys.first(), self.keys.last()) else {
             return Err("a timing model needs at least start and end".into());
         };
-        // every name read once (a short name lives inside its `Id`, behind a branch per read)
-        let mut names: smallvec::SmallVec<[&str; 16]> = smallvec::SmallVec::new();
-        names.extend(self.keys.iter().map(|k| k.name.as_str()));
+        // every name read once (a short name lives inside its `Id`, behind a branch per read),
+        // into a plain array for a model of up to 16 keys
+        let mut few = [""; 16];
+        let many: Vec<&str>;
+        let names: &[&str] = if self.keys.len() <= few.len() {
+            for (name, key) in few.iter_mut().zip(&self.keys) {
+                *name = key.name.as_str();
+            }
+            &few[..self.keys.len()]
+        } else {
+            many = self.keys.iter().map(|k| k.name.as_str()).collect();
+            &many
+        };
         let same = crate::xmlname::same_name;
         if !same(names[0], "start") || first.at != 0.0 {
             return Err(format!(

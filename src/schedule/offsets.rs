@@ -8,9 +8,15 @@ use super::diff::EPSILON;
 /// Nodes joined by fixed distances (those of a typical block on the stack).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Offsets {
-    parent: SmallVec<[usize; 16]>,
-    offset: SmallVec<[f64; 16]>,
+    /// Per node: the node above it and its distance from that one (`ROOT`, 0 for a root).
+    nodes: SmallVec<[(usize, f64); 16]>,
 }
+
+/// Node values (those of a typical block on the stack).
+pub(crate) type Values = SmallVec<[f64; 16]>;
+
+/// The "node above" of a root.
+const ROOT: usize = usize::MAX;
 
 impl Offsets {
     /// `n` separate nodes.
@@ -24,22 +30,26 @@ impl Offsets {
     /// Makes this `n` separate nodes. (Filling a list in place: a constructor that returned
     /// one would copy its inline storage.)
     pub(crate) fn reset(&mut self, n: usize) {
-        self.parent.clear();
-        self.parent.extend(0..n);
-        self.offset.clear();
-        self.offset.resize(n, 0.0);
+        self.nodes.clear();
+        self.nodes.resize(n, (ROOT, 0.0));
     }
 
-    /// The node's root and its offset from it.
+    /// The node's root and its offset from it; the path to the root is shortened on the way.
     pub(crate) fn find(&mut self, v: usize) -> (usize, f64) {
-        let p = self.parent[v];
-        if p == v {
-            return (v, 0.0);
+        // on a slice: no inline-or-heap check per step
+        fn walk(nodes: &mut [(usize, f64)], v: usize) -> (usize, f64) {
+            let (up, d) = nodes[v];
+            if up == ROOT {
+                return (v, 0.0);
+            }
+            if nodes[up].0 == ROOT {
+                return (up, d); // right under the root (the common case)
+            }
+            let (root, off) = walk(nodes, up);
+            nodes[v] = (root, d + off);
+            (root, d + off)
         }
-        let (root, off) = self.find(p);
-        self.parent[v] = root;
-        self.offset[v] += off;
-        (root, self.offset[v])
+        walk(&mut self.nodes, v)
     }
 
     /// Records `value(a) = value(b) + d`. Returns whether that is consistent: `false` if `a` and
@@ -51,8 +61,7 @@ impl Offsets {
             return (oa - (ob + d)).abs() <= EPSILON;
         }
         // value(ra) = value(a) - oa = value(b) + d - oa = value(rb) + ob + d - oa
-        self.parent[ra] = rb;
-        self.offset[ra] = ob + d - oa;
+        self.nodes[ra] = (rb, ob + d - oa);
         true
     }
 
@@ -63,38 +72,41 @@ impl Offsets {
     /// must be in node 0's group or in a group with a bound.
     ///
     /// This is the least solution of the difference system with the joins as equalities and the
-    /// bounds as constraints from node 0 (without a search over its edges).
-    pub(crate) fn least(&mut self, bounds: impl Iterator<Item = (usize, f64)>) -> Option<Vec<f64>> {
-        let n = self.parent.len();
-        // every node straight under its root, at its distance from it
-        for v in 0..n {
-            self.find(v);
-        }
-        let (parent, offset) = (self.parent.as_slice(), self.offset.as_slice());
+    /// bounds as constraints from node 0 (without a search over its edges). It is written into
+    /// `x` (a list on the caller's stack for a typical block: nothing is allocated).
+    pub(crate) fn least(
+        &mut self,
+        bounds: impl Iterator<Item = (usize, f64)>,
+        x: &mut Values,
+    ) -> Option<()> {
+        let n = self.nodes.len();
+        // every node's root and distance from it
+        let mut root: SmallVec<[(usize, f64); 16]> = SmallVec::new();
+        root.extend((0..n).map(|v| self.find(v)));
+        let root = root.as_slice();
         // where each group's root must be for every bound in the group to hold
         let mut root_at: SmallVec<[f64; 16]> = SmallVec::new();
         root_at.resize(n, f64::NEG_INFINITY);
         for (v, bound) in bounds {
-            let r = parent[v];
-            root_at[r] = root_at[r].max(bound - offset[v]);
+            let (r, off) = root[v];
+            root_at[r] = root_at[r].max(bound - off);
         }
-        let r0 = parent[0];
-        let fixed = -offset[0];
+        let (r0, off0) = root[0];
+        let fixed = -off0;
         if root_at[r0] > fixed + EPSILON {
             return None;
         }
         root_at[r0] = fixed;
-        debug_assert!(root_at
-            .iter()
-            .enumerate()
-            .all(|(r, t)| parent[r] != r || t.is_finite()));
-        Some((0..n).map(|v| offset[v] + root_at[parent[v]]).collect())
+        debug_assert!(root.iter().all(|&(r, _)| root_at[r].is_finite()));
+        x.clear();
+        x.extend(root.iter().map(|&(r, off)| off + root_at[r]));
+        Some(())
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::Offsets;
+    use super::{Offsets, Values};
     use crate::bml::Relation;
     use crate::schedule::diff::{DiffSystem, EPSILON};
     use proptest::prelude::*;
@@ -162,7 +174,12 @@ mod tests {
                 s.at_least(v, 0, bound, 0);
             }
             let expected = s.into_least().filter(|x| x[0] <= EPSILON);
-            let got = if consistent { o.least(t.bounds.iter().copied()) } else { None };
+            let mut x = Values::new();
+            let got = if consistent {
+                o.least(t.bounds.iter().copied(), &mut x).map(|()| x.to_vec())
+            } else {
+                None
+            };
             match (expected, got) {
                 (None, None) => {}
                 (Some(x), Some(y)) => {
@@ -185,15 +202,18 @@ mod tests {
         assert!(o.join(2, 0, 3.0), "the same distance again");
         assert!(!o.join(2, 0, 3.5), "half a second off");
         assert_eq!(o.find(2).1 - o.find(0).1, 3.0);
-        assert_eq!(o.least([(1, 0.0)].into_iter()), Some(vec![0.0, 2.0, 3.0]));
+        let mut x = Values::new();
+        assert_eq!(o.least([(1, 0.0)].into_iter(), &mut x), Some(()));
+        assert_eq!(x.as_slice(), [0.0, 2.0, 3.0]);
         // a bound that node 0's group cannot meet; elsewhere, groups move up to their bounds
-        assert_eq!(o.least([(1, 2.5)].into_iter()), None);
+        assert_eq!(o.least([(1, 2.5)].into_iter(), &mut x), None);
         let mut apart = Offsets::new(3);
         apart.join(2, 1, 1.0);
         assert_eq!(
-            apart.least([(2, 4.0), (1, 0.5)].into_iter()),
-            Some(vec![0.0, 3.0, 4.0])
+            apart.least([(2, 4.0), (1, 0.5)].into_iter(), &mut x),
+            Some(())
         );
+        assert_eq!(x.as_slice(), [0.0, 3.0, 4.0]);
     }
 
     #[test]

@@ -28,7 +28,7 @@ use smallvec::SmallVec;
 
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
-use super::offsets::Offsets;
+use super::offsets::{Offsets, Values};
 use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
 use crate::bml::{extract, Block, Constraint, Relation};
 use crate::engine::timing::{Flexibility, TimingModels, MIN_DURATION};
@@ -286,7 +286,8 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
             Term::Fixed(t) => (block, t),
         }
     };
-    let x = if links.iter().all(|l| l.relation == Relation::At) {
+    let (mut by_groups, by_system);
+    let x: &[f64] = if links.iter().all(|l| l.relation == Relation::At) {
         // only `at` constraints: the joined groups hold the least solution
         let mut offsets = Offsets::default();
         offsets.reset(items.len() + 1);
@@ -297,7 +298,9 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
                 return None;
             }
         }
-        offsets.least((1..=items.len()).map(|v| (v, 0.0)))?
+        by_groups = Values::new();
+        offsets.least((1..=items.len()).map(|v| (v, 0.0)), &mut by_groups)?;
+        &by_groups
     } else {
         let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
         s.var(0.0);
@@ -310,11 +313,11 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
             let offset = l.offset + bo - ao;
             s.relate(a, l.relation, b, offset, tag);
         }
-        let x = s.into_least()?;
-        if x[block] > EPSILON {
+        by_system = s.into_least()?;
+        if by_system[block] > EPSILON {
             return None;
         }
-        x
+        &by_system
     };
     let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
     for (i, it) in items.iter().enumerate() {
@@ -465,8 +468,11 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     };
     // least solution over the nodes: with only `at` constraints, the joined groups already
     // hold it (each as early as its items allow)
-    let x = if links.iter().all(|l| l.relation == Relation::At) {
-        offsets.least((0..m).map(|i| (base[i], lead(i))))?
+    let (mut by_groups, by_system);
+    let x: &[f64] = if links.iter().all(|l| l.relation == Relation::At) {
+        by_groups = Values::new();
+        offsets.least((0..m).map(|i| (base[i], lead(i))), &mut by_groups)?;
+        &by_groups
     } else {
         let mut s = DiffSystem::with_capacity(n, 2 * links.len() + m);
         for v in 0..n {
@@ -480,11 +486,11 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         for (i, &b) in base.iter().enumerate() {
             s.at_least(b, 0, lead(i), links.len() + i);
         }
-        let x = s.into_least()?;
-        if x[0] > EPSILON {
+        by_system = s.into_least()?;
+        if by_system[0] > EPSILON {
             return None;
         }
-        x
+        &by_system
     };
     let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
     for (i, it) in items.iter().enumerate() {
