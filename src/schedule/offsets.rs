@@ -36,19 +36,6 @@ impl Offsets {
 
     /// The node's root and its offset from it; the path to the root is shortened on the way.
     pub(crate) fn find(&mut self, v: usize) -> (usize, f64) {
-        // on a slice: no inline-or-heap check per step
-        fn walk(nodes: &mut [(usize, f64)], v: usize) -> (usize, f64) {
-            let (up, d) = nodes[v];
-            if up == ROOT {
-                return (v, 0.0);
-            }
-            if nodes[up].0 == ROOT {
-                return (up, d); // right under the root (the common case)
-            }
-            let (root, off) = walk(nodes, up);
-            nodes[v] = (root, d + off);
-            (root, d + off)
-        }
         walk(&mut self.nodes, v)
     }
 
@@ -80,28 +67,55 @@ impl Offsets {
         x: &mut Values,
     ) -> Option<()> {
         let n = self.nodes.len();
-        // every node's root and distance from it
-        let mut root: SmallVec<[(usize, f64); 16]> = SmallVec::new();
-        root.extend((0..n).map(|v| self.find(v)));
-        let root = root.as_slice();
-        // where each group's root must be for every bound in the group to hold
-        let mut root_at: SmallVec<[f64; 16]> = SmallVec::new();
-        root_at.resize(n, f64::NEG_INFINITY);
-        for (v, bound) in bounds {
-            let (r, off) = root[v];
-            root_at[r] = root_at[r].max(bound - off);
+        // both lists read as slices from here on (no inline-or-heap check per step)
+        x.clear();
+        x.resize(n, 0.0);
+        let x = x.as_mut_slice();
+        let nodes = self.nodes.as_mut_slice();
+        // every node straight under its root; x[v] holds v's distance from its root, and for a
+        // root, where it must be for every bound in its group to hold
+        for v in 0..n {
+            let (root, off) = walk(nodes, v);
+            x[v] = if root == v { f64::NEG_INFINITY } else { off };
         }
-        let (r0, off0) = root[0];
+        let root = |x: &[f64], v: usize| match nodes[v].0 {
+            ROOT => (v, 0.0),
+            r => (r, x[v]),
+        };
+        for (v, bound) in bounds {
+            let (r, off) = root(x, v);
+            x[r] = x[r].max(bound - off);
+        }
+        let (r0, off0) = root(x, 0);
         let fixed = -off0;
-        if root_at[r0] > fixed + EPSILON {
+        if x[r0] > fixed + EPSILON {
             return None;
         }
-        root_at[r0] = fixed;
-        debug_assert!(root.iter().all(|&(r, _)| root_at[r].is_finite()));
-        x.clear();
-        x.extend(root.iter().map(|&(r, off)| off + root_at[r]));
+        x[r0] = fixed;
+        // the other nodes where their roots are
+        for v in 0..n {
+            let r = nodes[v].0;
+            if r != ROOT {
+                x[v] += x[r];
+            }
+        }
+        debug_assert!(x.iter().all(|t| t.is_finite()));
         Some(())
     }
+}
+
+/// [`Offsets::find`] on the list of nodes.
+fn walk(nodes: &mut [(usize, f64)], v: usize) -> (usize, f64) {
+    let (up, d) = nodes[v];
+    if up == ROOT {
+        return (v, 0.0);
+    }
+    if nodes[up].0 == ROOT {
+        return (up, d); // right under the root (the common case)
+    }
+    let (root, off) = walk(nodes, up);
+    nodes[v] = (root, d + off);
+    (root, d + off)
 }
 
 #[cfg(test)]
