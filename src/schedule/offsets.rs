@@ -74,9 +74,9 @@ impl Offsets {
         let nodes = self.nodes.as_mut_slice();
         // every node straight under its root; x[v] holds v's distance from its root, and for a
         // root, where it must be for every bound in its group to hold
-        for v in 0..n {
+        for (v, xv) in x.iter_mut().enumerate() {
             let (root, off) = walk(nodes, v);
-            x[v] = if root == v { f64::NEG_INFINITY } else { off };
+            *xv = if root == v { f64::NEG_INFINITY } else { off };
         }
         let root = |x: &[f64], v: usize| match nodes[v].0 {
             ROOT => (v, 0.0),
