@@ -3,6 +3,7 @@
 
 use smallvec::SmallVec;
 
+use super::room::room;
 use super::strategy::{Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour};
 use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
 use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
@@ -44,11 +45,15 @@ pub(crate) fn items<'b>(
     constraints: &[Constraint],
     dropped: &mut Vec<Dropped>,
 ) -> Vec<Item<'b>> {
-    let mut order: SmallVec<[&Behaviour; 8]> = SmallVec::new();
-    order.extend(&block.behaviours);
-    order.sort_by(|a, b| a.id.cmp(&b.id));
+    // positions of the behaviours, sorted by id
+    let (mut stack, mut heap) = ([0; 8], Vec::new());
+    let order = room(block.behaviours.len(), &mut stack, &mut heap);
+    for (i, at) in order.iter_mut().enumerate() {
+        *at = i;
+    }
+    order.sort_by(|&a, &b| block.behaviours[a].id.cmp(&block.behaviours[b].id));
     let mut items = Vec::with_capacity(order.len());
-    for beh in order {
+    for beh in order.iter().map(|&i| &block.behaviours[i]) {
         let model = models.model(beh).map(|m| {
             let valid = m.check();
             (m, valid)

@@ -11,6 +11,7 @@ pub mod greedy;
 mod links;
 mod offsets;
 pub mod optimal;
+mod room;
 pub mod strategy;
 pub mod to_pegs;
 

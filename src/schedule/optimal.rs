@@ -24,11 +24,10 @@ use good_lp::{
     constraint, microlp, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
 };
 
-use smallvec::SmallVec;
-
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
 use super::offsets::{Offsets, Values};
+use super::room::{dedup_sorted, room};
 use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
 use crate::bml::{extract, Block, Constraint, Relation};
 use crate::engine::timing::{Flexibility, TimingModels, MIN_DURATION};
@@ -331,7 +330,9 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
 /// An exact shortcut, found without building a difference system.
 fn pinned_apart(items: &[Item], links: &[Link]) -> bool {
     // (item, the start that the fixed time implies for it)
-    let mut starts: SmallVec<[(usize, f64); 8]> = SmallVec::new();
+    let (mut stack, mut heap) = ([(0, 0.0); 8], Vec::new());
+    let starts = room(links.len(), &mut stack, &mut heap);
+    let mut len = 0;
     for l in links.iter().filter(|l| l.relation == Relation::At) {
         // left = right + offset
         let implied = match (l.left, l.right) {
@@ -340,11 +341,13 @@ fn pinned_apart(items: &[Item], links: &[Link]) -> bool {
             _ => continue,
         };
         let (i, k, at) = implied;
-        starts.push((i, at - items[i].model.keys[k].at));
+        starts[len] = (i, at - items[i].model.keys[k].at);
+        len += 1;
     }
-    if starts.len() < 2 {
+    if len < 2 {
         return false;
     }
+    let starts = &mut starts[..len];
     starts.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     starts
         .windows(2)
@@ -357,25 +360,24 @@ fn pinned_apart(items: &[Item], links: &[Link]) -> bool {
 fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     // anchored (item, key) pairs, sorted: item i's anchors are `pairs[first[i]..first[i + 1]]`
     // (the lists of a typical block fit on the stack)
-    // (lists on the stack start empty and are filled in place: a constructor that returns one
-    // would copy it)
-    let mut pairs: SmallVec<[(usize, usize); 16]> = SmallVec::new();
-    pairs.reserve(2 * links.len());
+    let (mut stack, mut heap) = ([(0, 0); 16], Vec::new());
+    let pairs = room(2 * links.len(), &mut stack, &mut heap);
+    let mut len = 0;
     for l in links {
         for t in [l.left, l.right] {
             if let Term::Key(i, k) = t {
-                pairs.push((i, k));
+                pairs[len] = (i, k);
+                len += 1;
             }
         }
     }
-    pairs.sort_unstable();
-    pairs.dedup();
-    // read as a slice from here on: no inline-or-heap check per access
-    let pairs = pairs.as_slice();
-    // per item: first anchor, first node, and (for a stretched item) its scale, in one vector
+    pairs[..len].sort_unstable();
+    let distinct = dedup_sorted(&mut pairs[..len]);
+    let pairs = &pairs[..distinct];
+    // per item: first anchor, then first node
     let m = items.len();
-    let mut first: SmallVec<[usize; 17]> = SmallVec::new();
-    first.resize(2 * m + 1, 0);
+    let (mut stack, mut heap) = ([0; 17], Vec::new());
+    let first = room(2 * m + 1, &mut stack, &mut heap);
     for &(i, _) in pairs {
         first[i + 1] += 1;
     }
@@ -421,8 +423,9 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
         }
     }
     // the uniform scale of each multi-anchor item, from its fixed anchor distances
-    let mut scale: SmallVec<[f64; 8]> = SmallVec::new();
-    scale.resize(m, 1.0);
+    let (mut stack, mut heap) = ([0.0; 8], Vec::new());
+    let scale = room(m, &mut stack, &mut heap);
+    scale.fill(1.0);
     for i in (0..m).filter(|&i| multi(i)) {
         let keys = &items[i].model.keys;
         let count = anchors(i);
@@ -457,7 +460,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
             }
         }
     }
-    let scale = scale.as_slice();
+    let scale = &*scale;
     // nothing before the block: for a stretched item, its extrapolated start
     let lead = |i: usize| {
         if multi(i) {
