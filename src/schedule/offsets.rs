@@ -12,9 +12,6 @@ pub(crate) struct Offsets {
     nodes: SmallVec<[(usize, f64); 16]>,
 }
 
-/// Node values (those of a typical block on the stack).
-pub(crate) type Values = SmallVec<[f64; 16]>;
-
 /// The "node above" of a root.
 const ROOT: usize = usize::MAX;
 
@@ -60,17 +57,14 @@ impl Offsets {
     ///
     /// This is the least solution of the difference system with the joins as equalities and the
     /// bounds as constraints from node 0 (without a search over its edges). It is written into
-    /// `x` (a list on the caller's stack for a typical block: nothing is allocated).
+    /// `x`, one value per node (see [`super::room`] for a list on the caller's stack).
     pub(crate) fn least(
         &mut self,
         bounds: impl Iterator<Item = (usize, f64)>,
-        x: &mut Values,
+        x: &mut [f64],
     ) -> Option<()> {
-        let n = self.nodes.len();
-        // both lists read as slices from here on (no inline-or-heap check per step)
-        x.clear();
-        x.resize(n, 0.0);
-        let x = x.as_mut_slice();
+        assert_eq!(x.len(), self.nodes.len(), "one value per node");
+        // read as a slice from here on (no inline-or-heap check per step)
         let nodes = self.nodes.as_mut_slice();
         // every node straight under its root; x[v] holds v's distance from its root, and for a
         // root, where it must be for every bound in its group to hold
@@ -93,7 +87,7 @@ impl Offsets {
         }
         x[r0] = fixed;
         // the other nodes where their roots are
-        for v in 0..n {
+        for v in 0..nodes.len() {
             let r = nodes[v].0;
             if r != ROOT {
                 x[v] += x[r];
@@ -120,7 +114,7 @@ fn walk(nodes: &mut [(usize, f64)], v: usize) -> (usize, f64) {
 
 #[cfg(test)]
 mod tests {
-    use super::{Offsets, Values};
+    use super::Offsets;
     use crate::bml::Relation;
     use crate::schedule::diff::{DiffSystem, EPSILON};
     use proptest::prelude::*;
@@ -188,9 +182,9 @@ mod tests {
                 s.at_least(v, 0, bound, 0);
             }
             let expected = s.into_least().filter(|x| x[0] <= EPSILON);
-            let mut x = Values::new();
+            let mut x = vec![0.0; t.n];
             let got = if consistent {
-                o.least(t.bounds.iter().copied(), &mut x).map(|()| x.to_vec())
+                o.least(t.bounds.iter().copied(), &mut x).map(|()| x)
             } else {
                 None
             };
@@ -216,9 +210,9 @@ mod tests {
         assert!(o.join(2, 0, 3.0), "the same distance again");
         assert!(!o.join(2, 0, 3.5), "half a second off");
         assert_eq!(o.find(2).1 - o.find(0).1, 3.0);
-        let mut x = Values::new();
+        let mut x = [0.0; 3];
         assert_eq!(o.least([(1, 0.0)].into_iter(), &mut x), Some(()));
-        assert_eq!(x.as_slice(), [0.0, 2.0, 3.0]);
+        assert_eq!(x, [0.0, 2.0, 3.0]);
         // a bound that node 0's group cannot meet; elsewhere, groups move up to their bounds
         assert_eq!(o.least([(1, 2.5)].into_iter(), &mut x), None);
         let mut apart = Offsets::new(3);
@@ -227,7 +221,7 @@ mod tests {
             apart.least([(2, 4.0), (1, 0.5)].into_iter(), &mut x),
             Some(())
         );
-        assert_eq!(x.as_slice(), [0.0, 3.0, 4.0]);
+        assert_eq!(x, [0.0, 3.0, 4.0]);
     }
 
     #[test]

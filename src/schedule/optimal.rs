@@ -26,7 +26,7 @@ use good_lp::{
 
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
-use super::offsets::{Offsets, Values};
+use super::offsets::Offsets;
 use super::room::{dedup_sorted, room};
 use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
 use crate::bml::{extract, Block, Constraint, Relation};
@@ -297,9 +297,10 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
                 return None;
             }
         }
-        by_groups = Values::new();
-        offsets.least((1..=items.len()).map(|v| (v, 0.0)), &mut by_groups)?;
-        &by_groups
+        by_groups = ([0.0; 16], Vec::new());
+        let x = room(items.len() + 1, &mut by_groups.0, &mut by_groups.1);
+        offsets.least((1..=items.len()).map(|v| (v, 0.0)), x)?;
+        x
     } else {
         let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
         s.var(0.0);
@@ -473,9 +474,10 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     // hold it (each as early as its items allow)
     let (mut by_groups, by_system);
     let x: &[f64] = if links.iter().all(|l| l.relation == Relation::At) {
-        by_groups = Values::new();
-        offsets.least((0..m).map(|i| (base[i], lead(i))), &mut by_groups)?;
-        &by_groups
+        by_groups = ([0.0; 16], Vec::new());
+        let x = room(n, &mut by_groups.0, &mut by_groups.1);
+        offsets.least((0..m).map(|i| (base[i], lead(i))), x)?;
+        x
     } else {
         let mut s = DiffSystem::with_capacity(n, 2 * links.len() + m);
         for v in 0..n {
