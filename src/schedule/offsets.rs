@@ -163,7 +163,7 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(600))]
 
-        /// S43: the joined groups give the same least solution as the difference system with
+        /// The joined groups give the same least solution as the difference system with
         /// the joins as `at` constraints and the bounds as constraints from node 0, and both
         /// refuse the same systems (contradicting joins, a bound node 0's group cannot meet).
         #[test]
