@@ -31,6 +31,11 @@ impl Offsets {
         self.nodes.resize(n, (ROOT, 0.0));
     }
 
+    /// The number of nodes.
+    pub(crate) fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
     /// The node's root and its offset from it; the path to the root is shortened on the way.
     pub(crate) fn find(&mut self, v: usize) -> (usize, f64) {
         walk(&mut self.nodes, v)

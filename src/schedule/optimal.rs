@@ -275,55 +275,76 @@ fn preferred(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     at_preferred_timing(items, links)
 }
 
-/// [`preferred`] without the shortcut: the least solution over the block start (variable 0) and
-/// each item's start (item i's is variable i + 1).
+/// [`preferred`] without the shortcut: the least solution over the block start (node 0) and
+/// each item's start (item i's is node i + 1).
 fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
-    let block = 0;
     let var = |t: Term| -> (usize, f64) {
         match t {
             Term::Key(i, k) => (i + 1, items[i].model.keys[k].at),
-            Term::Fixed(t) => (block, t),
+            Term::Fixed(t) => (0, t),
         }
     };
-    let (mut by_groups, by_system);
-    let x: &[f64] = if links.iter().all(|l| l.relation == Relation::At) {
-        // only `at` constraints: the joined groups hold the least solution
-        let mut offsets = Offsets::default();
-        offsets.reset(items.len() + 1);
-        for l in links {
-            // left = right + offset  =>  value(a) + ao = value(b) + bo + offset
-            let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
-            if !offsets.join(a, b, l.offset + bo - ao) {
-                return None;
-            }
-        }
-        by_groups = ([0.0; 16], Vec::new());
-        let x = room(items.len() + 1, &mut by_groups.0, &mut by_groups.1);
-        offsets.least((1..=items.len()).map(|v| (v, 0.0)), x)?;
-        x
-    } else {
-        let mut s = DiffSystem::with_capacity(items.len() + 1, 2 * links.len() + items.len());
-        s.var(0.0);
-        for i in 0..items.len() {
-            let v = s.var(f64::MIN / 4.0);
-            s.at_least(v, block, 0.0, links.len() + i);
-        }
-        for (tag, l) in links.iter().enumerate() {
-            let ((a, ao), (b, bo)) = (var(l.left), var(l.right));
-            let offset = l.offset + bo - ao;
-            s.relate(a, l.relation, b, offset, tag);
-        }
-        by_system = s.into_least()?;
-        if by_system[block] > EPSILON {
-            return None;
-        }
-        &by_system
-    };
+    let mut groups = Offsets::default();
+    groups.reset(items.len() + 1);
+    join_at_links(&mut groups, links, var)?;
+    let (mut stack, mut heap) = ([0.0; 16], Vec::new());
+    let starts = (1..=items.len()).map(|v| (v, 0.0));
+    let x = least_solution(links, var, starts, &mut groups, &mut stack, &mut heap)?;
     let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
     for (i, it) in items.iter().enumerate() {
         times.extend(it.model.keys[..it.len].iter().map(|k| x[i + 1] + k.at));
     }
     Some(times)
+}
+
+/// Joins the nodes that each `at` link ties (`node` gives a term's node and its distance from
+/// it); `None` if two of them contradict each other.
+fn join_at_links(
+    groups: &mut Offsets,
+    links: &[Link],
+    node: impl Fn(Term) -> (usize, f64),
+) -> Option<()> {
+    for l in links.iter().filter(|l| l.relation == Relation::At) {
+        // left = right + offset  =>  value(a) + oa = value(b) + ob + offset
+        let ((a, oa), (b, ob)) = (node(l.left), node(l.right));
+        groups.join(a, b, ob + l.offset - oa).then_some(())?;
+    }
+    Some(())
+}
+
+/// The least solution of a fast path over `groups.len()` nodes (node 0 the block start, at 0):
+/// the links (through `node`, as in [`join_at_links`], which `groups` has been through) and, for
+/// item i, `value(node) >= bound` for the i-th `(node, bound)` of `starts` (nothing before the
+/// block). With only `at` links the joined groups hold it; otherwise the difference system is
+/// searched. `None` if there is none, or if the block start would have to move. Written into
+/// `stack` when it fits, else into `heap`.
+fn least_solution<'a>(
+    links: &[Link],
+    node: impl Fn(Term) -> (usize, f64),
+    starts: impl Iterator<Item = (usize, f64)>,
+    groups: &mut Offsets,
+    stack: &'a mut [f64; 16],
+    heap: &'a mut Vec<f64>,
+) -> Option<&'a mut [f64]> {
+    let n = groups.len();
+    if links.iter().all(|l| l.relation == Relation::At) {
+        let x = room(n, stack, heap);
+        groups.least(starts, x)?;
+        return Some(x);
+    }
+    let mut s = DiffSystem::with_capacity(n, 2 * links.len() + n);
+    for v in 0..n {
+        s.var(if v == 0 { 0.0 } else { f64::MIN / 4.0 });
+    }
+    for (tag, l) in links.iter().enumerate() {
+        let ((a, oa), (b, ob)) = (node(l.left), node(l.right));
+        s.relate(a, l.relation, b, l.offset + ob - oa, tag);
+    }
+    for (i, (v, bound)) in starts.enumerate() {
+        s.at_least(v, 0, bound, links.len() + i);
+    }
+    *heap = s.into_least()?;
+    (heap[0] <= EPSILON).then_some(heap.as_mut_slice())
 }
 
 /// Whether some behaviour has two keys set `at` fixed times that its preferred timing cannot
@@ -416,13 +437,7 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     };
     let mut offsets = Offsets::default();
     offsets.reset(n);
-    for l in links.iter().filter(|l| l.relation == Relation::At) {
-        // left = right + offset  =>  value(a) + oa = value(b) + ob + offset
-        let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
-        if !offsets.join(a, b, ob + l.offset - oa) {
-            return None; // `at` constraints that contradict each other
-        }
-    }
+    join_at_links(&mut offsets, links, term)?;
     // the uniform scale of each multi-anchor item, from its fixed anchor distances
     let (mut stack, mut heap) = ([0.0; 8], Vec::new());
     let scale = room(m, &mut stack, &mut heap);
@@ -470,33 +485,9 @@ fn uniform(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
             0.0
         }
     };
-    // least solution over the nodes: with only `at` constraints, the joined groups already
-    // hold it (each as early as its items allow)
-    let (mut by_groups, by_system);
-    let x: &[f64] = if links.iter().all(|l| l.relation == Relation::At) {
-        by_groups = ([0.0; 16], Vec::new());
-        let x = room(n, &mut by_groups.0, &mut by_groups.1);
-        offsets.least((0..m).map(|i| (base[i], lead(i))), x)?;
-        x
-    } else {
-        let mut s = DiffSystem::with_capacity(n, 2 * links.len() + m);
-        for v in 0..n {
-            s.var(if v == 0 { 0.0 } else { f64::MIN / 4.0 });
-        }
-        for (tag, l) in links.iter().enumerate() {
-            let ((a, oa), (b, ob)) = (term(l.left), term(l.right));
-            let offset = l.offset + ob - oa;
-            s.relate(a, l.relation, b, offset, tag);
-        }
-        for (i, &b) in base.iter().enumerate() {
-            s.at_least(b, 0, lead(i), links.len() + i);
-        }
-        by_system = s.into_least()?;
-        if by_system[0] > EPSILON {
-            return None;
-        }
-        &by_system
-    };
+    let (mut stack, mut heap) = ([0.0; 16], Vec::new());
+    let starts = (0..m).map(|i| (base[i], lead(i)));
+    let x = least_solution(links, term, starts, &mut offsets, &mut stack, &mut heap)?;
     let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
     for (i, it) in items.iter().enumerate() {
         let keys = &it.model.keys[..it.len];
