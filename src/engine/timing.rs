@@ -34,6 +34,20 @@ pub struct SyncKey {
     pub name: crate::bml::Id,
     /// Preferred offset from `start`, seconds.
     pub at: f64,
+    /// The longest the phase that ends at this key may last, seconds (infinite: no limit). Only
+    /// a stretchable model's limits count; the scheduler never stretches a phase past it.
+    pub max_phase: f64,
+}
+
+impl SyncKey {
+    /// A key at `at` seconds from `start` whose phase has no limit.
+    pub fn new(name: impl Into<crate::bml::Id>, at: f64) -> Self {
+        SyncKey {
+            name: name.into(),
+            at,
+            max_phase: f64::INFINITY,
+        }
+    }
 }
 
 /// The timing an engine gives the scheduler for one behaviour.
@@ -81,7 +95,21 @@ impl TimingModel {
                     }
                 }
             }
-            _ => {}
+            Flexibility::Stretchable { .. } => {
+                let phases = syncs.windows(2).zip(self.keys.windows(2));
+                for (w, k) in phases {
+                    let (a, b) = (&w[0], &w[1]);
+                    if k[1].name == b.0 && b.1 - a.1 > k[1].max_phase + TOLERANCE {
+                        return Err(format!(
+                            "the phase {}-{} lasts {:.3} s, more than its limit of {} s",
+                            a.0,
+                            b.0,
+                            b.1 - a.1,
+                            k[1].max_phase
+                        ));
+                    }
+                }
+            }
         }
         Ok(())
     }
@@ -91,10 +119,7 @@ impl TimingModel {
         TimingModel {
             keys: keys
                 .iter()
-                .map(|(name, at)| SyncKey {
-                    name: crate::bml::Id::new_static(name),
-                    at: *at,
-                })
+                .map(|(name, at)| SyncKey::new(crate::bml::Id::new_static(name), *at))
                 .collect(),
             flexibility,
             persistent: false,
@@ -127,10 +152,22 @@ impl TimingModel {
         m.scaled(duration / preferred)
     }
 
-    /// The same keys with every offset multiplied by `factor`.
+    /// The same keys with every offset (and every phase limit) multiplied by `factor`.
     fn scaled(mut self, factor: f64) -> Self {
         for k in &mut self.keys {
             k.at *= factor;
+            k.max_phase *= factor;
+        }
+        self
+    }
+
+    /// The same model with the phase that ends at each named key limited to the given seconds
+    /// (names the model does not have are left out).
+    pub fn with_phase_limits(mut self, limits: &[(&str, f64)]) -> Self {
+        for &(name, max) in limits {
+            if let Some(k) = self.key(name) {
+                self.keys[k].max_phase = max;
+            }
         }
         self
     }
@@ -184,6 +221,15 @@ impl TimingModel {
                 return Err(format!(
                     "key {} at {} comes before {} at {}",
                     w[1].name, w[1].at, w[0].name, w[0].at
+                ));
+            }
+            if w[1].at - w[0].at > w[1].max_phase || w[1].max_phase.is_nan() {
+                return Err(format!(
+                    "the phase {}-{} lasts {} s, more than its limit of {} s",
+                    w[0].name,
+                    w[1].name,
+                    w[1].at - w[0].at,
+                    w[1].max_phase
                 ));
             }
         }
@@ -427,25 +473,16 @@ impl SpeechTiming {
             .filter(|p| matches!(p, TextPart::Sync(_)))
             .count();
         let mut keys = Vec::with_capacity(syncs + 2);
-        keys.push(SyncKey {
-            name: crate::bml::Id::new_static("start"),
-            at: 0.0,
-        });
+        keys.push(SyncKey::new(crate::bml::Id::new_static("start"), 0.0));
         let mut t = 0.0;
         for part in &speech.text {
             match part {
                 TextPart::Text(text) => t += self.text(text),
-                TextPart::Sync(id) => keys.push(SyncKey {
-                    name: id.clone(),
-                    at: t,
-                }),
+                TextPart::Sync(id) => keys.push(SyncKey::new(id.clone(), t)),
             }
         }
         let end = if t > 0.0 { t } else { self.syllable_seconds };
-        keys.push(SyncKey {
-            name: crate::bml::Id::new_static("end"),
-            at: end,
-        });
+        keys.push(SyncKey::new(crate::bml::Id::new_static("end"), end));
         let flexibility = if self.retimable {
             Flexibility::Stretchable {
                 min_duration: end / RETIME_RANGE,
@@ -506,6 +543,39 @@ const FACE: &[(&str, f64)] = &[
     ("end", 1.5),
 ];
 
+/// The longest a preparation (start to `ready`) or a retraction (`relax` to `end`) of each kind
+/// may last, seconds: a hand, head or gaze gets to where it is going in about a second, however
+/// far apart the constraints put the behaviour's keys. What is left goes into the holds (`ready`
+/// to `strokeStart`, `strokeEnd` to `relax`), which have no limit. A head's limits are per nod
+/// or shake (they scale with `repetition`).
+pub const PHASE_LIMITS: &[(&str, f64)] = &[
+    ("gesture", 1.0),
+    ("pointing", 1.5),
+    ("head", 1.0),
+    ("gaze", 1.5),
+    ("posture", 3.0),
+    ("face", 3.0),
+];
+
+/// The limit of [`PHASE_LIMITS`] for `kind`.
+fn phase_limit(kind: &str) -> f64 {
+    PHASE_LIMITS
+        .iter()
+        .find(|(k, _)| *k == kind)
+        .map_or(f64::INFINITY, |(_, max)| *max)
+}
+
+/// A stretchable model of `keys` whose preparation and retraction are limited as `kind`'s.
+fn limited(keys: &[(&'static str, f64)], kind: &str) -> TimingModel {
+    let max = phase_limit(kind);
+    // a face's preparation is its attack, to `attackPeak`
+    TimingModel::stretchable(keys).with_phase_limits(&[
+        ("ready", max),
+        ("attackPeak", max),
+        ("end", max),
+    ])
+}
+
 impl TimingModels for DefaultTimingModels {
     fn model(&self, b: &Behaviour) -> Option<TimingModel> {
         let se = |d: f64| TimingModel::stretchable(&[("start", 0.0), ("end", d)]);
@@ -521,18 +591,18 @@ impl TimingModels for DefaultTimingModels {
                 m
             }
             BehaviourKind::Gesture(_) | BehaviourKind::ProcAnimationGesture(_) => {
-                TimingModel::stretchable(GESTURE)
+                limited(GESTURE, "gesture")
             }
-            BehaviourKind::Pointing(_) => TimingModel::stretchable(POINTING),
+            BehaviourKind::Pointing(_) => limited(POINTING, "pointing"),
             BehaviourKind::Head(h) => {
-                TimingModel::stretchable(HEAD).scaled(h.repetition.unwrap_or(1).max(1) as f64)
+                limited(HEAD, "head").scaled(h.repetition.unwrap_or(1).max(1) as f64)
             }
-            BehaviourKind::Gaze(_) => TimingModel::stretchable(GAZE),
-            BehaviourKind::Posture(_) => TimingModel::stretchable(POSTURE),
+            BehaviourKind::Gaze(_) => limited(GAZE, "gaze"),
+            BehaviourKind::Posture(_) => limited(POSTURE, "posture"),
             BehaviourKind::Face(_)
             | BehaviourKind::FaceLexeme(_)
             | BehaviourKind::FaceFacs(_)
-            | BehaviourKind::FaceMorph(_) => TimingModel::stretchable(FACE),
+            | BehaviourKind::FaceMorph(_) => limited(FACE, "face"),
             BehaviourKind::GazeShift(_)
             | BehaviourKind::HeadDirectionShift { .. }
             | BehaviourKind::FaceShift(_) => se(1.0),

@@ -324,14 +324,8 @@ impl Engine for KeyframeEngine {
         let d = read_keys(c).map_or(1.0, |k| k.duration());
         Some(TimingModel {
             keys: vec![
-                SyncKey {
-                    name: "start".into(),
-                    at: 0.0,
-                },
-                SyncKey {
-                    name: "end".into(),
-                    at: d.max(MIN_DURATION),
-                },
+                SyncKey::new("start", 0.0),
+                SyncKey::new("end", d.max(MIN_DURATION)),
             ],
             flexibility: Flexibility::Stretchable {
                 min_duration: MIN_DURATION,

@@ -391,10 +391,7 @@ impl ProcUnit {
             keys: self
                 .keys
                 .iter()
-                .map(|(name, alpha)| SyncKey {
-                    name: name.clone(),
-                    at: alpha * preferred,
-                })
+                .map(|(name, alpha)| SyncKey::new(name.clone(), alpha * preferred))
                 .collect(),
             flexibility: Flexibility::Stretchable {
                 min_duration: min,

@@ -76,13 +76,7 @@ impl Engine for SpeechEngine {
             // the text ends at `relax`; the filler runs from there to `end`
             let end = model.keys.last().map_or(0.0, |k| k.at);
             let at = model.keys.len() - 1;
-            model.keys.insert(
-                at,
-                SyncKey {
-                    name: "relax".into(),
-                    at: end,
-                },
-            );
+            model.keys.insert(at, SyncKey::new("relax", end));
             if let Some(last) = model.keys.last_mut() {
                 last.at = end + FILLER_SECONDS;
             }

@@ -16,7 +16,7 @@ pub mod strategy;
 pub mod to_pegs;
 
 pub use greedy::SortedGreedy;
-pub use optimal::Optimal;
+pub use optimal::{LinearProgram, Optimal};
 pub use strategy::{
     BlockSchedule, Dropped, ExternalTimes, NoExternal, ScheduleError, ScheduledBehaviour,
     SchedulingStrategy, SyncName,

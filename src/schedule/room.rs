@@ -23,22 +23,9 @@ pub(crate) fn room<'a, T: Copy + Default, const N: usize>(
     }
 }
 
-/// Removes repeats from a sorted list in place; returns how many distinct items it holds (at its
-/// start).
-pub(crate) fn dedup_sorted<T: Copy + PartialEq>(list: &mut [T]) -> usize {
-    let mut kept = 0;
-    for j in 0..list.len() {
-        if kept == 0 || list[j] != list[kept - 1] {
-            list[kept] = list[j];
-            kept += 1;
-        }
-    }
-    kept
-}
-
 #[cfg(test)]
 mod tests {
-    use super::{dedup_sorted, room};
+    use super::room;
 
     #[test]
     fn room_is_on_the_stack_when_short_and_always_cleared() {
@@ -50,19 +37,5 @@ mod tests {
         let r = room(6, &mut stack, &mut heap);
         assert_eq!(r, [0; 6]);
         assert_eq!(heap.len(), 6, "six do not");
-    }
-
-    #[test]
-    fn dedup_keeps_one_of_each_in_order() {
-        for (input, expected) in [
-            (vec![], vec![]),
-            (vec![1], vec![1]),
-            (vec![1, 1, 2, 3, 3, 3, 4], vec![1, 2, 3, 4]),
-            (vec![2, 2, 2], vec![2]),
-        ] {
-            let mut list = input.clone();
-            let n = dedup_sorted(&mut list);
-            assert_eq!(list[..n], expected[..], "{input:?}");
-        }
     }
 }

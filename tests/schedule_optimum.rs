@@ -1,0 +1,220 @@
+//! `Optimal`'s fast paths give the optimum of its own objective: on random blocks of rigid
+//! speeches (chained, with inline syncs) and gestures and heads whose keys are tied to speech
+//! syncs, `Optimal` and the linear program alone (`LinearProgram`) schedule the same behaviours,
+//! reach the same total deviation from preferred timing and the same sum of sync times, and give
+//! the same times.
+//!
+//! The deviation of a schedule is computed here from its times alone, independently of the
+//! scheduler: for each stretchable behaviour, the least over a uniform scale σ ≥ 0 of
+//! `|σ − 1| · preferred duration + 2 · Σ |phase − σ · preferred phase|`.
+
+use bml_realizer::bml;
+use bml_realizer::engine::timing::{DefaultTimingModels, Flexibility, TimingModels};
+use bml_realizer::schedule::{
+    BlockSchedule, LinearProgram, NoExternal, Optimal, SchedulingStrategy,
+};
+use proptest::prelude::*;
+
+const WORDS: &[&str] = &[
+    "I", "am", "fine", "thank", "you", "very", "much", "goodbye", "now",
+];
+const GESTURE_KEYS: &[&str] = &[
+    "start",
+    "ready",
+    "strokeStart",
+    "stroke",
+    "strokeEnd",
+    "relax",
+    "end",
+];
+
+#[derive(Debug, Clone)]
+struct Speech {
+    /// Words before each inline sync, and after the last.
+    runs: Vec<Vec<usize>>,
+    /// 0: starts at 0; 1: at the previous speech's end; 2: at an absolute time; 3: at the
+    /// previous speech's end plus an offset.
+    start: (u8, u32),
+}
+
+#[derive(Debug, Clone)]
+struct Move {
+    /// false: gesture BEAT; true: head NOD.
+    head: bool,
+    /// (key index, speech sync picked, offset in ms: 0 or signed) per tied key.
+    ties: Vec<(usize, usize, i32)>,
+}
+
+fn speech() -> impl Strategy<Value = Speech> {
+    (
+        proptest::collection::vec(proptest::collection::vec(0..WORDS.len(), 1..4), 2..5),
+        (0u8..4, 0u32..3000),
+    )
+        .prop_map(|(runs, start)| Speech { runs, start })
+}
+
+fn motion() -> impl Strategy<Value = Move> {
+    (
+        any::<bool>(),
+        proptest::collection::vec(
+            (
+                0..GESTURE_KEYS.len(),
+                0usize..64,
+                prop_oneof![Just(0i32), -400i32..400],
+            ),
+            1..4,
+        ),
+    )
+        .prop_map(|(head, ties)| Move { head, ties })
+}
+
+/// The block's text.
+fn block(speeches: &[Speech], moves: &[Move]) -> String {
+    let mut body = String::new();
+    // every speech sync, as references, in the order they are spoken
+    let mut syncs = Vec::new();
+    for (i, s) in speeches.iter().enumerate() {
+        let start = match (i, s.start.0) {
+            (0, _) | (_, 0) => String::new(),
+            (_, 1) => format!(r#" start="s{}:end""#, i - 1),
+            (_, 2) => format!(r#" start="{}""#, s.start.1 as f64 / 1000.0),
+            _ => format!(r#" start="s{}:end+{}""#, i - 1, s.start.1 as f64 / 1000.0),
+        };
+        body.push_str(&format!(r#"<speech id="s{i}"{start}><text>"#));
+        for (j, run) in s.runs.iter().enumerate() {
+            if j > 0 {
+                body.push_str(&format!(r#"<sync id="x{j}"/> "#));
+                syncs.push(format!("s{i}:x{j}"));
+            }
+            for &w in run {
+                body.push_str(WORDS[w]);
+                body.push(' ');
+            }
+        }
+        body.push_str("</text></speech>");
+        syncs.push(format!("s{i}:end"));
+    }
+    for (i, m) in moves.iter().enumerate() {
+        // keys in their order, tied to syncs in spoken order (most such blocks are feasible)
+        let mut ties = m.ties.clone();
+        ties.sort_by_key(|t| t.0);
+        ties.dedup_by_key(|t| t.0);
+        let mut picks: Vec<usize> = ties.iter().map(|t| t.1 % syncs.len()).collect();
+        picks.sort_unstable();
+        let mut attrs = String::new();
+        for (&(key, _, offset), &pick) in ties.iter().zip(&picks) {
+            let sign = if offset < 0 { "-" } else { "+" };
+            let offset = match offset {
+                0 => String::new(),
+                o => format!("{sign}{}", o.unsigned_abs() as f64 / 1000.0),
+            };
+            attrs.push_str(&format!(
+                r#" {}="{}{offset}""#,
+                GESTURE_KEYS[key], syncs[pick]
+            ));
+        }
+        body.push_str(&if m.head {
+            format!(r#"<head id="m{i}" lexeme="NOD"{attrs}/>"#)
+        } else {
+            format!(r#"<gesture id="m{i}" lexeme="BEAT"{attrs}/>"#)
+        });
+    }
+    format!(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b">{body}</bml>"#)
+}
+
+/// The least over σ ≥ 0 of `|σ − 1| · d + 2 · Σ |x − σ · p|` (a convex piecewise-linear function
+/// of σ, so its least value is at one of its kinks or at 0).
+fn least_deviation(d: f64, phases: &[(f64, f64)]) -> f64 {
+    let cost = |s: f64| {
+        (s - 1.0).abs() * d + 2.0 * phases.iter().map(|&(x, p)| (x - s * p).abs()).sum::<f64>()
+    };
+    let kinks = phases.iter().filter(|(_, p)| *p > 0.0).map(|&(x, p)| x / p);
+    [0.0, 1.0]
+        .into_iter()
+        .chain(kinks)
+        .map(cost)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// (deviation from preferred timing, sum of all sync times) of a schedule of `src`.
+fn objective(src: &str, schedule: &BlockSchedule) -> (f64, f64) {
+    let block = bml::load(src).unwrap().block;
+    let models = DefaultTimingModels::default();
+    let (mut deviation, mut sum) = (0.0, 0.0);
+    for b in &schedule.behaviours {
+        let beh = block.behaviours.iter().find(|x| x.id == b.id).unwrap();
+        let model = models.model(beh).unwrap();
+        sum += b.syncs.iter().map(|s| s.1).sum::<f64>();
+        if let Flexibility::Stretchable { .. } = model.flexibility {
+            let phases: Vec<(f64, f64)> = b
+                .syncs
+                .windows(2)
+                .zip(model.keys.windows(2))
+                .map(|(t, k)| (t[1].1 - t[0].1, k[1].at - k[0].at))
+                .collect();
+            deviation += least_deviation(model.preferred_duration(), &phases);
+        }
+    }
+    (deviation, sum)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 600, ..ProptestConfig::default() })]
+
+    #[test]
+    fn the_fast_paths_give_the_linear_programs_optimum(
+        speeches in proptest::collection::vec(speech(), 1..4),
+        moves in proptest::collection::vec(motion(), 1..4),
+    ) {
+        let src = block(&speeches, &moves);
+        let parsed = bml::load(&src).unwrap().block;
+        let models = DefaultTimingModels::default();
+        let fast = Optimal.schedule(&parsed, &models, &NoExternal);
+        let lp = LinearProgram.schedule(&parsed, &models, &NoExternal);
+        let (fast, lp) = match (fast, lp) {
+            (Ok(f), Ok(l)) => (f, l),
+            (f, l) => {
+                prop_assert_eq!(f.is_ok(), l.is_ok(), "{}", src);
+                return Ok(());
+            }
+        };
+        let dropped = |s: &BlockSchedule| s.dropped.iter().map(|d| d.behaviour.to_string()).collect::<Vec<_>>();
+        prop_assert_eq!(dropped(&fast), dropped(&lp), "{}", src);
+        let (fd, fs) = objective(&src, &fast);
+        let (ld, ls) = objective(&src, &lp);
+        prop_assert!((fd - ld).abs() <= 1e-6 * (1.0 + ld), "deviation {} vs LP {}: {}", fd, ld, src);
+        prop_assert!((fs - ls).abs() <= 1e-5 * (1.0 + ls), "sum of times {} vs LP {}: {}", fs, ls, src);
+        for (f, l) in fast.behaviours.iter().zip(&lp.behaviours) {
+            for (a, b) in f.syncs.iter().zip(&l.syncs) {
+                prop_assert!((a.1 - b.1).abs() < 1e-5, "{}:{} {} vs LP {}: {}", f.id, a.0, a.1, b.1, src);
+            }
+        }
+    }
+}
+
+/// The block of the report: two chained speeches and a beat whose stroke phase spans them.
+#[test]
+fn a_beat_between_two_speeches_keeps_its_preparation_and_the_speech_starts_at_once() {
+    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b1">
+      <speech id="s2"><text>I am fine thank you <sync id="d"/>very much.</text></speech>
+      <speech id="s3" start="s2:end"><text>Goodbye <sync id="e"/>now.</text></speech>
+      <gesture id="g2" lexeme="BEAT" strokeStart="s2:d" stroke="s3:e"/>
+    </bml>"#;
+    let parsed = bml::load(src).unwrap().block;
+    let s = Optimal
+        .schedule(&parsed, &DefaultTimingModels::default(), &NoExternal)
+        .unwrap();
+    let time = |b: &str, k: &str| {
+        s.behaviours
+            .iter()
+            .find(|x| x.id == b)
+            .unwrap()
+            .time(k)
+            .unwrap()
+    };
+    assert_eq!(time("s2", "start"), 0.0);
+    let beat = time("g2", "end") - time("g2", "start");
+    assert!(beat < 3.0, "the beat lasts {beat} s");
+    // the preparation keeps its preferred length (0.3 s of 0.4 before strokeStart)
+    assert!((time("g2", "strokeStart") - time("g2", "start") - 0.4).abs() < 1e-9);
+}
