@@ -220,6 +220,24 @@ fn contradiction_drops_a_non_required_behaviour_and_names_the_constraints() {
 }
 
 #[test]
+fn a_drops_warning_names_the_constraints_of_other_behaviours_that_it_lifts() {
+    // h1 contradicts itself; g1 and p1 were tied to it and move freely once it is dropped
+    let s = schedule(&block(
+        r#"<head id="h1" lexeme="NOD" start="2" end="1"/>
+           <gesture id="g1" lexeme="BEAT" stroke="h1:stroke"/>
+           <gaze id="z1" target="t" start="0.5"/>
+           <constraint id="c1"><before ref="h1:end"><sync ref="z1:end"/></before></constraint>"#,
+    ));
+    assert_eq!(s.dropped.len(), 1);
+    let reason = &s.dropped[0].reason;
+    assert_eq!(s.dropped[0].behaviour, "h1");
+    assert!(reason.contains("g1:stroke = h1:stroke"), "{reason}");
+    assert!(reason.contains("z1:end <= h1:end"), "{reason}");
+    // its own attributes are the conflict, not something it lifts
+    assert!(!reason.contains("no longer hold: h1:start"), "{reason}");
+}
+
+#[test]
 fn contradiction_inside_required_fails_the_block() {
     let src = block(
         r#"<required><speech id="s1" start="1"><text>Hello world</text></speech>

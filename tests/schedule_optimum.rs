@@ -218,3 +218,23 @@ fn a_beat_between_two_speeches_keeps_its_preparation_and_the_speech_starts_at_on
     // the preparation keeps its preferred length (0.3 s of 0.4 before strokeStart)
     assert!((time("g2", "strokeStart") - time("g2", "start") - 0.4).abs() < 1e-9);
 }
+
+/// A gesture whose start and stroke are far apart prepares in at most its phase limit and holds
+/// before the stroke; its retraction is limited the same way when its end is far off.
+#[test]
+fn preparation_and_retraction_stay_within_their_limits_however_far_apart_the_keys() {
+    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b1">
+      <gesture id="g1" lexeme="BEAT" start="0" stroke="5" end="12"/>
+    </bml>"#;
+    let parsed = bml::load(src).unwrap().block;
+    for strategy in [&Optimal as &dyn SchedulingStrategy, &LinearProgram] {
+        let s = strategy
+            .schedule(&parsed, &DefaultTimingModels::default(), &NoExternal)
+            .unwrap();
+        let t = |k: &str| s.behaviours[0].time(k).unwrap();
+        assert_eq!((t("start"), t("stroke"), t("end")), (0.0, 5.0, 12.0));
+        let (preparation, retraction) = (t("ready") - t("start"), t("end") - t("relax"));
+        assert!(preparation <= 1.0 + 1e-9, "preparation {preparation} s");
+        assert!(retraction <= 1.0 + 1e-9, "retraction {retraction} s");
+    }
+}

@@ -18,7 +18,7 @@
 //! reference the `Optimal` strategy is measured and tested against.
 
 use super::diff::EPSILON;
-use super::links::{is_required, items, resolve_all, scheduled, Item, Link, Term};
+use super::links::{is_required, items, resolve_all, scheduled, with_lifted, Item, Link, Term};
 use super::strategy::{
     BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
 };
@@ -76,9 +76,14 @@ impl SchedulingStrategy for SortedGreedy {
                 None => dropped.push(Dropped {
                     behaviour: items[i].beh.id.clone(),
                     warning: KnownWarning::CannotSatisfyConstraints,
-                    reason: format!(
-                        "'{}' cannot be timed from the behaviours scheduled before it (sorted greedy)",
-                        items[i].beh.id
+                    reason: with_lifted(
+                        format!(
+                            "'{}' cannot be timed from the behaviours scheduled before it (sorted greedy)",
+                            items[i].beh.id
+                        ),
+                        &items[i].beh.id,
+                        block,
+                        &constraints,
                     ),
                 }),
             }

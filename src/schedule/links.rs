@@ -86,7 +86,12 @@ pub(crate) fn items<'b>(
             None => dropped.push(Dropped {
                 behaviour: beh.id.clone(),
                 warning: KnownWarning::BehaviorTypeNotSupported,
-                reason: format!("no engine realizes <{}>", beh.kind.element_name()),
+                reason: with_lifted(
+                    format!("no engine realizes <{}>", beh.kind.element_name()),
+                    &beh.id,
+                    block,
+                    constraints,
+                ),
             }),
         }
     }
@@ -232,6 +237,45 @@ pub(crate) fn scheduled(item: Item, times: &[f64], shift: f64) -> ScheduledBehav
     }
 }
 
+/// The behaviour a constraint side names within the block, if any.
+fn named<'a>(a: &'a Anchor, block: &str) -> Option<&'a str> {
+    match a {
+        Anchor::Point(SyncPoint::Local { behaviour, .. }) => Some(behaviour),
+        Anchor::Point(SyncPoint::External {
+            block: b,
+            behaviour,
+            ..
+        }) if *b == block => Some(behaviour),
+        _ => None,
+    }
+}
+
+/// `reason`, followed by the constraints between `id` and other behaviours: dropping `id` lifts
+/// them, and the behaviours they tied move freely (a drop's warning must say which).
+pub(crate) fn with_lifted(
+    reason: String,
+    id: &str,
+    block: &Block,
+    constraints: &[Constraint],
+) -> String {
+    let lifted: Vec<String> = constraints
+        .iter()
+        .filter(|c| {
+            let (l, r) = (named(&c.left, &block.id), named(&c.right, &block.id));
+            let other = |a: Option<&str>| a.is_some_and(|b| b != id);
+            (l == Some(id) && other(r)) || (r == Some(id) && other(l))
+        })
+        .map(|c| c.to_string())
+        .collect();
+    if lifted.is_empty() {
+        return reason;
+    }
+    format!(
+        "{reason}; these constraints of other behaviours on '{id}' no longer hold: {}",
+        lifted.join("; ")
+    )
+}
+
 /// Resolves the constraints, dropping each behaviour that names a sync it lacks or an unknown
 /// external time (the block fails if that behaviour is required).
 pub(crate) fn resolve_all(
@@ -249,10 +293,11 @@ pub(crate) fn resolve_all(
         if is_required(&items[i], constraints) {
             return Err(ScheduleError { reason });
         }
+        let id = &items[i].beh.id;
         dropped.push(Dropped {
-            behaviour: items[i].beh.id.clone(),
+            behaviour: id.clone(),
             warning,
-            reason,
+            reason: with_lifted(reason, id, block, constraints),
         });
         items.remove(i);
     }

@@ -27,7 +27,9 @@ use good_lp::{
 };
 
 use super::diff::{DiffSystem, EPSILON};
-use super::links::{is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
+use super::links::{
+    is_required, items, resolve_all, scheduled, with_lifted, IdIndex, Item, Link, Term,
+};
 use super::offsets::Offsets;
 use super::room::room;
 use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
@@ -104,7 +106,7 @@ fn schedule(
                 None => match feasible(&items, &links, &constraints) {
                     Ok(()) => optimise(&items, &links),
                     Err(involved) => {
-                        drop_one(&mut items, &involved, &constraints, &mut dropped)?;
+                        drop_one(block, &mut items, &involved, &constraints, &mut dropped)?;
                         continue;
                     }
                 },
@@ -136,6 +138,7 @@ fn schedule(
 /// own sync is the left side of its attributes; ties by id), or fails the block if only required
 /// behaviours are involved.
 fn drop_one(
+    block: &Block,
     items: &mut Vec<Item>,
     involved: &Involved,
     constraints: &[Constraint],
@@ -162,9 +165,14 @@ fn drop_one(
     dropped.push(Dropped {
         behaviour: items[i].beh.id.clone(),
         warning,
-        reason: format!(
-            "'{}' dropped: these constraints contradict each other: {text}",
-            items[i].beh.id
+        reason: with_lifted(
+            format!(
+                "'{}' dropped: these constraints contradict each other: {text}",
+                items[i].beh.id
+            ),
+            &items[i].beh.id,
+            block,
+            constraints,
         ),
     });
     items.remove(i);
