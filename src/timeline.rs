@@ -443,6 +443,7 @@ mod tests {
             global_time: t,
             character_id: None,
             posix_time: None,
+            skipped: false,
         })
     }
 

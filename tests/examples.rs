@@ -93,7 +93,10 @@ fn interrupted_speech() {
     assert_eq!(sync(&fb, "talk:speech1:end"), 1.5);
     assert_eq!(sync(&fb, "talk:nod1:relax"), 1.5);
     assert_eq!(ms(sync(&fb, "talk:nod1:end")), 2.083);
-    assert_eq!(block(&fb, "talk", "end"), (2.083, Some(BlockStatus::Done)));
+    assert_eq!(
+        block(&fb, "talk", "end"),
+        (2.083, Some(BlockStatus::Interrupted))
+    );
 }
 
 #[test]

@@ -53,6 +53,7 @@ fn messages() -> Vec<Feedback> {
             global_time: 12.3456,
             character_id: None,
             posix_time: Some(1_700_000_003_120),
+            skipped: false,
         }),
         Feedback::Warning(WarningFeedback {
             id: "bml1:gaze2".into(),

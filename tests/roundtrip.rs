@@ -461,10 +461,11 @@ fn feedback() -> impl Strategy<Value = Feedback> {
             time(),
             time(),
             chr(),
-            option::of(any::<u64>())
+            option::of(any::<u64>()),
+            any::<bool>()
         )
             .prop_map(
-                |(block, behaviour, sync, time, global_time, character_id, posix_time)| {
+                |(block, behaviour, sync, time, global_time, character_id, posix_time, skipped)| {
                     Feedback::SyncPointProgress(SyncPointProgress {
                         block: block.into(),
                         behaviour: behaviour.into(),
@@ -473,6 +474,7 @@ fn feedback() -> impl Strategy<Value = Feedback> {
                         global_time,
                         character_id,
                         posix_time,
+                        skipped,
                     })
                 }
             ),

@@ -997,3 +997,80 @@ fn a_block_tied_to_a_sync_that_just_passed_starts_at_it() {
         [("bml2:pvc1".into(), "CANNOT_SATISFY_CONSTRAINTS".into())]
     );
 }
+
+/// A REPLACE block removes a queued APPEND block before it starts: the queued block ends REVOKED
+/// and never reports a start; the running one ends INTERRUPTED.
+#[test]
+fn replace_revokes_a_queued_block_without_starting_it() {
+    let mut s = Session::new();
+    s.send(0.0, &block("a", "", &speech("s1", 15, None, "")));
+    s.send(
+        0.5,
+        &block("b", r#"composition="APPEND""#, &speech("s1", 2, None, "")),
+    );
+    s.send(
+        1.0,
+        &block("c", r#"composition="REPLACE""#, &speech("s1", 2, None, "")),
+    );
+    s.finish();
+    let progress = s.progress();
+    let of = |b: &str| -> Vec<(String, Option<BlockStatus>)> {
+        progress
+            .iter()
+            .filter(|p| p.0 == b)
+            .map(|p| (p.1.clone(), p.3))
+            .collect()
+    };
+    assert_eq!(of("b"), [("end".to_string(), Some(BlockStatus::Revoked))]);
+    assert_eq!(
+        of("a")[1],
+        ("end".to_string(), Some(BlockStatus::Interrupted))
+    );
+    assert!(!s.has_sync("b", "s1"));
+}
+
+/// A `<bmla:interrupt>` behaviour that cuts a running block's speech ends that block
+/// INTERRUPTED, and the syncs the speech never reached are marked skipped; those it reached are
+/// not.
+#[test]
+fn an_interrupt_behaviour_ends_its_target_interrupted_with_skipped_syncs_marked() {
+    let mut s = Session::new();
+    s.send(
+        0.0,
+        &block("a", "", &speech("s1", 15, Some(("late", 10)), "")),
+    );
+    s.send(
+        1.0,
+        &block(
+            "b",
+            "",
+            r#"<bmla:interrupt id="i1" target="a" include="s1"/>"#,
+        ),
+    );
+    s.finish();
+    let end = s
+        .progress()
+        .into_iter()
+        .find(|p| p.0 == "a" && p.1 == "end")
+        .unwrap();
+    assert_eq!(end.3, Some(BlockStatus::Interrupted));
+    let skipped: Vec<(String, bool)> = s
+        .fb()
+        .iter()
+        .filter_map(|f| match f {
+            Feedback::SyncPointProgress(p) if p.block == "a" => {
+                Some((p.sync.to_string(), p.skipped))
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        skipped,
+        [
+            ("start".to_string(), false),
+            ("late".to_string(), true),
+            ("end".to_string(), false)
+        ]
+    );
+    assert!((s.at("a:s1:late") - 1.0).abs() < 1e-9);
+}

@@ -41,6 +41,9 @@ pub(crate) struct LiveBehaviour {
     pub(crate) phase: Phase,
     /// Internal timing fixed (speech): once started, it no longer follows its pegs.
     pub(crate) rigid: bool,
+    /// Syncs before this index that are still ahead were cut by an interrupt: they are reported
+    /// as skipped when their (moved) time comes.
+    pub(crate) skip_before: usize,
 }
 
 impl LiveBehaviour {
@@ -73,6 +76,17 @@ impl LiveBehaviour {
         }
     }
 
+    /// After an interrupt moved the syncs still ahead: those before the retraction (`relax`, or
+    /// `end` for a behaviour without one) will never be reached as planned.
+    pub(crate) fn cut_before_retraction(&mut self) {
+        let relax = self.syncs.iter().position(|(n, _)| n == "relax");
+        self.skip_before = match relax {
+            Some(r) if r >= self.next => r,
+            Some(_) => self.next,
+            None => self.syncs.len().saturating_sub(1),
+        };
+    }
+
     fn passed_relax(&self) -> bool {
         match self.syncs.iter().position(|(n, _)| n == "relax") {
             Some(r) => self.next > r,
@@ -102,6 +116,8 @@ pub(crate) struct LiveBlock {
     /// The block's own peg board, for blocks tied to anticipators: moving an anticipator's peg
     /// retimes what hangs on it (S56). Boxed: few blocks have one, and every block is kept.
     pub(crate) pegs: Option<Box<BlockPegs>>,
+    /// An interrupt behaviour cut some of its behaviours: it ends INTERRUPTED, not DONE.
+    pub(crate) cut: bool,
 }
 
 /// A block on its own peg board (only blocks that refer to anticipators have one).
@@ -180,6 +196,7 @@ impl LiveBlock {
             chunk_after,
             preplan: false,
             pegs: None,
+            cut: false,
         }
     }
 
@@ -206,6 +223,7 @@ impl LiveBlock {
                 next: 0,
                 phase: Phase::Planned,
                 rigid: s.rigid,
+                skip_before: 0,
             });
         }
     }

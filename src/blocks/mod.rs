@@ -68,6 +68,9 @@ pub struct BlockManager {
     index: HashMap<bml::Id, u64>,
     /// How many blocks are LURKING (nothing to check when none is).
     lurking: usize,
+    /// While a block's interrupts and REPLACE remove other blocks, nothing waiting starts (a
+    /// queued block that is about to be removed must not start first).
+    hold_starts: bool,
     finished: VecDeque<bml::Id>,
     finished_set: HashSet<bml::Id>,
     changes: Vec<ParameterChange>,
@@ -143,6 +146,7 @@ impl BlockManager {
             seqs: Vec::new(),
             index: HashMap::default(),
             lurking: 0,
+            hold_starts: false,
             finished: VecDeque::new(),
             finished_set: HashSet::default(),
             changes: Vec::new(),
@@ -379,17 +383,20 @@ impl BlockManager {
             return;
         }
         self.parse_warnings(&block, warnings);
-        // S25: blocks named in bmla:interrupt leave the plan first
+        // blocks named in bmla:interrupt leave the plan first, then REPLACE removes everything;
+        // what waited for them starts only once all of them are gone
+        self.hold_starts = true;
         for target in &block.ext.interrupt {
             self.interrupt_block_by_id(target, now, &block.id);
         }
-        // S35: REPLACE removes everything
         if block.composition == bml::Composition::Replace {
             let ids: Vec<bml::Id> = self.blocks.iter().map(|b| b.id.clone()).collect();
             for id in ids {
                 self.interrupt_block_by_id(&id, now, &block.id);
             }
         }
+        self.hold_starts = false;
+        self.start_ready(now);
         // S36, S37: blocks this one waits for
         let mut waits_for: Vec<bml::Id> = match &block.composition {
             bml::Composition::Append => self
@@ -628,7 +635,7 @@ impl BlockManager {
     /// Starts every LURKING block that is ready, at `t`, until none is left (a start can end a
     /// block at once, which can make others ready).
     fn start_ready(&mut self, t: f64) {
-        while self.lurking > 0 {
+        while self.lurking > 0 && !self.hold_starts {
             let next = (0..self.blocks.len())
                 .find(|&i| self.blocks[i].status == BlockStatus::Lurking && self.ready(i));
             match next {
@@ -766,7 +773,12 @@ impl BlockManager {
         if !self.blocks[i].all_ended() {
             return false;
         }
-        self.end_block(i, t, BlockStatus::Done);
+        let status = if self.blocks[i].cut {
+            BlockStatus::Interrupted
+        } else {
+            BlockStatus::Done
+        };
+        self.end_block(i, t, status);
         true
     }
 
@@ -844,8 +856,10 @@ impl BlockManager {
                 x.phase = Phase::Ended;
             }
         }
+        // every sync still ahead is cut; the behaviour ends now
         for (beh, sync) in reports {
-            self.sync_feedback(&id, &beh, &sync, t - start, t);
+            let skipped = sync != "end";
+            self.sync_feedback(&id, &beh, &sync, t - start, t, skipped);
         }
         self.end_block(i, t, BlockStatus::Interrupted);
     }
@@ -860,7 +874,9 @@ impl BlockManager {
             .registry
             .engine_mut(x.engine)
             .interrupt(&key, t, &x.global(start));
-        self.blocks[bi].behaviours[xi].retime(&times, start, t);
+        let x = &mut self.blocks[bi].behaviours[xi];
+        x.retime(&times, start, t);
+        x.cut_before_retraction();
     }
 
     /// Interrupts behaviours of block `target` at `t` (a BMLA interrupt behaviour): a behaviour
@@ -893,6 +909,12 @@ impl BlockManager {
             if !selected {
                 continue;
             }
+            // a running block that loses behaviours this way was cut short
+            let cut = matches!(x.phase, Phase::Planned | Phase::Added | Phase::Running);
+            if cut && self.blocks[i].started() {
+                self.blocks[i].cut = true;
+            }
+            let x = &self.blocks[i].behaviours[xi];
             match x.phase {
                 Phase::Planned => self.blocks[i].behaviours[xi].phase = Phase::Removed,
                 Phase::Added => {
@@ -962,6 +984,7 @@ impl BlockManager {
         sync: &bml::Id,
         local: f64,
         t: f64,
+        skipped: bool,
     ) {
         let character_id = self.character.clone();
         self.emit(Feedback::SyncPointProgress(SyncPointProgress {
@@ -972,6 +995,7 @@ impl BlockManager {
             global_time: t,
             character_id,
             posix_time: None,
+            skipped,
         }));
     }
 
@@ -1053,10 +1077,11 @@ impl BlockManager {
     }
 
     fn pass_sync(&mut self, bi: usize, xi: usize, t: f64) {
-        let (block_id, beh_id, sync, local, engine, last) = {
+        let (block_id, beh_id, sync, local, engine, last, skipped) = {
             let b = &mut self.blocks[bi];
             let x = &mut b.behaviours[xi];
             let (name, local) = x.syncs[x.next].clone();
+            let skipped = x.next < x.skip_before;
             x.next += 1;
             x.phase = Phase::Running;
             (
@@ -1066,9 +1091,10 @@ impl BlockManager {
                 local,
                 x.engine,
                 x.next == x.syncs.len(),
+                skipped,
             )
         };
-        self.sync_feedback(&block_id, &beh_id, &sync, local, t);
+        self.sync_feedback(&block_id, &beh_id, &sync, local, t, skipped);
         let key = UnitKey::new(block_id.clone(), beh_id.clone());
         let mut actions = Vec::new();
         self.registry

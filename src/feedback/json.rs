@@ -45,6 +45,9 @@ fn to_value(fb: &Feedback) -> Value {
                 s.character_id.as_ref().map(|c| json!(c)),
             );
             put_opt(&mut m, "bmla:posixTime", s.posix_time.map(|p| json!(p)));
+            if s.skipped {
+                m.insert("bmla:skipped".into(), json!(true));
+            }
         }
         Feedback::Prediction(p) => {
             put_opt(
@@ -202,6 +205,7 @@ pub fn from_json(line: &str) -> Result<Feedback, FeedbackError> {
                 global_time: num_of(m, "globalTime")?,
                 character_id,
                 posix_time: opt_posix(m)?,
+                skipped: m.get("bmla:skipped") == Some(&Value::Bool(true)),
             }))
         }
         "warningFeedback" => Ok(Feedback::Warning(WarningFeedback {

@@ -148,6 +148,9 @@ pub struct SyncPointProgress {
     pub character_id: Option<String>,
     /// BMLA wall-clock time, ms since the Unix epoch.
     pub posix_time: Option<u64>,
+    /// The behaviour never reached this sync point: it was interrupted (or its block was) before
+    /// it, and the point is reported at the moment of the interruption (`bmla:skipped="true"`).
+    pub skipped: bool,
 }
 
 /// A `<bml id globalStart globalEnd bmla:status>` child of a prediction.

@@ -49,7 +49,11 @@ pub fn to_xml(fb: &Feedback) -> String {
             o.push_str("/>");
         }
         Feedback::SyncPointProgress(s) => {
-            open(&mut o, "syncPointProgress", s.posix_time.is_some());
+            open(
+                &mut o,
+                "syncPointProgress",
+                s.posix_time.is_some() || s.skipped,
+            );
             attr(
                 &mut o,
                 "id",
@@ -62,6 +66,9 @@ pub fn to_xml(fb: &Feedback) -> String {
             }
             if let Some(p) = s.posix_time {
                 attr(&mut o, "bmla:posixTime", &p.to_string());
+            }
+            if s.skipped {
+                attr(&mut o, "bmla:skipped", "true");
             }
             o.push_str("/>");
         }
@@ -243,6 +250,7 @@ pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
                     global_time: num(req(&a, "globalTime", &name)?, "globalTime")?,
                     character_id,
                     posix_time: posix(&a, "posixTime")?,
+                    skipped: get(&a, true, "skipped").is_some_and(|v| v.trim() == "true"),
                 }))
             }
             "warningFeedback" => {
