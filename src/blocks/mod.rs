@@ -666,7 +666,7 @@ impl BlockManager {
         let id = b.id.clone();
         self.progress(&id, "start", t, BlockStatus::InExec);
         // hand every unit to its engine
-        let mut failed = Vec::new();
+        let (mut failed, mut moves_nothing) = (Vec::new(), Vec::new());
         {
             let b = &mut self.blocks[i];
             for x in b
@@ -681,8 +681,14 @@ impl BlockManager {
                     syncs: x.global(t),
                     world: &self.world,
                 };
+                let unanimated = self.registry.engine(x.engine).unanimated(unit.behaviour);
                 match self.registry.engine_mut(x.engine).add(unit) {
-                    Ok(()) => x.phase = Phase::Added,
+                    Ok(()) => {
+                        x.phase = Phase::Added;
+                        if let Some(why) = unanimated {
+                            moves_nothing.push((x.id.clone(), why));
+                        }
+                    }
                     Err(e) => {
                         x.phase = Phase::Removed;
                         failed.push((x.id.clone(), e.to_string()));
@@ -694,6 +700,13 @@ impl BlockManager {
             self.warn(
                 format!("{id}:{beh}"),
                 KnownWarning::ExecutionFailure,
+                reason,
+            );
+        }
+        for (beh, reason) in moves_nothing {
+            self.warn(
+                format!("{id}:{beh}"),
+                KnownWarning::LexemeNotSupported,
                 reason,
             );
         }

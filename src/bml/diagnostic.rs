@@ -195,6 +195,9 @@ pub enum Code {
     UnsupportedAttribute,
     /// A lexeme outside the vocabulary of the BML 1.0 standard (accepted; engines may not know it).
     UnknownLexeme,
+    /// Constraints that no timing can satisfy together (a cycle such as `a:start = b:end` with
+    /// `b:start = a:end`): the realizer would drop a behaviour or refuse the block.
+    ContradictoryConstraints,
 }
 
 impl Code {
@@ -224,6 +227,7 @@ impl Code {
             Code::UnsupportedExtension => "unsupported-extension",
             Code::UnsupportedAttribute => "unsupported-attribute",
             Code::UnknownLexeme => "unknown-lexeme",
+            Code::ContradictoryConstraints => "contradictory-constraints",
         }
     }
 }

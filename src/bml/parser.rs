@@ -531,11 +531,13 @@ impl<'i> Parser<'i> {
                 }
             }
         };
-        if root.name != "bml" || !root.ns.is_core() {
-            let ns = if root.ns.is_core() {
-                String::new()
-            } else {
-                format!(" in namespace {}", root.ns.uri())
+        // the root must be in the BML 1.0 namespace (as the schema says); elements inside it
+        // without a prefix are in it too
+        if root.name != "bml" || !matches!(root.ns, Ns::Bml) {
+            let ns = match root.ns {
+                Ns::Bml => String::new(),
+                Ns::None => format!(" in no namespace (add xmlns=\"{NS_BML}\")"),
+                _ => format!(" in namespace {}", root.ns.uri()),
             };
             self.error(
                 Code::WrongRoot,
@@ -1010,6 +1012,42 @@ impl<'i> Parser<'i> {
         out
     }
 
+    /// A `<lexeme lexeme amount>` child of `<face>` or `<faceShift>` (the BML 1.0 standard's
+    /// child form): its values go into `kind`, unless the behaviour has a lexeme already.
+    fn face_lexeme_child(
+        &mut self,
+        c: &mut El<'i>,
+        kind: &mut BehaviourKind,
+        on: &dyn fmt::Display,
+    ) -> Result<(), Fatal> {
+        let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
+        let lexeme = self.req_str(&mut attrs, "lexeme", &"<lexeme>", c.offset);
+        let amount = self.opt_f64(&mut attrs, "amount");
+        let _ = self.leftover_attrs(attrs, &"<lexeme>");
+        let taken = match kind {
+            BehaviourKind::Face(f) if f.lexeme.is_none() && f.au.is_none() => {
+                f.lexeme = lexeme;
+                f.amount = amount.or(f.amount);
+                true
+            }
+            BehaviourKind::FaceShift(f) if f.lexeme.is_empty() => {
+                f.lexeme = lexeme.unwrap_or_default();
+                f.amount = amount.or(f.amount);
+                true
+            }
+            _ => false,
+        };
+        if !taken {
+            self.error(
+                Code::UnknownElement,
+                c.offset,
+                format!("{on} has its lexeme already; a <lexeme> child is one too many"),
+            );
+        }
+        self.skip(c)?;
+        Ok(())
+    }
+
     /// Reads the children of a known behaviour into `kind`; returns its descriptions.
     fn behaviour_children(
         &mut self,
@@ -1125,6 +1163,9 @@ impl<'i> Parser<'i> {
                     }
                     p.skip(&c)?;
                 }
+                (BehaviourKind::Face(_) | BehaviourKind::FaceShift(_), "lexeme") if core => {
+                    p.face_lexeme_child(&mut c, kind, on)?;
+                }
                 (BehaviourKind::ParameterValueChange(pvc), "trajectory")
                     if c.ns.is_ext() || c.ns == Ns::None =>
                 {
@@ -1235,6 +1276,20 @@ impl<'i> Parser<'i> {
                     format!("{on} has no <stance> child"),
                 );
             }
+            BehaviourKind::Face(Face {
+                lexeme: None,
+                au: None,
+                ..
+            }) => self.error(
+                Code::MissingAttribute,
+                el.offset,
+                format!("{on} needs a lexeme or an au attribute, or a <lexeme> child"),
+            ),
+            BehaviourKind::FaceShift(f) if f.lexeme.is_empty() => self.error(
+                Code::MissingAttribute,
+                el.offset,
+                format!("{on} needs a lexeme attribute or a <lexeme> child"),
+            ),
             BehaviourKind::ParameterValueChange(_) if !saw_trajectory => {
                 self.error(
                     Code::MissingElement,
@@ -1546,14 +1601,7 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
                     self.p
                         .opt_enum(self.attrs, "side", self.on, Side::parse, Side::expected);
                 let amount = self.f64("amount");
-                if lexeme.is_none() && au.is_none() {
-                    self.p.error(
-                        Code::MissingAttribute,
-                        self.el.offset,
-                        format!("{} needs a lexeme or an au attribute", self.on),
-                    );
-                    return None;
-                }
+                // without lexeme and au, a <lexeme> child must give them (checked after it)
                 BehaviourKind::Face(Face {
                     lexeme,
                     au,
@@ -1562,7 +1610,11 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
                 })
             }
             "faceLexeme" => BehaviourKind::FaceLexeme(self.face_lexeme()?),
-            "faceShift" => BehaviourKind::FaceShift(self.face_lexeme()?),
+            // the lexeme may come from a <lexeme> child instead (checked after the children)
+            "faceShift" => BehaviourKind::FaceShift(FaceLexeme {
+                lexeme: self.opt("lexeme").unwrap_or_default(),
+                amount: self.f64("amount"),
+            }),
             "faceFacs" => {
                 let au = match self
                     .attrs

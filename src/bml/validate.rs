@@ -64,7 +64,7 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
                 diags.push(Diagnostic::warning(Code::UnknownLexeme, b.pos, format!("head lexeme '{}' of '{}' is not a BML 1.0 lexeme (NOD, SHAKE); it is realized only if a binding defines it", h.lexeme, b.id)));
             }
             BehaviourKind::FaceLexeme(f) | BehaviourKind::FaceShift(f)
-                if !FACE_LEXEMES.contains(&f.lexeme.as_str()) =>
+                if !f.lexeme.is_empty() && !FACE_LEXEMES.contains(&f.lexeme.as_str()) =>
             {
                 diags.push(Diagnostic::warning(Code::UnknownLexeme, b.pos, format!("face lexeme '{}' of '{}' is not a BML 1.0 lexeme; it is realized only if a binding defines it", f.lexeme, b.id)));
             }

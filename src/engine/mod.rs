@@ -291,6 +291,13 @@ pub trait Engine {
         false
     }
 
+    /// Why this engine plays `behaviour` with its timing only, moving nothing (a lexeme no
+    /// binding defines, say), or `None` if it moves the body. The runtime warns
+    /// (LEXEME_NOT_SUPPORTED) once when such a behaviour starts, and `bmlr validate` warns too.
+    fn unanimated(&self, _behaviour: &Behaviour) -> Option<String> {
+        None
+    }
+
     /// Takes a scheduled unit into the engine's plan.
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError>;
 

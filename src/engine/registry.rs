@@ -94,6 +94,12 @@ impl Registry {
         self.engines[i].as_ref()
     }
 
+    /// Why the engine of `behaviour` would move nothing for it (see [`Engine::unanimated`]).
+    pub fn unanimated(&self, behaviour: &Behaviour) -> Option<String> {
+        self.engine(self.engine_for(behaviour)?)
+            .unanimated(behaviour)
+    }
+
     /// Engine `i`, mutably.
     pub fn engine_mut(&mut self, i: usize) -> &mut dyn Engine {
         self.engines[i].as_mut()

@@ -11,6 +11,7 @@ use super::gesture::Lexicon;
 use super::head::HeadLexicon;
 use super::posture::PoseBindings;
 use super::procedural::Library;
+use crate::body::Skeleton;
 
 /// The data of the motion engines.
 #[derive(Debug, Clone)]
@@ -54,13 +55,34 @@ impl Assets {
             Ok(Some((path.display().to_string(), text)))
         };
         let mut assets = Assets::default();
+        let skeleton = Skeleton::adult();
+        let unknown = |path: &str, what: String, joint: &str| {
+            format!(
+                "{path}: {what} names joint '{joint}', which the skeleton does not have (H-Anim \
+                 names such as r_shoulder, r_elbow, r_wrist, vc4, skullbase)"
+            )
+        };
         if let Some((path, text)) = read("units.json")? {
             let units = Library::from_json(&text).map_err(|e| format!("{path}: {e}"))?;
+            let mut names: Vec<(&str, &str)> = units
+                .units()
+                .flat_map(|u| u.joint_names().map(move |j| (u.name.as_str(), j)))
+                .collect();
+            names.sort_unstable();
+            if let Some((unit, joint)) = names.iter().find(|(_, j)| skeleton.joint(j).is_none()) {
+                return Err(unknown(&path, format!("unit '{unit}'"), joint));
+            }
             assets.units = assets.units.extended(units);
         }
         if let Some((path, text)) = read("gestures.json")? {
             let first =
                 Lexicon::from_json(&text, &assets.units).map_err(|e| format!("{path}: {e}"))?;
+            let bad = first
+                .key_joints()
+                .find(|(_, j)| skeleton.joint(j).is_none());
+            if let Some((lexeme, joint)) = bad {
+                return Err(unknown(&path, format!("the binding of '{lexeme}'"), joint));
+            }
             assets.gestures = assets.gestures.extended_by(first);
         }
         if let Some((path, text)) = read("poses.json")? {
@@ -73,5 +95,24 @@ impl Assets {
             assets.heads = assets.heads.extended_by(first);
         }
         Ok(assets)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The embedded data passes the check a directory's data must pass.
+    #[test]
+    fn the_embedded_units_and_bindings_name_only_joints_of_the_skeleton() {
+        let (assets, skeleton) = (Assets::default(), Skeleton::adult());
+        let units: Vec<&str> = assets.units.units().flat_map(|u| u.joint_names()).collect();
+        assert!(units.len() > 10, "{units:?}");
+        for j in units {
+            assert!(skeleton.joint(j).is_some(), "{j}");
+        }
+        for (lexeme, j) in assets.gestures.key_joints() {
+            assert!(skeleton.joint(j).is_some(), "{lexeme}: {j}");
+        }
     }
 }

@@ -167,6 +167,32 @@ impl Lexicon {
             .map(|b| &b.bound)
     }
 
+    /// The joints that the bindings' keys rotate (procedural units not included).
+    pub fn key_joints(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.bindings.iter().flat_map(|b| {
+            let keys: &[(String, Vec<(String, Quat)>)] = match &b.bound {
+                Bound::Keys(k) => k,
+                Bound::Procedural(..) => &[],
+            };
+            keys.iter().flat_map(move |(_, joints)| {
+                joints
+                    .iter()
+                    .map(move |(j, _)| (b.lexeme.as_str(), j.as_str()))
+            })
+        })
+    }
+
+    /// The lexemes some binding names, in order, once each.
+    pub fn lexemes(&self) -> Vec<&str> {
+        let mut out: Vec<&str> = Vec::new();
+        for b in &self.bindings {
+            if !out.contains(&b.lexeme.as_str()) {
+                out.push(&b.lexeme);
+            }
+        }
+        out
+    }
+
     /// Whether some binding filters on the extension attribute `name`.
     fn filters_on(&self, name: &str) -> bool {
         self.bindings
@@ -363,6 +389,21 @@ impl Engine for GestureEngine {
 
     fn interprets(&self, _ns: &str, name: &str) -> bool {
         self.lexicon.filters_on(name)
+    }
+
+    fn unanimated(&self, behaviour: &Behaviour) -> Option<String> {
+        let BehaviourKind::Gesture(g) = &behaviour.kind else {
+            return None;
+        };
+        self.lexicon.find(behaviour).is_none().then(|| {
+            format!(
+                "gesture '{}': no binding moves lexeme '{}'{}; it plays its timing only (bound: {})",
+                behaviour.id,
+                g.lexeme,
+                g.mode.map_or(String::new(), |m| format!(" with mode {}", m.as_str())),
+                self.lexicon.lexemes().join(", ")
+            )
+        })
     }
 
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {

@@ -102,6 +102,11 @@ impl HeadLexicon {
     pub fn get(&self, lexeme: &str) -> Option<Motion> {
         self.motions.iter().find(|m| m.0 == lexeme).map(|m| m.1)
     }
+
+    /// The bound lexemes, in order.
+    pub fn lexemes(&self) -> Vec<&str> {
+        self.motions.iter().map(|m| m.0.as_str()).collect()
+    }
 }
 
 /// One head unit: its motion (none for a lexeme this engine does not know: timing only),
@@ -208,6 +213,20 @@ impl Engine for HeadEngine {
 
     fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
         &["head"]
+    }
+
+    fn unanimated(&self, behaviour: &Behaviour) -> Option<String> {
+        let BehaviourKind::Head(h) = &behaviour.kind else {
+            return None;
+        };
+        self.lexicon.get(&h.lexeme).is_none().then(|| {
+            format!(
+                "head '{}': no binding moves lexeme '{}'; it plays its timing only (bound: {})",
+                behaviour.id,
+                h.lexeme,
+                self.lexicon.lexemes().join(", ")
+            )
+        })
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {

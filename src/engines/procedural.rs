@@ -232,6 +232,12 @@ fn three_exprs(v: &serde_json::Value, what: &str) -> Result<[Expr; 3], String> {
 }
 
 impl ProcUnit {
+    /// The joints the unit rotates or moves an end effector of.
+    pub fn joint_names(&self) -> impl Iterator<Item = &str> {
+        let rotated = self.rotations.iter().map(|(j, _)| j.as_str());
+        rotated.chain(self.effectors.iter().map(|e| e.joint.as_str()))
+    }
+
     fn from_json(name: &str, v: &serde_json::Value) -> Result<ProcUnit, String> {
         let at = |what: &str| format!("unit '{name}': {what}");
         let mut params = Vec::new();
@@ -624,6 +630,11 @@ impl Library {
     pub fn extended(mut self, other: Library) -> Library {
         self.units.extend(other.units);
         self
+    }
+
+    /// Every unit, in no particular order.
+    pub fn units(&self) -> impl Iterator<Item = &Arc<ProcUnit>> {
+        self.units.values()
     }
 
     /// The unit called `name`.

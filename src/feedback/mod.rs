@@ -90,6 +90,8 @@ constants!(
         InvalidTiming = "INVALID_TIMING",
         /// An engine failed while executing.
         ExecutionFailure = "EXECUTION_FAILURE",
+        /// The behaviour plays its timing, but no binding of its lexeme moves anything.
+        LexemeNotSupported = "LEXEME_NOT_SUPPORTED",
     }
 );
 

@@ -44,9 +44,8 @@ impl SchedulingStrategy for SortedGreedy {
         let constraints = extract(block);
         if let Some(c) = constraints.iter().find(|c| c.relation != Relation::At) {
             return Err(ScheduleError {
-                reason: format!(
-                    "'{c}': the sorted greedy strategy supports only at-constraints (S47)"
-                ),
+                reason: format!("'{c}': the sorted greedy strategy supports only at-constraints"),
+                contradiction: false,
             });
         }
         let mut dropped = Vec::new();
@@ -71,6 +70,7 @@ impl SchedulingStrategy for SortedGreedy {
                 None if is_required(&items[i], &constraints) => {
                     return Err(ScheduleError {
                         reason: format!("required '{}' cannot be timed from the behaviours before it", items[i].beh.id),
+                        contradiction: true,
                     });
                 }
                 None => dropped.push(Dropped {
@@ -85,6 +85,7 @@ impl SchedulingStrategy for SortedGreedy {
                         block,
                         &constraints,
                     ),
+                    contradiction: true,
                 }),
             }
         }

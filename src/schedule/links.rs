@@ -5,7 +5,7 @@ use smallvec::SmallVec;
 
 use super::room::room;
 use super::strategy::{Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour};
-use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, SyncPoint};
+use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, Source, SyncPoint};
 use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
 use crate::feedback::KnownWarning;
 
@@ -66,6 +66,7 @@ pub(crate) fn items<'b>(
                     "the engine's timing model for '{}' is invalid: {why}",
                     beh.id
                 ),
+                contradiction: false,
             }),
             Some((model, Ok(()))) => {
                 // a persistent behaviour has no end unless a constraint names it
@@ -92,6 +93,7 @@ pub(crate) fn items<'b>(
                     block,
                     constraints,
                 ),
+                contradiction: false,
             }),
         }
     }
@@ -250,8 +252,10 @@ fn named<'a>(a: &'a Anchor, block: &str) -> Option<&'a str> {
     }
 }
 
-/// `reason`, followed by the constraints between `id` and other behaviours: dropping `id` lifts
-/// them, and the behaviours they tied move freely (a drop's warning must say which).
+/// `reason`, followed by the constraints of other behaviours that refer to `id` (their sync
+/// attributes, and `<constraint>` elements between `id` and another behaviour) and that `reason`
+/// does not name already: dropping `id` lifts them, and the behaviours they tied move freely (a
+/// drop's warning must say which).
 pub(crate) fn with_lifted(
     reason: String,
     id: &str,
@@ -263,9 +267,15 @@ pub(crate) fn with_lifted(
         .filter(|c| {
             let (l, r) = (named(&c.left, &block.id), named(&c.right, &block.id));
             let other = |a: Option<&str>| a.is_some_and(|b| b != id);
-            (l == Some(id) && other(r)) || (r == Some(id) && other(l))
+            match c.source {
+                Source::Attribute { .. } => other(l) && r == Some(id),
+                Source::Element { .. } => {
+                    (l == Some(id) && other(r)) || (r == Some(id) && other(l))
+                }
+            }
         })
         .map(|c| c.to_string())
+        .filter(|c| !reason.contains(c.as_str()))
         .collect();
     if lifted.is_empty() {
         return reason;
@@ -291,13 +301,17 @@ pub(crate) fn resolve_all(
             return Ok(links);
         };
         if is_required(&items[i], constraints) {
-            return Err(ScheduleError { reason });
+            return Err(ScheduleError {
+                reason,
+                contradiction: false,
+            });
         }
         let id = &items[i].beh.id;
         dropped.push(Dropped {
             behaviour: id.clone(),
             warning,
             reason: with_lifted(reason, id, block, constraints),
+            contradiction: false,
         });
         items.remove(i);
     }

@@ -4,8 +4,10 @@
 //! - [`optimal`]: the default, order-invariant strategy;
 //! - [`greedy`]: Elckerlyc's sorted greedy algorithm, the baseline;
 //! - [`diff`]: the difference-constraint solver under it;
+//! - [`check`]: what the scheduler would refuse, as diagnostics (`bmlr validate`);
 //! - [`to_pegs`]: a schedule put on the peg board, and validity after run-time changes.
 
+pub mod check;
 pub mod diff;
 pub mod greedy;
 mod links;

@@ -154,9 +154,10 @@ fn drop_one(
     let Some(i) = candidate else {
         return Err(ScheduleError {
             reason: format!("required behaviours cannot satisfy: {text}"),
+            contradiction: true,
         });
     };
-    // S58/A58: constraints that would stretch a behaviour beyond its bounds make its timing invalid
+    // constraints that would stretch a behaviour beyond its bounds make its timing invalid
     let warning = if involved.bounded.contains(&i) {
         KnownWarning::InvalidTiming
     } else {
@@ -174,6 +175,7 @@ fn drop_one(
             block,
             constraints,
         ),
+        contradiction: true,
     });
     items.remove(i);
     Ok(())

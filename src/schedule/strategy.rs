@@ -68,6 +68,9 @@ pub struct Dropped {
     pub warning: KnownWarning,
     /// Explanation, naming the constraints involved.
     pub reason: String,
+    /// Whether it was dropped because constraints contradict each other (rather than for an
+    /// unknown kind, sync point or external time).
+    pub contradiction: bool,
 }
 
 /// The schedule of one block.
@@ -97,4 +100,7 @@ impl BlockSchedule {
 pub struct ScheduleError {
     /// Why, naming the constraints involved.
     pub reason: String,
+    /// Whether required behaviours' constraints contradict each other (rather than a reference
+    /// that cannot be resolved).
+    pub contradiction: bool,
 }

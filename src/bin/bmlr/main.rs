@@ -8,7 +8,10 @@ mod tcp;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use bml_realizer::bml::{self, Severity};
+use bml_realizer::bml::{self, Diagnostic, Severity};
+use bml_realizer::engine::timing::DefaultTimingModels;
+use bml_realizer::engine::Registry;
+use bml_realizer::schedule::check::timing_diagnostics;
 use clap::{Parser, Subcommand};
 
 /// The BML realizer command line.
@@ -61,7 +64,27 @@ fn main() -> ExitCode {
     }
 }
 
+/// Warnings for the behaviours that the built-in engines would play with their timing only (a
+/// lexeme no binding defines), where the language check has not warned about the lexeme already.
+fn unanimated(block: &bml::Block, models: &Registry, diags: &[Diagnostic]) -> Vec<Diagnostic> {
+    block
+        .behaviours
+        .iter()
+        .filter(|b| {
+            !diags.iter().any(|d| {
+                d.code == bml::Code::UnknownLexeme
+                    && (d.pos.line, d.pos.col) == (b.pos.line, b.pos.col)
+            })
+        })
+        .filter_map(|b| {
+            let why = models.unanimated(b)?;
+            Some(Diagnostic::warning(bml::Code::UnknownLexeme, b.pos, why))
+        })
+        .collect()
+}
+
 fn validate(files: &[PathBuf], quiet: bool) -> ExitCode {
+    let models = bml_realizer::engines::default_registry(DefaultTimingModels::default());
     let (mut invalid, mut unreadable) = (0usize, 0usize);
     for f in files {
         let text = match std::fs::read_to_string(f) {
@@ -72,7 +95,13 @@ fn validate(files: &[PathBuf], quiet: bool) -> ExitCode {
                 continue;
             }
         };
-        let (_, diags) = bml::check(&text);
+        let (block, mut diags) = bml::check(&text);
+        // what the scheduler would refuse, once the block itself is valid
+        if let Some(block) = block.filter(|_| diags.iter().all(|d| d.severity != Severity::Error)) {
+            diags.extend(timing_diagnostics(&block, &models));
+            diags.extend(unanimated(&block, &models, &diags));
+            diags.sort_by_key(|d| (d.pos.line, d.pos.col));
+        }
         let errors = diags
             .iter()
             .filter(|d| d.severity == Severity::Error)

@@ -1,0 +1,39 @@
+//! The timing check behind `bmlr validate`: what the scheduler would refuse in a block, as
+//! diagnostics. The block is scheduled with `Optimal` and the given timing models; each behaviour
+//! it would drop because its constraints contradict each other (or stretch it beyond its bounds)
+//! becomes an error at that behaviour, naming the constraints, and so does a required block that
+//! cannot be scheduled at all. References to other blocks and anticipators are not known here:
+//! behaviours that use them are left out of the check, not reported.
+
+use super::optimal::Optimal;
+use super::strategy::{NoExternal, SchedulingStrategy};
+use crate::bml::{Block, Code, Diagnostic};
+use crate::engine::timing::TimingModels;
+
+/// Errors for the constraints of `block` that no timing satisfies.
+pub fn timing_diagnostics(block: &Block, models: &dyn TimingModels) -> Vec<Diagnostic> {
+    let error =
+        |pos, message: String| Diagnostic::error(Code::ContradictoryConstraints, pos, message);
+    match Optimal.schedule(block, models, &NoExternal) {
+        Err(e) if e.contradiction => {
+            vec![error(
+                block.pos,
+                format!("the block cannot be scheduled: {}", e.reason),
+            )]
+        }
+        Err(_) => Vec::new(),
+        Ok(schedule) => schedule
+            .dropped
+            .iter()
+            .filter(|d| d.contradiction)
+            .map(|d| {
+                let pos = block
+                    .behaviours
+                    .iter()
+                    .find(|b| b.id == d.behaviour)
+                    .map_or(block.pos, |b| b.pos);
+                error(pos, format!("refused at run time: {}", d.reason))
+            })
+            .collect(),
+    }
+}
