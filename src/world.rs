@@ -1,14 +1,18 @@
-//! The world the characters act in: named points (gaze and pointing targets) that the host places
-//! and moves every frame. Characters stand at the origin facing +z (y up, metres).
+//! The world the characters act in: named points (gaze, pointing and head-direction targets) that
+//! the host places and moves, and points that move by themselves along keyed paths. Characters
+//! stand at the origin facing +z (y up, metres). A world can be read from a JSON world file.
 
 use std::collections::BTreeMap;
 
 use glam::Vec3;
+use serde::Deserialize;
 
-/// Named points in world coordinates.
+/// Named points in world coordinates, some of them moving along paths.
 #[derive(Debug, Clone, PartialEq)]
 pub struct World {
     points: BTreeMap<String, Vec3>,
+    /// Points that move: their keys (time in seconds, position), in time order.
+    paths: BTreeMap<String, Vec<(f64, Vec3)>>,
 }
 
 impl Default for World {
@@ -23,12 +27,64 @@ impl Default for World {
     }
 }
 
+/// The world file: `{"points": {"user": [0, 1.6, 1.5]}, "paths": {"walker": {"keys": [[0, [1,
+/// 1.6, 2]], [4, [-1, 1.6, 2]]]}}, "obstacles": [...]}`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WorldFile {
+    #[serde(default)]
+    points: BTreeMap<String, [f64; 3]>,
+    #[serde(default)]
+    paths: BTreeMap<String, PathFile>,
+    /// Read so that files written for locomotion load; nothing uses them yet.
+    #[serde(default)]
+    obstacles: Vec<serde_json::Value>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PathFile {
+    keys: Vec<(f64, [f64; 3])>,
+}
+
+/// Longest list of keys a path may have.
+pub const MAX_PATH_KEYS: usize = 100_000;
+
+fn vec3(name: &str, v: [f64; 3]) -> Result<Vec3, String> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+    } else {
+        Err(format!("'{name}': coordinates must be finite numbers"))
+    }
+}
+
 impl World {
     /// A world without points.
     pub fn empty() -> Self {
         World {
             points: BTreeMap::new(),
+            paths: BTreeMap::new(),
         }
+    }
+
+    /// The default scene with the points and paths of a world file (its points win over the
+    /// default ones of the same name). Returns the world and how many obstacles the file lists
+    /// (they are not used yet). The error says what is wrong.
+    pub fn from_json(text: &str) -> Result<(World, usize), String> {
+        let file: WorldFile = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        let mut w = World::default();
+        for (name, at) in file.points {
+            w.set(&name, vec3(&name, at)?);
+        }
+        for (name, path) in file.paths {
+            let keys = path
+                .keys
+                .into_iter()
+                .map(|(t, at)| Ok((t, vec3(&name, at)?)))
+                .collect::<Result<Vec<_>, String>>()?;
+            w.set_path(&name, keys)?;
+        }
+        Ok((w, file.obstacles.len()))
     }
 
     /// Places (or moves) point `name`.
@@ -36,9 +92,44 @@ impl World {
         self.points.insert(name.to_string(), at);
     }
 
-    /// Removes point `name`.
+    /// Makes `name` a point that moves along `keys` (time in seconds, position): linearly
+    /// between keys, resting at the first before it and at the last after it. Keys must be
+    /// in time order with finite times; at least one, at most [`MAX_PATH_KEYS`].
+    pub fn set_path(&mut self, name: &str, keys: Vec<(f64, Vec3)>) -> Result<(), String> {
+        if keys.is_empty() || keys.len() > MAX_PATH_KEYS {
+            return Err(format!(
+                "path '{name}' needs 1 to {MAX_PATH_KEYS} keys, not {}",
+                keys.len()
+            ));
+        }
+        if keys.iter().any(|k| !k.0.is_finite()) || keys.windows(2).any(|w| w[1].0 < w[0].0) {
+            return Err(format!(
+                "path '{name}': key times must be finite and in increasing order"
+            ));
+        }
+        self.points.insert(name.to_string(), keys[0].1);
+        self.paths.insert(name.to_string(), keys);
+        Ok(())
+    }
+
+    /// Whether some point moves along a path.
+    pub fn has_paths(&self) -> bool {
+        !self.paths.is_empty()
+    }
+
+    /// Puts every point that has a path where its path is at time `t`.
+    pub fn move_to(&mut self, t: f64) {
+        for (name, keys) in &self.paths {
+            if let Some(p) = self.points.get_mut(name) {
+                *p = along(keys, t);
+            }
+        }
+    }
+
+    /// Removes point `name` (and its path).
     pub fn remove(&mut self, name: &str) {
         self.points.remove(name);
+        self.paths.remove(name);
     }
 
     /// Where point `name` is.
@@ -49,5 +140,73 @@ impl World {
     /// Every point, by name.
     pub fn points(&self) -> impl Iterator<Item = (&str, Vec3)> {
         self.points.iter().map(|(k, v)| (k.as_str(), *v))
+    }
+
+    /// The sentence for a target the world does not have, listing the points it has.
+    pub fn unknown_target(&self, target: &str) -> String {
+        let known: Vec<&str> = self.points.keys().map(String::as_str).collect();
+        format!(
+            "there is no target '{target}' in the world (it has {}; add points with --world or Realizer::world_mut)",
+            known.join(", ")
+        )
+    }
+}
+
+/// The position along `keys` (time order, at least one) at time `t`.
+fn along(keys: &[(f64, Vec3)], t: f64) -> Vec3 {
+    let after = keys.partition_point(|k| k.0 <= t);
+    match (after.checked_sub(1).map(|i| keys[i]), keys.get(after)) {
+        (None, _) => keys[0].1,
+        (Some(k), None) => k.1,
+        (Some((t0, p0)), Some(&(t1, p1))) => {
+            let a = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+            p0.lerp(p1, a as f32)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_path_point_moves_linearly_between_its_keys_and_rests_outside_them() {
+        let text = r#"{"points": {"lamp": [0, 2, 1]},
+            "paths": {"walker": {"keys": [[1, [1, 1.6, 2]], [5, [-1, 1.6, 2]]]}}}"#;
+        let (mut w, obstacles) = World::from_json(text).unwrap();
+        assert_eq!(obstacles, 0);
+        assert_eq!(w.get("lamp"), Some(Vec3::new(0.0, 2.0, 1.0)));
+        assert!(w.get("bluebox").is_some(), "the default scene stays");
+        for (t, x) in [
+            (0.0, 1.0),
+            (1.0, 1.0),
+            (2.0, 0.5),
+            (3.0, 0.0),
+            (5.0, -1.0),
+            (9.0, -1.0),
+        ] {
+            w.move_to(t);
+            let p = w.get("walker").unwrap();
+            assert!(
+                (p.x - x).abs() < 1e-6 && (p.y - 1.6).abs() < 1e-6,
+                "{t}: {p}"
+            );
+        }
+    }
+
+    #[test]
+    fn bad_world_files_say_what_is_wrong() {
+        for (text, says) in [
+            (r#"{"points": {"a": [0, 1]}}"#, "expected"),
+            (
+                r#"{"paths": {"w": {"keys": [[2, [0, 0, 0]], [1, [0, 0, 0]]]}}}"#,
+                "increasing",
+            ),
+            (r#"{"paths": {"w": {"keys": []}}}"#, "1 to"),
+            (r#"{"pionts": {}}"#, "unknown field"),
+        ] {
+            let e = World::from_json(text).unwrap_err();
+            assert!(e.contains(says), "{text}: {e}");
+        }
     }
 }

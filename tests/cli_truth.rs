@@ -175,3 +175,210 @@ fn a_misspelled_joint_in_an_assets_file_is_an_error() {
         "{err}"
     );
 }
+
+#[test]
+fn a_world_file_gives_named_and_moving_targets_and_unknown_targets_list_them() {
+    let (code, out, err) = bmlr(
+        &[
+            "run",
+            "--world",
+            "fixtures/examples/world.json",
+            "fixtures/examples/follow-walker.xml",
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(!out.contains("warningFeedback"), "{out}");
+    assert!(out.contains(r#"id="follow:end""#), "{out}");
+    // without the file, the targets are unknown, and the warning lists what the world has
+    let (_, out, _) = bmlr(&["run", "fixtures/examples/follow-walker.xml"], "");
+    assert!(
+        out.contains("no target &apos;walker&apos; in the world (it has bluebox, speaker, user"),
+        "{out}"
+    );
+    let (code, out, _) = bmlr(
+        &[
+            "plan",
+            "--world",
+            "fixtures/examples/world.json",
+            "fixtures/examples/follow-walker.xml",
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{out}");
+    // a bad file: exit 2, naming it
+    let dir = dir_with("badworld", &[("w.json", r#"{"points": {"a": [0, 1]}}"#)]);
+    let w = dir.join("w.json");
+    for cmd in ["run", "plan"] {
+        let (code, _, err) = bmlr(
+            &[
+                cmd,
+                "--world",
+                w.to_str().unwrap(),
+                "fixtures/examples/welcome.xml",
+            ],
+            "",
+        );
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("w.json"), "{err}");
+    }
+    let (code, _, err) = bmlr(&["serve", "--stdio", "--world", w.to_str().unwrap()], "");
+    assert_eq!(code, 2, "{err}");
+}
+
+/// The head follows a point moving along its path: looking at it at 0.5 s and at 3.5 s turns
+/// the head to opposite sides.
+#[test]
+fn gaze_follows_a_point_moving_along_its_path() {
+    use bml_realizer::body::Skeleton;
+    use bml_realizer::realizer::Realizer;
+    let mut r = Realizer::new();
+    let text = std::fs::read_to_string("fixtures/examples/world.json").unwrap();
+    *r.world_mut() = bml_realizer::world::World::from_json(&text).unwrap().0;
+    let bml = std::fs::read_to_string("fixtures/examples/follow-walker.xml").unwrap();
+    r.perform_bml(&bml).unwrap();
+    let skeleton = Skeleton::adult();
+    let skull = skeleton.joint("skullbase").unwrap();
+    let mut facing = |t: f64| {
+        let frame = r.tick(t);
+        let (_, q) = frame.poses[0].pose.joint_world(&skeleton, skull);
+        let forward = q * glam::Vec3::Z;
+        forward.x
+    };
+    let (early, late) = (facing(0.5), facing(3.5));
+    // +x is the character's left: the walker starts there and ends on the right
+    assert!(
+        early > 0.2 && late < -0.2,
+        "facing x at 0.5 s {early}, at 3.5 s {late}"
+    );
+}
+
+#[test]
+fn run_and_plan_exit_1_after_running_the_rest_when_a_block_is_invalid_and_name_its_file() {
+    let dir = dir_with(
+        "invalid",
+        &[
+            // not well-formed, but its id can be read
+            (
+                "bad.xml",
+                &format!(r#"<bml {NS} id="bad"><gesture lexeme="BEAT"></bml>"#),
+            ),
+            ("noid.xml", "<bml <<"),
+        ],
+    );
+    let (bad, noid) = (dir.join("bad.xml"), dir.join("noid.xml"));
+    let (bad, noid) = (bad.to_str().unwrap(), noid.to_str().unwrap());
+    let (code, out, err) = bmlr(&["run", bad, "fixtures/examples/welcome.xml", noid], "");
+    assert_eq!(code, 1, "{err}");
+    assert!(out.contains(r#"id="greet:end""#), "the rest ran: {out}");
+    let warnings: Vec<&str> = out
+        .lines()
+        .filter(|l| l.contains("PARSING_FAILURE"))
+        .collect();
+    assert_eq!(warnings.len(), 2, "{out}");
+    assert!(
+        warnings[0].contains(r#"id="bad""#) && warnings[0].contains(&format!("{bad}:1:")),
+        "{}",
+        warnings[0]
+    );
+    assert!(
+        warnings[1].contains(r#"id="&lt;no id&gt;""#) && warnings[1].contains(noid),
+        "{}",
+        warnings[1]
+    );
+    assert!(err.contains("2 blocks could not be parsed"), "{err}");
+    let (code, _, _) = bmlr(&["plan", bad, "fixtures/examples/welcome.xml"], "");
+    assert_eq!(code, 1);
+    // on stdin too
+    let stream = format!(r#"<bml {NS} id="x"><gesture lexeme="BEAT"></bml>"#);
+    let (code, out, _) = bmlr(&["run", "-"], &stream);
+    assert_eq!(code, 1);
+    assert!(out.contains("&lt;stdin&gt;:1:"), "{out}");
+    let (code, _, _) = bmlr(&["run", "fixtures/examples/welcome.xml"], "");
+    assert_eq!(code, 0);
+}
+
+#[test]
+fn bvh_records_the_character_that_received_the_blocks() {
+    let dir = dir_with(
+        "bvhchar",
+        &[(
+            "anna.xml",
+            &format!(
+                r#"<bml {NS} id="b1" characterId="anna"><gesture id="g1" lexeme="BEAT"/></bml>"#
+            ),
+        )],
+    );
+    let (file, bvh) = (dir.join("anna.xml"), dir.join("out.bvh"));
+    let (file, bvh) = (file.to_str().unwrap(), bvh.to_str().unwrap());
+    let (code, _, err) = bmlr(&["run", "--bvh", bvh, file], "");
+    assert_eq!(code, 0, "{err}");
+    // the right wrist moves: the BVH's motion lines differ over time
+    let text = std::fs::read_to_string(bvh).unwrap();
+    let motion: Vec<&str> = text
+        .split("Frame Time:")
+        .nth(1)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .collect();
+    assert!(motion.len() > 30);
+    assert_ne!(motion[0], motion[motion.len() / 2], "a still BVH");
+    // a character that received nothing: said so, exit 1
+    let (code, _, err) = bmlr(&["run", "--bvh", bvh, "--character", "bob", file], "");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("'bob' received no blocks") && err.contains("'anna'"),
+        "{err}"
+    );
+}
+
+#[test]
+fn writing_into_a_closed_pipe_is_no_panic() {
+    use std::process::Stdio;
+    for args in [
+        vec![
+            "validate",
+            "fixtures/realizertester/bml-1/core/testspeech.xml",
+            "fixtures/realizertester/bml-1/core/testgaze.xml",
+        ],
+        vec!["run", "fixtures/examples/welcome.xml"],
+        vec!["plan", "fixtures/examples/welcome.xml"],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+            .args(&args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // the reader goes away before anything is written
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert_ne!(out.status.code(), Some(101), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn serve_without_a_port_names_both_and_conformance_says_when_its_realizer_cannot_start() {
+    let (code, _, err) = bmlr(&["serve"], "");
+    assert_eq!(code, 2);
+    assert!(err.contains("--stdio") && err.contains("--tcp"), "{err}");
+    let (code, _, err) = bmlr(&["conformance", "--realizer", "no-such-realizer-cmd"], "");
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("cannot start") && err.contains("not found"),
+        "{err}"
+    );
+    // `bmlr` in the command is this binary (here it exits at once on a bad flag)
+    let (code, _, err) = bmlr(
+        &["conformance", "--realizer", "bmlr serve --no-such-flag"],
+        "",
+    );
+    assert_eq!(code, 2);
+    assert!(
+        err.contains(env!("CARGO_BIN_EXE_bmlr")) && err.contains("exited at once"),
+        "{err}"
+    );
+}

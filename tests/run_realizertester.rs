@@ -18,8 +18,16 @@ struct Log {
     fb: Vec<Feedback>,
 }
 
-/// Runs `bmlr run` with RealizerTester files (relative to bml-1/) and `+SECS` items.
+/// Runs `bmlr run` with RealizerTester files (relative to bml-1/) and `+SECS` items; it must
+/// succeed.
 fn run(items: &[&str]) -> Log {
+    let (log, code) = run_with_code(items);
+    assert_eq!(code, 0, "bmlr run failed");
+    log
+}
+
+/// [`run`], with the exit code (1 when some input is invalid).
+fn run_with_code(items: &[&str]) -> (Log, i32) {
     let dir = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/fixtures/realizertester/bml-1/"
@@ -39,18 +47,18 @@ fn run(items: &[&str]) -> Log {
         .args(&args)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let code = out.status.code().unwrap_or(-1);
+    if code != 0 {
+        eprintln!("{}", String::from_utf8_lossy(&out.stderr));
+    }
     let text = String::from_utf8(out.stdout).unwrap();
-    Log {
+    let log = Log {
         fb: text
             .lines()
             .map(|l| feedback::from_line(l).unwrap_or_else(|e| panic!("{e}: {l}")))
             .collect(),
-    }
+    };
+    (log, code)
 }
 
 impl Log {
@@ -212,7 +220,8 @@ fn empty_block() {
 
 #[test]
 fn invalid_block_gives_exactly_one_warning() {
-    let log = run(&["core/bmlnoid.xml"]);
+    let (log, code) = run_with_code(&["core/bmlnoid.xml"]);
+    assert_eq!(code, 1, "an invalid block is invalid input");
     let w = log.warnings();
     assert_eq!(w.len(), 1);
     assert_eq!(w[0].kind.as_str(), "PARSING_FAILURE");

@@ -171,6 +171,12 @@ impl ProcessPort {
         Self::spawn_with(command, command)
     }
 
+    /// Whether the process has already ended, with its status: a command that cannot run (not
+    /// found, bad arguments) ends at once.
+    pub fn exited(&mut self) -> Option<std::process::ExitStatus> {
+        self.child.try_wait().ok().flatten()
+    }
+
     /// Starts `standard` (with `sh -c`); the incremental-speech tests run on `incremental`.
     pub fn spawn_with(standard: &str, incremental: &str) -> std::io::Result<Self> {
         let (child, stdin, lines) = Self::start(standard)?;

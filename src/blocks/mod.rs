@@ -212,6 +212,12 @@ impl BlockManager {
         }
     }
 
+    /// Whether any block has been accepted for this character (a block refused for a duplicate
+    /// id does not count).
+    pub fn received_blocks(&self) -> bool {
+        self.seq > 0
+    }
+
     /// Ids and statuses of the blocks not yet finished, in arrival order.
     pub fn live_blocks(&self) -> Vec<(String, BlockStatus)> {
         self.blocks

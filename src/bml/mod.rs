@@ -60,3 +60,20 @@ fn check_into(src: &str, block: &mut Option<Block>) -> Vec<Diagnostic> {
     }
     diags
 }
+
+/// The `id` of the first element in `src`, read leniently: for naming a block in a warning when
+/// the rest of it is not well-formed. `None` if the first element cannot be read or has no id.
+pub fn root_id(src: &str) -> Option<String> {
+    use quick_xml::events::Event;
+    let mut reader = quick_xml::Reader::from_str(src);
+    loop {
+        match reader.read_event().ok()? {
+            Event::Start(e) | Event::Empty(e) => {
+                let id = e.attributes().flatten().find(|a| a.key.as_ref() == b"id")?;
+                return id.unescape_value().ok().map(|v| v.into_owned());
+            }
+            Event::Eof => return None,
+            _ => {}
+        }
+    }
+}

@@ -223,10 +223,10 @@ impl Engine for GazeEngine {
         let (target, influence, shift, offset) = gaze(unit.behaviour)
             .ok_or_else(|| EngineError("the gaze engine realizes gaze and gazeShift".into()))?;
         if unit.world.get(target).is_none() {
-            let known: Vec<&str> = unit.world.points().map(|p| p.0).collect();
             return Err(EngineError(format!(
-                "{}: there is no target '{target}' in the world (it has {known:?})",
-                unit.key
+                "{}: {}",
+                unit.key,
+                unit.world.unknown_target(target)
             )));
         }
         self.units.add(

@@ -63,10 +63,10 @@ impl Engine for HeadDirectionEngine {
             ));
         };
         if unit.world.get(target).is_none() {
-            let known: Vec<&str> = unit.world.points().map(|p| p.0).collect();
             return Err(EngineError(format!(
-                "{}: there is no target '{target}' in the world (it has {known:?})",
-                unit.key
+                "{}: {}",
+                unit.key,
+                unit.world.unknown_target(target)
             )));
         }
         let target = target.clone();

@@ -135,10 +135,10 @@ impl Engine for PointingEngine {
             ));
         };
         if unit.world.get(&p.target).is_none() {
-            let known: Vec<&str> = unit.world.points().map(|q| q.0).collect();
             return Err(EngineError(format!(
-                "{}: there is no target '{}' in the world (it has {known:?})",
-                unit.key, p.target
+                "{}: {}",
+                unit.key,
+                unit.world.unknown_target(&p.target)
             )));
         }
         let target = p.target.clone();

@@ -167,6 +167,12 @@ impl Realizer {
     /// Submits one `<bml>` block at the current time. Invalid BML yields a PARSING_FAILURE
     /// warning (and the error, for callers that want it); the stream keeps working.
     pub fn perform_bml(&mut self, text: &str) -> Result<(), BmlError> {
+        self.perform_bml_from(text, None)
+    }
+
+    /// [`perform_bml`](Self::perform_bml) for a block read from `source` (a file name, say):
+    /// a PARSING_FAILURE warning then names it before each position (`FILE:LINE:COL: ...`).
+    pub fn perform_bml_from(&mut self, text: &str, source: Option<&str>) -> Result<(), BmlError> {
         let (block, diagnostics) = bml::check(text);
         let errors: Vec<&Diagnostic> = diagnostics.iter().filter(|d| d.is_error()).collect();
         match block {
@@ -184,18 +190,20 @@ impl Realizer {
                 Ok(())
             }
             block => {
+                // the id as far as it can be read, even from a block that is not well-formed
                 let id = block
                     .as_ref()
-                    .map(|b| b.id.as_str())
+                    .map(|b| b.id.to_string())
+                    .or_else(|| bml::root_id(text))
                     .filter(|id| !id.is_empty())
-                    .unwrap_or(NO_ID)
-                    .to_string();
+                    .unwrap_or_else(|| NO_ID.to_string());
                 let character_id = block
                     .and_then(|b| b.character_id)
                     .or_else(|| self.default_character.clone());
+                let at = source.map_or(String::new(), |s| format!("{s}:"));
                 let text = errors
                     .iter()
-                    .map(|d| format!("{}:{}: {}", d.pos.line, d.pos.col, d.message))
+                    .map(|d| format!("{at}{}:{}: {}", d.pos.line, d.pos.col, d.message))
                     .collect::<Vec<_>>()
                     .join("; ");
                 self.unframed.push(Feedback::Warning(WarningFeedback {
@@ -203,7 +211,9 @@ impl Realizer {
                     kind: KnownWarning::ParsingFailure.into(),
                     character_id,
                     text: if text.is_empty() {
-                        "the block could not be read".into()
+                        format!("{at} the block could not be read")
+                            .trim_start()
+                            .to_string()
                     } else {
                         text
                     },
@@ -253,6 +263,9 @@ impl Realizer {
             self.now
         };
         self.now = now;
+        if self.world.has_paths() {
+            self.world_mut().move_to(now);
+        }
         let mut frame = Frame {
             time: now,
             ..Frame::default()

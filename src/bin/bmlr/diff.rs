@@ -27,6 +27,9 @@ fn read(path: &PathBuf) -> Result<Log, String> {
 
 /// `bmlr diff`: exit 0 equal, 1 different, 2 unreadable input.
 pub fn run(args: DiffArgs) -> ExitCode {
+    use std::io::Write;
+    // a reader that stops early (`| head`) is no error: what is left is not printed
+    let mut out = std::io::stdout().lock();
     if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
         eprintln!("bmlr diff: --tolerance must be a number of seconds >= 0");
         return ExitCode::from(2);
@@ -39,13 +42,14 @@ pub fn run(args: DiffArgs) -> ExitCode {
         }
     };
     let differences = diff(&a, &b, args.tolerance);
-    println!("A = {}", args.a.display());
-    println!("B = {}", args.b.display());
+    let _ = writeln!(out, "A = {}", args.a.display());
+    let _ = writeln!(out, "B = {}", args.b.display());
     for d in &differences {
-        println!("{d}");
+        let _ = writeln!(out, "{d}");
     }
     if differences.is_empty() {
-        println!(
+        let _ = writeln!(
+            out,
             "equal: {} messages, times within {} s",
             a.messages.len(),
             args.tolerance
@@ -53,7 +57,7 @@ pub fn run(args: DiffArgs) -> ExitCode {
         ExitCode::SUCCESS
     } else {
         let n = differences.len();
-        println!("{n} difference{}", if n == 1 { "" } else { "s" });
+        let _ = writeln!(out, "{n} difference{}", if n == 1 { "" } else { "s" });
         ExitCode::from(1)
     }
 }

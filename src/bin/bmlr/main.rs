@@ -84,6 +84,9 @@ fn unanimated(block: &bml::Block, models: &Registry, diags: &[Diagnostic]) -> Ve
 }
 
 fn validate(files: &[PathBuf], quiet: bool) -> ExitCode {
+    use std::io::Write;
+    // a reader that stops early (`| head`) is no error: what is left is not printed
+    let mut out = std::io::stdout().lock();
     let models = bml_realizer::engines::default_registry(DefaultTimingModels::default());
     let (mut invalid, mut unreadable) = (0usize, 0usize);
     for f in files {
@@ -107,16 +110,17 @@ fn validate(files: &[PathBuf], quiet: bool) -> ExitCode {
             .filter(|d| d.severity == Severity::Error)
             .count();
         for d in &diags {
-            println!("{}:{d}", f.display());
+            let _ = writeln!(out, "{}:{d}", f.display());
         }
         if errors > 0 {
             invalid += 1;
         } else if !quiet {
             let warnings = diags.len();
             if warnings == 0 {
-                println!("{}: valid", f.display());
+                let _ = writeln!(out, "{}: valid", f.display());
             } else {
-                println!(
+                let _ = writeln!(
+                    out,
                     "{}: valid ({warnings} warning{})",
                     f.display(),
                     if warnings == 1 { "" } else { "s" }

@@ -56,6 +56,10 @@ pub struct RunArgs {
     /// ones for what they bind).
     #[arg(long, value_name = "DIR")]
     pub assets: Option<std::path::PathBuf>,
+    /// A world file (JSON): named points and points moving along keyed paths, as targets of
+    /// gaze, pointing and headDirectionShift, added to the built-in scene.
+    #[arg(long, value_name = "WORLD.json")]
+    pub world: Option<std::path::PathBuf>,
     /// Write the realized motion of the character (--character, else the default one) as BVH,
     /// one frame every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.bvh")]
@@ -80,6 +84,24 @@ pub fn with_assets(realizer: Realizer, dir: Option<&Path>) -> Result<Realizer, S
     }))
 }
 
+/// `realizer` in the world of the file at `path`, if given. The error names the file.
+pub fn with_world(mut realizer: Realizer, path: Option<&Path>) -> Result<Realizer, String> {
+    let Some(path) = path else {
+        return Ok(realizer);
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let (world, obstacles) = bml_realizer::world::World::from_json(&text)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    if obstacles > 0 {
+        eprintln!(
+            "{}: {obstacles} obstacle(s) read but not used: locomotion is timing only",
+            path.display()
+        );
+    }
+    *realizer.world_mut() = world;
+    Ok(realizer)
+}
+
 /// Arguments of `bmlr plan`.
 #[derive(Args)]
 pub struct PlanArgs {
@@ -89,6 +111,10 @@ pub struct PlanArgs {
     /// A directory of motion data adding to the embedded defaults (see `bmlr run --assets`).
     #[arg(long, value_name = "DIR")]
     assets: Option<std::path::PathBuf>,
+    /// A world file (JSON): named points and points moving along keyed paths, as targets of
+    /// gaze, pointing and headDirectionShift, added to the built-in scene.
+    #[arg(long, value_name = "WORLD.json")]
+    pub world: Option<std::path::PathBuf>,
     /// Also draw the plan as a timeline picture (SVG) with the constraints as links.
     #[arg(long, value_name = "OUT.svg")]
     svg: Option<std::path::PathBuf>,
@@ -99,7 +125,8 @@ pub struct PlanArgs {
 
 /// An item of the command line, read before anything runs.
 enum Item {
-    Text(String),
+    /// A file's name and text.
+    Text(String, String),
     Advance(f64),
     Stdin,
 }
@@ -119,7 +146,7 @@ fn read_items(items: &[String]) -> Result<Vec<Item>, String> {
                 }
             } else {
                 std::fs::read_to_string(Path::new(a))
-                    .map(Item::Text)
+                    .map(|text| Item::Text(a.clone(), text))
                     .map_err(|e| format!("{a}: cannot read: {e}"))
             }
         })
@@ -136,6 +163,9 @@ fn print(out: &mut impl Write, format: Format, feedback: &[Feedback]) -> bool {
     out.flush().is_ok()
 }
 
+/// How warnings name blocks read from standard input.
+const STDIN: &str = "<stdin>";
+
 /// A realizer on the virtual clock that prints its feedback as it goes.
 struct VirtualRun {
     realizer: Realizer,
@@ -145,13 +175,75 @@ struct VirtualRun {
     open: bool,
     /// BVH recording: the character, the frame period, the next frame's time and the poses.
     motion: Option<Motion>,
+    /// Blocks that could not be parsed (the run goes on; it exits 1).
+    invalid: usize,
 }
 
+/// BVH recording: the frame period, the next frame's time, and every character's pose in each
+/// frame so far (which character the file shows is decided at the end).
 struct Motion {
-    character: Option<String>,
     period: f64,
     next: f64,
-    poses: Vec<bml_realizer::body::Pose>,
+    frames: Vec<Vec<bml_realizer::engine::CharacterPose>>,
+}
+
+impl Motion {
+    /// The poses of `character` ("" the default one), frame by frame (the rest pose where a
+    /// frame has none for it).
+    fn poses_of(&self, character: &str) -> Vec<bml_realizer::body::Pose> {
+        let rest = bml_realizer::body::Pose::rest(&bml_realizer::body::Skeleton::adult());
+        self.frames
+            .iter()
+            .map(|f| {
+                f.iter()
+                    .find(|p| p.character.as_deref().unwrap_or("") == character)
+                    .map_or_else(|| rest.clone(), |p| p.pose.clone())
+            })
+            .collect()
+    }
+}
+
+/// The character a BVH shows: `asked` (--character) if it received blocks, else the only one
+/// that did (or, of several, the default one, else the first by id, with a note on stderr).
+/// An error names the characters that received blocks.
+fn recorded_character(realizer: &Realizer, asked: Option<&str>) -> Result<String, String> {
+    let mut received: Vec<&str> = realizer
+        .characters()
+        .filter(|(_, m)| m.received_blocks())
+        .map(|(c, _)| c)
+        .collect();
+    received.sort_unstable();
+    let named = |list: &[&str]| -> String {
+        let names: Vec<String> = list
+            .iter()
+            .map(|c| {
+                if c.is_empty() {
+                    "the default character".into()
+                } else {
+                    format!("'{c}'")
+                }
+            })
+            .collect();
+        names.join(", ")
+    };
+    match (asked, received.as_slice()) {
+        (Some(c), list) if list.contains(&c) => Ok(c.to_string()),
+        (_, []) => Err("no character received a block: the BVH would show nothing move".into()),
+        (Some(c), list) => Err(format!(
+            "character '{c}' received no blocks (these did: {}); choose one with --character",
+            named(list)
+        )),
+        (None, [one]) => Ok(one.to_string()),
+        (None, list) => {
+            let c = if list.contains(&"") { "" } else { list[0] };
+            eprintln!(
+                "bmlr run: several characters received blocks ({}); the BVH shows {} (choose with --character)",
+                named(list),
+                named(&[c])
+            );
+            Ok(c.to_string())
+        }
+    }
 }
 
 impl VirtualRun {
@@ -161,7 +253,7 @@ impl VirtualRun {
         let t = t.min(self.until);
         while let Some(m) = self.motion.as_mut().filter(|m| m.next <= t) {
             let at = m.next;
-            m.next = (m.poses.len() + 1) as f64 * m.period;
+            m.next = (m.frames.len() + 1) as f64 * m.period;
             let frame = self.realizer.tick(at);
             self.open &= print(&mut self.out, self.format, &frame.feedback);
             self.record(frame.poses);
@@ -171,31 +263,25 @@ impl VirtualRun {
     }
 
     fn record(&mut self, poses: Vec<bml_realizer::engine::CharacterPose>) {
-        let Some(m) = self.motion.as_mut() else {
-            return;
-        };
-        let pose = poses
-            .into_iter()
-            .find(|p| p.character == m.character)
-            .map(|p| p.pose)
-            .unwrap_or_else(|| {
-                bml_realizer::body::Pose::rest(&bml_realizer::body::Skeleton::adult())
-            });
-        m.poses.push(pose);
+        if let Some(m) = self.motion.as_mut() {
+            m.frames.push(poses);
+        }
     }
 
-    fn perform(&mut self, text: &str) {
+    fn perform(&mut self, text: &str, source: &str) {
         if self.realizer.now() >= self.until {
             return;
         }
-        let _ = self.realizer.perform_bml(text);
+        if self.realizer.perform_bml_from(text, Some(source)).is_err() {
+            self.invalid += 1;
+        }
         let frame = self.realizer.tick(self.realizer.now());
         self.open &= print(&mut self.out, self.format, &frame.feedback);
     }
 
     fn stream(&mut self, item: StreamItem) {
         match item {
-            StreamItem::Block(text) | StreamItem::Garbage(text) => self.perform(&text),
+            StreamItem::Block(text) | StreamItem::Garbage(text) => self.perform(&text, STDIN),
             StreamItem::Advance(s) => self.advance_to(self.realizer.now() + s),
         }
     }
@@ -226,6 +312,13 @@ pub fn run(args: RunArgs) -> ExitCode {
             eprintln!("bmlr run: --assets {e}");
             return ExitCode::from(2);
         }
+    };
+    let realizer = match with_world(realizer, args.world.as_deref()) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("bmlr run: --world {e}");
+            return ExitCode::from(2);
+        }
     }
     .with_default_character(args.character.clone())
     .with_posix_time(args.realtime);
@@ -242,16 +335,16 @@ pub fn run(args: RunArgs) -> ExitCode {
         until: args.until.unwrap_or(f64::INFINITY),
         out: std::io::stdout().lock(),
         open: true,
+        invalid: 0,
         motion: args.bvh.as_ref().map(|_| Motion {
-            character: args.character.clone(),
             period: 1.0 / args.fps,
             next: 0.0,
-            poses: Vec::new(),
+            frames: Vec::new(),
         }),
     };
     for item in items {
         match item {
-            Item::Text(text) => run.perform(&text),
+            Item::Text(path, text) => run.perform(&text, &path),
             Item::Advance(s) => run.advance_to(run.realizer.now() + s),
             Item::Stdin => {
                 let mut text = String::new();
@@ -282,18 +375,20 @@ pub fn run(args: RunArgs) -> ExitCode {
         // one last frame at the final time
         let now = run.realizer.now();
         let mut m = m;
-        if m.poses.is_empty() || m.next <= now + 1e-9 {
+        if m.frames.is_empty() || m.next <= now + 1e-9 {
             let frame = run.realizer.tick(now);
-            m.poses.extend(
-                frame
-                    .poses
-                    .into_iter()
-                    .find(|p| p.character == m.character)
-                    .map(|p| p.pose),
-            );
+            m.frames.push(frame.poses);
         }
+        let character = match recorded_character(&run.realizer, args.character.as_deref()) {
+            Ok(c) => c,
+            Err(e) => {
+                eprintln!("bmlr run: --bvh: {e}");
+                return ExitCode::from(1);
+            }
+        };
+        let poses = m.poses_of(&character);
         let skeleton = bml_realizer::body::Skeleton::adult();
-        let text = bml_realizer::body::bvh::write(&skeleton, &m.poses, args.fps);
+        let text = bml_realizer::body::bvh::write(&skeleton, &poses, args.fps);
         if let Err(e) = std::fs::write(path, text) {
             eprintln!("bmlr run: {}: cannot write: {e}", path.display());
             return ExitCode::from(2);
@@ -301,12 +396,12 @@ pub fn run(args: RunArgs) -> ExitCode {
         eprintln!(
             "wrote {} ({} frames at {} fps, {} joints)",
             path.display(),
-            m.poses.len(),
+            poses.len(),
             args.fps,
             skeleton.len()
         );
     }
-    ExitCode::SUCCESS
+    exit_for(run.invalid, "run")
 }
 
 /// Tells stderr which blocks did not finish (waiting for activation, persistent behaviour, or
@@ -339,6 +434,7 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
     let until = args.until.unwrap_or(f64::INFINITY);
     let period = 1.0 / args.fps;
     let mut out = std::io::stdout().lock();
+    let mut invalid = 0;
     let wait_until = |realizer: &mut Realizer, t: f64, out: &mut std::io::StdoutLock| loop {
         let now = clock.now().min(until);
         let frame = realizer.tick(now);
@@ -352,12 +448,12 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
     };
     for item in items {
         match item {
-            Item::Text(text) => {
+            Item::Text(path, text) => {
                 let frame = realizer.tick(clock.now().min(until));
                 if !print(&mut out, format, &frame.feedback) {
                     return ExitCode::SUCCESS;
                 }
-                let _ = realizer.perform_bml(&text);
+                invalid += usize::from(realizer.perform_bml_from(&text, Some(&path)).is_err());
             }
             Item::Advance(s) => {
                 let t = clock.now() + s;
@@ -396,7 +492,8 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
                                 if !print(&mut out, format, &frame.feedback) {
                                     return ExitCode::SUCCESS;
                                 }
-                                let _ = realizer.perform_bml(&t);
+                                let result = realizer.perform_bml_from(&t, Some(STDIN));
+                                invalid += usize::from(result.is_err());
                             }
                             StreamItem::Advance(s) => {
                                 let t = clock.now() + s;
@@ -424,7 +521,17 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
         wait_until(&mut realizer, until, &mut out);
     }
     report_unfinished(&realizer);
-    ExitCode::SUCCESS
+    exit_for(invalid, "run")
+}
+
+/// Success, or exit 1 (after a line on stderr) when `invalid` blocks could not be parsed.
+fn exit_for(invalid: usize, command: &str) -> ExitCode {
+    if invalid == 0 {
+        return ExitCode::SUCCESS;
+    }
+    let s = if invalid == 1 { "" } else { "s" };
+    eprintln!("bmlr {command}: {invalid} block{s} could not be parsed (see the warnings)");
+    ExitCode::from(1)
 }
 
 /// `bmlr plan`: submits the files at time 0 without running the clock and prints each block's
@@ -444,12 +551,20 @@ pub fn plan(args: PlanArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    realizer = match with_world(realizer, args.world.as_deref()) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("bmlr plan: --world {e}");
+            return ExitCode::from(2);
+        }
+    };
     let mut feedback = Vec::new();
     let mut blocks = Vec::new();
+    let mut invalid = 0;
     for item in items {
         match item {
-            Item::Text(text) => {
-                let _ = realizer.perform_bml(&text);
+            Item::Text(path, text) => {
+                invalid += usize::from(realizer.perform_bml_from(&text, Some(&path)).is_err());
                 feedback.extend(realizer.tick(0.0).feedback);
                 if let Ok(parsed) = bml_realizer::bml::load(&text) {
                     blocks.push(parsed.block);
@@ -477,7 +592,7 @@ pub fn plan(args: PlanArgs) -> ExitCode {
             break;
         }
     }
-    ExitCode::SUCCESS
+    exit_for(invalid, "plan")
 }
 
 /// The plan report: for each block's last full prediction, a header and one line per sync;

@@ -20,9 +20,10 @@ use realizer_tests::{run, Outcome, ProcessPort, TestPort};
 
 /// Arguments of `bmlr serve`.
 #[derive(Args)]
+#[command(group(clap::ArgGroup::new("port").required(true).args(["stdio", "tcp"])))]
 pub struct ServeArgs {
     /// Serve on stdin/stdout.
-    #[arg(long, required_unless_present = "tcp", conflicts_with = "tcp")]
+    #[arg(long, conflicts_with = "tcp")]
     stdio: bool,
     /// Serve several clients on a TCP address (e.g. 127.0.0.1:7700; port 0 picks one, printed
     /// on stderr).
@@ -40,6 +41,10 @@ pub struct ServeArgs {
     /// A directory of motion data adding to the embedded defaults (see `bmlr run --assets`).
     #[arg(long, value_name = "DIR")]
     assets: Option<std::path::PathBuf>,
+    /// A world file (JSON): named points and points moving along keyed paths, as targets of
+    /// gaze, pointing and headDirectionShift, added to the built-in scene.
+    #[arg(long, value_name = "WORLD.json")]
+    world: Option<std::path::PathBuf>,
 }
 
 /// `bmlr serve --stdio` (runs until stdin closes and nothing more is scheduled) or `--tcp`.
@@ -59,9 +64,16 @@ pub fn serve(args: ServeArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let mut realizer = Realizer::new()
+    let realizer = Realizer::new()
         .with_engines(move || registry_with(DefaultTimingModels { speech }, &assets))
         .with_posix_time(true);
+    let mut realizer = match crate::run::with_world(realizer, args.world.as_deref()) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("bmlr serve: --world {e}");
+            return ExitCode::from(2);
+        }
+    };
     if let Some(addr) = &args.tcp {
         return crate::tcp::serve(addr, args.per_client, args.fps, realizer);
     }
@@ -150,6 +162,41 @@ fn incremental_command(cmd: &str, given: Option<&str>) -> String {
     }
 }
 
+/// `cmd` with a leading `bmlr` replaced by the path of this very binary (so that the suite tests
+/// this build, not whatever `bmlr` is on the PATH).
+fn this_bmlr(cmd: &str) -> String {
+    let Some(rest) = cmd.trim_start().strip_prefix("bmlr") else {
+        return cmd.to_string();
+    };
+    match std::env::current_exe() {
+        Ok(exe) if rest.is_empty() || rest.starts_with(char::is_whitespace) => {
+            format!(
+                "'{}'{rest}",
+                exe.display().to_string().replace('\'', r"'\''")
+            )
+        }
+        _ => cmd.to_string(),
+    }
+}
+
+/// The port, once its process has shown that it runs: one that ends within half a second (a
+/// command that is not found, a bad argument) is an error with its exit status.
+fn started(port: std::io::Result<ProcessPort>) -> Result<ProcessPort, String> {
+    let mut port = port.map_err(|e| e.to_string())?;
+    for _ in 0..25 {
+        if let Some(status) = port.exited() {
+            let why = if status.code() == Some(127) {
+                "the command was not found".to_string()
+            } else {
+                format!("it exited at once ({status})")
+            };
+            return Err(why);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Ok(port)
+}
+
 /// `bmlr conformance`.
 pub fn conformance(args: ConformanceArgs) -> ExitCode {
     let mut port: Box<dyn TestPort> = match &args.realizer {
@@ -159,7 +206,8 @@ pub fn conformance(args: ConformanceArgs) -> ExitCode {
             if incremental != *cmd {
                 eprintln!("bmlr conformance: incremental-speech tests run on '{incremental}'");
             }
-            match ProcessPort::spawn_with(cmd, &incremental) {
+            let (cmd, incremental) = (this_bmlr(cmd), this_bmlr(&incremental));
+            match started(ProcessPort::spawn_with(&cmd, &incremental)) {
                 Ok(p) => Box::new(p),
                 Err(e) => {
                     eprintln!("bmlr conformance: cannot start '{cmd}': {e}");
