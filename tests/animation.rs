@@ -1,4 +1,4 @@
-//! Motion, measured on the body the realizer moves (headless numeric tests, issue #7): a nod
+//! Motion, measured on the body the realizer moves (headless numeric tests): a nod
 //! through the whole realizer at 60 Hz.
 
 use bml_realizer::body::Skeleton;
@@ -607,7 +607,7 @@ fn assert_warned(warnings: &[String], parts: &[&str]) {
 const BMLT: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
 
 #[test]
-fn a40_a_procedural_wrist_follows_its_expression_by_ik_and_keeps_its_keys_when_stretched() {
+fn a_procedural_wrist_follows_its_expression_by_ik_and_keeps_its_keys_when_stretched() {
     // lift: keys start 0, stroke 0.5, end 1; preferred 1 s, stretched here to 2 s (max 3 s)
     let Track {
         positions: wrist,
@@ -644,7 +644,7 @@ fn a40_a_procedural_wrist_follows_its_expression_by_ik_and_keeps_its_keys_when_s
 }
 
 #[test]
-fn a58_a_procedural_unit_stretched_beyond_its_maximum_is_invalid_and_dropped() {
+fn a_procedural_unit_stretched_beyond_its_maximum_is_invalid_and_dropped() {
     // 4 s asked, the unit lasts at most 3 s
     let Track {
         positions: wrist,
@@ -674,7 +674,7 @@ fn a58_a_procedural_unit_stretched_beyond_its_maximum_is_invalid_and_dropped() {
 }
 
 #[test]
-fn a40_a_limb_frame_effector_lifts_the_foot_relative_to_the_hip() {
+fn a_limb_frame_effector_lifts_the_foot_relative_to_the_hip() {
     let skeleton = Skeleton::adult();
     let hip = skeleton.joint("l_hip").unwrap();
     let ankle = skeleton.joint("l_talocrural").unwrap();
@@ -694,7 +694,7 @@ fn a40_a_limb_frame_effector_lifts_the_foot_relative_to_the_hip() {
 }
 
 #[test]
-fn a35_a_procedural_parameter_changes_while_the_unit_runs() {
+fn a_procedural_parameter_changes_while_the_unit_runs() {
     let skeleton = Skeleton::adult();
     let wrist = skeleton.joint("r_wrist").unwrap();
     let mut r = Realizer::new();
@@ -770,7 +770,7 @@ fn noise_of_an_unknown_type_is_refused_with_the_reason() {
 }
 
 #[test]
-fn s77_a_gesture_bound_to_a_procedural_unit_takes_its_timing_and_both_hands_mirror() {
+fn a_gesture_bound_to_a_procedural_unit_takes_its_timing_and_both_hands_mirror() {
     let run = record(
         r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gesture id="g" lexeme="HELLO" mode="BOTH_HANDS" start="0.5"/></bml>"#,
         3.0,
@@ -792,7 +792,7 @@ fn s77_a_gesture_bound_to_a_procedural_unit_takes_its_timing_and_both_hands_mirr
 }
 
 #[test]
-fn a39_two_units_of_one_replacement_group_with_the_same_timing_keep_one_and_warn() {
+fn two_units_of_one_replacement_group_with_the_same_timing_keep_one_and_warn() {
     let Track {
         warnings, syncs, ..
     } = track(
@@ -812,7 +812,7 @@ fn a39_two_units_of_one_replacement_group_with_the_same_timing_keep_one_and_warn
 }
 
 #[test]
-fn a54_a_transition_starts_at_the_current_pose_and_ends_at_the_predicted_one() {
+fn a_transition_starts_at_the_current_pose_and_ends_at_the_predicted_one() {
     let skeleton = Skeleton::adult();
     let (shoulder, elbow, wrist) = (
         skeleton.joint("r_shoulder").unwrap(),
@@ -974,7 +974,7 @@ fn a_murml_keyframed_gesture_turns_its_joints_exactly_at_its_frames() {
 }
 
 #[test]
-fn a36_every_motion_behaviour_declares_the_joints_it_steers() {
+fn every_motion_behaviour_declares_the_joints_it_steers() {
     use bml_realizer::engine::timing::DefaultTimingModels;
     use bml_realizer::engine::MotionKind;
     use bml_realizer::engines::default_registry;
@@ -1046,7 +1046,7 @@ fn a36_every_motion_behaviour_declares_the_joints_it_steers() {
 }
 
 #[test]
-fn a47_a45_the_eyes_saccade_in_an_amplitude_dependent_time_then_the_head_catches_up() {
+fn the_eyes_saccade_in_an_amplitude_dependent_time_then_the_head_catches_up() {
     use bml_realizer::engines::gaze::{saccade_duration, SACCADE_PEAK_VELOCITY};
     let skeleton = Skeleton::adult();
     let target = Vec3::new(0.6, 1.2, 1.2); // bluebox
@@ -1106,7 +1106,7 @@ fn a47_a45_the_eyes_saccade_in_an_amplitude_dependent_time_then_the_head_catches
 }
 
 #[test]
-fn a47_saccades_are_affine_in_amplitude_and_never_too_fast() {
+fn saccades_are_affine_in_amplitude_and_never_too_fast() {
     use bml_realizer::engines::gaze::{saccade_duration, SACCADE_PEAK_VELOCITY};
     for deg in [1.0f64, 5.0, 10.0, 20.0, 40.0, 60.0, 90.0] {
         let a = deg.to_radians();

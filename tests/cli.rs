@@ -1,4 +1,4 @@
-//! The `bmlr` command line: exit codes and output of `validate`, `run` and `plan` (DESIGN §5).
+//! The `bmlr` command line: exit codes and output of `validate`, `run` and `plan`.
 
 use std::process::Command;
 

@@ -1,4 +1,4 @@
-//! Property tests of the difference-constraint solver under the scheduler (issue #3): on systems
+//! Property tests of the difference-constraint solver under the scheduler: on systems
 //! built from a known feasible assignment it satisfies every constraint within 1e-9, respects lower
 //! bounds, returns the least solution and ignores constraint order; an injected contradictory cycle
 //! is reported, and the reported set is itself infeasible and minimal.

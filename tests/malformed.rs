@@ -208,7 +208,7 @@ fn xml_lang_survives_a_write_parse_round_trip() {
 }
 
 #[test]
-fn r55_a_sync_may_follow_only_one_anticipator_sync() {
+fn a_sync_may_follow_only_one_anticipator_sync() {
     let src = block(
         "  <head id=\"h\" lexeme=\"NOD\" start=\"anticipators:a:x\"/>\n  <constraint><synchronize ref=\"anticipators:b:y\"><sync ref=\"h:start\"/></synchronize></constraint>",
     );

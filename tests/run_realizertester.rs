@@ -1,4 +1,4 @@
-//! The RealizerTester expectations (spec/realizertester-catalogue.md §1.7–1.10) reproduced through
+//! The RealizerTester expectations (its test classes' assertions) reproduced through
 //! `bmlr run` on the virtual clock: each test sends the catalogued files in order (sleeps become
 //! `+SECS` clock advances), reads the feedback log back and checks the catalogued assertions with
 //! their exact semantics (0.1 s for equalities, strict inequalities, subsequence order). The full

@@ -1,7 +1,7 @@
 //! The realizer runtime through its library API: the thesis' continuous-interaction scenarios that
-//! need only speech and control behaviours (spec/bml-bmlt-realizertester.md §3), robustness
+//! need only speech and control behaviours (thesis §6.5), robustness
 //! against bad input, determinism, bounded memory, characters and engines registered from outside
-//! the core (S76).
+//! the core.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -768,7 +768,7 @@ fn blocks_are_routed_to_characters_and_their_feedback_names_them() {
     assert_eq!(names, ["anna", "bob"]);
 }
 
-/// An engine written outside the crate for a kind the core does not know (S76).
+/// An engine written outside the crate for a kind the core does not know.
 struct Blinker {
     units: Vec<UnitKey>,
 }
@@ -819,7 +819,7 @@ fn a_new_kind_and_engine_register_from_outside_the_core() {
     assert!(close(s.at("b:k:end"), 1.15));
 }
 
-// ---- anticipators (S56, S57; thesis scenarios 1–3) ---------------------------------------
+// ---- anticipators (thesis scenarios 1–3) -------------------------------------------------
 
 use bml_realizer::plan::anticipator::{Metronome, Scripted};
 
@@ -939,7 +939,7 @@ fn a_prediction_that_breaks_a_behaviours_timing_drops_it_with_invalid_timing() {
     let s = beat_block(1.4);
     // the stroke followed the beat
     assert!(close(s.at("b:g1:stroke"), 1.4));
-    // the nod would have to end (1.4) before it starts (1.5): dropped before it started (S57)
+    // the nod would have to end (1.4) before it starts (1.5): dropped before it started
     assert!(!s.has_sync("b", "n1"));
     assert_eq!(s.warnings(), [("b:n1".into(), "INVALID_TIMING".into())]);
     assert!(close(s.block_time("b", "end").unwrap(), s.at("b:g1:end")));

@@ -1,5 +1,5 @@
 //! The `SortedGreedy` baseline reproduces the thesis' account of Elckerlyc's scheduler: sorting fixes
-//! Ex. 27b but not 28b or 29b (L5754–5832, L6213–6218); it rejects before/after (S47). Side by side
+//! Ex. 27b but not 28b or 29b (thesis §7.3.5); it rejects before/after. Side by side
 //! with `Optimal`, which schedules all of them.
 
 use bml_realizer::bml;
@@ -23,7 +23,7 @@ fn close(a: f64, b: f64) -> bool {
 }
 
 #[test]
-fn s43_sorting_schedules_ex27b_like_ex27a() {
+fn sorting_schedules_ex27b_like_ex27a() {
     let a = run(&SortedGreedy, "thesis/ex27a.xml");
     let b = run(&SortedGreedy, "thesis/ex27b.xml");
     assert!(

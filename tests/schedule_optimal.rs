@@ -1,5 +1,5 @@
-//! The `Optimal` strategy on the thesis examples and RealizerTester files (issue #3 acceptance
-//! timings), before/after constraints, conflicts and order invariance.
+//! The `Optimal` strategy on the thesis examples and RealizerTester files (their
+//! expected timings), before/after constraints, conflicts and order invariance.
 
 use bml_realizer::bml;
 use bml_realizer::engine::timing::DefaultTimingModels;
@@ -287,7 +287,7 @@ mod order_invariance {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
 
-        /// S85 / R19: any order of the behaviours in a block gives the same times.
+        /// any order of the behaviours in a block gives the same times.
         #[test]
         fn permuting_behaviours_gives_identical_times(file in proptest::sample::select(FILES), seed in any::<u64>()) {
             let original = bml::load(&fixture(file)).unwrap().block;

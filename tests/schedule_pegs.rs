@@ -1,6 +1,6 @@
-//! Schedules on the peg board: shared pegs for `at`-linked syncs (S11), offset pegs (S12), unnamed
-//! syncs following their behaviour (S19, S20), anticipator moves without rescheduling and the
-//! validity check after them (S56–S58), and before/after as pushing order links.
+//! Schedules on the peg board: shared pegs for `at`-linked syncs, offset pegs, unnamed
+//! syncs following their behaviour, anticipator moves without rescheduling and the
+//! validity check after them, and before/after as pushing order links.
 
 use bml_realizer::bml;
 use bml_realizer::engine::timing::DefaultTimingModels;
@@ -53,7 +53,7 @@ fn planned(
 }
 
 #[test]
-fn s11_s12_s19_thesis_example_30_on_pegs() {
+fn thesis_example_30_on_pegs() {
     let src = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/fixtures/thesis/ex30.xml"
@@ -62,13 +62,13 @@ fn s11_s12_s19_thesis_example_30_on_pegs() {
     let (mut board, mut ants) = (PegBoard::new(), Anticipators::default());
     planned(&src, &mut board, &mut ants, 10.0);
     let peg = |b: &str, s: &str| board.peg_of(&addr(b, s)).unwrap();
-    // S11: speech1:s1 = nod1:stroke share a peg; point1:start = walk1:end share another
+    // speech1:s1 = nod1:stroke share a peg; point1:start = walk1:end share another
     assert_eq!(peg("speech1", "s1"), peg("nod1", "stroke"));
     assert_eq!(peg("point1", "start"), peg("walk1", "end"));
-    // S12: point1:stroke = speech1:s1 + 0.5 is an offset peg
+    // point1:stroke = speech1:s1 + 0.5 is an offset peg
     assert_ne!(peg("point1", "stroke"), peg("speech1", "s1"));
     let s1 = board.time_of(&addr("speech1", "s1")).unwrap();
-    // S14, S19: moving the s1 peg moves everything linked to it and the unnamed syncs of its behaviours
+    // moving the s1 peg moves everything linked to it and the unnamed syncs of its behaviours
     let speech_start = board.time_of(&addr("speech1", "start")).unwrap();
     let nod_end = board.time_of(&addr("nod1", "end")).unwrap();
     board.move_to(peg("speech1", "s1"), s1 + 1.0).unwrap();
@@ -91,7 +91,7 @@ fn s11_s12_s19_thesis_example_30_on_pegs() {
 }
 
 #[test]
-fn s20_a_behaviour_no_constraint_names_gets_its_own_peg() {
+fn a_behaviour_no_constraint_names_gets_its_own_peg() {
     let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1"><head id="nod1" lexeme="NOD"/><gesture id="g1" lexeme="BEAT"/></bml>"#;
     let (mut board, mut ants) = (PegBoard::new(), Anticipators::default());
     planned(src, &mut board, &mut ants, 0.0);
@@ -112,7 +112,7 @@ fn s20_a_behaviour_no_constraint_names_gets_its_own_peg() {
 }
 
 #[test]
-fn s56_s57_s58_anticipator_moves_retime_without_rescheduling_and_invalidate() {
+fn anticipator_moves_retime_without_rescheduling_and_invalidate() {
     let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1">
         <head id="nod1" lexeme="NOD" start="anticipators:beat:b1"/>
         <gesture id="g1" lexeme="BEAT" start="nod1:end"/></bml>"#;
@@ -153,7 +153,7 @@ fn after_constraints_become_order_links_that_push() {
 }
 
 #[test]
-fn s60_cluster_constraint_violations_after_moves_are_tolerated() {
+fn cluster_constraint_violations_after_moves_are_tolerated() {
     // the gesture's cluster starts at block start; after the anticipator moves the speech later,
     // the gesture no longer starts "as early as possible", which is accepted, not reported
     let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1">

@@ -1,4 +1,4 @@
-//! Random blocks built around a known feasible timing (issue #3 acceptance): the `Optimal`
+//! Random blocks built around a known feasible timing: the `Optimal`
 //! strategy schedules every behaviour, satisfies every constraint within 1e-6, places nothing
 //! before the block start, keeps each behaviour's sync order, and gives identical times for any
 //! order of the behaviours.

@@ -1,4 +1,5 @@
-//! Constraint semantics S1–S10 of spec/scheduling-architecture.md §6, one test each, with the
+//! The semantics of each kind of constraint (at, before, after, absolute and relative, offsets,
+//! ungrounded clusters, anticipators), one test each, with the
 //! `Optimal` strategy and the default timing models.
 
 use bml_realizer::bml::{self, SyncPoint};
@@ -29,7 +30,7 @@ const SAMPLE: &str = r#"<speech id="s1" start="1"><text>Look <sync id="w"/>here,
     <faceLexeme id="f1" lexeme="RAISE_BROWS" attackPeak="s1:w" end="s1:end"/>"#;
 
 #[test]
-fn s1_every_sync_of_every_behaviour_has_a_time() {
+fn every_sync_of_every_behaviour_has_a_time() {
     let s = run(&block(SAMPLE));
     assert_eq!(s.behaviours.len(), 4);
     for b in &s.behaviours {
@@ -44,20 +45,20 @@ fn s1_every_sync_of_every_behaviour_has_a_time() {
 }
 
 #[test]
-fn s2_absolute_at_is_block_start_plus_offset() {
+fn absolute_at_is_block_start_plus_offset() {
     let s = run(&block(r#"<head id="h" lexeme="NOD" stroke="2.5"/>"#));
     assert_eq!(s.time("h", "stroke"), Some(2.5));
 }
 
 #[test]
-fn s3_relative_at_with_offset_means_time_plus_offset() {
+fn relative_at_with_offset_means_time_plus_offset() {
     let s = run(&block(SAMPLE));
     let (w, stroke) = (s.time("s1", "w").unwrap(), s.time("g1", "stroke").unwrap());
     assert!((stroke - (w + 0.25)).abs() < 1e-9);
 }
 
 #[test]
-fn s4_no_sync_before_block_start() {
+fn no_sync_before_block_start() {
     // the gesture's preparation would start before the block if the stroke were at 0.1
     let s = run(&block(
         r#"<speech id="s1"><text>Hi <sync id="w"/>you</text></speech><gesture id="g1" lexeme="BEAT" stroke="s1:w"/>"#,
@@ -73,7 +74,7 @@ fn s4_no_sync_before_block_start() {
 }
 
 #[test]
-fn s5_end_strictly_after_start() {
+fn end_strictly_after_start() {
     // asked to squeeze a nod into zero time it still ends after it starts
     let s = run(&block(
         r#"<head id="h" lexeme="NOD" start="1" end="1.00001"/>"#,
@@ -82,7 +83,7 @@ fn s5_end_strictly_after_start() {
 }
 
 #[test]
-fn s6_default_sync_points_are_in_order() {
+fn default_sync_points_are_in_order() {
     let s = run(&block(SAMPLE));
     for b in &s.behaviours {
         assert!(
@@ -95,7 +96,7 @@ fn s6_default_sync_points_are_in_order() {
 }
 
 #[test]
-fn s7_custom_syncs_lie_between_start_and_end() {
+fn custom_syncs_lie_between_start_and_end() {
     let s = run(&block(SAMPLE));
     let (start, w, end) = (
         s.time("s1", "start").unwrap(),
@@ -106,7 +107,7 @@ fn s7_custom_syncs_lie_between_start_and_end() {
 }
 
 #[test]
-fn s8_a_persistent_behaviour_has_an_infinite_end() {
+fn a_persistent_behaviour_has_an_infinite_end() {
     let s = run(&block(
         r#"<bmlt:controller id="c" class="Balance" start="1"/>"#,
     ));
@@ -122,7 +123,7 @@ impl ExternalTimes for Predicted {
 }
 
 #[test]
-fn s9_anticipator_at_is_prediction_plus_offset() {
+fn anticipator_at_is_prediction_plus_offset() {
     let s = run_with(
         &block(r#"<head id="h" lexeme="NOD" stroke="anticipators:beat:b1+0.5"/>"#),
         &Predicted(3.0),
@@ -131,7 +132,7 @@ fn s9_anticipator_at_is_prediction_plus_offset() {
 }
 
 #[test]
-fn s10_linking_a_sync_to_two_anticipator_syncs_is_rejected() {
+fn linking_a_sync_to_two_anticipator_syncs_is_rejected() {
     let src = block(
         r#"<head id="h" lexeme="NOD" stroke="anticipators:beat:b1"/><constraint><synchronize ref="anticipators:clap:c1"><sync ref="h:stroke"/></synchronize></constraint>"#,
     );

@@ -52,10 +52,17 @@ fn render(svg: &Path) -> (u32, u32) {
     };
     let mut lanes = 0;
     for line in text.lines().filter(|l| l.contains(r#"stroke-width="3""#)) {
-        let (x, y) = ((attr(line, "x1") + attr(line, "x2")) / 2.0, attr(line, "y1"));
+        let (x, y) = (
+            (attr(line, "x1") + attr(line, "x2")) / 2.0,
+            attr(line, "y1"),
+        );
         let px = pixmap.pixel(x as u32, y as u32).unwrap();
         let white = px.red() > 240 && px.green() > 240 && px.blue() > 240;
-        assert!(!white, "{}: the lane at ({x}, {y}) is not drawn", svg.display());
+        assert!(
+            !white,
+            "{}: the lane at ({x}, {y}) is not drawn",
+            svg.display()
+        );
         lanes += 1;
     }
     assert!(lanes > 0, "{}: no lanes", svg.display());

@@ -1,4 +1,4 @@
-//! The RealizerTester conformance suite (thesis ch. 9; spec/realizertester-catalogue.md §1), as a
+//! The RealizerTester conformance suite (thesis ch. 9), as a
 //! reusable crate that knows nothing of any particular realizer:
 //!
 //! - [`record`]: the feedback recorder — the five arrival-ordered lists of the original handler,

@@ -1,5 +1,5 @@
 //! The 41 RealizerTester tests, each with the catalogued files, order, waits and assertions
-//! (spec/realizertester-catalogue.md §1.7–1.10 and the incremental-speech fixture), and the runner
+//! (those of the original Java test classes and the incremental-speech fixture), and the runner
 //! that resets the realizer before each one.
 
 use crate::check::{Check, Failure};

@@ -1,6 +1,5 @@
 //! Anticipators at run time: registering them, polling their predictions, and blocks that hang on
-//! them following their pegs without rescheduling (S56), losing behaviours whose timing broke
-//! (S57).
+//! them following their pegs without rescheduling, losing behaviours whose timing broke.
 
 use super::live::Phase;
 use super::BlockManager;

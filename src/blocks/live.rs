@@ -114,7 +114,7 @@ pub(crate) struct LiveBlock {
     /// Waiting for an activation.
     pub(crate) preplan: bool,
     /// The block's own peg board, for blocks tied to anticipators: moving an anticipator's peg
-    /// retimes what hangs on it (S56). Boxed: few blocks have one, and every block is kept.
+    /// retimes what hangs on it. Boxed: few blocks have one, and every block is kept.
     pub(crate) pegs: Option<Box<BlockPegs>>,
     /// An interrupt behaviour cut some of its behaviours: it ends INTERRUPTED, not DONE.
     pub(crate) cut: bool,
@@ -228,7 +228,7 @@ impl LiveBlock {
         }
     }
 
-    /// R33: behaviours of one exclusive group (gaze, posture) with the same start and end cannot
+    /// behaviours of one exclusive group (gaze, posture) with the same start and end cannot
     /// both run; all but the first in document order leave the plan. Returns (id, reason) of each.
     pub(crate) fn resolve_exclusive_ties(&mut self, registry: &Registry) -> Vec<(bml::Id, String)> {
         let mut dropped = Vec::new();
@@ -293,7 +293,7 @@ impl LiveBlock {
         Some(self.start + t)
     }
 
-    /// Every behaviour still in the plan has ended (S31).
+    /// Every behaviour still in the plan has ended.
     pub(crate) fn all_ended(&self) -> bool {
         self.behaviours
             .iter()

@@ -1,8 +1,8 @@
 //! Blocks at run time for one character: the lifecycle state machine (IN_PREP → PENDING | LURKING →
-//! IN_EXEC → SUBSIDING → DONE, ending INTERRUPTED or REVOKED; S23–S39), composition (MERGE, APPEND,
+//! IN_EXEC → SUBSIDING → DONE, ending INTERRUPTED or REVOKED), composition (MERGE, APPEND,
 //! REPLACE, APPEND-AFTER) and the BMLA block attributes (interrupt, onStart, preplan, appendAfter,
 //! chunkAfter, chunkBefore, prependBefore), the event loop that passes sync points at their exact
-//! times, the control actions of engines, and the feedback of DESIGN §4.
+//! times, the control actions of engines, and the feedback of docs/cli.md.
 //!
 //! Time is the host's: [`BlockManager::submit`] happens at the manager's current time and
 //! [`BlockManager::advance`] moves it forward, processing every event up to the new time in time
@@ -317,7 +317,7 @@ impl BlockManager {
     }
 
     // ---------------------------------------------------------------------------------------
-    // submitting a block (S23–S27, S34–S38)
+    // submitting a block
 
     /// Reports what of an accepted block will not be interpreted: extension attributes that no
     /// engine reads (CUSTOM_ATTRIBUTE_NOT_SUPPORTED) and extension content the parser ignored.
@@ -403,7 +403,7 @@ impl BlockManager {
         }
         self.hold_starts = false;
         self.start_ready(now);
-        // S36, S37: blocks this one waits for
+        // blocks this one waits for
         let mut waits_for: Vec<bml::Id> = match &block.composition {
             bml::Composition::Append => self
                 .blocks
@@ -441,7 +441,7 @@ impl BlockManager {
             }
         }
 
-        // S24: scheduling starts
+        // scheduling starts
         self.seq += 1;
         let mut live = LiveBlock::new(block, self.seq, start, waits_for, chunk_after);
         let fb = self.prediction(&live, false);
@@ -479,7 +479,7 @@ impl BlockManager {
             Vec::new()
         };
         if !refs.is_empty() {
-            // its own peg board: anticipator moves retime it without rescheduling (S56)
+            // its own peg board: anticipator moves retime it without rescheduling
             let (mut board, mut anticipators) = (PegBoard::new(), Anticipators::default());
             for (a, sync) in refs {
                 let predicted = self
@@ -539,7 +539,7 @@ impl BlockManager {
                 }
             }
         }
-        // S26, S27
+        // scheduled: PENDING, and pre-planned blocks wait for an activation
         let preplan = ext.preplan;
         live.status = BlockStatus::Pending;
         live.preplan = preplan;
@@ -627,7 +627,7 @@ impl BlockManager {
         self.predict(i, false);
     }
 
-    /// S29: every append target is done and every chunk target subsiding or done.
+    /// every append target is done and every chunk target subsiding or done.
     fn ready(&self, i: usize) -> bool {
         let b = &self.blocks[i];
         let live = |id: &bml::Id| self.pos(id).map(|i| &self.blocks[i]);
@@ -651,7 +651,7 @@ impl BlockManager {
         }
     }
 
-    /// S30: the block peg moves to `t`, start feedback, onStart activations, units to engines.
+    /// the block peg moves to `t`, start feedback, onStart activations, units to engines.
     fn start_block(&mut self, i: usize, t: f64) {
         if self.blocks[i].status == BlockStatus::Lurking {
             self.lurking -= 1;
@@ -770,7 +770,7 @@ impl BlockManager {
         }
     }
 
-    /// Activates pre-planned block `target` (by `activate` or onStart, S28).
+    /// Activates pre-planned block `target` (by `activate` or onStart).
     fn activate(&mut self, target: &str, t: f64, by: &str) {
         match self.pos(target) {
             Some(j) if self.blocks[j].status == BlockStatus::Pending => {
@@ -787,7 +787,7 @@ impl BlockManager {
         }
     }
 
-    /// Ends block `i` with DONE if every behaviour still in its plan has ended (S31).
+    /// Ends block `i` with DONE if every behaviour still in its plan has ended.
     fn finish_if_done(&mut self, i: usize, t: f64) -> bool {
         if !self.blocks[i].all_ended() {
             return false;
@@ -836,7 +836,7 @@ impl BlockManager {
     }
 
     // ---------------------------------------------------------------------------------------
-    // interruption (S32, S33)
+    // interruption
 
     /// The live block `target` of an interrupt by `by`. A block that finished a moment ago is a
     /// quiet no-op; one that never existed gets a NO_SUCH_TARGET warning.
@@ -1074,7 +1074,7 @@ impl BlockManager {
     }
 
     /// Gives every engine that asks for them the poses the predictable units will have at the
-    /// times it names (A43, A54).
+    /// times it names.
     fn predict_poses(&mut self, now: f64) {
         for i in 0..self.registry.len() {
             let times = self.registry.engine(i).prediction_times(now);
@@ -1161,7 +1161,7 @@ impl BlockManager {
                     return;
                 };
                 if c.initial.is_none() {
-                    // S64: start from the target's current value
+                    // start from the target's current value
                     c.initial = self.registry.engine(engine).parameter(&c.target, &c.param);
                     if c.initial.is_none() {
                         self.warn(
@@ -1179,7 +1179,7 @@ impl BlockManager {
     }
 
     /// Sets every running parameter change's value at `t`; changes past their end are done (the
-    /// value stays, S65).
+    /// value stays).
     fn apply_changes(&mut self, t: f64) {
         if !self.changes.is_empty() {
             self.touch(); // a change may retime its target

@@ -1,4 +1,4 @@
-//! Facts about each behaviour kind: its element name and namespace, its sync points (DESIGN §3),
+//! Facts about each behaviour kind: its element name and namespace, its sync points,
 //! and whether its sync points are open (defined by animation data rather than by BML).
 
 use super::model::{Behaviour, BehaviourKind, NS_BML, NS_BMLA, NS_BMLT, NS_CORE_EXT};

@@ -43,7 +43,7 @@ pub enum SyncPoint {
         /// Sync point id.
         sync: Id,
     },
-    /// `anticipators:id:sync` — a predicted time of an anticipator (R10).
+    /// `anticipators:id:sync` — a predicted time of an anticipator.
     Anticipator {
         /// Anticipator id.
         anticipator: Id,

@@ -94,7 +94,7 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
             }
         }
     }
-    // R55 / S10: a sync point may be at-linked to at most one anticipator sync (checked only when
+    // a sync point may be at-linked to at most one anticipator sync (checked only when
     // the block names an anticipator, to keep validation allocation-free otherwise)
     let anticipator = |r: &SyncRef| {
         matches!(

@@ -1,4 +1,4 @@
-//! Analytic two-link inverse kinematics (A40): where to put the middle joint (elbow, knee) so that
+//! Analytic two-link inverse kinematics: where to put the middle joint (elbow, knee) so that
 //! the end of the second link (wrist, ankle) reaches a target, bending toward a pole direction.
 
 use glam::{Quat, Vec3};

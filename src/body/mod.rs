@@ -1,7 +1,6 @@
 //! The body: an H-Anim skeleton ([`skeleton`]), poses with forward kinematics ([`pose`]) and BVH
 //! export ([`bvh`]), and two-link inverse kinematics ([`ik`]).
-//! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians
-//! (A1, A2).
+//! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians.
 
 pub mod bvh;
 pub mod ik;

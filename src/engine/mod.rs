@@ -1,5 +1,5 @@
-//! The engine layer: what an engine is to the realizer (the `Engine` trait, S75), the registry that
-//! maps behaviour kinds to engines (S76), and what engines produce (actions for the runtime, frame
+//! The engine layer: what an engine is to the realizer (the `Engine` trait), the registry that
+//! maps behaviour kinds to engines, and what engines produce (actions for the runtime, frame
 //! output). Timing models, the scheduler's view of an engine, are in [`timing`].
 
 mod registry;
@@ -42,7 +42,7 @@ impl fmt::Display for UnitKey {
     }
 }
 
-/// How a motion unit moves its joints (A36).
+/// How a motion unit moves its joints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MotionKind {
     /// It sets or changes joint rotations directly.
@@ -51,7 +51,7 @@ pub enum MotionKind {
     Physical,
 }
 
-/// What a motion unit steers (A36): its joints, how, and whether it layers over other units.
+/// What a motion unit steers: its joints, how, and whether it layers over other units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Steering {
     /// Joints whose rotation it sets or changes (the root joint also for its translation), in
@@ -157,16 +157,16 @@ pub struct Unit<'a> {
     pub world: &'a World,
 }
 
-/// A change of a parameter of a running behaviour over time (BMLA `parametervaluechange`, S63–S65).
+/// A change of a parameter of a running behaviour over time (BMLA `parametervaluechange`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParameterChange {
     /// The behaviour whose parameter changes.
     pub target: UnitKey,
     /// Parameter name, e.g. `volume`.
     pub param: String,
-    /// Start value; `None` reads the target's value when the change starts (S64).
+    /// Start value; `None` reads the target's value when the change starts.
     pub initial: Option<f64>,
-    /// Value reached at `end` and held afterwards (S65).
+    /// Value reached at `end` and held afterwards.
     pub target_value: f64,
     /// Linear or instant.
     pub kind: TrajectoryType,
@@ -179,7 +179,7 @@ pub struct ParameterChange {
 }
 
 impl ParameterChange {
-    /// The value at global time `t` starting from `from` (S63): linear or instant, held after `end`.
+    /// The value at global time `t` starting from `from`: linear or instant, held after `end`.
     pub fn value_at(&self, from: f64, t: f64) -> f64 {
         match self.kind {
             TrajectoryType::Instant => self.target_value,
@@ -262,7 +262,7 @@ pub struct Frame {
 #[error("{0}")]
 pub struct EngineError(pub String);
 
-/// An engine realizes the behaviour kinds it is registered for (S75). The runtime tells it which
+/// An engine realizes the behaviour kinds it is registered for. The runtime tells it which
 /// units to play and when their sync points pass; it answers with timing models, interruption
 /// timing, parameters, frame output and actions.
 pub trait Engine {
@@ -272,7 +272,7 @@ pub trait Engine {
     /// The timing model of `behaviour`, or `None` if this engine cannot realize it.
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel>;
 
-    /// Behaviours of the same exclusive group cannot run at once (R33: gaze, posture; A39: the
+    /// Behaviours of the same exclusive group cannot run at once (gaze, posture; the
     /// replacement groups of procedural units).
     fn exclusive_group(&self, _behaviour: &Behaviour) -> Option<&str> {
         None
@@ -316,7 +316,7 @@ pub trait Engine {
         relax_now(now, syncs)
     }
 
-    /// Whether `behaviour` can be realized with these sync times (S58, S59): the default checks
+    /// Whether `behaviour` can be realized with these sync times: the default checks
     /// them against the engine's timing model — sync order, a duration within the model's bounds,
     /// a rigid behaviour's internal distances. Called when pegs move without rescheduling.
     fn check_timing(&self, behaviour: &Behaviour, syncs: &[(SyncName, f64)]) -> Result<(), String> {
@@ -326,7 +326,7 @@ pub trait Engine {
         }
     }
 
-    /// The unit's sync times moved (an anticipator's prediction changed, S56): new global times,
+    /// The unit's sync times moved (an anticipator's prediction changed): new global times,
     /// in sync order. Passed syncs keep theirs.
     fn retime(&mut self, _key: &UnitKey, _syncs: &[(SyncName, f64)]) {}
 
@@ -346,13 +346,13 @@ pub trait Engine {
     /// default.
     fn animate(&mut self, _now: f64, _skeleton: &Skeleton, _world: &World, _pose: &mut Pose) {}
 
-    /// The joints a unit for `behaviour` steers on `skeleton`, how, and whether additively (A36);
+    /// The joints a unit for `behaviour` steers on `skeleton`, how, and whether additively;
     /// `None` for behaviours that move no joints.
     fn steers(&self, _behaviour: &Behaviour, _skeleton: &Skeleton) -> Option<Steering> {
         None
     }
 
-    /// The animation predictor's part (A43, A54): writes what this engine's *predictable* units
+    /// The animation predictor's part: writes what this engine's *predictable* units
     /// (whose motion is a function of time alone, such as keyframes and procedural units) will
     /// have set at global time `t` into `pose`, without changing any state. Returns whether any
     /// of its units is running then. Engines whose motion depends on the world or on the past
@@ -362,7 +362,7 @@ pub trait Engine {
     }
 
     /// Global times at which this engine needs the predicted pose for its frame at `now` (a
-    /// transition's end, A54); the runtime then calls [`predicted`](Engine::predicted) before
+    /// transition's end); the runtime then calls [`predicted`](Engine::predicted) before
     /// [`animate`](Engine::animate).
     fn prediction_times(&self, _now: f64) -> Vec<f64> {
         Vec::new()

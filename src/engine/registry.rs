@@ -1,6 +1,6 @@
 //! The engine registry: behaviour kind (namespace + element name) → engine. One engine may serve
 //! several kinds; registering a kind again hands it to the newer engine. New kinds and engines
-//! register from outside the core (S76).
+//! register from outside the core.
 
 use super::timing::{TimingModel, TimingModels};
 use super::Engine;

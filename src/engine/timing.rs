@@ -262,7 +262,7 @@ pub struct SpeechTiming {
     pub sentence_pause: f64,
     /// An incremental TTS that can change its speaking rate (AsapRealizer's incremental speech):
     /// speech is stretchable between 1/[`RETIME_RANGE`] and [`RETIME_RANGE`] times its preferred
-    /// length instead of rigid. Off by default: a TTS decides its timing (DESIGN §3).
+    /// length instead of rigid. Off by default: a TTS decides its timing.
     pub retimable: bool,
 }
 
@@ -612,7 +612,7 @@ impl TimingModels for DefaultTimingModels {
             BehaviourKind::Interrupt(_) | BehaviourKind::Activate(_) => {
                 TimingModel::new(&[("start", 0.0), ("end", INSTANT)], Flexibility::Rigid)
             }
-            // instant unless its end is constrained: then the change spans start to end (S63)
+            // instant unless its end is constrained: then the change spans start to end
             BehaviourKind::ParameterValueChange(_) => se(INSTANT),
             BehaviourKind::AudioFile { .. } => {
                 // the file's length decides; until the audio engine reads it, one second
@@ -752,7 +752,7 @@ mod tests {
     }
 
     #[test]
-    fn s58_s59_timing_models_admit_only_ordered_times_within_their_bounds() {
+    fn timing_models_admit_only_ordered_times_within_their_bounds() {
         let syncs = |v: &[(&'static str, f64)]| -> Vec<(crate::bml::Id, f64)> {
             v.iter()
                 .map(|&(n, t)| (crate::bml::Id::new_static(n), t))

@@ -1,6 +1,6 @@
 //! The control engine: `wait` (holds its block open), BMLA/BMLT `interrupt` and `activate` (act on
 //! blocks when their `start` passes) and `parametervaluechange` (starts a parameter trajectory on
-//! another behaviour, S63–S65). It moves nothing; its work is the actions it hands the runtime.
+//! another behaviour). It moves nothing; its work is the actions it hands the runtime.
 
 use std::collections::HashMap;
 

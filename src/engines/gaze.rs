@@ -1,5 +1,5 @@
 //! The gaze engine: `gaze` and `gazeShift` as real motion of eyes, neck and trunk toward a named
-//! point of the [`World`] (A44–A47).
+//! point of the [`World`].
 //!
 //! - The aim is a yaw (about +y, toward the character's left) and a pitch (about +x, down) from the
 //!   point between the eyes to the target, recomputed every frame, so moving targets are tracked.
@@ -11,12 +11,12 @@
 //!   (vergence), within ±35° yaw and ±30° pitch.
 //! - Timing: from `start` to `ready` the aim moves from the rest aim to the target along a
 //!   minimum-jerk profile (single-peaked velocity). The eyes lead with a saccade whose duration is
-//!   affine in its amplitude (21 ms + 3.8 ms per degree, A47: the slope that keeps the symmetric
+//!   affine in its amplitude (21 ms + 3.8 ms per degree, the slope that keeps the symmetric
 //!   profile's peak velocity below 8.7 rad/s at any amplitude), and then stay on the target while
-//!   the head catches up (the eye-in-head angle shrinks: A45); it holds
+//!   the head catches up (the eye-in-head angle shrinks); it holds
 //!   until `relax`, then returns to the rest aim by `end`. A `gazeShift` moves over its whole span
 //!   and makes its target the new rest aim, kept after it ends (`engines::motion`).
-//! - Of several gazes running at once the one that started last wins (R33).
+//! - Of several gazes running at once the one that started last wins.
 //! - `offsetAngle` in `offsetDirection` turns the aim away from the target (LEFT, RIGHT, UP, DOWN
 //!   and the diagonals; POLAR gives no offset).
 //! - A target the world does not have is refused when the behaviour starts (the runtime reports
@@ -32,16 +32,16 @@ use crate::engines::motion::{at, envelope, finished_shift};
 use crate::schedule::SyncName;
 use crate::world::World;
 
-/// Saccade duration at zero amplitude (seconds), A47.
+/// Saccade duration at zero amplitude (seconds).
 pub const SACCADE_BASE: f64 = 0.021;
-/// The eyes' peak angular velocity never exceeds this (rad/s), A47.
+/// The eyes' peak angular velocity never exceeds this (rad/s).
 pub const SACCADE_PEAK_VELOCITY: f64 = 8.7;
 /// Saccade duration per radian of amplitude (seconds; 3.8 ms per degree): the least slope for
 /// which the symmetric minimum-jerk profile, whose peak velocity is 1.875 × amplitude /
 /// duration, stays below [`SACCADE_PEAK_VELOCITY`] at every amplitude.
 pub const SACCADE_PER_RADIAN: f64 = 1.875 / SACCADE_PEAK_VELOCITY;
 
-/// How long a saccade of `amplitude` radians takes: affine in the amplitude (A47).
+/// How long a saccade of `amplitude` radians takes: affine in the amplitude.
 pub fn saccade_duration(amplitude: f64) -> f64 {
     SACCADE_BASE + SACCADE_PER_RADIAN * amplitude.abs()
 }
@@ -258,7 +258,7 @@ impl Engine for GazeEngine {
                 .get(target)
                 .map_or(0.0, |p| f64::from(from.angle_between(p - eyes)))
         };
-        // the gaze that started last wins (R33); ties go to the one that ends first
+        // the gaze that started last wins; ties go to the one that ends first
         let active = self
             .units
             .all()

@@ -1,4 +1,4 @@
-//! The gesture engine: `gesture` lexemes as arm motion defined by data (S77). A bindings file
+//! The gesture engine: `gesture` lexemes as arm motion defined by data. A bindings file
 //! (`fixtures/bindings/gestures.json`, embedded as the default lexicon) gives for each lexeme the
 //! right arm's local joint rotations at some of the gesture's sync points (Z, X, Y Euler degrees).
 //! The arm is at those rotations exactly at those syncs, slerps between them, moves from where it
@@ -36,7 +36,7 @@ pub enum Bound {
     Procedural(Arc<ProcUnit>, Vec<(String, f64)>),
 }
 
-/// One binding (S77): a lexeme, an attribute filter, and what it plays.
+/// One binding: a lexeme, an attribute filter, and what it plays.
 #[derive(Debug, Clone)]
 struct Binding {
     lexeme: String,
@@ -535,7 +535,7 @@ mod tests {
     }
 
     #[test]
-    fn s77_bindings_pick_by_lexeme_and_attribute_filter_in_file_order() {
+    fn bindings_pick_by_lexeme_and_attribute_filter_in_file_order() {
         let l = Lexicon::from_json(
             r#"{"gestures": [
                 {"lexeme": "B", "when": {"mode": "LEFT_HAND"}, "procedural": "lift"},

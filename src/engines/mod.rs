@@ -17,7 +17,7 @@
 //! - [`posture`]: posture stances (standing, sitting, crouching, lying) as leg and root motion;
 //! - [`procedural`]: BMLT procanimation(gesture) as procedural units from data (expressions, IK);
 //! - [`noise`]: BMLT Perlin noise on a joint, added on top of the other engines;
-//! - [`transition`]: BMLT transitions from the current pose to the predicted one (A54).
+//! - [`transition`]: BMLT transitions from the current pose to the predicted one.
 
 pub mod assets;
 pub mod control;

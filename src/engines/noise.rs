@@ -13,7 +13,7 @@
 //! octaves, fading in and out over `fade` seconds (minimum jerk) so that the joint never jumps.
 //! Parameters (defaults): `basefreqx/y/z` (1 Hz), `baseamplitudex/y/z` (2°, 2°, 0°),
 //! `persistence` (0.5), `octaves` (2), `fade` (0.3 s); they can change while it runs. The only
-//! `type` is `perlin`. Noise has no natural end (A59): without a constrained end it runs until
+//! `type` is `perlin`. Noise has no natural end: without a constrained end it runs until
 //! its block is interrupted or replaced.
 
 use glam::{EulerRot, Quat};

@@ -5,7 +5,7 @@
 //! to its stance from `start` to `ready` (minimum jerk), holds it until `relax` and returns to the
 //! rest stance by `end`; a `postureShift` moves over its whole span and its stance becomes the rest
 //! stance, kept after it ends. Of several postures running at once the one that started last wins
-//! (R33). `<pose part lexeme>` children hold a part of the body in a pose bound in
+//!. `<pose part lexeme>` children hold a part of the body in a pose bound in
 //! `fixtures/bindings/poses.json` to a procedural unit (arms akimbo, crossed or hanging, legs
 //! spread, head tilted; mirrored for the other side), eased in and out with the stance; a pose
 //! the bindings lack refuses the posture, naming the poses there are.

@@ -1,4 +1,4 @@
-//! Procedural motion units from data (A37, A40–A42): joint rotations and end-effector positions
+//! Procedural motion units from data: joint rotations and end-effector positions
 //! given as expressions in the unit's canonical time α ∈ [0, 1] and named parameters, compiled
 //! once (the `fasteval` crate) and evaluated every frame.
 //!
@@ -23,17 +23,17 @@
 //! continuity, bias, s)` (Kochanek–Bartels between `p1` and `p2`) and `perlin(x)` / `perlin(x,
 //! seed)` (1-D gradient noise in [−1, 1], zero at integers).
 //!
-//! A unit may also declare a replacement `group` (A39: of the running units of a group only the
+//! A unit may also declare a replacement `group` (of the running units of a group only the
 //! one with the latest start plays, ties going to the earliest end; units of one block with the
-//! same start and end leave one and a warning, R33), that it is `additive` (its rotations add to
+//! same start and end leave one and a warning), that it is `additive` (its rotations add to
 //! what the joints have: a layer, e.g. a sway over a posture) and a `blend` time (it eases in
 //! from what the joints have after its start and back out before its end; otherwise it replaces
 //! the joints it sets).
 //!
-//! Time is warped linearly between keys (A37): at each key's scheduled time α is exactly the key's
+//! Time is warped linearly between keys: at each key's scheduled time α is exactly the key's
 //! α. Effector `frame` is `body` (the character's space, as [`Pose::world`] gives it) or `limb`
 //! (relative to the limb's root joint: the shoulder for a wrist, the hip for an ankle). A mirrored
-//! unit (A42) swaps left and right joints first, then reflects every rotation and position in the
+//! unit swaps left and right joints first, then reflects every rotation and position in the
 //! body's mid-sagittal plane (x ↦ −x); mirroring twice gives the unit back.
 //!
 //! The [`ProceduralEngine`] realizes BMLT `procanimation` and `procanimationgesture` with units of
@@ -202,7 +202,7 @@ pub struct ProcUnit {
     pub additive: bool,
     /// Seconds over which it blends in after its start and out before its end (0: none).
     pub blend: f64,
-    /// Its replacement group (A39): of the running units of a group, only the one with the
+    /// Its replacement group: of the running units of a group, only the one with the
     /// latest start plays (ties: the earliest end).
     pub group: Option<String>,
     rotations: Vec<(String, [Expr; 3])>,
@@ -439,7 +439,7 @@ impl ProcUnit {
 
     /// Plays a run timed by `syncs` (its keys' global times) at `t` on `sides` (`false` as
     /// authored, `true` mirrored): nothing outside `start..=end` (the end frame shows α = 1),
-    /// else α from the keys (A37) and the blend weight. Returns whether it was active. An
+    /// else α from the keys and the blend weight. Returns whether it was active. An
     /// expression that fails at run time (a division by zero) leaves the pose as it is: the
     /// parameters were checked when the unit was added and on every change.
     pub fn play(
@@ -468,7 +468,7 @@ impl ProcUnit {
     /// Applies the unit at `alpha` with `weight` to `pose`: rotations first, then effectors by
     /// IK. A weight below 1 slerps from what the joints have toward the unit's rotations (for an
     /// additive unit: from none of its rotation); `mirrored` swaps left and right and reflects in
-    /// the mid-sagittal plane (A42).
+    /// the mid-sagittal plane.
     pub fn apply(
         &self,
         alpha: f64,
@@ -575,7 +575,7 @@ fn reach(
     Some(([root, mid], rotations))
 }
 
-/// α at global time `t` for a unit whose keys are at `syncs` (linear warping between keys, A37):
+/// α at global time `t` for a unit whose keys are at `syncs` (linear warping between keys):
 /// exactly each key's α at its time, monotone in between, clamped to [0, 1].
 pub fn alpha_at(keys: &[(Id, f64)], syncs: &[(SyncName, f64)], t: f64) -> f64 {
     let mut prev: Option<(f64, f64)> = None;
@@ -773,7 +773,7 @@ impl Engine for ProceduralEngine {
     }
 
     fn predict(&self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) -> bool {
-        // active from start to end (A38); the end frame shows α = 1
+        // active from start to end; the end frame shows α = 1
         let active: Vec<(&SyncTimes, &Running, f64, f64)> = self
             .units
             .all()
@@ -783,7 +783,7 @@ impl Engine for ProceduralEngine {
             })
             .collect();
         for (i, &(syncs, r, start, end)) in active.iter().enumerate() {
-            // A39: in a replacement group the latest start plays; ties go to the earliest end,
+            // in a replacement group the latest start plays; ties go to the earliest end,
             // then to the unit added first
             let replaced = r.unit.group.as_ref().is_some_and(|g| {
                 active.iter().enumerate().any(|(k, &(_, o, s, e))| {
@@ -810,7 +810,7 @@ mod tests {
     }
 
     #[test]
-    fn a37_time_warps_linearly_and_hits_every_key_exactly() {
+    fn time_warps_linearly_and_hits_every_key_exactly() {
         let keys = ids(&[("start", 0.0), ("stroke", 0.4), ("end", 1.0)]);
         let syncs = ids(&[("start", 2.0), ("stroke", 2.3), ("end", 4.0)]);
         for (k, s) in keys.iter().zip(&syncs) {
@@ -827,7 +827,7 @@ mod tests {
     }
 
     #[test]
-    fn a41_macros_match_their_definitions() {
+    fn macros_match_their_definitions() {
         // Hermite: ends and end tangents
         assert_eq!(hermite(1.0, 3.0, 0.5, -2.0, 0.0), 1.0);
         assert_eq!(hermite(1.0, 3.0, 0.5, -2.0, 1.0), 3.0);
@@ -858,7 +858,7 @@ mod tests {
     }
 
     #[test]
-    fn a41_expressions_have_trig_if_parameters_and_alpha() {
+    fn expressions_have_trig_if_parameters_and_alpha() {
         let e = Expr::compile("if(t < 0.5, a * sin(pi * t), cos(pi) + max(a, 2)) + alpha").unwrap();
         let params = [("a".to_string(), 3.0)];
         let at = |t: f64| {
@@ -893,7 +893,7 @@ mod tests {
     }
 
     #[test]
-    fn a42_a_mirrored_unit_is_the_reflected_motion_on_the_other_side_and_mirrors_back() {
+    fn a_mirrored_unit_is_the_reflected_motion_on_the_other_side_and_mirrors_back() {
         let skeleton = Skeleton::adult();
         let lib = Library::default_library();
         let reflect = |v: Vec3| Vec3::new(-v.x, v.y, v.z);
@@ -972,7 +972,7 @@ mod tests {
     }}"#;
 
     #[test]
-    fn a39_in_a_replacement_group_the_latest_start_plays_then_the_earliest_end() {
+    fn in_a_replacement_group_the_latest_start_plays_then_the_earliest_end() {
         // b starts later: from its start it replaces a
         let mut e = engine(UNITS, &[("pa", "a", 0.0, 4.0), ("pb", "b", 1.0, 2.0)]);
         assert!((elbow(&mut e, 0.5) - 30.0).abs() < 1e-3);
@@ -984,7 +984,7 @@ mod tests {
         // same start: the earlier end plays
         let mut e = engine(UNITS, &[("pa", "a", 0.0, 4.0), ("pb", "b", 0.0, 2.0)]);
         assert!((elbow(&mut e, 1.0) - 60.0).abs() < 1e-3);
-        // full tie: the unit added first (the runtime drops the other with a warning, R33)
+        // full tie: the unit added first (the runtime drops the other with a warning)
         let mut e = engine(UNITS, &[("pa", "a", 0.0, 2.0), ("pb", "b", 0.0, 2.0)]);
         assert!((elbow(&mut e, 1.0) - 30.0).abs() < 1e-3);
     }

@@ -1,4 +1,4 @@
-//! The transition engine: BMLT `transition` units (A54). Given only a start, an end and the
+//! The transition engine: BMLT `transition` units. Given only a start, an end and the
 //! joints to move, a transition starts at the pose the body had when it began and ends at the
 //! pose the animation predictor computes for its end from the predictable units (keyframes,
 //! procedural units: [`Engine::predict`]), so that the motion that follows starts without a jump:

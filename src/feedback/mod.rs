@@ -1,6 +1,6 @@
 //! BML 1.0 feedback: typed messages (block progress, sync-point progress, predictions, warnings,
 //! with the BMLA status and posix-time extensions), the listener trait, and the two line codecs of
-//! DESIGN §4 — XML (one element per line) and JSON lines.
+//! docs/cli.md — XML (one element per line) and JSON lines.
 
 pub mod diff;
 mod json;
@@ -61,7 +61,7 @@ constants!(
     }
 );
 
-/// The `type` of a warning. The named constants are those of DESIGN §4; `Other` keeps any other
+/// The `type` of a warning. The named constants are those of docs/cli.md; `Other` keeps any other
 /// type read from a log.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum WarningType {
@@ -72,7 +72,7 @@ pub enum WarningType {
 }
 
 constants!(
-    /// The warning types of DESIGN §4.
+    /// The warning types of docs/cli.md.
     KnownWarning {
         /// The BML could not be parsed.
         ParsingFailure = "PARSING_FAILURE",

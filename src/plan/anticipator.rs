@@ -1,4 +1,4 @@
-//! Anticipators (R10, S56): sources of predicted times of events outside the realizer (a user's
+//! Anticipators: sources of predicted times of events outside the realizer (a user's
 //! end of speech, a metronome's ticks) that BML refers to as `anticipators:ID:SYNC±o`. The runtime
 //! polls them; when a prediction changes, the pegs tied to it move without rescheduling.
 //!

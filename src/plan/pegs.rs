@@ -1,4 +1,4 @@
-//! The peg board, the flexible plan's representation of time (thesis §7.3; spec S11–S22):
+//! The peg board, the flexible plan's representation of time (thesis §7.3):
 //! - every sync point of every planned behaviour hangs on a peg;
 //! - sync points joined by `at` share one peg, so moving the peg keeps the constraint;
 //! - a `TimePeg` holds block-local time on a `BlockPeg`, so moving a block moves all of its pegs;
@@ -16,7 +16,7 @@ use std::fmt;
 pub struct BlockPegId(usize);
 
 impl BlockPegId {
-    /// The immovable global block peg at 0 that anticipator pegs hang on (S17).
+    /// The immovable global block peg at 0 that anticipator pegs hang on.
     pub const GLOBAL: BlockPegId = BlockPegId(0);
 }
 
@@ -24,7 +24,7 @@ impl BlockPegId {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct PegId(usize);
 
-/// Addresses a sync point of a planned behaviour: (block id, behaviour id, sync id) (S22).
+/// Addresses a sync point of a planned behaviour: (block id, behaviour id, sync id).
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SyncAddr {
     /// Block id.
@@ -136,7 +136,7 @@ impl PegBoard {
         self.blocks[b.0].start
     }
 
-    /// Moves a block peg; all its pegs move with it, their local times unchanged (S16, S18).
+    /// Moves a block peg; all its pegs move with it, their local times unchanged.
     pub fn set_block_start(&mut self, b: BlockPegId, start: f64) -> Result<(), PegError> {
         if b == BlockPegId::GLOBAL {
             return Err(PegError::ImmovableGlobal);
@@ -154,7 +154,7 @@ impl PegBoard {
         PegId(self.pegs.len() - 1)
     }
 
-    /// A new offset peg, `offset` seconds after `link` (S12). Linking to an offset peg links to
+    /// A new offset peg, `offset` seconds after `link`. Linking to an offset peg links to
     /// its time peg with the offsets added.
     pub fn offset_peg(&mut self, link: PegId, offset: f64) -> PegId {
         let (root, base) = self.root(link);
@@ -181,7 +181,7 @@ impl PegBoard {
         }
     }
 
-    /// Global time of a peg: its block's start plus its local time (S15).
+    /// Global time of a peg: its block's start plus its local time.
     pub fn global(&self, p: PegId) -> f64 {
         let (root, offset) = self.root(p);
         match self.pegs[root.0] {
@@ -200,7 +200,7 @@ impl PegBoard {
         self.orders.push(Order { early, late, gap });
     }
 
-    /// Hangs a sync point on a peg (several sync points may share one) (S14, S22).
+    /// Hangs a sync point on a peg (several sync points may share one).
     pub fn attach(&mut self, sync: SyncAddr, p: PegId) {
         self.syncs.insert(sync, p);
     }
@@ -234,7 +234,7 @@ impl PegBoard {
         }
     }
 
-    /// Moves peg `p` to global time `t` (an offset peg moves its time peg by the same delta, S13),
+    /// Moves peg `p` to global time `t` (an offset peg moves its time peg by the same delta),
     /// then pushes or drags pegs linked by order links so that every link still holds. Returns the
     /// time pegs that moved, the first being `p`'s.
     pub fn move_to(&mut self, p: PegId, t: f64) -> Result<Vec<PegId>, PegError> {
@@ -290,9 +290,9 @@ mod tests {
         SyncAddr::new(b, beh, s)
     }
 
-    /// S14: syncs joined by `at` share a peg; moving it moves them all and keeps the constraint.
+    /// syncs joined by `at` share a peg; moving it moves them all and keeps the constraint.
     #[test]
-    fn s14_moving_a_peg_moves_every_sync_on_it() {
+    fn moving_a_peg_moves_every_sync_on_it() {
         let mut board = PegBoard::new();
         let b = board.add_block("bml1", 10.0);
         let p = board.time_peg(b, 1.0);
@@ -304,9 +304,9 @@ mod tests {
         assert_eq!(board.syncs_on(p).len(), 2);
     }
 
-    /// S12, S13: an offset peg keeps its offset; moving either moves the other.
+    /// An offset peg keeps its offset; moving either moves the other.
     #[test]
-    fn s13_offset_pegs_move_with_their_time_peg_and_back() {
+    fn offset_pegs_move_with_their_time_peg_and_back() {
         let mut board = PegBoard::new();
         let b = board.add_block("bml1", 0.0);
         let tp = board.time_peg(b, 2.0);
@@ -320,9 +320,9 @@ mod tests {
         assert_eq!((board.global(tp), board.global(op2)), (4.5, 4.0));
     }
 
-    /// S15, S16: global = block start + local; moving the block shifts its pegs, keeping relations.
+    /// Global = block start + local; moving the block shifts its pegs, keeping relations.
     #[test]
-    fn s16_moving_a_block_peg_shifts_its_pegs_only() {
+    fn moving_a_block_peg_shifts_its_pegs_only() {
         let mut board = PegBoard::new();
         let b1 = board.add_block("bml1", 1.0);
         let b2 = board.add_block("bml2", 1.0);
@@ -339,9 +339,9 @@ mod tests {
         assert_eq!(board.block_of(c), b1);
     }
 
-    /// S17: anticipator pegs hang on the immovable global block peg at 0.
+    /// anticipator pegs hang on the immovable global block peg at 0.
     #[test]
-    fn s17_global_block_peg_is_immovable_and_its_pegs_are_global_times() {
+    fn global_block_peg_is_immovable_and_its_pegs_are_global_times() {
         let mut board = PegBoard::new();
         assert_eq!(board.block_id(BlockPegId::GLOBAL), "anticipators");
         let stop = board.time_peg(BlockPegId::GLOBAL, 7.25);
@@ -354,9 +354,9 @@ mod tests {
         assert_eq!(board.global(stop), 8.0);
     }
 
-    /// S21: a behaviour constrained to another block's or an anticipator's peg moves with it.
+    /// a behaviour constrained to another block's or an anticipator's peg moves with it.
     #[test]
-    fn s21_external_pegs_move_referring_behaviours() {
+    fn external_pegs_move_referring_behaviours() {
         let mut board = PegBoard::new();
         let b = board.add_block("bml2", 3.0);
         let anticipated = board.time_peg(BlockPegId::GLOBAL, 6.0);

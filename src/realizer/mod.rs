@@ -69,13 +69,13 @@ impl Realizer {
     }
 
     /// Uses `factory` to make the engines of each character (register extra kinds and engines
-    /// here, S76).
+    /// here).
     pub fn with_engines(mut self, factory: impl Fn() -> Registry + 'static) -> Self {
         self.engines = Box::new(factory);
         self
     }
 
-    /// Uses another scheduling strategy (S40).
+    /// Uses another scheduling strategy.
     pub fn with_strategy(
         mut self,
         factory: impl Fn() -> Box<dyn SchedulingStrategy> + 'static,

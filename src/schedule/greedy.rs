@@ -1,5 +1,5 @@
 //! `SortedGreedy`: the baseline strategy, Elckerlyc's sorted form of the SmartBody algorithm
-//! (thesis §7.3.5, L6199–6227; spec S41–S44, S47).
+//! (thesis §7.3.5).
 //!
 //! Behaviours are sorted into three groups:
 //! 1. rigid behaviours with an absolute `at`;
@@ -14,7 +14,7 @@
 //!
 //! A behaviour whose timing comes out invalid is dropped. Finally the block is shifted so that nothing
 //! precedes its start (SmartBody's normalisation). `before`/`after` constraints are not supported
-//! (S47), and the result depends on behaviour order (thesis Ex. 28b and 29b fail). It is kept as the
+//!, and the result depends on behaviour order (thesis Ex. 28b and 29b fail). It is kept as the
 //! reference the `Optimal` strategy is measured and tested against.
 
 use super::diff::EPSILON;
@@ -112,8 +112,8 @@ impl SchedulingStrategy for SortedGreedy {
     }
 }
 
-/// Group 1, 2 or 3 (S41); inside group 2, rigid behaviours linked at two or more sync points first
-/// (S42), encoded as 2 versus 3 (and the flexible group as 4).
+/// Group 1, 2 or 3; inside group 2, rigid behaviours linked at two or more sync points first
+///, encoded as 2 versus 3 (and the flexible group as 4).
 fn group(items: &[Item], links: &[Link], i: usize) -> u8 {
     let it = &items[i];
     if matches!(it.beh.kind, BehaviourKind::ParameterValueChange(_)) {
@@ -182,7 +182,7 @@ fn known(
     Some(known)
 }
 
-/// The engine's "resolve unknown from known" step (S44, S48, S49): all keys from the known ones.
+/// The engine's "resolve unknown from known" step: all keys from the known ones.
 fn place(model: &TimingModel, len: usize, known: &[(usize, f64)]) -> Option<Vec<f64>> {
     let p: Vec<f64> = model.keys[..len].iter().map(|k| k.at).collect();
     let t: Vec<f64> = match (known, model.flexibility) {

@@ -210,7 +210,7 @@ fn hard_system(items: &[Item], links: &[Link]) -> (DiffSystem, Vec<usize>) {
         let first = s.len();
         for _ in 0..it.len {
             let v = s.var(f64::MIN / 4.0);
-            s.at_least(v, block, 0.0, tag); // S4
+            s.at_least(v, block, 0.0, tag);
         }
         let keys = &it.model.keys;
         let phase_tag = links.len() + 2 * items.len() + i;
@@ -242,7 +242,7 @@ fn hard_system(items: &[Item], links: &[Link]) -> (DiffSystem, Vec<usize>) {
             } else {
                 tag
             };
-            s.at_least(end, first, min_duration, min_tag); // S5
+            s.at_least(end, first, min_duration, min_tag);
             if max_duration.is_finite() {
                 s.at_most(end, first, max_duration, bound);
             }

@@ -1,4 +1,4 @@
-//! What every scheduling strategy shares: the `SchedulingStrategy` trait (S40), the schedule it
+//! What every scheduling strategy shares: the `SchedulingStrategy` trait, the schedule it
 //! produces, the reasons it drops behaviours or fails a block, and the source of times for references
 //! that leave the block.
 
@@ -6,7 +6,7 @@ use crate::bml::{Block, SyncPoint};
 use crate::engine::timing::TimingModels;
 use crate::feedback::KnownWarning;
 
-/// A way of turning a block into sync times; strategies plug in from outside the core (S40).
+/// A way of turning a block into sync times; strategies plug in from outside the core.
 pub trait SchedulingStrategy {
     /// A short name for logs and benches.
     fn name(&self) -> &'static str;

@@ -1,5 +1,5 @@
-//! From a schedule to pegs (thesis §7.3.3; S11, S12, S19–S21) and back to validity after run-time
-//! changes (S56–S58).
+//! From a schedule to pegs (thesis §7.3.3) and back to validity after run-time
+//! changes.
 //!
 //! - Sync points joined by `at` constraints share one time peg, and so do the named syncs of a rigid
 //!   behaviour; a fixed nonzero offset becomes an offset peg.
@@ -7,8 +7,8 @@
 //! - A sync that no constraint names and that lies between two named syncs of its behaviour is not
 //!   a peg. It is placed proportionally between them, the way an engine stretches a motion between
 //!   its constrained keys.
-//! - Unnamed syncs before the first or after the last named sync are offset pegs on it (S19). A
-//!   behaviour that no constraint names gets a time peg for its start (S20).
+//! - Unnamed syncs before the first or after the last named sync are offset pegs on it. A
+//!   behaviour that no constraint names gets a time peg for its start.
 //! - `before`/`after` constraints become order links, which push or drag when a peg moves.
 //!
 //! Moving an anticipator peg then retimes everything linked to it without rescheduling. `invalid`
@@ -206,7 +206,7 @@ pub fn plan_block(
             joined.join(w[1], w[0], times[w[1]] - times[w[0]]);
         }
     }
-    // one time peg per cluster of named syncs (S11), offset pegs for the others in it (S12)
+    // one time peg per cluster of named syncs, offset pegs for the others in it
     let mut root_peg: HashMap<usize, PegId> = HashMap::new();
     let mut peg = vec![None; n];
     for v in 0..n {
@@ -215,7 +215,7 @@ pub fn plan_block(
         }
         let (root, off) = joined.find(v);
         let tp = *root_peg.entry(root).or_insert_with(|| {
-            // a cluster at-linked to an anticipator hangs on its peg (S21)
+            // a cluster at-linked to an anticipator hangs on its peg
             let linked = (0..n).find(|&w| on_anticipator[w].is_some() && joined.find(w).0 == root);
             match linked.and_then(|w| on_anticipator[w].clone().map(|a| (w, a))) {
                 Some((w, (anticipator, sync, o))) => {
@@ -233,7 +233,7 @@ pub fn plan_block(
             board.offset_peg(tp, off)
         });
     }
-    // unnamed syncs: between named ones proportionally, outside them as offset pegs (S19, S20)
+    // unnamed syncs: between named ones proportionally, outside them as offset pegs
     let mut behaviours = Vec::new();
     for b in &schedule.behaviours {
         let ids: Vec<(SyncName, usize)> = b
@@ -329,7 +329,7 @@ pub fn plan_block(
 }
 
 /// Behaviours of a planned block whose timing is no longer valid: syncs out of order, before the
-/// block start, or an end not after the start (S57, S58).
+/// block start, or an end not after the start.
 pub fn invalid(board: &PegBoard, planned: &PlannedBlock) -> Vec<Id> {
     let start = board.block_start(planned.block);
     planned

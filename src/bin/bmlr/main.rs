@@ -1,4 +1,4 @@
-//! `bmlr`: the command-line front end of the BML realizer (DESIGN §5).
+//! `bmlr`: the command-line front end of the BML realizer.
 
 mod diff;
 mod run;
