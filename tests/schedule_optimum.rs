@@ -18,14 +18,41 @@ use proptest::prelude::*;
 const WORDS: &[&str] = &[
     "I", "am", "fine", "thank", "you", "very", "much", "goodbye", "now",
 ];
-const GESTURE_KEYS: &[&str] = &[
-    "start",
-    "ready",
-    "strokeStart",
-    "stroke",
-    "strokeEnd",
-    "relax",
-    "end",
+/// (element with its attributes, sync keys) of the kinds of motion the blocks use.
+const MOTIONS: &[(&str, &[&str])] = &[
+    (
+        r#"gesture lexeme="BEAT""#,
+        &[
+            "start",
+            "ready",
+            "strokeStart",
+            "stroke",
+            "strokeEnd",
+            "relax",
+            "end",
+        ],
+    ),
+    (
+        r#"head lexeme="NOD""#,
+        &[
+            "start",
+            "ready",
+            "strokeStart",
+            "stroke",
+            "strokeEnd",
+            "relax",
+            "end",
+        ],
+    ),
+    (
+        r#"head lexeme="SHAKE" repetition="3""#,
+        &["start", "ready", "stroke", "relax", "end"],
+    ),
+    (r#"gaze target="user""#, &["start", "ready", "relax", "end"]),
+    (
+        r#"pointing target="bluebox""#,
+        &["start", "ready", "stroke", "relax", "end"],
+    ),
 ];
 
 #[derive(Debug, Clone)]
@@ -39,9 +66,10 @@ struct Speech {
 
 #[derive(Debug, Clone)]
 struct Move {
-    /// false: gesture BEAT; true: head NOD.
-    head: bool,
-    /// (key index, speech sync picked, offset in ms: 0 or signed) per tied key.
+    /// Index into [`MOTIONS`].
+    kind: usize,
+    /// (key index, speech sync picked or, past the syncs, an absolute time, offset in ms: 0 or
+    /// signed) per tied key.
     ties: Vec<(usize, usize, i32)>,
 }
 
@@ -55,17 +83,13 @@ fn speech() -> impl Strategy<Value = Speech> {
 
 fn motion() -> impl Strategy<Value = Move> {
     (
-        any::<bool>(),
+        0..MOTIONS.len(),
         proptest::collection::vec(
-            (
-                0..GESTURE_KEYS.len(),
-                0usize..64,
-                prop_oneof![Just(0i32), -400i32..400],
-            ),
+            (0usize..7, 0usize..64, prop_oneof![Just(0i32), -400i32..400]),
             1..4,
         ),
     )
-        .prop_map(|(head, ties)| Move { head, ties })
+        .prop_map(|(kind, ties)| Move { kind, ties })
 }
 
 /// The block's text.
@@ -95,29 +119,33 @@ fn block(speeches: &[Speech], moves: &[Move]) -> String {
         syncs.push(format!("s{i}:end"));
     }
     for (i, m) in moves.iter().enumerate() {
-        // keys in their order, tied to syncs in spoken order (most such blocks are feasible)
-        let mut ties = m.ties.clone();
+        let (element, keys) = MOTIONS[m.kind];
+        // keys in their order, tied to syncs in spoken order, or to absolute times up to 8 s
+        // further on (most such blocks are feasible)
+        let mut ties: Vec<(usize, usize, i32)> = m
+            .ties
+            .iter()
+            .map(|t| (t.0 % keys.len(), t.1, t.2))
+            .collect();
         ties.sort_by_key(|t| t.0);
         ties.dedup_by_key(|t| t.0);
-        let mut picks: Vec<usize> = ties.iter().map(|t| t.1 % syncs.len()).collect();
+        let mut picks: Vec<usize> = ties.iter().map(|t| t.1 % (syncs.len() + 8)).collect();
         picks.sort_unstable();
         let mut attrs = String::new();
         for (&(key, _, offset), &pick) in ties.iter().zip(&picks) {
             let sign = if offset < 0 { "-" } else { "+" };
-            let offset = match offset {
-                0 => String::new(),
-                o => format!("{sign}{}", o.unsigned_abs() as f64 / 1000.0),
+            let value = match (syncs.get(pick), offset) {
+                (Some(sync), 0) => sync.clone(),
+                (Some(sync), o) => format!("{sync}{sign}{}", o.unsigned_abs() as f64 / 1000.0),
+                (None, o) => format!("{}", (pick - syncs.len()) as f64 + o.max(0) as f64 / 1000.0),
             };
-            attrs.push_str(&format!(
-                r#" {}="{}{offset}""#,
-                GESTURE_KEYS[key], syncs[pick]
-            ));
+            attrs.push_str(&format!(r#" {}="{value}""#, keys[key]));
         }
-        body.push_str(&if m.head {
-            format!(r#"<head id="m{i}" lexeme="NOD"{attrs}/>"#)
-        } else {
-            format!(r#"<gesture id="m{i}" lexeme="BEAT"{attrs}/>"#)
-        });
+        let name = element.split(' ').next().unwrap();
+        body.push_str(&format!(
+            r#"<{name} id="m{i}" {}{attrs}/>"#,
+            &element[name.len() + 1..]
+        ));
     }
     format!(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b">{body}</bml>"#)
 }

@@ -529,80 +529,160 @@ fn anchored_keys(items: &[Item], links: &[Link]) -> Vec<Vec<usize>> {
 /// first anchor, or `None` where that choice is not provably unique or breaks a bound.
 ///
 /// The item's deviation is `|σ − 1| · D + 2 · Σ |phase − σ · preferred phase|` (D its preferred
-/// duration). The phases outside the anchors are free, so at the best σ each is `σ` times its
-/// preferred length; the phases between two anchors must add up to their fixed distance `L`, at
-/// the least cost `2 · |L − σ · P|` (P their preferred sum). So the best σ minimises
-/// `f(σ) = |σ − 1| · D + 2 · Σ |L − σ · P|`, a convex piecewise-linear function whose least value
-/// lies at 1 or at some `L / P`. Between two anchors, the earliest times at that cost keep every
-/// phase at σ times its preferred length but for the last one, which takes what is left over, or
-/// shrink the phases from the first on when the distance is short.
+/// duration), each phase at most its limit. For a given σ the best phases are known in closed
+/// form (see [`Spans::cost`]), so the best σ minimises a convex piecewise-linear function of σ,
+/// whose least value lies at one of its kinks. At that σ, a phase outside the anchors is σ times
+/// its preferred length (or its limit); the phases between two anchors start from the same and
+/// make up their fixed distance with the earliest times: what is missing goes into the last
+/// phases first (up to their limits), what is too much comes out of the first phases first.
 fn best_timing(item: &Item, anchors: &[usize], at: &[f64]) -> Option<Vec<f64>> {
     let keys = &item.model.keys[..item.len];
-    let d = item.model.preferred_duration().max(EPSILON);
-    // (fixed distance, preferred distance) between consecutive anchors
-    let spans: Vec<(f64, f64)> = anchors
-        .windows(2)
-        .zip(at.windows(2))
-        .map(|(k, t)| (t[1] - t[0], keys[k[1]].at - keys[k[0]].at))
-        .collect();
-    if spans.iter().any(|&(l, _)| l < -EPSILON) {
-        return None; // anchors out of order: no valid timing
-    }
-    let sigma = unique_best_scale(d, &spans)?;
-    let mut offsets = vec![0.0; keys.len()];
+    let phase = |k: usize| (keys[k].at - keys[k - 1].at, keys[k].max_phase);
     let (a0, last) = (anchors[0], anchors[anchors.len() - 1]);
+    let spans = Spans {
+        d: item.model.preferred_duration().max(EPSILON),
+        outer: (1..=a0).chain(last + 1..keys.len()).map(phase).collect(),
+        inner: anchors
+            .windows(2)
+            .zip(at.windows(2))
+            .map(|(k, t)| (t[1] - t[0], (k[0] + 1..=k[1]).map(phase).collect()))
+            .collect(),
+    };
+    let sigma = spans.unique_best_scale()?;
+    let fitted = |k: usize| {
+        let (p, max) = phase(k);
+        (sigma * p).min(max)
+    };
+    let mut offsets = vec![0.0; keys.len()];
     for k in (0..a0).rev() {
-        offsets[k] = offsets[k + 1] - sigma * (keys[k + 1].at - keys[k].at);
+        offsets[k] = offsets[k + 1] - fitted(k + 1);
     }
     for (j, w) in anchors.windows(2).enumerate() {
+        let mut phases: Vec<f64> = (w[0] + 1..=w[1]).map(fitted).collect();
+        let limits: Vec<f64> = (w[0] + 1..=w[1]).map(|k| phase(k).1).collect();
+        let mut missing = spans.inner[j].0 - phases.iter().sum::<f64>();
+        // too long a distance: the last phases take it, as far as their limits let them
+        for (x, max) in phases.iter_mut().zip(&limits).rev() {
+            let take = missing.clamp(0.0, max - *x);
+            *x += take;
+            missing -= take;
+        }
+        // too short: the first phases give it up
+        for x in phases.iter_mut() {
+            let give = (-missing).clamp(0.0, *x);
+            *x -= give;
+            missing += give;
+        }
+        if missing.abs() > EPSILON {
+            return None; // the limits cannot make up the distance
+        }
         offsets[w[0]] = at[j];
-        let preferred = |k: usize| sigma * (keys[k].at - keys[k - 1].at);
-        // the shortfall from σ times the preferred span, taken from the first phases on
-        let mut short = (sigma * spans[j].1 - spans[j].0).max(0.0);
-        for k in w[0] + 1..w[1] {
-            let phase = preferred(k) - short.min(preferred(k));
-            short -= preferred(k) - phase;
-            offsets[k] = offsets[k - 1] + phase;
+        for (i, x) in phases.iter().enumerate() {
+            offsets[w[0] + 1 + i] = offsets[w[0] + i] + x;
         }
         offsets[w[1]] = at[j + 1];
     }
     for k in last + 1..keys.len() {
-        offsets[k] = offsets[k - 1] + sigma * (keys[k].at - keys[k - 1].at);
+        offsets[k] = offsets[k - 1] + fitted(k);
     }
     within_bounds(item, &offsets).then_some(offsets)
 }
 
-/// The σ ≥ 0 that minimises `|σ − 1| · d + 2 · Σ |l − σ · p|` over `spans` of `(l, p)`, if only one
-/// does: `None` when the least value is reached on a whole interval (a tie the LP may break either
-/// way).
-fn unique_best_scale(d: f64, spans: &[(f64, f64)]) -> Option<f64> {
-    let f = |s: f64| {
-        (s - 1.0).abs() * d + 2.0 * spans.iter().map(|&(l, p)| (l - s * p).abs()).sum::<f64>()
-    };
-    let kinks = spans.iter().filter(|s| s.1 > EPSILON).map(|&(l, p)| l / p);
-    let best = std::iter::once(1.0)
-        .chain(kinks)
-        .min_by(|&a, &b| f(a).total_cmp(&f(b)))?;
-    // the slopes either side of the best σ: it is the only minimum if both point away from it
-    let side = |right: bool| {
-        let sign = |s: f64, kink: f64| {
-            let above = if right { s >= kink } else { s > kink };
-            if above {
-                1.0
-            } else {
-                -1.0
+/// One behaviour's phases for [`best_timing`]: (preferred length, limit) of each phase outside
+/// its anchors, and for each span between two consecutive anchors its fixed distance and its
+/// phases.
+struct Spans {
+    d: f64,
+    outer: Vec<(f64, f64)>,
+    inner: Vec<(f64, Vec<(f64, f64)>)>,
+}
+
+impl Spans {
+    /// The least deviation at scale σ (infinite where the limits cannot make up a distance). A
+    /// phase costs nothing at `min(σ · p, limit)` and twice what it must exceed its limit by
+    /// otherwise; a span's phases start there and change by what their distance needs, at 2 per
+    /// second.
+    fn cost(&self, s: f64) -> f64 {
+        let over = |&(p, max): &(f64, f64)| 2.0 * (s * p - max).max(0.0);
+        let mut cost = (s - 1.0).abs() * self.d + self.outer.iter().map(over).sum::<f64>();
+        for (l, phases) in &self.inner {
+            let fitted: f64 = phases.iter().map(|&(p, max)| (s * p).min(max)).sum();
+            let room: f64 = phases.iter().map(|p| p.1).sum();
+            if *l > room + EPSILON {
+                return f64::INFINITY;
             }
-        };
-        sign(best, 1.0) * d
-            + spans
+            cost += phases.iter().map(over).sum::<f64>() + 2.0 * (l - fitted).abs();
+        }
+        cost
+    }
+
+    /// Where the cost may kink: σ = 0 and 1, where a phase reaches its limit, and where a span's
+    /// fitted phases add up to its distance.
+    fn kinks(&self) -> Vec<f64> {
+        let mut out = vec![0.0, 1.0];
+        let all = self
+            .outer
+            .iter()
+            .chain(self.inner.iter().flat_map(|s| &s.1));
+        out.extend(
+            all.filter(|p| p.0 > EPSILON && p.1.is_finite())
+                .map(|p| p.1 / p.0),
+        );
+        for (l, phases) in &self.inner {
+            // the fitted sum is linear between the points where phases reach their limits
+            let mut ends: Vec<f64> = phases
                 .iter()
-                .filter(|s| s.1 > EPSILON)
-                .map(|&(l, p)| 2.0 * p * sign(best, l / p))
-                .sum::<f64>()
-    };
-    let tolerance = 1e-9 * (d + spans.iter().map(|s| 2.0 * s.1).sum::<f64>());
-    let left_falls = best <= 0.0 || side(false) < -tolerance;
-    (left_falls && side(true) > tolerance).then_some(best)
+                .filter(|p| p.0 > EPSILON && p.1.is_finite())
+                .map(|p| p.1 / p.0)
+                .collect();
+            ends.push(f64::INFINITY);
+            ends.sort_by(f64::total_cmp);
+            let mut from = 0.0;
+            for to in ends {
+                let mid = if to.is_finite() {
+                    (from + to) / 2.0
+                } else {
+                    from + 1.0
+                };
+                let free: f64 = phases.iter().filter(|p| mid * p.0 < p.1).map(|p| p.0).sum();
+                let capped: f64 = phases
+                    .iter()
+                    .filter(|p| mid * p.0 >= p.1)
+                    .map(|p| p.1)
+                    .sum();
+                if free > EPSILON {
+                    let s = (l - capped) / free;
+                    if s >= from - EPSILON && s <= to + EPSILON {
+                        out.push(s.max(0.0));
+                    }
+                }
+                from = to;
+            }
+        }
+        out.sort_by(f64::total_cmp);
+        out.dedup_by(|a, b| (*a - *b).abs() <= EPSILON);
+        out
+    }
+
+    /// The σ ≥ 0 of least cost, if only one has it: `None` when the least cost is reached on a
+    /// whole interval (a tie the LP may break either way) or nowhere.
+    fn unique_best_scale(&self) -> Option<f64> {
+        let kinks = self.kinks();
+        let (i, &best) = kinks
+            .iter()
+            .enumerate()
+            .min_by(|a, b| self.cost(*a.1).total_cmp(&self.cost(*b.1)))?;
+        let least = self.cost(best);
+        if !least.is_finite() {
+            return None;
+        }
+        // the cost is linear between kinks: look half-way to the neighbours
+        let scale = self.d + self.outer.len() as f64 + self.inner.len() as f64;
+        let rises = |s: f64| self.cost(s) > least + 1e-9 * scale * (s - best).abs().max(1e-3);
+        let left = i == 0 || rises((kinks[i - 1] + best) / 2.0);
+        let right = rises(kinks.get(i + 1).map_or(best + 1.0, |n| (best + n) / 2.0));
+        (left && right).then_some(best)
+    }
 }
 
 /// Whether key times (`offsets`, any origin) keep the item's order, duration bounds and phase
