@@ -85,6 +85,8 @@ impl Timeline {
     /// predictions) otherwise. Sync points of one block that coincide are linked.
     pub fn from_feedback(feedback: &[Feedback]) -> Timeline {
         let mut t = Timeline::default();
+        // blocks that reported a start (a block revoked before it has none)
+        let mut started = std::collections::HashSet::new();
         for fb in feedback {
             match fb {
                 Feedback::Prediction(p) => {
@@ -127,6 +129,17 @@ impl Timeline {
                                 }
                             }
                             row.start = Some(p.global_time);
+                            started.insert(p.block.to_string());
+                        }
+                        // revoked before it started: it never ran, so nothing of it is drawn
+                        // but the moment it was removed
+                        "end"
+                            if p.status == Some(BlockStatus::Revoked)
+                                && !started.contains(p.block.as_str()) =>
+                        {
+                            row.start = Some(p.global_time);
+                            row.end = Some(p.global_time);
+                            row.lanes.clear();
                         }
                         "end" => row.end = Some(p.global_time),
                         _ => {}
@@ -445,6 +458,31 @@ mod tests {
             posix_time: None,
             skipped: false,
         })
+    }
+
+    #[test]
+    fn a_block_revoked_before_it_started_is_drawn_without_lanes() {
+        let progress = |block: &str, sync: &str, t: f64, status| {
+            Feedback::BlockProgress(BlockProgress {
+                block: block.into(),
+                sync: sync.into(),
+                global_time: t,
+                character_id: None,
+                status: Some(status),
+                posix_time: None,
+            })
+        };
+        let fb = vec![
+            progress("a", "start", 0.0, BlockStatus::InExec),
+            sync("a", "s", "start", 0.0),
+            progress("a", "end", 1.0, BlockStatus::Interrupted),
+            progress("b", "end", 1.0, BlockStatus::Revoked),
+        ];
+        let t = Timeline::from_feedback(&fb);
+        let b = &t.blocks[1];
+        assert_eq!((b.start, b.end, b.lanes.len()), (Some(1.0), Some(1.0), 0));
+        assert_eq!(t.blocks[0].lanes.len(), 1);
+        assert!(t.to_svg().contains("REVOKED"));
     }
 
     #[test]
