@@ -459,7 +459,10 @@ impl BlockManager {
                 .schedule(&live.source, &self.registry, &external)
         };
         let schedule = match schedule {
-            Ok(s) => s,
+            Ok(mut s) => {
+                s.drop_unreachable();
+                s
+            }
             Err(e) => {
                 let id = live.id.clone();
                 self.warn(id, KnownWarning::CannotSatisfyConstraints, e.to_string());

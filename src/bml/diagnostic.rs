@@ -198,6 +198,8 @@ pub enum Code {
     /// Constraints that no timing can satisfy together (a cycle such as `a:start = b:end` with
     /// `b:start = a:end`): the realizer would drop a behaviour or refuse the block.
     ContradictoryConstraints,
+    /// The block passes one of its limits (nesting depth, attributes, size, behaviours, time).
+    LimitExceeded,
 }
 
 impl Code {
@@ -228,6 +230,7 @@ impl Code {
             Code::UnsupportedAttribute => "unsupported-attribute",
             Code::UnknownLexeme => "unknown-lexeme",
             Code::ContradictoryConstraints => "contradictory-constraints",
+            Code::LimitExceeded => "limit-exceeded",
         }
     }
 }

@@ -14,6 +14,7 @@
 mod constraints;
 mod diagnostic;
 mod kinds;
+mod limits;
 mod model;
 mod parser;
 mod stream;
@@ -28,6 +29,7 @@ pub use kinds::{
     ALL_STANDARD_SYNCS, BMLT_BEHAVIOURS, BUILTIN_KINDS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS,
     FACE_SYNCS, GAZE_SYNCS, GESTURE_SYNCS, START_END,
 };
+pub use limits::Limits;
 pub use model::*;
 pub use parser::{parse, parse_with_diagnostics, Parsed};
 pub use stream::{BlockStream, StreamItem};
@@ -38,22 +40,39 @@ pub use writer::write;
 /// Parses and validates one block: the block plus warnings, or every diagnostic if any is an error.
 pub fn load(src: &str) -> Result<Parsed, BmlError> {
     let mut block = None;
-    let diags = check_into(src, &mut block);
+    let diags = check_into(src, &mut block, &Limits::default());
     parser::parsed(&mut block, diags)
 }
 
 /// Parses and validates as far as possible, returning the block (if the text is a `<bml>`
 /// document) and every diagnostic in source order.
 pub fn check(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
+    check_with(src, &Limits::default())
+}
+
+/// [`check`] within `limits`: a block that passes one is refused with a `limit-exceeded` error.
+pub fn check_with(src: &str, limits: &Limits) -> (Option<Block>, Vec<Diagnostic>) {
     let mut block = None;
-    let diags = check_into(src, &mut block);
+    let diags = check_into(src, &mut block, limits);
     (block, diags)
 }
 
-/// [`check`] with the block written into `block` (`None` before): the block is not copied up
-/// the return values. The diagnostics come sorted by position either way.
-fn check_into(src: &str, block: &mut Option<Block>) -> Vec<Diagnostic> {
-    let mut diags = parser::parse_into(src, block);
+/// [`check_with`] with the block written into `block` (`None` before): the block is not copied
+/// up the return values. The diagnostics come sorted by position either way.
+fn check_into(src: &str, block: &mut Option<Block>, limits: &Limits) -> Vec<Diagnostic> {
+    if src.len() > limits.block_bytes {
+        let message = format!(
+            "the block is {} bytes long, more than the limit of {} (--max-block-bytes)",
+            src.len(),
+            limits.block_bytes
+        );
+        return vec![Diagnostic::error(
+            Code::LimitExceeded,
+            Pos { line: 1, col: 1 },
+            message,
+        )];
+    }
+    let mut diags = parser::parse_into(src, block, limits);
     if let Some(b) = block {
         diags.extend(validate(b));
         diags.sort_by_key(|d| (d.pos.line, d.pos.col));

@@ -8,6 +8,7 @@ use std::fmt;
 
 use super::diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos};
 use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
+use super::limits::Limits;
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
 use super::xml::{self, Event, Tag, Tokenizer, XmlError};
@@ -26,7 +27,7 @@ pub struct Parsed {
 /// Cross-reference checks are not done here: use [`super::load`] for parse + validation.
 pub fn parse(src: &str) -> Result<Parsed, BmlError> {
     let mut block = None;
-    let diags = parse_into(src, &mut block);
+    let diags = parse_into(src, &mut block, &Limits::default());
     parsed(&mut block, diags)
 }
 
@@ -49,14 +50,14 @@ pub(crate) fn parsed(
 /// diagnostics, errors included.
 pub fn parse_with_diagnostics(src: &str) -> (Option<Block>, Vec<Diagnostic>) {
     let mut block = None;
-    let diags = parse_into(src, &mut block);
+    let diags = parse_into(src, &mut block, &Limits::default());
     (block, diags)
 }
 
 /// [`parse_with_diagnostics`] with the block written into `block` (which must be `None`): a
 /// block is a few hundred bytes, and it is not copied up the parser's return values.
-pub(crate) fn parse_into(src: &str, block: &mut Option<Block>) -> Vec<Diagnostic> {
-    let mut p = Parser::new(src);
+pub(crate) fn parse_into(src: &str, block: &mut Option<Block>, limits: &Limits) -> Vec<Diagnostic> {
+    let mut p = Parser::new(src, limits);
     if p.document(block).is_err() {
         *block = None;
     }
@@ -171,6 +172,7 @@ struct Parser<'i> {
     pending: Option<Tok<'i>>,
     /// An emptied attribute list, for the next element (one list serves a whole block).
     spare_attrs: Vec<Option<RawAttr<'i>>>,
+    limits: Limits,
 }
 
 /// The scratch lists of a parse (the tokenizer's, the line starts, the attribute list), kept on
@@ -220,7 +222,7 @@ impl<'i> Attrs<'i> {
 }
 
 impl<'i> Parser<'i> {
-    fn new(src: &'i str) -> Self {
+    fn new(src: &'i str, limits: &Limits) -> Self {
         // A byte-order mark is not content; offsets are relative to the rest.
         let src = src.strip_prefix('\u{feff}').unwrap_or(src);
         let scratch = SCRATCH
@@ -231,12 +233,14 @@ impl<'i> Parser<'i> {
         let (lines, forbidden) = LineIndex::scan(src, scratch.lines);
         Parser {
             src,
-            tok: Tokenizer::with_lists(src, scratch.tokens),
+            tok: Tokenizer::with_lists(src, scratch.tokens)
+                .limited(limits.attributes, limits.depth),
             lines,
             forbidden,
             diags: Vec::new(),
             pending: None,
             spare_attrs: xml::recycle(scratch.attrs),
+            limits: *limits,
         }
     }
 
@@ -273,11 +277,12 @@ impl<'i> Parser<'i> {
     }
 
     fn xml_error(&mut self, e: XmlError) -> Fatal {
-        self.error(
-            Code::NotXml,
-            e.offset,
-            format!("not well-formed XML: {}", e.message),
-        );
+        if e.limit {
+            self.error(Code::LimitExceeded, e.offset, e.message);
+        } else {
+            let message = format!("not well-formed XML: {}", e.message);
+            self.error(Code::NotXml, e.offset, message);
+        }
         Fatal
     }
 
@@ -740,6 +745,9 @@ impl<'i> Parser<'i> {
                     child.offset,
                     "<required> cannot be nested in <required>",
                 );
+                // what is inside is not read as behaviours (nor recursed into)
+                self.skip(&child)?;
+                return Ok(());
             }
             for a in child.attrs.iter().flatten() {
                 self.error(
@@ -751,6 +759,16 @@ impl<'i> Parser<'i> {
             self.children(&child, |p, c| {
                 p.block_child(c, true, behaviours, constraints)
             })?;
+        } else if behaviours.len() >= self.limits.behaviours {
+            self.error(
+                Code::LimitExceeded,
+                child.offset,
+                format!(
+                    "the block has more than {} behaviours (the limit; --max-behaviours)",
+                    self.limits.behaviours
+                ),
+            );
+            return Err(Fatal);
         } else {
             self.behaviour(child, required, behaviours)?;
         }
@@ -759,7 +777,23 @@ impl<'i> Parser<'i> {
 
     fn sync_ref(&mut self, a: &RawAttr<'i>, on: &dyn fmt::Display) -> Option<SyncRef> {
         match SyncRef::parse(&a.value) {
-            Ok(r) => Some(r),
+            Ok(r) => {
+                let t = match &r {
+                    SyncRef::Time(t) | SyncRef::Point { offset: t, .. } => *t,
+                };
+                if t.abs() > self.limits.time {
+                    self.error(
+                        Code::LimitExceeded,
+                        a.offset,
+                        format!(
+                            "{on}, attribute {}: {t:e} s is further from the block start than the limit of {} s (--max-time)",
+                            a.name, self.limits.time
+                        ),
+                    );
+                    return None;
+                }
+                Some(r)
+            }
             Err(e) => {
                 self.error(
                     e.code,

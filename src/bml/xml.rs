@@ -20,12 +20,24 @@ pub(crate) struct XmlError {
     pub offset: usize,
     /// What is wrong, in a sentence without the position.
     pub message: String,
+    /// The input passes one of the limits (the XML itself may be fine).
+    pub limit: bool,
 }
 
 fn err<T>(offset: usize, message: impl Into<String>) -> Result<T, XmlError> {
     Err(XmlError {
         offset,
         message: message.into(),
+        limit: false,
+    })
+}
+
+/// An error for input that passes a limit.
+fn over_limit<T>(offset: usize, message: String) -> Result<T, XmlError> {
+    Err(XmlError {
+        offset,
+        message,
+        limit: true,
     })
 }
 
@@ -150,6 +162,11 @@ pub(crate) struct Tokenizer<'i> {
     attrs: Vec<Attr<'i>>,
     /// The last event was an empty-element tag: its scope ends before the next event.
     close_empty: Option<usize>,
+    /// Most attributes per element, and most namespace declarations in scope (a longer list
+    /// is an error: every attribute is checked against the others).
+    max_attributes: usize,
+    /// Deepest nesting of open elements.
+    max_depth: usize,
 }
 
 impl<'i> Tokenizer<'i> {
@@ -163,7 +180,17 @@ impl<'i> Tokenizer<'i> {
             bindings: recycle(lists.bindings),
             attrs: recycle(lists.attrs),
             close_empty: None,
+            max_attributes: usize::MAX,
+            max_depth: usize::MAX,
         }
+    }
+
+    /// The same tokenizer refusing elements with more than `attributes` attributes (or more
+    /// namespace declarations in scope) and nesting deeper than `depth`.
+    pub fn limited(mut self, attributes: usize, depth: usize) -> Self {
+        self.max_attributes = attributes;
+        self.max_depth = depth;
+        self
     }
 
     /// The lists, emptied, for the next tokenizer (this one is done with them; taken through
@@ -400,6 +427,15 @@ impl<'i> Tokenizer<'i> {
                         format!("attributes of <{qname}> must be separated by white space"),
                     )
                 }
+                Some(_) if self.attrs.len() >= self.max_attributes => {
+                    return over_limit(
+                        self.pos,
+                        format!(
+                            "<{qname}> has more than {} attributes (the limit; --max-attributes)",
+                            self.max_attributes
+                        ),
+                    )
+                }
                 Some(_) => self.attribute(qname)?,
             }
         };
@@ -419,6 +455,7 @@ impl<'i> Tokenizer<'i> {
                         "namespace declaration has a bad character or entity reference: {}",
                         e.message
                     ),
+                    limit: false,
                 })?;
                 if !prefix.is_empty() && uri.is_empty() {
                     return err(
@@ -429,10 +466,28 @@ impl<'i> Tokenizer<'i> {
                 if matches!(prefix, "xml" | "xmlns") && uri != XML_URI {
                     return err(a.offset, format!("the prefix {prefix} cannot be declared"));
                 }
+                if self.bindings.len() >= self.max_attributes {
+                    return over_limit(
+                        a.offset,
+                        format!(
+                            "more than {} namespace declarations in scope (the limit; --max-attributes)",
+                            self.max_attributes
+                        ),
+                    );
+                }
                 self.bindings.push((prefix, uri));
             }
         }
         let end = self.pos;
+        if !empty && self.open.len() + 1 > self.max_depth {
+            return over_limit(
+                start,
+                format!(
+                    "<{qname}> is nested deeper than {} elements (the limit; --max-depth)",
+                    self.max_depth
+                ),
+            );
+        }
         if empty {
             self.close_empty = Some(mark);
         } else {
@@ -695,6 +750,7 @@ fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlError> {
             let (c, next) = reference(raw, i).map_err(|e| XmlError {
                 offset: offset + e.offset,
                 message: e.message,
+                limit: false,
             })?;
             out.push_str(&c);
             i = next;

@@ -39,6 +39,8 @@ pub struct Realizer {
     strategy: StrategyFactory,
     listeners: Vec<Box<dyn FeedbackListener>>,
     posix_time: bool,
+    /// What one block may hold (see [`bml::Limits`]).
+    limits: bml::Limits,
     skeleton: Skeleton,
     world: std::sync::Arc<World>,
     now: f64,
@@ -61,6 +63,7 @@ impl Realizer {
             strategy: Box::new(|| Box::new(Optimal)),
             listeners: Vec::new(),
             posix_time: false,
+            limits: bml::Limits::default(),
             skeleton: Skeleton::adult(),
             world: std::sync::Arc::new(World::default()),
             now: 0.0,
@@ -100,6 +103,13 @@ impl Realizer {
     /// runs leave it out so that logs are byte-identical).
     pub fn with_posix_time(mut self, on: bool) -> Self {
         self.posix_time = on;
+        self
+    }
+
+    /// Refuses blocks that pass `limits` (nesting, attributes, size, behaviours, times) with a
+    /// PARSING_FAILURE warning that names the limit.
+    pub fn with_limits(mut self, limits: bml::Limits) -> Self {
+        self.limits = limits;
         self
     }
 
@@ -173,7 +183,7 @@ impl Realizer {
     /// [`perform_bml`](Self::perform_bml) for a block read from `source` (a file name, say):
     /// a PARSING_FAILURE warning then names it before each position (`FILE:LINE:COL: ...`).
     pub fn perform_bml_from(&mut self, text: &str, source: Option<&str>) -> Result<(), BmlError> {
-        let (block, diagnostics) = bml::check(text);
+        let (block, diagnostics) = bml::check_with(text, &self.limits);
         let errors: Vec<&Diagnostic> = diagnostics.iter().filter(|d| d.is_error()).collect();
         match block {
             Some(block) if errors.is_empty() => {

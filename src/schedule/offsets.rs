@@ -57,8 +57,9 @@ impl Offsets {
     /// The least values of all nodes when the joins are the only ties between them: node 0 is
     /// at 0, and `value(v) >= bound` for each `(v, bound)` of `bounds`. Every group of joined
     /// nodes sits as early as its bounds allow, node 0's group where node 0 is at 0; `None` if a
-    /// bound in node 0's group does not hold there (more than [`EPSILON`] short). Every node
-    /// must be in node 0's group or in a group with a bound.
+    /// bound in node 0's group does not hold there (more than [`EPSILON`] short), or if a value
+    /// is beyond the range of `f64`. Every node must be in node 0's group or in a group with a
+    /// bound.
     ///
     /// This is the least solution of the difference system with the joins as equalities and the
     /// bounds as constraints from node 0 (without a search over its edges). It is written into
@@ -98,8 +99,8 @@ impl Offsets {
                 x[v] += x[r];
             }
         }
-        debug_assert!(x.iter().all(|t| t.is_finite()));
-        Some(())
+        // times beyond the range of f64 (offsets near its limits) are no solution
+        x.iter().all(|t| t.is_finite()).then_some(())
     }
 }
 

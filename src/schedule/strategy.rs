@@ -82,6 +82,38 @@ pub struct BlockSchedule {
     pub dropped: Vec<Dropped>,
 }
 
+/// The furthest a scheduled time may lie from its block's start, seconds (about 31 years): a
+/// behaviour timed further away could never be waited for.
+pub const MAX_SCHEDULED_TIME: f64 = 1e9;
+
+impl BlockSchedule {
+    /// Moves every behaviour that could never run to `dropped` (INVALID_TIMING): one with a time
+    /// that is not a number, or infinite (but for a persistent behaviour's `end`), or further
+    /// than [`MAX_SCHEDULED_TIME`] from the block start. Whatever a strategy computes, what is
+    /// left can start and end.
+    pub fn drop_unreachable(&mut self) {
+        let reachable = |b: &ScheduledBehaviour| {
+            let last = b.syncs.len().saturating_sub(1);
+            b.syncs.iter().enumerate().all(|(k, &(_, t))| {
+                t.abs() <= MAX_SCHEDULED_TIME || (k == last && t == f64::INFINITY)
+            })
+        };
+        let (keep, gone): (Vec<_>, Vec<_>) = std::mem::take(&mut self.behaviours)
+            .into_iter()
+            .partition(reachable);
+        self.behaviours = keep;
+        self.dropped.extend(gone.into_iter().map(|b| Dropped {
+            reason: format!(
+                "'{}' cannot be timed: its sync times are not numbers or lie further than {MAX_SCHEDULED_TIME} s from the block start",
+                b.id
+            ),
+            behaviour: b.id,
+            warning: KnownWarning::InvalidTiming,
+            contradiction: false,
+        }));
+    }
+}
+
 impl BlockSchedule {
     /// The scheduled behaviour `id`.
     pub fn behaviour(&self, id: &str) -> Option<&ScheduledBehaviour> {

@@ -48,13 +48,19 @@ enum Command {
         /// Print nothing for valid files.
         #[arg(short, long)]
         quiet: bool,
+        #[command(flatten)]
+        limits: run::LimitArgs,
     },
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Validate { files, quiet } => validate(&files, quiet),
+        Command::Validate {
+            files,
+            quiet,
+            limits,
+        } => validate(&files, quiet, &limits.limits()),
         Command::Run(args) => run::run(args),
         Command::Plan(args) => run::plan(args),
         Command::Diff(args) => diff::run(args),
@@ -83,7 +89,7 @@ fn unanimated(block: &bml::Block, models: &Registry, diags: &[Diagnostic]) -> Ve
         .collect()
 }
 
-fn validate(files: &[PathBuf], quiet: bool) -> ExitCode {
+fn validate(files: &[PathBuf], quiet: bool, limits: &bml::Limits) -> ExitCode {
     use std::io::Write;
     // a reader that stops early (`| head`) is no error: what is left is not printed
     let mut out = std::io::stdout().lock();
@@ -98,7 +104,7 @@ fn validate(files: &[PathBuf], quiet: bool) -> ExitCode {
                 continue;
             }
         };
-        let (block, mut diags) = bml::check(&text);
+        let (block, mut diags) = bml::check_with(&text, limits);
         // what the scheduler would refuse, once the block itself is valid
         if let Some(block) = block.filter(|_| diags.iter().all(|d| d.severity != Severity::Error)) {
             diags.extend(timing_diagnostics(&block, &models));

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use std::sync::mpsc;
 use std::time::Duration;
 
-use bml_realizer::bml::{BlockStream, StreamItem};
+use bml_realizer::bml::{BlockStream, Limits, StreamItem};
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{BlockStatus, Feedback, Format};
 use bml_realizer::realizer::Realizer;
@@ -64,10 +64,54 @@ pub struct RunArgs {
     /// one frame every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.bvh")]
     bvh: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    pub limits: LimitArgs,
     /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
     /// clock before the next item.
     #[arg(required = true, value_name = "ITEM")]
     items: Vec<String>,
+}
+
+/// The limits on one block (`docs/cli.md`, "Limits"), shared by the commands that read BML.
+#[derive(Args, Clone, Copy)]
+pub struct LimitArgs {
+    /// Deepest nesting of elements in a block (the <bml> root counts as 1).
+    #[arg(long, value_name = "N", default_value_t = Limits::default().depth)]
+    max_depth: usize,
+    /// Most attributes on one element (and namespace declarations in scope).
+    #[arg(long, value_name = "N", default_value_t = Limits::default().attributes)]
+    max_attributes: usize,
+    /// Largest block, in bytes.
+    #[arg(long, value_name = "BYTES", default_value_t = Limits::default().block_bytes)]
+    max_block_bytes: usize,
+    /// Most behaviours in one block.
+    #[arg(long, value_name = "N", default_value_t = Limits::default().behaviours)]
+    max_behaviours: usize,
+    /// Largest absolute time or offset in a sync reference, seconds (at most 1e9).
+    #[arg(long, value_name = "SECS", default_value_t = Limits::default().time, value_parser = max_time)]
+    max_time: f64,
+}
+
+/// A `--max-time` value: a number of seconds above 0 and at most the furthest a schedule may go.
+fn max_time(s: &str) -> Result<f64, String> {
+    let bound = bml_realizer::schedule::strategy::MAX_SCHEDULED_TIME;
+    match s.parse::<f64>() {
+        Ok(t) if t > 0.0 && t <= bound => Ok(t),
+        _ => Err(format!("expected seconds above 0 and at most {bound}")),
+    }
+}
+
+impl LimitArgs {
+    /// The limits asked for.
+    pub fn limits(&self) -> Limits {
+        Limits {
+            depth: self.max_depth,
+            attributes: self.max_attributes,
+            block_bytes: self.max_block_bytes,
+            behaviours: self.max_behaviours,
+            time: self.max_time,
+        }
+    }
 }
 
 /// `realizer` with the motion data of `dir` (units and bindings), if given.
@@ -118,6 +162,8 @@ pub struct PlanArgs {
     /// Also draw the plan as a timeline picture (SVG) with the constraints as links.
     #[arg(long, value_name = "OUT.svg")]
     svg: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    limits: LimitArgs,
     /// BML files, planned in order as if sent at once.
     #[arg(required = true, value_name = "FILE")]
     files: Vec<String>,
@@ -321,7 +367,8 @@ pub fn run(args: RunArgs) -> ExitCode {
         }
     }
     .with_default_character(args.character.clone())
-    .with_posix_time(args.realtime);
+    .with_posix_time(args.realtime)
+    .with_limits(args.limits.limits());
     if args.realtime && args.bvh.is_some() {
         eprintln!("bmlr run: --bvh records on the virtual clock; leave out --realtime");
         return ExitCode::from(2);
@@ -545,7 +592,9 @@ pub fn plan(args: PlanArgs) -> ExitCode {
         }
     };
     let mut realizer = match with_assets(Realizer::new(), args.assets.as_deref()) {
-        Ok(r) => r.with_default_character(args.character),
+        Ok(r) => r
+            .with_default_character(args.character)
+            .with_limits(args.limits.limits()),
         Err(e) => {
             eprintln!("bmlr plan: --assets {e}");
             return ExitCode::from(2);

@@ -41,6 +41,8 @@ pub struct ServeArgs {
     /// A directory of motion data adding to the embedded defaults (see `bmlr run --assets`).
     #[arg(long, value_name = "DIR")]
     assets: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    limits: crate::run::LimitArgs,
     /// A world file (JSON): named points and points moving along keyed paths, as targets of
     /// gaze, pointing and headDirectionShift, added to the built-in scene.
     #[arg(long, value_name = "WORLD.json")]
@@ -66,7 +68,8 @@ pub fn serve(args: ServeArgs) -> ExitCode {
     };
     let realizer = Realizer::new()
         .with_engines(move || registry_with(DefaultTimingModels { speech }, &assets))
-        .with_posix_time(true);
+        .with_posix_time(true)
+        .with_limits(args.limits.limits());
     let mut realizer = match crate::run::with_world(realizer, args.world.as_deref()) {
         Ok(r) => r,
         Err(e) => {

@@ -1,0 +1,156 @@
+//! Every block the realizer accepts ends, whatever numbers it holds: random blocks with extreme
+//! times and offsets (tiny, huge, negative, beyond the limits, ties between behaviours, APPEND
+//! and REPLACE between blocks) go through the runtime on the virtual clock until nothing more
+//! will happen. Each block that was scheduled (a PENDING prediction) reports exactly one start
+//! and one end, or one REVOKED end and no start; the others were refused with a warning.
+
+use std::collections::BTreeMap;
+
+use bml_realizer::bml::Limits;
+use bml_realizer::feedback::{BlockStatus, Feedback};
+use bml_realizer::realizer::Realizer;
+use proptest::prelude::*;
+
+const NUMBERS: &[&str] = &[
+    "0", "1e-9", "0.001", "1", "2.5", "1e5", "999999", "1e6", "1e7", "1e308", "-1", "-1e6", "-0",
+];
+const KINDS: &[&str] = &[
+    r#"gesture lexeme="BEAT""#,
+    r#"head lexeme="NOD" repetition="1000""#,
+    r#"gaze target="user""#,
+    r#"faceLexeme lexeme="SMILE""#,
+    r#"wait max-wait="1e6""#,
+    r#"locomotion target="user""#,
+];
+const SYNCS: &[&str] = &["start", "ready", "stroke", "relax", "end"];
+const COMPOSITIONS: &[&str] = &["", r#" composition="APPEND""#, r#" composition="REPLACE""#];
+
+/// A behaviour: its kind, and (sync, number, tied to an earlier behaviour's sync?) attributes.
+type Beh = (usize, Vec<(usize, usize, Option<usize>)>);
+
+fn block(i: usize, composition: usize, behaviours: &[Beh]) -> String {
+    let mut body = String::new();
+    for (b, (kind, syncs)) in behaviours.iter().enumerate() {
+        let kind = KINDS[*kind];
+        let name = kind.split(' ').next().unwrap();
+        let mut attrs = String::new();
+        let mut seen = Vec::new();
+        for &(sync, number, tie) in syncs {
+            let sync = if name == "wait" || name == "locomotion" {
+                sync % 2 * 4
+            } else {
+                sync
+            };
+            if seen.contains(&sync) {
+                continue;
+            }
+            seen.push(sync);
+            let value = match tie.filter(|_| b > 0) {
+                Some(other) => format!("x{}:{}+{}", other % b, SYNCS[sync], NUMBERS[number]),
+                None => NUMBERS[number].to_string(),
+            };
+            attrs.push_str(&format!(r#" {}="{value}""#, SYNCS[sync]));
+        }
+        body.push_str(&format!(r#"<{kind} id="x{b}"{attrs}/>"#));
+    }
+    format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b{i}"{}>{body}</bml>"#,
+        COMPOSITIONS[composition]
+    )
+}
+
+fn behaviour() -> impl Strategy<Value = Beh> {
+    (
+        0..KINDS.len(),
+        proptest::collection::vec(
+            (
+                0..SYNCS.len(),
+                0..NUMBERS.len(),
+                proptest::option::of(0usize..4),
+            ),
+            0..3,
+        ),
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    #[test]
+    fn every_scheduled_block_starts_and_ends_once(
+        blocks in proptest::collection::vec(
+            (0..COMPOSITIONS.len(), 0.0f64..3.0, proptest::collection::vec(behaviour(), 1..4)),
+            1..4,
+        )
+    ) {
+        // with the time limit, and without it (then the runtime's own guard must hold)
+        for limits in [Limits::default(), Limits { time: f64::MAX, ..Limits::default() }] {
+            settles(&blocks, limits)?;
+        }
+    }
+}
+
+type Blocks = Vec<(usize, f64, Vec<Beh>)>;
+
+fn settles(blocks: &Blocks, limits: Limits) -> Result<(), TestCaseError> {
+    {
+        let mut r = Realizer::new().with_limits(limits);
+        let mut feedback = Vec::new();
+        for (i, (composition, after, behaviours)) in blocks.iter().enumerate() {
+            let now = r.now() + after;
+            feedback.extend(r.tick(now).feedback);
+            let _ = r.perform_bml(&block(i, *composition, behaviours));
+            feedback.extend(r.tick(now).feedback);
+        }
+        let mut events = 0;
+        while let Some(t) = r.next_event() {
+            events += 1;
+            prop_assert!(events < 100_000, "the realizer never settles");
+            feedback.extend(r.tick(t).feedback);
+        }
+        // (scheduled, starts, ends, revoked ends) per block
+        let mut seen: BTreeMap<String, (bool, usize, usize, usize)> = BTreeMap::new();
+        for f in &feedback {
+            match f {
+                Feedback::Prediction(p) => {
+                    for b in &p.blocks {
+                        if b.status == Some(BlockStatus::Pending) {
+                            seen.entry(b.id.to_string()).or_default().0 = true;
+                        }
+                    }
+                }
+                Feedback::BlockProgress(p) => {
+                    let e = seen.entry(p.block.to_string()).or_default();
+                    match (p.sync.as_str(), p.status) {
+                        ("start", _) => e.1 += 1,
+                        ("end", Some(BlockStatus::Revoked)) => e.3 += 1,
+                        _ => e.2 += 1,
+                    }
+                }
+                _ => {}
+            }
+        }
+        for (id, (scheduled, starts, ends, revoked)) in seen {
+            if scheduled {
+                let once = (starts == 1 && ends == 1 && revoked == 0)
+                    || (starts == 0 && ends == 0 && revoked == 1);
+                prop_assert!(
+                    once,
+                    "{}: {} starts, {} ends, {} revoked",
+                    id,
+                    starts,
+                    ends,
+                    revoked
+                );
+            } else {
+                prop_assert_eq!(
+                    (starts, ends, revoked),
+                    (0, 0, 0),
+                    "{} was never scheduled",
+                    id
+                );
+            }
+        }
+    }
+    Ok(())
+}

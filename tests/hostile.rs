@@ -1,0 +1,154 @@
+//! Hostile input through the built binary: deep nesting, thousands of attributes and namespace
+//! declarations, and times far from the block start are refused with a `limit-exceeded`
+//! diagnostic or a PARSING_FAILURE warning naming the limit, never a crash; the blocks after them
+//! still run, and every flag changes its limit.
+
+use std::process::Command;
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+fn bmlr(args: &[&str], input: &str) -> (i32, String, String) {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let input = input.to_string();
+    let writer = std::thread::spawn(move || {
+        let _ = stdin.write_all(input.as_bytes());
+    });
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn deep(n: usize) -> String {
+    format!(
+        r#"<bml {NS} id="deep">{}<gesture id="g" lexeme="BEAT"/>{}</bml>"#,
+        "<required>".repeat(n),
+        "</required>".repeat(n)
+    )
+}
+
+fn wide(n: usize) -> String {
+    let attrs: String = (0..n)
+        .map(|i| format!(r#" xmlns:p{i}="urn:x{i}" p{i}:a="1""#))
+        .collect();
+    format!(r#"<bml {NS} id="wide"><gesture id="g" lexeme="BEAT"{attrs}/></bml>"#)
+}
+
+const GOOD: &str = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="good"><gesture id="g" lexeme="BEAT"/></bml>"#;
+
+fn write(name: &str, text: &str) -> String {
+    let path = std::env::temp_dir().join(format!("bmlr-hostile-{}-{name}", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn six_thousand_nested_elements_are_refused_not_a_stack_overflow() {
+    let file = write("deep.xml", &deep(6000));
+    let (code, out, err) = bmlr(&["validate", &file], "");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        out.contains("error[limit-exceeded]") && out.contains("deeper than 64"),
+        "{out}"
+    );
+    // run, and a port, go on with the next block
+    let (code, out, err) = bmlr(&["run", &file, "fixtures/examples/welcome.xml"], "");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        out.contains("PARSING_FAILURE") && out.contains(r#"id="greet:end""#),
+        "{out}"
+    );
+    let (code, out, err) = bmlr(&["serve", "--stdio"], &format!("{}\n{GOOD}\n", deep(6000)));
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("deeper than 64") && out.contains(r#"id="good:end""#),
+        "{out}"
+    );
+    // the flag moves the limit
+    let (_, out, _) = bmlr(&["validate", "--max-depth", "10000", &file], "");
+    assert!(
+        out.contains("nested in <required>") && !out.contains("deeper than"),
+        "{out}"
+    );
+}
+
+#[test]
+fn thirty_thousand_attributes_are_refused_at_the_attribute_limit() {
+    let file = write("wide.xml", &wide(30_000));
+    let (code, out, _) = bmlr(&["validate", &file], "");
+    assert_eq!(code, 1);
+    assert!(out.contains("more than 256 attributes"), "{out}");
+    let (_, out, _) = bmlr(
+        &["serve", "--stdio"],
+        &format!("{}\n{GOOD}\n", wide(30_000)),
+    );
+    assert!(
+        out.contains("more than 256 attributes") && out.contains(r#"id="good:end""#),
+        "{out}"
+    );
+    let (code, out, _) = bmlr(
+        &[
+            "validate",
+            "--max-attributes",
+            "100000",
+            &write("w2.xml", &wide(200)),
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{out}");
+}
+
+#[test]
+fn a_time_far_from_the_block_start_is_refused_and_every_other_block_ends() {
+    let far = format!(
+        r#"<bml {NS} id="far"><gesture id="g" lexeme="BEAT" start="1e308" end="0"/></bml>"#
+    );
+    let (code, out, _) = bmlr(&["validate", &write("far.xml", &far)], "");
+    assert_eq!(code, 1);
+    assert!(
+        out.contains("error[limit-exceeded]") && out.contains("1e308"),
+        "{out}"
+    );
+    // an APPEND block after it does not wait for ever
+    let append = format!(
+        r#"<bml {NS} id="next" composition="APPEND"><gesture id="g" lexeme="BEAT"/></bml>"#
+    );
+    let (code, out, _) = bmlr(&["run", "-"], &format!("{far}\n{append}\n"));
+    assert_eq!(code, 1);
+    assert!(out.contains(r#"id="next:end""#), "{out}");
+    // a bad flag value is a usage error
+    let (code, _, err) = bmlr(&["validate", "--max-time", "inf", "x.xml"], "");
+    assert_eq!(code, 2, "{err}");
+}
+
+#[test]
+fn a_block_over_the_size_limit_is_refused_by_its_size() {
+    let big = format!(
+        r#"<bml {NS} id="big">{}</bml>"#,
+        (0..200)
+            .map(|i| format!(r#"<gesture id="g{i}" lexeme="BEAT"/>"#))
+            .collect::<String>()
+    );
+    let file = write("big.xml", &big);
+    let (code, out, _) = bmlr(&["validate", "--max-block-bytes", "1000", &file], "");
+    assert_eq!(code, 1);
+    assert!(out.contains("more than the limit of 1000"), "{out}");
+    let (code, out, _) = bmlr(&["validate", "--max-behaviours", "100", &file], "");
+    assert_eq!(code, 1);
+    assert!(out.contains("more than 100 behaviours"), "{out}");
+    let (code, _, _) = bmlr(&["validate", &file], "");
+    assert_eq!(code, 0);
+}
