@@ -152,3 +152,59 @@ fn a_block_over_the_size_limit_is_refused_by_its_size() {
     let (code, _, _) = bmlr(&["validate", &file], "");
     assert_eq!(code, 0);
 }
+
+/// The ports read one block per line: a line that is not UTF-8, a stray comment or CDATA
+/// opener, a broken block and a garbage line each cost only themselves and one warning; `run -`
+/// (where a block may span lines) picks up again at the next block the same way.
+#[test]
+fn bad_lines_cost_exactly_themselves_on_the_ports_and_in_run() {
+    let good = |id: &str| format!(r#"<bml {NS} id="{id}"><gesture id="g" lexeme="BEAT"/></bml>"#);
+    let mut input: Vec<u8> = Vec::new();
+    input.extend_from_slice(format!("{}\n", good("first")).as_bytes());
+    input.extend_from_slice(b"<bml id=\"bad\">\xff</bml>\n");
+    input.extend_from_slice(b"<!-- a comment that never ends\n");
+    input.extend_from_slice(b"<![CDATA[x]]>\n");
+    input.extend_from_slice(format!("{}\n", good("second")).as_bytes());
+    input.extend_from_slice(format!("<bml {NS} id=\"broken\"><speech></bml>\nhello\n").as_bytes());
+    input.extend_from_slice(format!("{}\n", good("third")).as_bytes());
+    for args in [vec!["serve", "--stdio"], vec!["run", "-"]] {
+        let (code, out, err) = bmlr_bytes(&args, &input);
+        for id in ["first", "second", "third"] {
+            assert!(
+                out.contains(&format!(r#"id="{id}:end""#)),
+                "{args:?}: {id} lost: {out}"
+            );
+        }
+        // in `run -` the comment that never ends takes the text up to the next block with it
+        // (a comment may span lines there), so the CDATA line shares its warning
+        let warnings = out
+            .lines()
+            .filter(|l| l.contains("PARSING_FAILURE"))
+            .count();
+        let expected = if args[0] == "run" { 4 } else { 5 };
+        assert_eq!(warnings, expected, "{args:?}: {out}");
+        assert!(out.contains("not UTF-8"), "{out}");
+        let expected = if args[0] == "run" { 1 } else { 0 };
+        assert_eq!(code, expected, "{args:?}: {err}");
+    }
+}
+
+fn bmlr_bytes(args: &[&str], input: &[u8]) -> (i32, String, String) {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}

@@ -161,3 +161,27 @@ fn garbage_gets_a_warning_for_its_sender_only_and_a_disconnect_disturbs_no_one()
     );
     assert!(bad_lines.iter().any(|l| l.contains("id=\"g1:end\"")));
 }
+
+/// A line that is not UTF-8 costs that line and one warning to its sender; the connection stays
+/// and the next block from it runs.
+#[test]
+fn a_line_that_is_not_utf8_costs_only_itself() {
+    let s = server(&[]);
+    let mut conn = TcpStream::connect(&s.addr).unwrap();
+    let mut reader = BufReader::new(conn.try_clone().unwrap());
+    conn.write_all(b"<bml id=\"x\">\xff\xfe</bml>\n").unwrap();
+    let good = format!(r#"<bml {NS} id="after"><gesture id="g" lexeme="BEAT"/></bml>"#);
+    conn.write_all(format!("{good}\n").as_bytes()).unwrap();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let lines = read_until(&mut reader, deadline, |l| l.contains(r#"id="after:end""#));
+    let warnings: Vec<&String> = lines
+        .iter()
+        .filter(|l| l.contains("PARSING_FAILURE"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{lines:?}");
+    assert!(warnings[0].contains("not UTF-8"), "{lines:?}");
+    assert!(
+        lines.iter().any(|l| l.contains(r#"id="after:end""#)),
+        "{lines:?}"
+    );
+}

@@ -236,6 +236,24 @@ impl Realizer {
         }
     }
 
+    /// Reports input that could not even be read as text (a line that is not UTF-8, or too
+    /// long): a PARSING_FAILURE warning with `<no id>` whose text is `SOURCE:LINE: reason`.
+    pub fn refuse_line(&mut self, source: &str, bad: &bml::BadLine) {
+        let character_id = self.default_character.clone();
+        self.unframed.push(Feedback::Warning(WarningFeedback {
+            id: NO_ID.into(),
+            kind: KnownWarning::ParsingFailure.into(),
+            character_id,
+            text: format!("{source}:{}: {}", bad.line, bad.reason),
+        }));
+        self.deliver(self.unframed.len() - 1);
+    }
+
+    /// What one block may hold.
+    pub fn limits(&self) -> &bml::Limits {
+        &self.limits
+    }
+
     /// Adds a listener that receives every feedback message from now on, in order.
     pub fn add_listener(&mut self, listener: Box<dyn FeedbackListener>) {
         self.listeners.push(listener);

@@ -1,7 +1,7 @@
 //! `bmlr run` and `bmlr plan`: feed BML files and streams to a realizer on a virtual clock (or in
 //! real time) and print its feedback, or print the planned sync times without executing.
 
-use std::io::{BufRead, Read, Write};
+use std::io::Write;
 use std::path::Path;
 use std::process::ExitCode;
 use std::sync::mpsc;
@@ -394,13 +394,24 @@ pub fn run(args: RunArgs) -> ExitCode {
             Item::Text(path, text) => run.perform(&text, &path),
             Item::Advance(s) => run.advance_to(run.realizer.now() + s),
             Item::Stdin => {
-                let mut text = String::new();
-                if let Err(e) = std::io::stdin().read_to_string(&mut text) {
-                    eprintln!("bmlr run: cannot read stdin: {e}");
-                    return ExitCode::from(2);
-                }
+                // line by line: a line that is not UTF-8 (or too long) costs only itself
                 let mut stream = BlockStream::new();
-                stream.push(&text);
+                let max_line = run.realizer.limits().block_bytes;
+                for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
+                    match line {
+                        Ok(text) => {
+                            stream.push(&text);
+                            stream.push("\n");
+                            while let Some(item) = stream.next_item(false) {
+                                run.stream(item);
+                            }
+                        }
+                        Err(bad) => {
+                            run.invalid += 1;
+                            run.realizer.refuse_line(STDIN, &bad);
+                        }
+                    }
+                }
                 while let Some(item) = stream.next_item(true) {
                     run.stream(item);
                 }
@@ -510,16 +521,13 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
             }
             Item::Stdin => {
                 // a reader thread hands over lines; blocks run as soon as they are complete
-                let (tx, rx) = mpsc::channel::<Option<String>>();
+                // (a line that is not UTF-8, or too long, costs only itself)
+                let (tx, rx) = mpsc::channel();
+                let max_line = realizer.limits().block_bytes;
                 std::thread::spawn(move || {
-                    for line in std::io::stdin().lock().lines() {
-                        match line {
-                            Ok(l) => {
-                                if tx.send(Some(l + "\n")).is_err() {
-                                    return;
-                                }
-                            }
-                            Err(_) => break,
+                    for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
+                        if tx.send(Some(line)).is_err() {
+                            return;
                         }
                     }
                     let _ = tx.send(None);
@@ -528,7 +536,14 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
                 let mut finished = false;
                 while !finished {
                     match rx.recv_timeout(Duration::from_secs_f64(period)) {
-                        Ok(Some(text)) => stream.push(&text),
+                        Ok(Some(Ok(text))) => {
+                            stream.push(&text);
+                            stream.push("\n");
+                        }
+                        Ok(Some(Err(bad))) => {
+                            invalid += 1;
+                            realizer.refuse_line(STDIN, &bad);
+                        }
                         Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => finished = true,
                         Err(mpsc::RecvTimeoutError::Timeout) => {}
                     }

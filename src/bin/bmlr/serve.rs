@@ -2,12 +2,12 @@
 //! per input line, one feedback element per output line) and `bmlr conformance` (the RealizerTester
 //! suite, in process or against a realizer command).
 
-use std::io::{BufRead, Write};
+use std::io::Write;
 use std::process::ExitCode;
 use std::sync::mpsc;
 use std::time::Duration;
 
-use bml_realizer::bml::{BlockStream, StreamItem};
+use bml_realizer::bml::BadLine;
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::conformance::InProcess;
 use bml_realizer::engine::timing::{DefaultTimingModels, SpeechTiming};
@@ -81,11 +81,12 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         return crate::tcp::serve(addr, args.per_client, args.fps, realizer);
     }
     let clock = WallClock::new();
-    let (tx, rx) = mpsc::channel::<Option<String>>();
+    // one block per line; a line that is not UTF-8 or too long costs only itself
+    let (tx, rx) = mpsc::channel::<Option<Result<String, BadLine>>>();
+    let max_line = realizer.limits().block_bytes;
     std::thread::spawn(move || {
-        for line in std::io::stdin().lock().lines() {
-            let Ok(line) = line else { break };
-            if tx.send(Some(line + "\n")).is_err() {
+        for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
+            if tx.send(Some(line)).is_err() {
                 return;
             }
         }
@@ -93,27 +94,36 @@ pub fn serve(args: ServeArgs) -> ExitCode {
     });
     let period = Duration::from_secs_f64(1.0 / args.fps);
     let mut out = std::io::stdout().lock();
-    let mut stream = BlockStream::new();
     let mut open = true;
     loop {
+        let mut lines = Vec::new();
         if open {
             match rx.recv_timeout(period) {
-                Ok(Some(text)) => stream.push(&text),
+                Ok(Some(line)) => lines.push(line),
                 Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => open = false,
                 Err(mpsc::RecvTimeoutError::Timeout) => {}
+            }
+            // and whatever else has arrived
+            for more in rx.try_iter() {
+                match more {
+                    Some(line) => lines.push(line),
+                    None => open = false,
+                }
             }
         } else {
             std::thread::sleep(period);
         }
         // bring the clock up to date before blocks arrive (they are planned at this time)
         let mut feedback = realizer.tick(clock.now()).feedback;
-        while let Some(item) = stream.next_item(!open) {
-            match item {
-                StreamItem::Block(t) | StreamItem::Garbage(t) => {
-                    let _ = realizer.perform_bml(&t);
-                }
+        for line in lines {
+            match line {
+                Ok(text) if text.trim().is_empty() => {}
                 // a live port has no use for clock advances: time passes by itself
-                StreamItem::Advance(_) => {}
+                Ok(text) if is_advance(&text) => {}
+                Ok(text) => {
+                    let _ = realizer.perform_bml_from(&text, Some("<stdin>"));
+                }
+                Err(bad) => realizer.refuse_line("<stdin>", &bad),
             }
         }
         feedback.extend(realizer.tick(clock.now()).feedback);
@@ -129,6 +139,12 @@ pub fn serve(args: ServeArgs) -> ExitCode {
             return ExitCode::SUCCESS;
         }
     }
+}
+
+/// Whether a line is a `+SECS` clock advance.
+fn is_advance(line: &str) -> bool {
+    let secs = line.trim().strip_prefix('+').map(str::parse::<f64>);
+    matches!(secs, Some(Ok(s)) if s.is_finite() && s >= 0.0)
 }
 
 /// Arguments of `bmlr conformance`.

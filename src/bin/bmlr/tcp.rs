@@ -7,7 +7,7 @@
 //! main thread owns the realizer, ticks it on the wall clock and routes feedback.
 
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufReader, Write};
 use std::net::{TcpListener, TcpStream};
 use std::process::ExitCode;
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -23,11 +23,13 @@ type Client = u64;
 enum Event {
     Connected(Client, Sender<String>),
     Line(Client, String),
+    /// A line that is not UTF-8 or too long: it costs only itself.
+    BadLine(Client, bml::BadLine),
     Disconnected(Client),
 }
 
 /// Accepts connections and starts a reader and a writer thread for each.
-fn accept(listener: TcpListener, events: Sender<Event>) {
+fn accept(listener: TcpListener, events: Sender<Event>, max_line: usize) {
     let mut next: Client = 0;
     for stream in listener.incoming() {
         let Ok(stream) = stream else { continue };
@@ -44,9 +46,12 @@ fn accept(listener: TcpListener, events: Sender<Event>) {
         }
         let events = events.clone();
         std::thread::spawn(move || {
-            for line in BufReader::new(stream).lines() {
-                let Ok(line) = line else { break };
-                if events.send(Event::Line(client, line)).is_err() {
+            for line in bml::lines(BufReader::new(stream), max_line) {
+                let event = match line {
+                    Ok(line) => Event::Line(client, line),
+                    Err(bad) => Event::BadLine(client, bad),
+                };
+                if events.send(event).is_err() {
                     return;
                 }
             }
@@ -96,7 +101,8 @@ pub fn serve(addr: &str, per_client: bool, fps: f64, realizer: Realizer) -> Exit
         }
     }
     let (tx, events) = mpsc::channel();
-    std::thread::spawn(move || accept(listener, tx));
+    let max_line = realizer.limits().block_bytes;
+    std::thread::spawn(move || accept(listener, tx, max_line));
     run(realizer, events, per_client, fps);
     ExitCode::SUCCESS
 }
@@ -131,11 +137,20 @@ fn run(mut realizer: Realizer, events: Receiver<Event>, per_client: bool, fps: f
                         Event::Disconnected(c) => {
                             clients.remove(&c);
                         }
+                        Event::BadLine(c, bad) => routed.push((
+                            Some(c),
+                            Feedback::Warning(WarningFeedback {
+                                id: NO_ID.into(),
+                                kind: KnownWarning::ParsingFailure.into(),
+                                character_id: None,
+                                text: format!("line {}: {}", bad.line, bad.reason),
+                            }),
+                        )),
                         Event::Line(c, line) => {
                             if line.trim().is_empty() {
                                 continue;
                             }
-                            let (block, diagnostics) = bml::check(&line);
+                            let (block, diagnostics) = bml::check_with(&line, realizer.limits());
                             let errors: Vec<String> = diagnostics
                                 .iter()
                                 .filter(|d| d.is_error())
@@ -145,6 +160,7 @@ fn run(mut realizer: Realizer, events: Receiver<Event>, per_client: bool, fps: f
                                 // the sender's problem: only the sender hears of it
                                 let id = block
                                     .map(|b| b.id.to_string())
+                                    .or_else(|| bml::root_id(&line))
                                     .filter(|id| !id.is_empty())
                                     .unwrap_or_else(|| NO_ID.to_string());
                                 routed.push((
