@@ -208,3 +208,50 @@ fn bmlr_bytes(args: &[&str], input: &[u8]) -> (i32, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// A port paused (SIGSTOP) and resumed reports the sync points it missed at their planned
+/// `globalTime`, and says once how late it is.
+#[cfg(unix)]
+#[test]
+fn a_paused_port_says_how_late_it_is() {
+    use std::io::{Read, Write};
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(["serve", "--stdio"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let speech = format!(
+        r#"<bml {NS} id="talk"><speech id="s"><text>one <sync id="a"/>two <sync id="b"/>three <sync id="c"/>four <sync id="d"/>five <sync id="e"/>six <sync id="f"/>seven <sync id="g"/>eight nine ten eleven twelve</text></speech></bml>"#
+    );
+    writeln!(stdin, "{speech}").unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let signal = |s: &str| {
+        let status = Command::new("kill")
+            .args([s, &child.id().to_string()])
+            .status();
+        assert!(status.unwrap().success());
+    };
+    signal("-STOP");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    signal("-CONT");
+    drop(stdin);
+    let mut out = String::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut out)
+        .unwrap();
+    child.wait().unwrap();
+    let late: Vec<&str> = out.lines().filter(|l| l.contains("fell behind")).collect();
+    assert_eq!(late.len(), 1, "{out}");
+    assert!(
+        late[0].contains("EXECUTION_FAILURE") && late[0].contains("s late"),
+        "{out}"
+    );
+    assert!(out.contains(r#"id="talk:end""#), "{out}");
+}

@@ -20,6 +20,10 @@ use crate::world::World;
 /// The id used in warnings about a block whose id could not be read.
 pub const NO_ID: &str = "<no id>";
 
+/// On the wall clock, a tick that comes this much later than a sync point it passes (seconds)
+/// reports that the realizer fell behind.
+pub const LATE: f64 = 0.25;
+
 /// The string-level realizer port (BML in, feedback out), as in RealizerTester and AsapRealizer.
 pub trait RealizerPort {
     /// Submits one `<bml>` block as text. Problems are reported as warning feedback.
@@ -100,7 +104,9 @@ impl Realizer {
     }
 
     /// Stamps block and sync progress with `bmla:posixTime` (for wall-clock runs; virtual-clock
-    /// runs leave it out so that logs are byte-identical).
+    /// runs leave it out so that logs are byte-identical). A wall-clock realizer also reports
+    /// when it fell behind: a tick more than [`LATE`] after a sync point it passes gives an
+    /// EXECUTION_FAILURE warning saying how late (the sync's feedback keeps its planned time).
     pub fn with_posix_time(mut self, on: bool) -> Self {
         self.posix_time = on;
         self
@@ -290,6 +296,10 @@ impl Realizer {
         } else {
             self.now
         };
+        // on the wall clock, the realizer may fall behind (a stalled host, a paused process)
+        let due = self
+            .next_event()
+            .filter(|t| self.posix_time && now - t > LATE);
         self.now = now;
         if self.world.has_paths() {
             self.world_mut().move_to(now);
@@ -302,6 +312,17 @@ impl Realizer {
         for m in self.characters.values_mut() {
             m.advance(now, &self.world, &mut frame);
             m.move_feedback(&mut self.unframed);
+        }
+        if let Some(due) = due {
+            self.unframed.push(Feedback::Warning(WarningFeedback {
+                id: NO_ID.into(),
+                kind: KnownWarning::ExecutionFailure.into(),
+                character_id: self.default_character.clone(),
+                text: format!(
+                    "the realizer fell behind its clock: sync points due from {due:.3} s were reported at {now:.3} s, up to {:.3} s late (their feedback keeps the planned globalTime)",
+                    now - due
+                ),
+            }));
         }
         self.deliver(from);
         frame.feedback = std::mem::take(&mut self.unframed);
