@@ -255,3 +255,61 @@ fn a_paused_port_says_how_late_it_is() {
     );
     assert!(out.contains(r#"id="talk:end""#), "{out}");
 }
+
+/// 100 000 blocks piped into `serve --stdio` as fast as the pipe takes them, a bad line among
+/// every thousand: the port stays under 64 MB, every block ends, every bad line warns once.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_hundred_thousand_blocks_through_the_stdio_port_in_bounded_memory() {
+    use std::io::{BufRead, BufReader, Write};
+    use std::process::Stdio;
+    const BLOCKS: usize = 100_000;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(["serve", "--stdio"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        for i in 0..BLOCKS {
+            let line = if i % 1000 == 999 {
+                "this line is not a block\n".to_string()
+            } else {
+                format!("<bml {NS} id=\"b{i}\"/>\n")
+            };
+            stdin.write_all(line.as_bytes()).unwrap();
+        }
+    });
+    let peak = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let watching = peak.clone();
+    let watcher = std::thread::spawn(move || loop {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+        let Some(kb) = status
+            .lines()
+            .find_map(|l| l.strip_prefix("VmHWM:"))
+            .and_then(|v| v.split_whitespace().next()?.parse::<u64>().ok())
+        else {
+            return;
+        };
+        watching.store(kb, std::sync::atomic::Ordering::Relaxed);
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    });
+    let (mut ends, mut warnings) = (0, 0);
+    for line in BufReader::new(child.stdout.take().unwrap()).lines() {
+        let line = line.unwrap();
+        if line.contains("blockProgress") && line.contains(":end\"") {
+            ends += 1;
+        } else if line.contains("PARSING_FAILURE") {
+            warnings += 1;
+        }
+    }
+    writer.join().unwrap();
+    child.wait().unwrap();
+    watcher.join().unwrap();
+    assert_eq!((ends, warnings), (BLOCKS - BLOCKS / 1000, BLOCKS / 1000));
+    let kb = peak.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(kb > 0 && kb < 64 * 1024, "peak RSS {kb} kB");
+}

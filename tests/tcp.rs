@@ -185,3 +185,61 @@ fn a_line_that_is_not_utf8_costs_only_itself() {
         "{lines:?}"
     );
 }
+
+/// Peak resident memory of a process, kB (Linux).
+fn peak_rss_kb(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0)
+}
+
+/// One client floods the server and never reads its feedback; another sends a block every half
+/// second. The flooder is cut off when its unread feedback passes the limit, the server stays
+/// small, and the second client's blocks end within 2 s of being sent.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_client_that_floods_and_never_reads_slows_no_one_and_grows_nothing() {
+    let s = server(&["--per-client"]);
+    let addr = s.addr.clone();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flooding = stop.clone();
+    let flooder = std::thread::spawn(move || {
+        let mut conn = TcpStream::connect(&addr).unwrap();
+        let mut n = 0u64;
+        while !flooding.load(std::sync::atomic::Ordering::Relaxed) {
+            let line = format!("<bml {NS} id=\"f{n}\"/>\n");
+            if conn.write_all(line.as_bytes()).is_err() {
+                break; // cut off
+            }
+            n += 1;
+        }
+        n
+    });
+    let conn = TcpStream::connect(&s.addr).unwrap();
+    let mut writer = conn.try_clone().unwrap();
+    let mut reader = BufReader::new(conn);
+    for b in 0..8 {
+        let sent = Instant::now();
+        let line = format!(
+            r#"<bml {NS} id="calm{b}"><head id="h" lexeme="NOD" start="0" end="0.3"/></bml>"#
+        );
+        writer.write_all(format!("{line}\n").as_bytes()).unwrap();
+        let end = format!(r#"id="calm{b}:end""#);
+        let lines = read_until(&mut reader, sent + Duration::from_secs(2), |l| {
+            l.contains(&end)
+        });
+        assert!(
+            lines.iter().any(|l| l.contains(&end)),
+            "calm{b} did not end within 2 s: {lines:?}"
+        );
+        std::thread::sleep(Duration::from_millis(500).saturating_sub(sent.elapsed()));
+    }
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    let flooded = flooder.join().unwrap();
+    assert!(flooded > 10_000, "the flood was only {flooded} blocks");
+    let rss = peak_rss_kb(s.child.id());
+    assert!(rss < 250_000, "the server grew to {rss} kB");
+}

@@ -522,7 +522,7 @@ fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> Exi
             Item::Stdin => {
                 // a reader thread hands over lines; blocks run as soon as they are complete
                 // (a line that is not UTF-8, or too long, costs only itself)
-                let (tx, rx) = mpsc::channel();
+                let (tx, rx) = mpsc::sync_channel(256);
                 let max_line = realizer.limits().block_bytes;
                 std::thread::spawn(move || {
                     for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {

@@ -82,7 +82,8 @@ pub fn serve(args: ServeArgs) -> ExitCode {
     }
     let clock = WallClock::new();
     // one block per line; a line that is not UTF-8 or too long costs only itself
-    let (tx, rx) = mpsc::channel::<Option<Result<String, BadLine>>>();
+    // bounded: the reader waits while the realizer is behind, and the pipe fills (backpressure)
+    let (tx, rx) = mpsc::sync_channel::<Option<Result<String, BadLine>>>(256);
     let max_line = realizer.limits().block_bytes;
     std::thread::spawn(move || {
         for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {

@@ -4,13 +4,16 @@
 //! sender only; a client that disconnects disturbs neither the others nor the plan.
 //!
 //! Threads: one accepts connections, one reads each client's lines, one writes to each client; the
-//! main thread owns the realizer, ticks it on the wall clock and routes feedback.
+//! main thread owns the realizer, ticks it on the wall clock and routes feedback. Every queue
+//! between them is bounded: the readers wait when the realizer is behind (the clients' sockets
+//! then fill: backpressure), and a client whose unread feedback passes [`UNREAD_LIMIT`] lines is
+//! disconnected with a line on stderr, so that it cannot grow the server or slow the others.
 
 use std::collections::HashMap;
 use std::io::{BufReader, Write};
 use std::net::{TcpListener, TcpStream};
 use std::process::ExitCode;
-use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
 use std::time::Duration;
 
 use bml_realizer::bml;
@@ -20,8 +23,20 @@ use bml_realizer::realizer::{Realizer, NO_ID};
 
 type Client = u64;
 
+/// Lines of feedback a client may leave unread before it is disconnected.
+pub const UNREAD_LIMIT: usize = 50_000;
+
+/// Lines read from all clients that wait for the realizer.
+const PENDING_LINES: usize = 1_024;
+
+/// A connected client: its feedback queue and its socket (to cut it off).
+struct Conn {
+    tx: SyncSender<String>,
+    socket: TcpStream,
+}
+
 enum Event {
-    Connected(Client, Sender<String>),
+    Connected(Client, Conn),
     Line(Client, String),
     /// A line that is not UTF-8 or too long: it costs only itself.
     BadLine(Client, bml::BadLine),
@@ -29,7 +44,7 @@ enum Event {
 }
 
 /// Accepts connections and starts a reader and a writer thread for each.
-fn accept(listener: TcpListener, events: Sender<Event>, max_line: usize) {
+fn accept(listener: TcpListener, events: SyncSender<Event>, max_line: usize) {
     let mut next: Client = 0;
     for stream in listener.incoming() {
         let Ok(stream) = stream else { continue };
@@ -39,9 +54,15 @@ fn accept(listener: TcpListener, events: Sender<Event>, max_line: usize) {
         };
         let client = next;
         next += 1;
-        let (tx, rx) = mpsc::channel::<String>();
+        let Ok(socket) = stream.try_clone() else {
+            continue;
+        };
+        let (tx, rx) = mpsc::sync_channel::<String>(UNREAD_LIMIT);
         std::thread::spawn(move || write_lines(write_half, rx));
-        if events.send(Event::Connected(client, tx)).is_err() {
+        if events
+            .send(Event::Connected(client, Conn { tx, socket }))
+            .is_err()
+        {
             return;
         }
         let events = events.clone();
@@ -100,7 +121,7 @@ pub fn serve(addr: &str, per_client: bool, fps: f64, realizer: Realizer) -> Exit
             return ExitCode::from(2);
         }
     }
-    let (tx, events) = mpsc::channel();
+    let (tx, events) = mpsc::sync_channel(PENDING_LINES);
     let max_line = realizer.limits().block_bytes;
     std::thread::spawn(move || accept(listener, tx, max_line));
     run(realizer, events, per_client, fps);
@@ -110,17 +131,35 @@ pub fn serve(addr: &str, per_client: bool, fps: f64, realizer: Realizer) -> Exit
 fn run(mut realizer: Realizer, events: Receiver<Event>, per_client: bool, fps: f64) {
     let clock = WallClock::new();
     let period = Duration::from_secs_f64(1.0 / fps);
-    let mut clients: HashMap<Client, Sender<String>> = HashMap::new();
+    let mut clients: HashMap<Client, Conn> = HashMap::new();
     // per-client routing: block id → the client that sent it (until the block ends)
     let mut owner: HashMap<String, Client> = HashMap::new();
-    let send = |clients: &mut HashMap<Client, Sender<String>>, to: Option<Client>, line: String| {
+    let send = |clients: &mut HashMap<Client, Conn>, to: Option<Client>, line: String| {
+        let cut = |c: &Client, conn: &Conn| {
+            // (stderr may be closed: that is no reason to stop serving)
+            let _ = writeln!(
+                std::io::stderr(),
+                "bmlr serve: client {c} left {UNREAD_LIMIT} lines of feedback unread; disconnected"
+            );
+            let _ = conn.socket.shutdown(std::net::Shutdown::Both);
+        };
+        let deliver = |c: &Client, conn: &Conn, line: String| match conn.tx.try_send(line) {
+            Ok(()) => true,
+            Err(TrySendError::Full(_)) => {
+                cut(c, conn);
+                false
+            }
+            Err(TrySendError::Disconnected(_)) => false,
+        };
         match to {
             Some(c) => {
-                if let Some(tx) = clients.get(&c) {
-                    let _ = tx.send(line);
+                if let Some(conn) = clients.get(&c) {
+                    if !deliver(&c, conn, line) {
+                        clients.remove(&c);
+                    }
                 }
             }
-            None => clients.retain(|_, tx| tx.send(line.clone()).is_ok()),
+            None => clients.retain(|c, conn| deliver(c, conn, line.clone())),
         }
     };
     loop {
@@ -129,10 +168,12 @@ fn run(mut realizer: Realizer, events: Receiver<Event>, per_client: bool, fps: f
             Ok(first) => {
                 let frame = realizer.tick(clock.now());
                 routed.extend(frame.feedback.into_iter().map(|f| (None, f)));
-                for event in std::iter::once(first).chain(events.try_iter()) {
+                // at most a queue's worth per frame, so that a flood cannot hold the frame up
+                let pending = events.try_iter().take(PENDING_LINES);
+                for event in std::iter::once(first).chain(pending) {
                     match event {
-                        Event::Connected(c, tx) => {
-                            clients.insert(c, tx);
+                        Event::Connected(c, conn) => {
+                            clients.insert(c, conn);
                         }
                         Event::Disconnected(c) => {
                             clients.remove(&c);
