@@ -95,6 +95,20 @@ impl LiveBehaviour {
     }
 }
 
+/// Whether every behaviour satisfies `done`, a property that once true stays true (a phase that
+/// ended, a sync that passed): the behaviours before `*checked` are known to, and the check goes
+/// on from there, so that asking once per sync of a block stays linear in the block.
+fn all_from(
+    behaviours: &[LiveBehaviour],
+    checked: &std::cell::Cell<usize>,
+    done: impl Fn(&LiveBehaviour) -> bool,
+) -> bool {
+    let from = checked.get().min(behaviours.len());
+    let first_open = behaviours[from..].iter().position(|b| !done(b));
+    checked.set(first_open.map_or(behaviours.len(), |i| from + i));
+    first_open.is_none()
+}
+
 /// A block in the plan.
 #[derive(Debug, Clone)]
 pub(crate) struct LiveBlock {
@@ -118,6 +132,10 @@ pub(crate) struct LiveBlock {
     pub(crate) pegs: Option<Box<BlockPegs>>,
     /// An interrupt behaviour cut some of its behaviours: it ends INTERRUPTED, not DONE.
     pub(crate) cut: bool,
+    /// The behaviours before this index have all ended (see [`all_from`]).
+    ended_before: std::cell::Cell<usize>,
+    /// The behaviours before this index have all passed `relax`.
+    relaxed_before: std::cell::Cell<usize>,
 }
 
 /// A block on its own peg board (only blocks that refer to anticipators have one).
@@ -128,8 +146,8 @@ pub(crate) struct BlockPegs {
     pub(crate) plan: PlannedBlock,
 }
 
-/// Every sync point that a sync reference of `block` names (attributes and `<constraint>`s), each
-/// once, in document order.
+/// Every sync point outside the block (of another block, or of an anticipator) that a sync
+/// reference of `block` names (attributes and `<constraint>`s), each once, sorted.
 pub(crate) fn referenced_points(block: &bml::Block) -> SmallVec<[&SyncPoint; 8]> {
     let mut out: SmallVec<[&SyncPoint; 8]> = SmallVec::new();
     let refs = block
@@ -154,13 +172,13 @@ pub(crate) fn referenced_points(block: &bml::Block) -> SmallVec<[&SyncPoint; 8]>
                     .chain(syncs.iter().map(|s| &s.reference))
             })
         }));
-    for r in refs {
-        if let SyncRef::Point { point, .. } = r {
-            if !out.contains(&point) {
-                out.push(point);
-            }
-        }
-    }
+    // only references that leave the block matter here; sorted, once each
+    out.extend(refs.filter_map(|r| match r {
+        SyncRef::Point { point, .. } if !matches!(point, SyncPoint::Local { .. }) => Some(point),
+        _ => None,
+    }));
+    out.sort_unstable();
+    out.dedup();
     out
 }
 
@@ -197,21 +215,23 @@ impl LiveBlock {
             preplan: false,
             pegs: None,
             cut: false,
+            ended_before: std::cell::Cell::new(0),
+            relaxed_before: std::cell::Cell::new(0),
         }
     }
 
     /// Takes the scheduled behaviours (in document order) and their engines.
     pub(crate) fn set_schedule(&mut self, schedule: BlockSchedule, registry: &Registry) {
         self.behaviours.reserve_exact(schedule.behaviours.len());
+        // both lists are in document order: each search goes on from where the last one ended
+        let mut from = 0;
         for s in schedule.behaviours {
-            let Some(index) = self
-                .source
-                .behaviours
-                .iter()
-                .position(|b| same_name(&b.id, &s.id))
-            else {
+            let source = &self.source.behaviours;
+            let found = source[from..].iter().position(|b| same_name(&b.id, &s.id));
+            let Some(index) = found.map(|i| from + i) else {
                 continue;
             };
+            from = index + 1;
             let Some(engine) = registry.engine_for(&self.source.behaviours[index]) else {
                 continue;
             };
@@ -295,14 +315,16 @@ impl LiveBlock {
 
     /// Every behaviour still in the plan has ended.
     pub(crate) fn all_ended(&self) -> bool {
-        self.behaviours
-            .iter()
-            .all(|b| matches!(b.phase, Phase::Ended | Phase::Removed))
+        let ended = |b: &LiveBehaviour| matches!(b.phase, Phase::Ended | Phase::Removed);
+        all_from(&self.behaviours, &self.ended_before, ended)
     }
 
     /// IN_EXEC → SUBSIDING once every behaviour passed `relax` (or `end`); true if it changed.
     pub(crate) fn update_subsiding(&mut self) -> bool {
-        if self.status == BlockStatus::InExec && self.live().all(LiveBehaviour::passed_relax) {
+        let passed = |b: &LiveBehaviour| b.phase == Phase::Removed || b.passed_relax();
+        if self.status == BlockStatus::InExec
+            && all_from(&self.behaviours, &self.relaxed_before, passed)
+        {
             self.status = BlockStatus::Subsiding;
             return true;
         }

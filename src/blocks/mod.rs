@@ -12,7 +12,8 @@
 mod anticipation;
 mod live;
 
-use std::collections::VecDeque;
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, VecDeque};
 
 // block ids come from the host: a fast hash (rustc's) instead of SipHash for the block index
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
@@ -53,10 +54,29 @@ pub struct Sizes {
     pub finished_ids: usize,
 }
 
+/// A behaviour's next sync in the heap of [`BlockManager::next_sync`], ordered by time (in whole
+/// nanoseconds, so that float noise makes ties), then block arrival, then document order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct Due {
+    ns: i64,
+    seq: u64,
+    index: usize,
+    /// The behaviour's position in its block, and the sync's position in the behaviour.
+    xi: usize,
+    k: usize,
+}
+
+/// A global time in whole nanoseconds.
+fn due_ns(t: f64) -> i64 {
+    (t * 1e9).round() as i64
+}
+
 /// The blocks of one character and the engines that realize them.
 pub struct BlockManager {
-    /// The next sync point due, while the plan has not changed (`None`: to be found again).
-    next_cache: std::cell::Cell<Option<Option<(f64, usize, usize)>>>,
+    /// The next sync of every live behaviour, earliest first (see [`Self::next_sync`]).
+    due: std::cell::RefCell<BinaryHeap<Reverse<Due>>>,
+    /// The plan changed since `due` was built.
+    due_stale: std::cell::Cell<bool>,
     registry: Registry,
     strategy: Box<dyn SchedulingStrategy>,
     character: Option<String>,
@@ -138,7 +158,8 @@ impl BlockManager {
         character: Option<String>,
     ) -> Self {
         BlockManager {
-            next_cache: std::cell::Cell::new(None),
+            due: std::cell::RefCell::new(BinaryHeap::new()),
+            due_stale: std::cell::Cell::new(true),
             registry,
             strategy,
             character,
@@ -956,46 +977,74 @@ impl BlockManager {
     // ---------------------------------------------------------------------------------------
     // the event loop
 
-    /// The earliest unreported sync of a running block: (global time, block index, behaviour
-    /// index). Ties go to the earlier block, then document order.
-    /// The next sync point due: (global time, block, behaviour). Cached between changes of the
-    /// plan ([`touch`](Self::touch)), so that frames without events do not scan every live
-    /// behaviour (no slowdown with many live blocks).
+    /// The next sync point due: (global time, block index, behaviour index). Ties (times within
+    /// a nanosecond: float noise of the solver) go to the earlier block, then document order.
+    ///
+    /// Every live behaviour's next sync waits in a heap. It is rebuilt after a change of the plan
+    /// ([`touch`](Self::touch)); a sync that passes without consequences for other behaviours
+    /// only queues the behaviour's next one ([`queue_next`](Self::queue_next)). An entry whose
+    /// behaviour has moved on is dropped when it comes up. So an event costs a heap operation,
+    /// not a scan of every live behaviour (a chain of 10 000 behaviours passes 70 000 syncs).
     fn next_sync(&self) -> Option<(f64, usize, usize)> {
-        if let Some(next) = self.next_cache.get() {
-            return next;
+        if self.due_stale.get() {
+            self.rebuild_due();
         }
-        let next = self.scan_next_sync();
-        self.next_cache.set(Some(next));
-        next
+        let mut due = self.due.borrow_mut();
+        while let Some(&Reverse(d)) = due.peek() {
+            if let Some((t, bi)) = self.still_due(d) {
+                return Some((t, bi, d.xi));
+            }
+            due.pop();
+        }
+        None
     }
 
-    /// Forgets the cached next sync: the plan changed (blocks, phases or sync times).
+    /// The plan changed (blocks, phases or sync times): the heap of next syncs is rebuilt.
     fn touch(&self) {
-        self.next_cache.set(None);
+        self.due_stale.set(true);
     }
 
-    fn scan_next_sync(&self) -> Option<(f64, usize, usize)> {
-        // times equal within a nanosecond (float noise of the solver) count as ties
-        let mut best: Option<((i64, u64, usize), usize, usize)> = None;
+    /// The entry of behaviour `xi` of block `bi`'s next sync, if it has one to report.
+    fn due_of(&self, bi: usize, xi: usize) -> Option<Due> {
+        let b = &self.blocks[bi];
+        let x = &b.behaviours[xi];
+        let live = b.started() && matches!(x.phase, Phase::Added | Phase::Running);
+        let local = x.syncs.get(x.next).filter(|_| live)?.1;
+        Some(Due {
+            ns: due_ns(b.start + local),
+            seq: b.seq,
+            index: x.index,
+            xi,
+            k: x.next,
+        })
+    }
+
+    /// Queues the next sync of behaviour `xi` of block `bi` (after one of its syncs passed).
+    fn queue_next(&self, bi: usize, xi: usize) {
+        if let Some(d) = self.due_of(bi, xi) {
+            self.due.borrow_mut().push(Reverse(d));
+        }
+    }
+
+    fn rebuild_due(&self) {
+        let mut all = Vec::new();
         for (bi, b) in self.blocks.iter().enumerate() {
-            if !b.started() {
-                continue;
-            }
-            for (xi, x) in b.behaviours.iter().enumerate() {
-                if !matches!(x.phase, Phase::Added | Phase::Running) || x.next >= x.syncs.len() {
-                    continue;
-                }
-                let t = b.start + x.syncs[x.next].1;
-                let order = ((t * 1e9).round() as i64, b.seq, x.index);
-                if best.is_none_or(|(o, _, _)| order < o) {
-                    best = Some((order, bi, xi));
-                }
+            if b.started() {
+                all.extend((0..b.behaviours.len()).filter_map(|xi| self.due_of(bi, xi)));
             }
         }
-        best.map(|(_, bi, xi)| {
-            let (b, x) = (&self.blocks[bi], &self.blocks[bi].behaviours[xi]);
-            (b.start + x.syncs[x.next].1, bi, xi)
+        *self.due.borrow_mut() = BinaryHeap::from(all.into_iter().map(Reverse).collect::<Vec<_>>());
+        self.due_stale.set(false);
+    }
+
+    /// Whether an entry still stands for its behaviour's next sync: its global time and its
+    /// block's index then.
+    fn still_due(&self, d: Due) -> Option<(f64, usize)> {
+        let bi = self.seqs.binary_search(&d.seq).ok()?;
+        let now = self.due_of(bi, d.xi)?;
+        (now == d).then(|| {
+            let b = &self.blocks[bi];
+            (b.start + b.behaviours[d.xi].syncs[d.k].1, bi)
         })
     }
 
@@ -1052,8 +1101,12 @@ impl BlockManager {
                 }
                 (Some((t, bi, xi)), _) => {
                     self.now = t;
-                    self.pass_sync(bi, xi, t);
-                    self.touch();
+                    let seq = self.blocks[bi].seq;
+                    if self.pass_sync(bi, xi, t) {
+                        self.touch();
+                    } else if let Ok(bi) = self.seqs.binary_search(&seq) {
+                        self.queue_next(bi, xi);
+                    }
                 }
                 (None, None) => break,
             }
@@ -1098,7 +1151,10 @@ impl BlockManager {
         }
     }
 
-    fn pass_sync(&mut self, bi: usize, xi: usize, t: f64) {
+    /// Reports the next sync of behaviour `xi` of block `bi`, passed at `t`, and what follows
+    /// from it. Returns whether the plan changed beyond that behaviour (an action, a block that
+    /// ended or started).
+    fn pass_sync(&mut self, bi: usize, xi: usize, t: f64) -> bool {
         let (block_id, beh_id, sync, local, engine, last, skipped) = {
             let b = &mut self.blocks[bi];
             let x = &mut b.behaviours[xi];
@@ -1126,15 +1182,18 @@ impl BlockManager {
             self.blocks[bi].behaviours[xi].phase = Phase::Ended;
             self.retiring.push((engine, key.clone()));
         }
+        let mut changed = !actions.is_empty();
         if self.blocks[bi].update_subsiding() {
             self.start_ready(t);
+            changed = true;
         }
         for a in actions {
             self.act(a, t);
         }
         if let Some(bi) = self.pos(&block_id) {
-            self.finish_if_done(bi, t);
+            changed |= self.finish_if_done(bi, t);
         }
+        changed
     }
 
     fn act(&mut self, action: Action, t: f64) {

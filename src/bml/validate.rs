@@ -81,7 +81,7 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
     // Shorthand attributes (the bulk): checked in place, without building constraints.
     for b in &block.behaviours {
         for s in &b.syncs {
-            check_ref(block, &s.value, s.pos, &mut diags);
+            check_ref(block, &ids, &s.value, s.pos, &mut diags);
             if matches!(s.value, SyncRef::Time(t) if t < 0.0) {
                 diags.push(Diagnostic::error(
                     Code::InvalidConstraint,
@@ -166,7 +166,7 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
         }
         for side in [&c.left, &c.right] {
             if let Anchor::Point(p) = side {
-                check_point(block, p, c.pos, &mut diags);
+                check_point(block, &ids, p, c.pos, &mut diags);
             }
         }
         // normalisation puts the block start on the right: left REL block + offset
@@ -182,15 +182,19 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
     diags
 }
 
-fn check_ref(block: &Block, r: &SyncRef, pos: Pos, diags: &mut Vec<Diagnostic>) {
+/// The behaviours' (id, position) pairs, sorted: found by binary search, so that checking every
+/// reference of a large block stays O(n log n).
+type Ids<'a> = [(&'a str, usize)];
+
+fn check_ref(block: &Block, ids: &Ids, r: &SyncRef, pos: Pos, diags: &mut Vec<Diagnostic>) {
     if let SyncRef::Point { point, .. } = r {
-        check_point(block, point, pos, diags);
+        check_point(block, ids, point, pos, diags);
     }
 }
 
 /// A reference to a behaviour of this block must name an existing behaviour and one of its sync
 /// points; references to other blocks and to anticipators are resolved at scheduling time.
-fn check_point(block: &Block, p: &SyncPoint, pos: Pos, diags: &mut Vec<Diagnostic>) {
+fn check_point(block: &Block, ids: &Ids, p: &SyncPoint, pos: Pos, diags: &mut Vec<Diagnostic>) {
     let (behaviour, sync) = match p {
         SyncPoint::Local { behaviour, sync } => (behaviour, sync),
         SyncPoint::External {
@@ -200,7 +204,13 @@ fn check_point(block: &Block, p: &SyncPoint, pos: Pos, diags: &mut Vec<Diagnosti
         } if *blk == block.id => (behaviour, sync),
         _ => return,
     };
-    match block.behaviour(behaviour) {
+    // the first behaviour with the id (pairs of equal ids are in position order)
+    let at = ids.partition_point(|(id, _)| *id < behaviour.as_str());
+    let found = ids
+        .get(at)
+        .filter(|(id, _)| *id == behaviour.as_str())
+        .map(|&(_, i)| &block.behaviours[i]);
+    match found {
         None => diags.push(Diagnostic::error(
             Code::UnknownBehaviour,
             pos,

@@ -5,6 +5,7 @@
 mod registry;
 pub mod timing;
 
+use std::collections::VecDeque;
 use std::fmt;
 use std::sync::Arc;
 
@@ -393,11 +394,35 @@ pub trait Engine {
     }
 }
 
-/// The units an engine holds, in the order they were added (so frames are deterministic without
-/// sorting), each with its key (shared with frame outputs) and current global sync times.
+/// The units an engine holds, each with its key (shared with frame outputs) and current global
+/// sync times, in the order of their start times (ties: the order they were added). So frames
+/// are deterministic, a unit that starts later is applied later (and wins where two overlap),
+/// and the units that have started at some moment come first: a frame looks at those only, and
+/// the unit that ends first is near the front when it goes. Both matter when a block holds
+/// thousands of units (a chain of 10 000 gestures).
 #[derive(Debug, Clone)]
 pub struct Units<T> {
-    units: Vec<(Arc<UnitKey>, SyncTimes, T)>,
+    units: VecDeque<Held<T>>,
+    /// How many units were ever added (the tie-break of equal starts).
+    added: u64,
+}
+
+#[derive(Debug, Clone)]
+struct Held<T> {
+    key: Arc<UnitKey>,
+    syncs: SyncTimes,
+    data: T,
+    added: u64,
+}
+
+impl<T> Held<T> {
+    fn start(&self) -> f64 {
+        self.syncs.first().map_or(f64::INFINITY, |s| s.1)
+    }
+
+    fn order(&self) -> (f64, u64) {
+        (self.start(), self.added)
+    }
 }
 
 /// A unit's (sync, global time) list, in sync order.
@@ -405,50 +430,76 @@ pub type SyncTimes = Vec<(SyncName, f64)>;
 
 impl<T> Default for Units<T> {
     fn default() -> Self {
-        Units { units: Vec::new() }
+        Units {
+            units: VecDeque::new(),
+            added: 0,
+        }
     }
 }
 
 impl<T> Units<T> {
     /// No units.
     pub fn new() -> Self {
-        Units { units: Vec::new() }
+        Self::default()
     }
 
     /// Adds a unit with the engine's own data `data`.
     pub fn add(&mut self, unit: Unit<'_>, data: T) {
-        self.units
-            .push((Arc::new(unit.key.clone()), unit.syncs, data));
+        self.added += 1;
+        let held = Held {
+            key: Arc::new(unit.key.clone()),
+            syncs: unit.syncs,
+            data,
+            added: self.added,
+        };
+        self.insert(held);
+    }
+
+    fn insert(&mut self, held: Held<T>) {
+        let (start, added) = held.order();
+        let at = self.units.partition_point(|u| {
+            let (s, a) = u.order();
+            s.total_cmp(&start).then(a.cmp(&added)).is_lt()
+        });
+        self.units.insert(at, held);
+    }
+
+    fn position(&self, key: &UnitKey) -> Option<usize> {
+        self.units.iter().position(|u| *u.key == *key)
     }
 
     /// Forgets a unit.
     pub fn remove(&mut self, key: &UnitKey) {
-        self.units.retain(|(k, _, _)| **k != *key);
+        if let Some(i) = self.position(key) {
+            self.units.remove(i);
+        }
     }
 
     /// New sync times for a unit.
     pub fn retime(&mut self, key: &UnitKey, times: &[f64]) {
-        if let Some((_, syncs, _)) = self.units.iter_mut().find(|(k, _, _)| **k == *key) {
-            for (s, t) in syncs.iter_mut().zip(times) {
-                s.1 = *t;
-            }
+        let Some(i) = self.position(key) else {
+            return;
+        };
+        let Some(mut held) = self.units.remove(i) else {
+            return;
+        };
+        for (s, t) in held.syncs.iter_mut().zip(times) {
+            s.1 = *t;
         }
+        self.insert(held);
     }
 
     /// A unit's data.
     pub fn get(&self, key: &UnitKey) -> Option<&T> {
-        self.units
-            .iter()
-            .find(|(k, _, _)| **k == *key)
-            .map(|(_, _, d)| d)
+        self.units.iter().find(|u| *u.key == *key).map(|u| &u.data)
     }
 
     /// A unit's sync times and data.
     pub fn get_mut(&mut self, key: &UnitKey) -> Option<(&mut SyncTimes, &mut T)> {
         self.units
             .iter_mut()
-            .find(|(k, _, _)| **k == *key)
-            .map(|(_, s, d)| (s, d))
+            .find(|u| *u.key == *key)
+            .map(|u| (&mut u.syncs, &mut u.data))
     }
 
     /// How many units.
@@ -461,22 +512,32 @@ impl<T> Units<T> {
         self.units.is_empty()
     }
 
-    /// Every unit's sync times and data, in the order they were added.
+    /// Every unit's sync times and data, in start order.
     pub fn all(&self) -> impl Iterator<Item = (&SyncTimes, &T)> + '_ {
-        self.units.iter().map(|(_, s, d)| (s, d))
+        self.units.iter().map(|u| (&u.syncs, &u.data))
     }
 
     /// Every unit's sync times and data, the data mutable (engines that compile a unit lazily).
     pub fn all_mut(&mut self) -> impl Iterator<Item = (&SyncTimes, &mut T)> + '_ {
-        self.units.iter_mut().map(|(_, s, d)| (&*s, d))
+        self.units.iter_mut().map(|u| (&u.syncs, &mut u.data))
+    }
+
+    /// The units that have started by `now` (start ≤ now), in start order, the data mutable:
+    /// what a frame at `now` can show.
+    pub fn started_mut(&mut self, now: f64) -> impl Iterator<Item = (&SyncTimes, &mut T)> + '_ {
+        self.units
+            .iter_mut()
+            .take_while(move |u| u.start() <= now)
+            .map(|u| (&u.syncs, &mut u.data))
     }
 
     /// The units running at `now` (start ≤ now < end) with their progress (0 at start, 1 at end;
-    /// 0 for a unit without a finite end), in the order they were added.
+    /// 0 for a unit without a finite end), in start order.
     pub fn running(&self, now: f64) -> impl Iterator<Item = (&Arc<UnitKey>, f64, &T)> + '_ {
-        self.units.iter().filter_map(move |(k, s, d)| {
-            let (start, end) = (s.first()?.1, s.last()?.1);
-            if !(start <= now && now < end) {
+        let started = self.units.iter().take_while(move |u| u.start() <= now);
+        started.filter_map(move |u| {
+            let (start, end) = (u.syncs.first()?.1, u.syncs.last()?.1);
+            if now >= end {
                 return None;
             }
             let p = if end.is_finite() {
@@ -484,7 +545,7 @@ impl<T> Units<T> {
             } else {
                 0.0
             };
-            Some((k, p.clamp(0.0, 1.0), d))
+            Some((&u.key, p.clamp(0.0, 1.0), &u.data))
         })
     }
 }

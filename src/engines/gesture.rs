@@ -467,7 +467,8 @@ impl Engine for GestureEngine {
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
-        for (syncs, u) in self.units.all_mut() {
+        // a unit that has not started shows nothing yet
+        for (syncs, u) in self.units.started_mut(now) {
             match u {
                 GestureUnit::Keys {
                     keys,
