@@ -362,3 +362,27 @@ fn blank_text_between_elements_is_skipped_and_speech_text_is_kept() {
         ]
     );
 }
+
+/// Found by the fuzzer: kept content that declares a prefix inside itself does not need (or
+/// record) the prefix from outside, so writing the block, which declares that prefix on its
+/// root, changes nothing.
+#[test]
+fn a_prefix_declared_inside_kept_content_survives_a_round_trip() {
+    let src = block(
+        "  <x:thing xmlns:x=\"urn:x\" id=\"t\"><bmlt:a xmlns:bmlt=\"http://hmi.ewi.utwente.nl/bmlt\"/></x:thing>",
+    );
+    let b = bml::parse(&src).unwrap().block;
+    assert_eq!(bml::parse(&bml::write(&b)).unwrap().block, b);
+}
+
+/// Found by the fuzzer: a carriage return in speech text (written `&#13;`) and line breaks in an
+/// attribute value survive a write → parse round trip (a reader turns raw ones into a line feed
+/// and spaces).
+#[test]
+fn carriage_returns_and_line_breaks_in_values_survive_a_round_trip() {
+    let src = block(
+        "  <speech id=\"s\"><text>one&#13;two</text></speech>\n  <gesture id=\"g\" lexeme=\"A&#10;B&#9;C&#13;D\"/>",
+    );
+    let b = bml::parse(&src).unwrap().block;
+    assert_eq!(bml::parse(&bml::write(&b)).unwrap().block, b);
+}

@@ -431,10 +431,16 @@ impl<'i> Parser<'i> {
             });
         }
         let mut depth = 0usize;
+        // prefixes declared inside the content need nothing from outside it
+        let mark = self.tok.bindings_len();
         loop {
             match self.next_markup()? {
                 Tok::Start(e) => {
-                    prefixes.extend(e.prefixes);
+                    let outer = e
+                        .prefixes
+                        .into_iter()
+                        .filter(|p| !self.tok.bound_since(mark, p));
+                    prefixes.extend(outer);
                     if !e.empty {
                         depth += 1;
                     }

@@ -2,8 +2,6 @@
 
 use std::fmt::Write as _;
 
-use quick_xml::escape::escape;
-
 use super::model::*;
 use super::syncref::fmt_seconds;
 
@@ -332,7 +330,7 @@ impl Writer {
                 let _ = write!(body, "<{tag}>");
                 for part in &s.text {
                     match part {
-                        TextPart::Text(t) => body.push_str(&escape(t)),
+                        TextPart::Text(t) => body.push_str(&escape_text(t)),
                         TextPart::Sync(id) => {
                             let _ = write!(body, "<sync id=\"{}\"/>", escape(id.as_str()));
                         }
@@ -400,11 +398,35 @@ impl Writer {
                 let _ = write!(
                     self.out,
                     "<sync ref=\"{}\"/>",
-                    escape(s.reference.to_string())
+                    escape(&s.reference.to_string())
                 );
             }
             let _ = writeln!(self.out, "</{tag}>");
         }
         let _ = writeln!(self.out, "{indent}</constraint>");
     }
+}
+
+/// `s` for an attribute value: the XML specials as entities, and tab, line feed and carriage
+/// return as character references (a reader turns them into spaces otherwise).
+fn escape(s: &str) -> std::borrow::Cow<'_, str> {
+    let escaped = quick_xml::escape::escape(s);
+    if !s.contains(['\t', '\n', '\r']) {
+        return escaped;
+    }
+    escaped
+        .replace('\t', "&#9;")
+        .replace('\n', "&#10;")
+        .replace('\r', "&#13;")
+        .into()
+}
+
+/// `s` for text content: the XML specials as entities, and a carriage return as a character
+/// reference (a reader turns a raw one into a line feed).
+fn escape_text(s: &str) -> std::borrow::Cow<'_, str> {
+    let escaped = quick_xml::escape::escape(s);
+    if !s.contains('\r') {
+        return escaped;
+    }
+    escaped.replace('\r', "&#13;").into()
 }

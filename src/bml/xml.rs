@@ -225,6 +225,18 @@ impl<'i> Tokenizer<'i> {
         }
     }
 
+    /// How many namespace bindings are in scope (a mark for [`Self::bound_since`]).
+    pub fn bindings_len(&self) -> usize {
+        self.bindings.len()
+    }
+
+    /// Whether `prefix` is bound by a declaration made after `mark` that is still in scope.
+    pub fn bound_since(&self, mark: usize, prefix: &str) -> bool {
+        self.bindings
+            .get(mark..)
+            .is_some_and(|b| b.iter().any(|(p, _)| *p == prefix))
+    }
+
     /// The prefixed bindings in scope (innermost first for each prefix), `xml` excluded.
     pub fn scope(&self) -> Vec<(String, String)> {
         let mut out: Vec<(String, String)> = Vec::new();
