@@ -18,6 +18,14 @@ impl Drop for Server {
     }
 }
 
+/// The tests of this file run one at a time: each measures how a server serves its clients, and
+/// the fifty-client and flood tests would otherwise share two cores.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn server(extra: &[&str]) -> Server {
     let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
         .args(["serve", "--tcp", "127.0.0.1:0"])
@@ -70,6 +78,7 @@ fn read_until(
 
 #[test]
 fn fifty_clients_times_200_blocks_lose_no_feedback() {
+    let _serial = one_at_a_time();
     let s = server(&["--per-client"]);
     let started = Instant::now();
     let handles: Vec<_> = (0..50)
@@ -117,6 +126,7 @@ fn fifty_clients_times_200_blocks_lose_no_feedback() {
 
 #[test]
 fn garbage_gets_a_warning_for_its_sender_only_and_a_disconnect_disturbs_no_one() {
+    let _serial = one_at_a_time();
     let s = server(&[]);
     let good = TcpStream::connect(&s.addr).unwrap();
     let mut bad = TcpStream::connect(&s.addr).unwrap();
@@ -166,6 +176,7 @@ fn garbage_gets_a_warning_for_its_sender_only_and_a_disconnect_disturbs_no_one()
 /// and the next block from it runs.
 #[test]
 fn a_line_that_is_not_utf8_costs_only_itself() {
+    let _serial = one_at_a_time();
     let s = server(&[]);
     let mut conn = TcpStream::connect(&s.addr).unwrap();
     let mut reader = BufReader::new(conn.try_clone().unwrap());
@@ -202,6 +213,7 @@ fn peak_rss_kb(pid: u32) -> u64 {
 #[cfg(target_os = "linux")]
 #[test]
 fn a_client_that_floods_and_never_reads_slows_no_one_and_grows_nothing() {
+    let _serial = one_at_a_time();
     let s = server(&["--per-client"]);
     let addr = s.addr.clone();
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
