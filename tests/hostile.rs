@@ -229,10 +229,10 @@ fn a_paused_port_says_how_late_it_is() {
     );
     writeln!(stdin, "{speech}").unwrap();
     std::thread::sleep(std::time::Duration::from_millis(300));
+    // the shell's own `kill` (no procps needed)
     let signal = |s: &str| {
-        let status = Command::new("kill")
-            .args([s, &child.id().to_string()])
-            .status();
+        let cmd = format!("kill {s} {}", child.id());
+        let status = Command::new("sh").args(["-c", &cmd]).status();
         assert!(status.unwrap().success());
     };
     signal("-STOP");
