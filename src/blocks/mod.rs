@@ -88,9 +88,6 @@ pub struct BlockManager {
     index: HashMap<bml::Id, u64>,
     /// How many blocks are LURKING (nothing to check when none is).
     lurking: usize,
-    /// While a block's interrupts and REPLACE remove other blocks, nothing waiting starts (a
-    /// queued block that is about to be removed must not start first).
-    hold_starts: bool,
     finished: VecDeque<bml::Id>,
     finished_set: HashSet<bml::Id>,
     changes: Vec<ParameterChange>,
@@ -167,7 +164,6 @@ impl BlockManager {
             seqs: Vec::new(),
             index: HashMap::default(),
             lurking: 0,
-            hold_starts: false,
             finished: VecDeque::new(),
             finished_set: HashSet::default(),
             changes: Vec::new(),
@@ -412,7 +408,6 @@ impl BlockManager {
         self.parse_warnings(&block, warnings);
         // blocks named in bmla:interrupt leave the plan first, then REPLACE removes everything;
         // what waited for them starts only once all of them are gone
-        self.hold_starts = true;
         for target in &block.ext.interrupt {
             self.interrupt_block_by_id(target, now, &block.id);
         }
@@ -422,7 +417,6 @@ impl BlockManager {
                 self.interrupt_block_by_id(&id, now, &block.id);
             }
         }
-        self.hold_starts = false;
         self.start_ready(now);
         // blocks this one waits for
         let mut waits_for: Vec<bml::Id> = match &block.composition {
@@ -665,7 +659,7 @@ impl BlockManager {
     /// Starts every LURKING block that is ready, at `t`, until none is left (a start can end a
     /// block at once, which can make others ready).
     fn start_ready(&mut self, t: f64) {
-        while self.lurking > 0 && !self.hold_starts {
+        while self.lurking > 0 {
             let next = (0..self.blocks.len())
                 .find(|&i| self.blocks[i].status == BlockStatus::Lurking && self.ready(i));
             match next {
@@ -811,7 +805,8 @@ impl BlockManager {
         }
     }
 
-    /// Ends block `i` with DONE if every behaviour still in its plan has ended.
+    /// Ends block `i` with DONE (INTERRUPTED if an interrupt cut it) if every behaviour still in
+    /// its plan has ended, and starts what waited for it.
     fn finish_if_done(&mut self, i: usize, t: f64) -> bool {
         if !self.blocks[i].all_ended() {
             return false;
@@ -822,10 +817,13 @@ impl BlockManager {
             BlockStatus::Done
         };
         self.end_block(i, t, status);
+        self.start_ready(t);
         true
     }
 
-    /// Removes block `i` from the plan with end feedback of `status`, then starts what waited.
+    /// Removes block `i` from the plan with end feedback of `status`. What waited for it is
+    /// started by the caller, once it has removed all it removes (a queued block that REPLACE is
+    /// about to remove must not start first).
     fn end_block(&mut self, i: usize, t: f64, status: BlockStatus) {
         let b = self.blocks.remove(i);
         self.seqs.remove(i);
@@ -845,7 +843,6 @@ impl BlockManager {
         self.changes.retain(|c| c.target.block != b.id);
         self.progress(&b.id, "end", t, status);
         self.remember(b.id);
-        self.start_ready(t);
     }
 
     fn remember(&mut self, id: bml::Id) {

@@ -18,9 +18,9 @@
 //! reference the `Optimal` strategy is measured and tested against.
 
 use super::diff::EPSILON;
-use super::links::{is_required, items, resolve_all, scheduled, with_lifted, Item, Link, Term};
+use super::links::{self, is_required, items, resolve_all, scheduled, Item, Link, Term};
 use super::strategy::{
-    BlockSchedule, Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
+    BlockSchedule, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
 };
 use crate::bml::{extract, Behaviour, BehaviourKind, Block, Relation};
 use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
@@ -69,24 +69,27 @@ impl SchedulingStrategy for SortedGreedy {
                 Some(t) => times[i] = Some(t),
                 None if is_required(&items[i], &constraints) => {
                     return Err(ScheduleError {
-                        reason: format!("required '{}' cannot be timed from the behaviours before it", items[i].beh.id),
+                        reason: format!(
+                            "required '{}' cannot be timed from the behaviours before it",
+                            items[i].beh.id
+                        ),
                         contradiction: true,
                     });
                 }
-                None => dropped.push(Dropped {
-                    behaviour: items[i].beh.id.clone(),
-                    warning: KnownWarning::CannotSatisfyConstraints,
-                    reason: with_lifted(
-                        format!(
-                            "'{}' cannot be timed from the behaviours scheduled before it (sorted greedy)",
-                            items[i].beh.id
-                        ),
-                        &items[i].beh.id,
-                        block,
-                        &constraints,
-                    ),
-                    contradiction: true,
-                }),
+                None => {
+                    let id = &items[i].beh.id;
+                    let reason = format!(
+                        "'{id}' cannot be timed from the behaviours scheduled before it (sorted greedy)"
+                    );
+                    let warning = KnownWarning::CannotSatisfyConstraints;
+                    dropped.push(links::dropped(
+                        (block, &constraints),
+                        id,
+                        warning,
+                        reason,
+                        true,
+                    ));
+                }
             }
         }
         // shift so that nothing precedes the block start

@@ -59,15 +59,16 @@ pub(crate) fn items<'b>(
             (m, valid)
         });
         match model {
-            Some((_, Err(why))) => dropped.push(Dropped {
-                behaviour: beh.id.clone(),
-                warning: KnownWarning::InvalidTiming,
-                reason: format!(
+            Some((_, Err(why))) => dropped.push(self::dropped(
+                (block, constraints),
+                &beh.id,
+                KnownWarning::InvalidTiming,
+                format!(
                     "the engine's timing model for '{}' is invalid: {why}",
                     beh.id
                 ),
-                contradiction: false,
-            }),
+                false,
+            )),
             Some((model, Ok(()))) => {
                 // a persistent behaviour has no end unless a constraint names it
                 let end_named = || {
@@ -84,17 +85,13 @@ pub(crate) fn items<'b>(
                 };
                 items.push(Item { beh, model, len });
             }
-            None => dropped.push(Dropped {
-                behaviour: beh.id.clone(),
-                warning: KnownWarning::BehaviorTypeNotSupported,
-                reason: with_lifted(
-                    format!("no engine realizes <{}>", beh.kind.element_name()),
-                    &beh.id,
-                    block,
-                    constraints,
-                ),
-                contradiction: false,
-            }),
+            None => dropped.push(self::dropped(
+                (block, constraints),
+                &beh.id,
+                KnownWarning::BehaviorTypeNotSupported,
+                format!("no engine realizes <{}>", beh.kind.element_name()),
+                false,
+            )),
         }
     }
     items
@@ -252,16 +249,27 @@ fn named<'a>(a: &'a Anchor, block: &str) -> Option<&'a str> {
     }
 }
 
-/// `reason`, followed by the constraints of other behaviours that refer to `id` (their sync
-/// attributes, and `<constraint>` elements between `id` and another behaviour) and that `reason`
-/// does not name already: dropping `id` lifts them, and the behaviours they tied move freely (a
-/// drop's warning must say which).
-pub(crate) fn with_lifted(
+/// Behaviour `id` of `block` leaves the schedule with `warning`. Every drop goes through here:
+/// its reason is followed by the constraints of other behaviours that refer to `id` (their sync
+/// attributes, and `<constraint>` elements between `id` and another behaviour) that the reason
+/// does not name already, since dropping `id` lifts them and the behaviours they tied move
+/// freely. `contradiction`: the reason is constraints that contradict each other.
+pub(crate) fn dropped(
+    (block, constraints): (&Block, &[Constraint]),
+    id: &crate::bml::Id,
+    warning: KnownWarning,
     reason: String,
-    id: &str,
-    block: &Block,
-    constraints: &[Constraint],
-) -> String {
+    contradiction: bool,
+) -> Dropped {
+    Dropped {
+        behaviour: id.clone(),
+        warning,
+        reason: with_lifted(reason, id, block, constraints),
+        contradiction,
+    }
+}
+
+fn with_lifted(reason: String, id: &str, block: &Block, constraints: &[Constraint]) -> String {
     let lifted: Vec<String> = constraints
         .iter()
         .filter(|c| {
@@ -307,12 +315,8 @@ pub(crate) fn resolve_all(
             });
         }
         let id = &items[i].beh.id;
-        dropped.push(Dropped {
-            behaviour: id.clone(),
-            warning,
-            reason: with_lifted(reason, id, block, constraints),
-            contradiction: false,
-        });
+        let drop = self::dropped((block, constraints), id, warning, reason, false);
+        dropped.push(drop);
         items.remove(i);
     }
 }

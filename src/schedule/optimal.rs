@@ -27,9 +27,7 @@ use good_lp::{
 };
 
 use super::diff::{DiffSystem, EPSILON};
-use super::links::{
-    is_required, items, resolve_all, scheduled, with_lifted, IdIndex, Item, Link, Term,
-};
+use super::links::{self, is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
 use super::offsets::Offsets;
 use super::room::room;
 use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
@@ -163,20 +161,15 @@ fn drop_one(
     } else {
         KnownWarning::CannotSatisfyConstraints
     };
-    dropped.push(Dropped {
-        behaviour: items[i].beh.id.clone(),
+    let id = &items[i].beh.id;
+    let reason = format!("'{id}' dropped: these constraints contradict each other: {text}");
+    dropped.push(links::dropped(
+        (block, constraints),
+        id,
         warning,
-        reason: with_lifted(
-            format!(
-                "'{}' dropped: these constraints contradict each other: {text}",
-                items[i].beh.id
-            ),
-            &items[i].beh.id,
-            block,
-            constraints,
-        ),
-        contradiction: true,
-    });
+        reason,
+        true,
+    ));
     items.remove(i);
     Ok(())
 }
