@@ -112,9 +112,11 @@ impl World {
         Ok(())
     }
 
-    /// Whether some point moves along a path.
-    pub fn has_paths(&self) -> bool {
-        !self.paths.is_empty()
+    /// Whether some point that moves along a path is elsewhere at time `t` than it is now.
+    pub fn moves_at(&self, t: f64) -> bool {
+        self.paths
+            .iter()
+            .any(|(name, keys)| self.points.get(name) != Some(&along(keys, t)))
     }
 
     /// Puts every point that has a path where its path is at time `t`.
@@ -192,6 +194,9 @@ mod tests {
                 "{t}: {p}"
             );
         }
+        // resting after its last key (at 9 s now), it no longer moves; inside its keys it does
+        assert!(!w.moves_at(9.0) && !w.moves_at(20.0));
+        assert!(w.moves_at(3.0));
     }
 
     #[test]

@@ -1,33 +1,9 @@
 //! The `bmlr` command line: exit codes and output of `validate`, `run` and `plan`.
 
-use std::process::Command;
+mod common;
 
 fn bmlr(args: &[&str]) -> (i32, String, String) {
-    bmlr_stdin(args, "")
-}
-
-fn bmlr_stdin(args: &[&str], input: &str) -> (i32, String, String) {
-    use std::io::Write;
-    use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // a command that fails early (a bad argument) may exit before reading its input
-    match child.stdin.take().unwrap().write_all(input.as_bytes()) {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-        other => other.unwrap(),
-    }
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    common::bmlr(args, "")
 }
 
 const RT: &str = "fixtures/realizertester/bml-1";
@@ -106,7 +82,7 @@ fn run_reads_a_stream_of_blocks_with_clock_advances_from_stdin() {
         "{}\n+1\nnot bml at all\n<bml xmlns=\"http://www.bml-initiative.org/bml/bml-1.0\" id=\"b\">\n<head id=\"h\" lexeme=\"NOD\"/>\n</bml>\n",
         r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><speech id="s"><text>Hi</text></speech></bml>"#
     );
-    let (code, out, err) = bmlr_stdin(&["run", "--format", "jsonl", "-"], &input);
+    let (code, out, err) = common::bmlr(&["run", "--format", "jsonl", "-"], &input);
     // the garbage line is invalid input: the rest runs, and the exit code says so
     assert_eq!(
         (code, err.as_str()),
@@ -196,7 +172,7 @@ fn serve_stdio_answers_each_line_with_feedback_and_warns_on_garbage() {
         "\n",
         "garbage\n",
     );
-    let (code, out, err) = bmlr_stdin(&["serve", "--stdio"], input);
+    let (code, out, err) = common::bmlr(&["serve", "--stdio"], input);
     assert_eq!((code, err.as_str()), (0, ""));
     let fb: Vec<bml_realizer::feedback::Feedback> = out
         .lines()
@@ -217,7 +193,7 @@ fn serve_stdio_answers_each_line_with_feedback_and_warns_on_garbage() {
 #[test]
 fn run_realtime_reports_on_the_wall_clock_with_posix_times() {
     let input = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><speech id="s"><text>Hi</text></speech></bml>"#;
-    let (code, out, err) = bmlr_stdin(&["run", "--realtime", "--format", "jsonl", "-"], input);
+    let (code, out, err) = common::bmlr(&["run", "--realtime", "--format", "jsonl", "-"], input);
     assert_eq!((code, err.as_str()), (0, ""));
     let end = out
         .lines()
@@ -386,7 +362,7 @@ fn run_assets_extend_the_motion_data_and_report_bad_files() {
     let block = "-";
     let bml = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b"><bmlt:procanimation id="p" name="swing"/><gesture id="g" lexeme="SWING" start="p:end"/></bml>"#;
     let assets = dir.to_str().unwrap();
-    let (code, out, err) = bmlr_stdin(
+    let (code, out, err) = common::bmlr(
         &["run", "--assets", assets, "--format", "jsonl", block],
         bml,
     );
@@ -396,7 +372,7 @@ fn run_assets_extend_the_motion_data_and_report_bad_files() {
     assert!(out.contains(r#""id":"b:p:end","time":1.5"#), "{out}");
     assert!(out.contains(r#""id":"b:g:end","time":3"#), "{out}");
     // without the directory the unit is unknown
-    let (_, out, _) = bmlr_stdin(&["run", "--format", "jsonl", block], bml);
+    let (_, out, _) = common::bmlr(&["run", "--format", "jsonl", block], bml);
     assert!(out.contains("no procedural unit 'swing'"), "{out}");
     // a bad file: exit 2 naming it
     std::fs::write(
@@ -404,7 +380,7 @@ fn run_assets_extend_the_motion_data_and_report_bad_files() {
         r#"{"heads": [{"lexeme": "X", "axis": "q", "degrees": 1}]}"#,
     )
     .unwrap();
-    let (code, _, err) = bmlr_stdin(&["run", "--assets", assets, block], bml);
+    let (code, _, err) = common::bmlr(&["run", "--assets", assets, block], bml);
     assert_eq!(code, 2);
     assert!(err.contains("heads.json") && err.contains("axis"), "{err}");
     let (code, _, err) = bmlr(&["run", "--assets", "no/such/dir", "-"]);

@@ -5,27 +5,10 @@
 
 use std::process::Command;
 
-const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+mod common;
+use common::bmlr;
 
-fn bmlr(args: &[&str], input: &str) -> (i32, String, String) {
-    use std::io::Write;
-    use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let _ = child.stdin.take().unwrap().write_all(input.as_bytes());
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 
 /// A temporary directory of this test process, with `files` written into it.
 fn dir_with(name: &str, files: &[(&str, &str)]) -> std::path::PathBuf {

@@ -5,32 +5,10 @@
 
 use std::process::Command;
 
-const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+mod common;
+use common::bmlr;
 
-fn bmlr(args: &[&str], input: &str) -> (i32, String, String) {
-    use std::io::Write;
-    use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stdin = child.stdin.take().unwrap();
-    let input = input.to_string();
-    let writer = std::thread::spawn(move || {
-        let _ = stdin.write_all(input.as_bytes());
-    });
-    let out = child.wait_with_output().unwrap();
-    writer.join().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 
 fn deep(n: usize) -> String {
     format!(
@@ -168,7 +146,7 @@ fn bad_lines_cost_exactly_themselves_on_the_ports_and_in_run() {
     input.extend_from_slice(format!("<bml {NS} id=\"broken\"><speech></bml>\nhello\n").as_bytes());
     input.extend_from_slice(format!("{}\n", good("third")).as_bytes());
     for args in [vec!["serve", "--stdio"], vec!["run", "-"]] {
-        let (code, out, err) = bmlr_bytes(&args, &input);
+        let (code, out, err) = bmlr(&args, &input);
         for id in ["first", "second", "third"] {
             assert!(
                 out.contains(&format!(r#"id="{id}:end""#)),
@@ -187,26 +165,6 @@ fn bad_lines_cost_exactly_themselves_on_the_ports_and_in_run() {
         let expected = if args[0] == "run" { 1 } else { 0 };
         assert_eq!(code, expected, "{args:?}: {err}");
     }
-}
-
-fn bmlr_bytes(args: &[&str], input: &[u8]) -> (i32, String, String) {
-    use std::io::Write;
-    use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child.stdin.take().unwrap().write_all(input).unwrap();
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
 }
 
 /// A port paused (SIGSTOP) and resumed reports the sync points it missed at their planned

@@ -18,42 +18,24 @@ use proptest::prelude::*;
 const WORDS: &[&str] = &[
     "I", "am", "fine", "thank", "you", "very", "much", "goodbye", "now",
 ];
-/// (element with its attributes, sync keys) of the kinds of motion the blocks use.
-const MOTIONS: &[(&str, &[&str])] = &[
-    (
-        r#"gesture lexeme="BEAT""#,
-        &[
-            "start",
-            "ready",
-            "strokeStart",
-            "stroke",
-            "strokeEnd",
-            "relax",
-            "end",
-        ],
-    ),
-    (
-        r#"head lexeme="NOD""#,
-        &[
-            "start",
-            "ready",
-            "strokeStart",
-            "stroke",
-            "strokeEnd",
-            "relax",
-            "end",
-        ],
-    ),
-    (
-        r#"head lexeme="SHAKE" repetition="3""#,
-        &["start", "ready", "stroke", "relax", "end"],
-    ),
-    (r#"gaze target="user""#, &["start", "ready", "relax", "end"]),
-    (
-        r#"pointing target="bluebox""#,
-        &["start", "ready", "stroke", "relax", "end"],
-    ),
+/// The kinds of motion the blocks use (element and attributes).
+const MOTIONS: &[&str] = &[
+    r#"gesture lexeme="BEAT""#,
+    r#"head lexeme="NOD""#,
+    r#"head lexeme="SHAKE" repetition="3""#,
+    r#"gaze target="user""#,
+    r#"pointing target="bluebox""#,
 ];
+
+/// The sync points of a behaviour written as `element`, in order (as the library knows them).
+fn sync_points(element: &str) -> Vec<String> {
+    let src = format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="k"><{element} id="x"/></bml>"#
+    );
+    let block = bml::load(&src).unwrap().block;
+    let points = block.behaviours[0].sync_points();
+    points.into_iter().map(str::to_string).collect()
+}
 
 #[derive(Debug, Clone)]
 struct Speech {
@@ -119,7 +101,8 @@ fn block(speeches: &[Speech], moves: &[Move]) -> String {
         syncs.push(format!("s{i}:end"));
     }
     for (i, m) in moves.iter().enumerate() {
-        let (element, keys) = MOTIONS[m.kind];
+        let element = MOTIONS[m.kind];
+        let keys = sync_points(element);
         // keys in their order, tied to syncs in spoken order, or to absolute times up to 8 s
         // further on (most such blocks are feasible)
         let mut ties: Vec<(usize, usize, i32)> = m

@@ -3,23 +3,15 @@
 //! 50 behaviours.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn tmp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("bmlr-timeline-{}-{name}", std::process::id()))
 }
 
+mod common;
+
 fn bmlr(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    common::bmlr(args, "")
 }
 
 fn well_formed(svg: &Path) -> String {

@@ -32,7 +32,7 @@ pub use kinds::{
 pub use limits::Limits;
 pub use model::*;
 pub use parser::{parse, parse_with_diagnostics, Parsed};
-pub use stream::{lines, BadLine, BlockStream, StreamItem};
+pub use stream::{advance, lines, BadLine, BlockStream, StreamItem};
 pub use syncref::{SyncPoint, SyncRef, SyncRefError, ANTICIPATORS};
 pub use validate::validate;
 pub use writer::write;

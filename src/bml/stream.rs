@@ -80,10 +80,9 @@ impl BlockStream {
             if end == self.buf.len() && !finished {
                 return None; // the number may go on
             }
-            let token = &self.buf[1..end];
-            let item = match token.parse::<f64>() {
-                Ok(secs) if secs.is_finite() && secs >= 0.0 => StreamItem::Advance(secs),
-                _ => StreamItem::Garbage(self.buf[..end].to_string()),
+            let item = match advance(&self.buf[..end]) {
+                Some(secs) => StreamItem::Advance(secs),
+                None => StreamItem::Garbage(self.buf[..end].to_string()),
             };
             self.buf.drain(..end);
             return Some(item);
@@ -167,6 +166,12 @@ fn element_end(text: &str) -> Element {
             Ok(_) => {}
         }
     }
+}
+
+/// The seconds of a `+SECS` clock advance (a number ≥ 0), if `token` is one.
+pub fn advance(token: &str) -> Option<f64> {
+    let secs = token.strip_prefix('+')?.parse::<f64>().ok()?;
+    (secs.is_finite() && secs >= 0.0).then_some(secs)
 }
 
 /// A line of a port or stream that cannot be read as text.

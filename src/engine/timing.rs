@@ -543,32 +543,12 @@ const FACE: &[(&str, f64)] = &[
     ("end", 1.5),
 ];
 
-/// The longest a preparation (start to `ready`) or a retraction (`relax` to `end`) of each kind
-/// may last, seconds: a hand, head or gaze gets to where it is going in about a second, however
-/// far apart the constraints put the behaviour's keys. What is left goes into the holds (`ready`
-/// to `strokeStart`, `strokeEnd` to `relax`), which have no limit. A head's limits are per nod
-/// or shake (they scale with `repetition`).
-pub const PHASE_LIMITS: &[(&str, f64)] = &[
-    ("gesture", 1.0),
-    ("pointing", 1.5),
-    ("head", 1.0),
-    ("gaze", 1.5),
-    ("posture", 3.0),
-    ("face", 3.0),
-];
-
-/// The limit of [`PHASE_LIMITS`] for `kind`.
-fn phase_limit(kind: &str) -> f64 {
-    PHASE_LIMITS
-        .iter()
-        .find(|(k, _)| *k == kind)
-        .map_or(f64::INFINITY, |(_, max)| *max)
-}
-
-/// A stretchable model of `keys` whose preparation and retraction are limited as `kind`'s.
-fn limited(keys: &[(&'static str, f64)], kind: &str) -> TimingModel {
-    let max = phase_limit(kind);
-    // a face's preparation is its attack, to `attackPeak`
+/// A stretchable model of `keys` whose preparation (start to `ready`; for a face, to
+/// `attackPeak`) and retraction (`relax` to `end`) last at most `max` seconds: a hand, head or
+/// gaze gets to where it is going in about a second, however far apart the constraints put the
+/// behaviour's keys. What is left goes into the holds (`ready` to `strokeStart`, `strokeEnd` to
+/// `relax`), which have no limit.
+fn limited(keys: &[(&'static str, f64)], max: f64) -> TimingModel {
     TimingModel::stretchable(keys).with_phase_limits(&[
         ("ready", max),
         ("attackPeak", max),
@@ -591,18 +571,19 @@ impl TimingModels for DefaultTimingModels {
                 m
             }
             BehaviourKind::Gesture(_) | BehaviourKind::ProcAnimationGesture(_) => {
-                limited(GESTURE, "gesture")
+                limited(GESTURE, 1.0)
             }
-            BehaviourKind::Pointing(_) => limited(POINTING, "pointing"),
+            BehaviourKind::Pointing(_) => limited(POINTING, 1.5),
+            // the limits are per nod or shake: they scale with `repetition`
             BehaviourKind::Head(h) => {
-                limited(HEAD, "head").scaled(h.repetition.unwrap_or(1).max(1) as f64)
+                limited(HEAD, 1.0).scaled(h.repetition.unwrap_or(1).max(1) as f64)
             }
-            BehaviourKind::Gaze(_) => limited(GAZE, "gaze"),
-            BehaviourKind::Posture(_) => limited(POSTURE, "posture"),
+            BehaviourKind::Gaze(_) => limited(GAZE, 1.5),
+            BehaviourKind::Posture(_) => limited(POSTURE, 3.0),
             BehaviourKind::Face(_)
             | BehaviourKind::FaceLexeme(_)
             | BehaviourKind::FaceFacs(_)
-            | BehaviourKind::FaceMorph(_) => limited(FACE, "face"),
+            | BehaviourKind::FaceMorph(_) => limited(FACE, 3.0),
             BehaviourKind::GazeShift(_)
             | BehaviourKind::HeadDirectionShift { .. }
             | BehaviourKind::FaceShift(_) => se(1.0),

@@ -301,7 +301,8 @@ impl Realizer {
             .next_event()
             .filter(|t| self.posix_time && now - t > LATE);
         self.now = now;
-        if self.world.has_paths() {
+        // (the world is shared with every character: copied only when a point moves)
+        if self.world.moves_at(now) {
             self.world_mut().move_to(now);
         }
         let mut frame = Frame {

@@ -183,13 +183,14 @@ fn read_items(items: &[String]) -> Result<Vec<Item>, String> {
         .map(|a| {
             if a == "-" {
                 Ok(Item::Stdin)
-            } else if let Some(secs) = a.strip_prefix('+') {
-                match secs.parse::<f64>() {
-                    Ok(s) if s.is_finite() && s >= 0.0 => Ok(Item::Advance(s)),
-                    _ => Err(format!(
-                        "'{a}' is not a clock advance: expected +SECS with SECS a number >= 0"
-                    )),
-                }
+            } else if a.starts_with('+') {
+                bml_realizer::bml::advance(a)
+                    .map(Item::Advance)
+                    .ok_or_else(|| {
+                        format!(
+                            "'{a}' is not a clock advance: expected +SECS with SECS a number >= 0"
+                        )
+                    })
             } else {
                 std::fs::read_to_string(Path::new(a))
                     .map(|text| Item::Text(a.clone(), text))

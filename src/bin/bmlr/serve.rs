@@ -120,7 +120,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
             match line {
                 Ok(text) if text.trim().is_empty() => {}
                 // a live port has no use for clock advances: time passes by itself
-                Ok(text) if is_advance(&text) => {}
+                Ok(text) if bml_realizer::bml::advance(text.trim()).is_some() => {}
                 Ok(text) => {
                     let _ = realizer.perform_bml_from(&text, Some("<stdin>"));
                 }
@@ -140,12 +140,6 @@ pub fn serve(args: ServeArgs) -> ExitCode {
             return ExitCode::SUCCESS;
         }
     }
-}
-
-/// Whether a line is a `+SECS` clock advance.
-fn is_advance(line: &str) -> bool {
-    let secs = line.trim().strip_prefix('+').map(str::parse::<f64>);
-    matches!(secs, Some(Ok(s)) if s.is_finite() && s >= 0.0)
 }
 
 /// Arguments of `bmlr conformance`.
