@@ -20,6 +20,7 @@ use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use crate::bml::{self, Diagnostic, SyncPoint};
 use crate::body::{Pose, Skeleton};
+use crate::engine::timing::TimingModels;
 use crate::engine::{Action, CharacterPose, Frame, ParameterChange, Registry, Unit, UnitKey};
 use crate::feedback::{
     BehaviourPrediction, BlockPrediction, BlockProgress, BlockStatus, Feedback, KnownWarning,
@@ -475,7 +476,12 @@ impl BlockManager {
         };
         let schedule = match schedule {
             Ok(mut s) => {
-                s.drop_unreachable();
+                // (asked only of a behaviour whose end is infinite)
+                s.drop_unreachable(|id| {
+                    let b = live.source.behaviours.iter().find(|b| b.id == *id);
+                    b.and_then(|b| TimingModels::model(&self.registry, b))
+                        .is_some_and(|m| m.persistent)
+                });
                 s
             }
             Err(e) => {

@@ -88,14 +88,15 @@ pub const MAX_SCHEDULED_TIME: f64 = 1e9;
 
 impl BlockSchedule {
     /// Moves every behaviour that could never run to `dropped` (INVALID_TIMING): one with a time
-    /// that is not a number, or infinite (but for a persistent behaviour's `end`), or further
-    /// than [`MAX_SCHEDULED_TIME`] from the block start. Whatever a strategy computes, what is
-    /// left can start and end.
-    pub fn drop_unreachable(&mut self) {
+    /// that is not a number, or infinite (but for the `end` of a behaviour that `persistent`
+    /// says runs until stopped), or further than [`MAX_SCHEDULED_TIME`] from the block start.
+    /// Whatever a strategy computes, what is left can start and end.
+    pub fn drop_unreachable(&mut self, persistent: impl Fn(&crate::bml::Id) -> bool) {
         let reachable = |b: &ScheduledBehaviour| {
             let last = b.syncs.len().saturating_sub(1);
             b.syncs.iter().enumerate().all(|(k, &(_, t))| {
-                t.abs() <= MAX_SCHEDULED_TIME || (k == last && t == f64::INFINITY)
+                t.abs() <= MAX_SCHEDULED_TIME
+                    || (k == last && t == f64::INFINITY && persistent(&b.id))
             })
         };
         let (keep, gone): (Vec<_>, Vec<_>) = std::mem::take(&mut self.behaviours)
