@@ -77,6 +77,12 @@ fn thirty_thousand_attributes_are_refused_at_the_attribute_limit() {
         out.contains("more than 256 attributes") && out.contains(r#"id="good:end""#),
         "{out}"
     );
+    // a stream is split by the same reader, which reads no further than the limit either
+    let (_, out, _) = bmlr(&["run", "-"], &format!("{}\n{GOOD}\n", wide(30_000)));
+    assert!(
+        out.contains("more than 256 attributes") && out.contains(r#"id="good:end""#),
+        "{out}"
+    );
     let (code, out, _) = bmlr(
         &[
             "validate",

@@ -297,41 +297,6 @@ proptest! {
     }
 }
 
-/// The parser keeps its scratch lists (tokenizer stacks, line starts, attribute list) on the
-/// thread between parses. A parse must not depend on what the thread parsed before, including a
-/// parse that stopped half-way with elements open and namespaces bound.
-#[test]
-fn a_parse_does_not_depend_on_earlier_parses_on_the_thread() {
-    let inputs = [
-        block(r#"<speech id="s1"><text>One <sync id="a"/> two.</text></speech>"#),
-        // stops inside nested elements with a prefix bound
-        format!(
-            "<bml {NS} xmlns:x=\"urn:x\" id=\"b2\">\n<speech id=\"s\" x:y=\"1\"><text>hi</speech>"
-        ),
-        "<!-- a comment\nover lines -->\n".to_string()
-            + &block(r#"<gesture id="g" lexeme="BEAT" start="1" x:q="2"/>"#),
-        format!("<bml {NS} xmlns:p=\"urn:p\" id=\"b4\" p:a=\"&amp;1\"><head id=\"h\" lexeme=\"NOD\"/></bml>"),
-        block(r#"<head id="h1" lexeme="NOD" start="0" end="5"/>"#),
-    ];
-    let seen = |src: &str| format!("{:?}", bml::check(src));
-    // each on a thread of its own: nothing kept from before
-    let alone: Vec<String> = inputs
-        .iter()
-        .map(|src| {
-            let src = src.clone();
-            std::thread::spawn(move || seen(&src)).join().unwrap()
-        })
-        .collect();
-    // all on this thread, forwards and backwards
-    for (i, src) in inputs
-        .iter()
-        .enumerate()
-        .chain(inputs.iter().enumerate().rev())
-    {
-        assert_eq!(seen(src), alone[i], "input {i} parsed after others");
-    }
-}
-
 /// White space between elements is passed over (also when written as a character reference),
 /// text that is not blank is reported once where it starts (also when a reference splits it), and
 /// a speech's text keeps its own white space, around inline syncs too.
@@ -385,4 +350,29 @@ fn carriage_returns_and_line_breaks_in_values_survive_a_round_trip() {
     );
     let b = bml::parse(&src).unwrap().block;
     assert_eq!(bml::parse(&bml::write(&b)).unwrap().block, b);
+}
+
+/// What XML allows but the reader refuses, each with an error that says why rather than a
+/// wrong reading.
+#[test]
+fn a_namespace_name_with_a_reference_and_a_quoted_doctype_gt_are_refused_clearly() {
+    let src = block(r#"  <head id="h" lexeme="NOD" xmlns:p="urn:a&amp;b" p:x="1"/>"#);
+    let e = bml::load(&src).unwrap_err();
+    assert_eq!(e.first().code, Code::NotXml);
+    assert!(
+        e.first().message.contains("holds a reference"),
+        "{}",
+        e.first().message
+    );
+    let src = format!(
+        "<!DOCTYPE bml [<!ENTITY gt2 \">\">]>\n{}",
+        block("  <head id=\"h\" lexeme=\"NOD\"/>")
+    );
+    let e = bml::load(&src).unwrap_err();
+    assert_eq!((e.first().code, e.first().pos.line), (Code::NotXml, 1));
+    assert!(
+        e.first().message.contains("not supported"),
+        "{}",
+        e.first().message
+    );
 }

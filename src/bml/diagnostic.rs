@@ -40,51 +40,28 @@ pub struct LineIndex {
 impl LineIndex {
     /// Index the line starts of `src`.
     pub fn new(src: &str) -> Self {
-        Self::scan(src, Vec::with_capacity(src.len() / 32 + 1)).0
+        Self::scan(src).0
     }
 
-    /// The index of `src`, with the line starts written into `starts` (emptied first; from
-    /// [`Self::take_starts`], so that indexing one block after another need not allocate), and
-    /// found in the same pass over the text, the offset of its first C0 control character other
-    /// than tab, line feed and carriage return (XML 1.0 forbids them).
-    pub(crate) fn scan(src: &str, mut starts: Vec<usize>) -> (Self, Option<usize>) {
+    /// The index of `src` and, found in the same pass over the text, the offset of its first
+    /// C0 control character other than tab, line feed and carriage return (XML 1.0 forbids
+    /// them).
+    pub(crate) fn scan(src: &str) -> (Self, Option<usize>) {
         let bytes = src.as_bytes();
-        starts.clear();
-        starts.push(0);
-        let (mut ascii, mut forbidden) = (true, None);
-        let mut byte = |at: usize, b: u8| match b {
-            b'\n' => starts.push(at + 1),
-            b'\t' | b'\r' => {}
-            0..=0x1f => {
-                forbidden.get_or_insert(at);
+        let mut starts = vec![0];
+        let mut forbidden = None;
+        for (at, &b) in bytes.iter().enumerate() {
+            match b {
+                b'\n' => starts.push(at + 1),
+                b'\t' | b'\r' => {}
+                0..=0x1f => {
+                    forbidden.get_or_insert(at);
+                }
+                _ => {}
             }
-            0x80.. => ascii = false,
-            _ => {}
-        };
-        // eight bytes at a time: most words of a block hold neither a byte below 0x20 (line
-        // ends, tabs, control characters) nor one above 0x7F, and need no closer look
-        use super::xml::{HIGH, ONES};
-        let mut words = bytes.chunks_exact(8);
-        let mut at = 0;
-        for w in &mut words {
-            let x = u64::from_le_bytes(w.try_into().expect("eight bytes"));
-            // a byte's high bit after subtracting 0x20 is set if it is below 0x20 or at least
-            // 0xA0, and every non-ASCII character starts with a byte of at least 0xC2; only the
-            // flagged bytes are looked at (a borrow, which only a byte below 0x20 makes, can
-            // also flag the byte after it: the look sorts that out)
-            let mut flagged = x.wrapping_sub(ONES * 0x20) & HIGH;
-            while flagged != 0 {
-                let i = flagged.trailing_zeros() as usize / 8;
-                byte(at + i, w[i]);
-                flagged &= flagged - 1;
-            }
-            at += 8;
-        }
-        for (i, &b) in words.remainder().iter().enumerate() {
-            byte(at + i, b);
         }
         // an ASCII text (nearly every block) needs no second table: columns are byte counts
-        let ascii_until = if ascii {
+        let ascii_until = if src.is_ascii() {
             Vec::new()
         } else {
             let ends = starts.iter().skip(1).copied().chain([src.len()]);
@@ -104,11 +81,6 @@ impl LineIndex {
             ascii_until,
         };
         (index, forbidden)
-    }
-
-    /// The list of line starts, for another index.
-    pub(crate) fn take_starts(&mut self) -> Vec<usize> {
-        std::mem::take(&mut self.starts)
     }
 
     /// The position of byte offset `offset` in `src` (the text this index was built from).
@@ -338,7 +310,7 @@ mod tests {
             let src: String = (0..len)
                 .map(|j| pieces[((seed >> (j % 60)) as usize + j * 7) % pieces.len()])
                 .collect();
-            let (index, forbidden) = LineIndex::scan(&src, Vec::new());
+            let (index, forbidden) = LineIndex::scan(&src);
             let starts: Vec<usize> = [0]
                 .into_iter()
                 .chain(src.match_indices('\n').map(|(i, _)| i + 1))

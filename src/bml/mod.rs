@@ -80,19 +80,18 @@ fn check_into(src: &str, block: &mut Option<Block>, limits: &Limits) -> Vec<Diag
     diags
 }
 
-/// The `id` of the first element in `src`, read leniently: for naming a block in a warning when
-/// the rest of it is not well-formed. `None` if the first element cannot be read or has no id.
+/// The `id` of the first element in `src`: for naming a block in a warning when the rest of it is
+/// not well-formed. `None` if the first element's tag cannot be read or has no id.
 pub fn root_id(src: &str) -> Option<String> {
-    use quick_xml::events::Event;
-    let mut reader = quick_xml::Reader::from_str(src);
+    let mut reader = xml::Reader::new(src, &Limits::default());
     loop {
-        match reader.read_event().ok()? {
-            Event::Start(e) | Event::Empty(e) => {
-                let id = e.attributes().flatten().find(|a| a.key.as_ref() == b"id")?;
-                return id.unescape_value().ok().map(|v| v.into_owned());
+        match reader.next() {
+            Ok(xml::Event::Start(_)) => {
+                let id = reader.attrs().iter().find(|a| a.key == "id")?;
+                return id.value().ok().map(|v| v.into_owned());
             }
-            Event::Eof => return None,
-            _ => {}
+            Ok(xml::Event::Eof) | Err(_) => return None,
+            Ok(_) => {}
         }
     }
 }

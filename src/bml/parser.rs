@@ -1,9 +1,8 @@
-//! The streaming BML parser (over the tokenizer in `xml.rs`): text → [`Block`], with every
+//! The streaming BML parser (over the XML reader in `xml.rs`): text → [`Block`], with every
 //! problem reported as a [`Diagnostic`] at its line:column. Structure, attribute values and sync
 //! reference syntax are checked here; cross-references are checked by `validate.rs`.
 
 use std::borrow::Cow;
-use std::cell::Cell;
 use std::fmt;
 
 use super::diagnostic::{BmlError, Code, Diagnostic, LineIndex, Pos};
@@ -11,7 +10,7 @@ use super::kinds::{BMLT_BEHAVIOURS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS};
 use super::limits::Limits;
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
-use super::xml::{self, Event, Tag, Tokenizer, XmlError};
+use super::xml::{Event, Problem, Reader, Tag, XmlError};
 use crate::xmlname::{same_name, split_qname};
 
 /// A parsed block together with the warnings found while reading it.
@@ -62,7 +61,6 @@ pub(crate) fn parse_into(src: &str, block: &mut Option<Block>, limits: &Limits) 
         *block = None;
     }
     let mut diags = std::mem::take(&mut p.diags);
-    p.keep_scratch();
     diags.sort_by_key(|d| (d.pos.line, d.pos.col));
     diags
 }
@@ -164,33 +162,14 @@ struct Fatal;
 
 struct Parser<'i> {
     src: &'i str,
-    tok: Tokenizer<'i>,
+    tok: Reader<'i>,
     lines: LineIndex,
     /// Offset of the first control character XML forbids (found while indexing the lines).
     forbidden: Option<usize>,
     diags: Vec<Diagnostic>,
     pending: Option<Tok<'i>>,
-    /// An emptied attribute list, for the next element (one list serves a whole block).
-    spare_attrs: Vec<Option<RawAttr<'i>>>,
     limits: Limits,
 }
-
-/// The scratch lists of a parse (the tokenizer's, the line starts, the attribute list), kept on
-/// the thread for the next parse: parsing one small block after another allocates no scratch
-/// space.
-#[derive(Default)]
-struct Scratch {
-    tokens: xml::Lists,
-    lines: Vec<usize>,
-    attrs: Vec<Option<RawAttr<'static>>>,
-}
-
-thread_local! {
-    static SCRATCH: Cell<Option<Scratch>> = const { Cell::new(None) };
-}
-
-/// Scratch lists longer than this are not kept (a rare huge block should not pin its memory).
-const SCRATCH_MAX: usize = 4096;
 
 /// Remaining attributes of an element, taken one by one by name.
 struct Attrs<'i> {
@@ -225,40 +204,15 @@ impl<'i> Parser<'i> {
     fn new(src: &'i str, limits: &Limits) -> Self {
         // A byte-order mark is not content; offsets are relative to the rest.
         let src = src.strip_prefix('\u{feff}').unwrap_or(src);
-        let scratch = SCRATCH
-            .try_with(Cell::take)
-            .ok()
-            .flatten()
-            .unwrap_or_default();
-        let (lines, forbidden) = LineIndex::scan(src, scratch.lines);
+        let (lines, forbidden) = LineIndex::scan(src);
         Parser {
             src,
-            tok: Tokenizer::with_lists(src, scratch.tokens)
-                .limited(limits.attributes, limits.depth),
+            tok: Reader::new(src, limits),
             lines,
             forbidden,
             diags: Vec::new(),
             pending: None,
-            spare_attrs: xml::recycle(scratch.attrs),
             limits: *limits,
-        }
-    }
-
-    /// Leaves the scratch lists to the next parse on this thread.
-    /// (Through a reference: the parser is a few hundred bytes, and it is not copied.)
-    fn keep_scratch(&mut self) {
-        let scratch = Scratch {
-            tokens: self.tok.take_lists(),
-            lines: self.lines.take_starts(),
-            attrs: xml::recycle(std::mem::take(&mut self.spare_attrs)),
-        };
-        let longest = scratch
-            .tokens
-            .longest()
-            .max(scratch.lines.capacity())
-            .max(scratch.attrs.capacity());
-        if longest <= SCRATCH_MAX {
-            let _ = SCRATCH.try_with(|s| s.set(Some(scratch)));
         }
     }
 
@@ -277,7 +231,7 @@ impl<'i> Parser<'i> {
     }
 
     fn xml_error(&mut self, e: XmlError) -> Fatal {
-        if e.limit {
+        if e.problem == Problem::Limit {
             self.error(Code::LimitExceeded, e.offset, e.message);
         } else {
             let message = format!("not well-formed XML: {}", e.message);
@@ -325,14 +279,20 @@ impl<'i> Parser<'i> {
         }
     }
 
-    /// The namespace `prefix` is bound to where the tokenizer is (`None`: the default one); an
+    /// The namespace of the element or attribute named `qname` where the reader is; an
     /// undeclared prefix is an error on `what`, at `offset`.
-    fn namespace(&mut self, prefix: Option<&str>, offset: usize, what: &dyn fmt::Display) -> Ns {
-        match self.tok.resolve(prefix) {
+    fn namespace(
+        &mut self,
+        qname: &str,
+        attribute: bool,
+        offset: usize,
+        what: &dyn fmt::Display,
+    ) -> Ns {
+        match self.tok.resolve(qname, attribute) {
             Ok(Some(uri)) => Ns::from_uri(uri),
             Ok(None) => Ns::None,
             Err(()) => {
-                let prefix = prefix.unwrap_or_default();
+                let prefix = split_qname(qname).0.unwrap_or_default();
                 self.error(
                     Code::NotXml,
                     offset,
@@ -348,15 +308,14 @@ impl<'i> Parser<'i> {
     fn element(&mut self, tag: Tag<'i>) -> Result<El<'i>, Fatal> {
         let qname = tag.qname;
         let (prefix, name) = split_qname(qname);
-        let ns = self.namespace(prefix, tag.offset, &format_args!("<{qname}>"));
+        let ns = self.namespace(qname, false, tag.offset, &format_args!("<{qname}>"));
         let mut prefixes: Vec<&'i str> = prefix.into_iter().collect();
         let n = self.tok.attrs().len();
-        let mut attrs = std::mem::take(&mut self.spare_attrs);
-        attrs.reserve(n);
+        let mut attrs: Vec<Option<RawAttr<'i>>> = Vec::with_capacity(n);
         for i in 0..n {
             let a = self.tok.attrs()[i];
             if a.declares().is_some() {
-                continue; // in scope now; the tokenizer checked them
+                continue; // in scope now; the reader checked them
             }
             let (aprefix, aname) = split_qname(a.key);
             let ans = match aprefix {
@@ -364,7 +323,7 @@ impl<'i> Parser<'i> {
                 Some(p) => {
                     prefixes.push(p);
                     let what = format_args!("attribute '{}'", a.key);
-                    match self.namespace(Some(p), a.offset, &what) {
+                    match self.namespace(a.key, true, a.offset, &what) {
                         Ns::Bml => Ns::None,
                         other => other,
                     }
@@ -432,7 +391,7 @@ impl<'i> Parser<'i> {
         }
         let mut depth = 0usize;
         // prefixes declared inside the content need nothing from outside it
-        let mark = self.tok.bindings_len();
+        let mark = self.tok.level();
         loop {
             match self.next_markup()? {
                 Tok::Start(e) => {
@@ -720,17 +679,7 @@ impl<'i> Parser<'i> {
                 });
             }
         }
-        self.give_back(items);
         kept
-    }
-
-    /// Keeps an element's attribute list, emptied, for the next element (the larger one, if
-    /// there is a spare already).
-    fn give_back(&mut self, mut items: Vec<Option<RawAttr<'i>>>) {
-        if items.capacity() > self.spare_attrs.capacity() {
-            items.clear();
-            self.spare_attrs = items;
-        }
     }
 
     fn block_child(
@@ -1157,7 +1106,6 @@ impl<'i> Parser<'i> {
                         );
                     }
                     p.speech_text(&c, &mut s.text)?;
-                    p.give_back(c.attrs);
                 }
                 (BehaviourKind::Posture(post) | BehaviourKind::PostureShift(post), "stance")
                     if core =>

@@ -5,8 +5,8 @@
 //! to the one where it breaks, an unterminated comment or a stray `<![CDATA[`, `<!DOCTYPE` the
 //! text up to the next block, and nothing eats a valid block after it.
 
-use quick_xml::events::Event;
-use quick_xml::Reader;
+use super::limits::Limits;
+use super::xml::{Event, Problem, Reader};
 
 /// One item of a BML stream.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,24 +146,27 @@ enum Element {
     Incomplete,
 }
 
+/// Where the first element of `text` ends, read by the same XML reader that parses blocks. A
+/// problem inside a tag or text that leaves the structure intact (a bad reference, a name, a
+/// limit) does not move the end: the parser reports it for the whole block.
 fn element_end(text: &str) -> Element {
-    let mut reader = Reader::from_str(text);
+    let mut reader = Reader::new(text, &Limits::default());
     let mut depth = 0usize;
     loop {
-        let event = reader.read_event();
-        let at = reader.buffer_position() as usize;
-        match event {
-            Ok(Event::Start(_)) => depth += 1,
-            Ok(Event::End(_)) => match depth.checked_sub(1) {
-                Some(0) => return Element::Complete(at),
-                Some(d) => depth = d,
-                None => return Element::Broken(at),
-            },
-            Ok(Event::Empty(_)) if depth == 0 => return Element::Complete(at),
-            // the text ended inside a tag, comment or CDATA section: more may come
-            Ok(Event::Eof) | Err(quick_xml::Error::Syntax(_)) => return Element::Incomplete,
-            Err(_) => return Element::Broken(reader.error_position() as usize),
-            Ok(_) => {}
+        match reader.next() {
+            Ok(Event::Start(tag)) if tag.empty && depth == 0 => return Element::Complete(tag.end),
+            Ok(Event::Start(tag)) if !tag.empty => depth += 1,
+            Ok(Event::End { after, .. }) => {
+                depth -= 1;
+                if depth == 0 {
+                    return Element::Complete(after);
+                }
+            }
+            // the text ended inside an element, a tag, comment or CDATA section: more may come
+            Ok(Event::Eof) => return Element::Incomplete,
+            Err(e) if e.problem == Problem::Unclosed => return Element::Incomplete,
+            Err(e) if e.problem == Problem::Broken => return Element::Broken(e.offset),
+            Ok(_) | Err(_) => {}
         }
     }
 }

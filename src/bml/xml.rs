@@ -1,17 +1,36 @@
-//! The XML 1.0 + Namespaces tokenizer under the BML parser: start, end and text events over a
-//! `&str`, with names, attribute values and text borrowed from the input, character and entity
-//! references resolved, and the namespace scope kept on a stack. It checks well-formedness
-//! (names, tag nesting, quoting, references, declarations) and reports each problem at its byte
-//! offset. Made for short BML blocks: no allocation for a tag, its attributes or plain text.
+//! The XML layer under the BML parser and the stream splitter: quick-xml's namespace reader over
+//! a `&str`, turned into start, end and text events that carry byte offsets, plus the checks of
+//! XML 1.0 + Namespaces that quick-xml leaves to its user: qualified names, white space between
+//! attributes, `<` in attribute values, `]]>` in text, references (to known entities and allowed
+//! characters), the XML declaration (version 1.x, UTF-8), undeclaring a prefix, and the limits
+//! on nesting depth and attributes per element. Names, values and text are borrowed from the
+//! input where nothing needs resolving.
 
 use std::borrow::Cow;
 
+use quick_xml::escape::{resolve_predefined_entity, unescape_with, EscapeError};
+use quick_xml::events::attributes::AttrError;
+use quick_xml::events::{BytesDecl, BytesRef, BytesStart, Event as XmlEvent};
+use quick_xml::name::{PrefixDeclaration, QName, ResolveResult};
+use quick_xml::NsReader;
+
+use super::limits::Limits;
 use crate::xmlname::{is_forbidden_char, is_ncname, split_qname};
 
-/// The namespace bound to the prefix `xml`.
-pub(crate) const XML_URI: &str = "http://www.w3.org/XML/1998/namespace";
-/// The namespace of `xmlns` declarations; no element or attribute may be in it.
-pub(crate) const XMLNS_URI: &str = "http://www.w3.org/2000/xmlns/";
+/// What kind of problem an [`XmlError`] is, which decides whether reading can go on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Problem {
+    /// The markup is broken where quick-xml reads it: reading cannot go on.
+    Broken,
+    /// The input ends inside a tag, comment, CDATA section or declaration: more text may
+    /// complete it.
+    Unclosed,
+    /// A tag or text is read but breaks a rule checked here (a name, a value, a reference):
+    /// the structure is intact and reading can go on.
+    Content,
+    /// The input passes one of the limits (the XML itself may be fine); reading can go on.
+    Limit,
+}
 
 /// A well-formedness error: where it is (byte offset) and what is wrong.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -20,24 +39,23 @@ pub(crate) struct XmlError {
     pub offset: usize,
     /// What is wrong, in a sentence without the position.
     pub message: String,
-    /// The input passes one of the limits (the XML itself may be fine).
-    pub limit: bool,
+    /// What kind of problem it is.
+    pub problem: Problem,
 }
 
-fn err<T>(offset: usize, message: impl Into<String>) -> Result<T, XmlError> {
+fn content<T>(offset: usize, message: impl Into<String>) -> Result<T, XmlError> {
     Err(XmlError {
         offset,
         message: message.into(),
-        limit: false,
+        problem: Problem::Content,
     })
 }
 
-/// An error for input that passes a limit.
 fn over_limit<T>(offset: usize, message: String) -> Result<T, XmlError> {
     Err(XmlError {
         offset,
         message,
-        limit: true,
+        problem: Problem::Limit,
     })
 }
 
@@ -48,22 +66,16 @@ pub(crate) struct Attr<'i> {
     pub key: &'i str,
     /// Byte offset of the name.
     pub offset: usize,
-    /// The value between the quotes, references not yet resolved (see [`unescape`]).
+    /// The value between the quotes, references not yet resolved (see [`Attr::value`]).
     pub raw: &'i str,
     /// Byte offset of the value's first character.
     pub value_offset: usize,
-    /// Whether the value holds a reference (`&`), so that [`Attr::value`] must resolve it.
-    pub references: bool,
 }
 
 impl<'i> Attr<'i> {
     /// The value with its references resolved (borrowed when it has none).
     pub fn value(&self) -> Result<Cow<'i, str>, XmlError> {
-        if self.references {
-            unescape(self.raw, self.value_offset)
-        } else {
-            Ok(Cow::Borrowed(self.raw))
-        }
+        unescape(self.raw, self.value_offset)
     }
 
     /// The prefix a namespace declaration binds: `Some("")` for `xmlns`, `Some(p)` for
@@ -90,13 +102,13 @@ pub(crate) struct Tag<'i> {
     pub end: usize,
 }
 
-/// What the tokenizer reads.
+/// What the reader reads.
 #[derive(Debug, Clone)]
 pub(crate) enum Event<'i> {
-    /// A start or empty-element tag; its attributes are in [`Tokenizer::attrs`] until the next
-    /// call to [`Tokenizer::next`], and its namespace declarations are in scope.
+    /// A start or empty-element tag; its attributes are in [`Reader::attrs`] until the next
+    /// call to [`Reader::next`], and its namespace declarations are in scope.
     Start(Tag<'i>),
-    /// An end tag (already checked to close the open element).
+    /// An end tag (quick-xml checked that it closes the open element).
     End {
         /// Byte offset of the `</`.
         offset: usize,
@@ -115,91 +127,42 @@ pub(crate) enum Event<'i> {
     Eof,
 }
 
-/// An open element: its name, and the length of the binding list before its declarations.
-struct Open<'i> {
-    qname: &'i str,
-    bindings: usize,
-}
-
-/// A tokenizer's lists, emptied, for building another one (see [`Tokenizer::take_lists`]): the
-/// parser keeps them between blocks, so parsing one small block after another allocates no
-/// scratch space.
-#[derive(Default)]
-pub(crate) struct Lists {
-    open: Vec<Open<'static>>,
-    bindings: Vec<(&'static str, Cow<'static, str>)>,
-    attrs: Vec<Attr<'static>>,
-}
-
-impl Lists {
-    /// The longest of the lists.
-    pub fn longest(&self) -> usize {
-        self.open
-            .capacity()
-            .max(self.bindings.capacity())
-            .max(self.attrs.capacity())
-    }
-}
-
-/// `v` emptied and retyped (here: only its lifetime), keeping its allocation: collecting a
-/// by-value iterator into elements of the same size and alignment reuses the buffer.
-pub(crate) fn recycle<T, U>(mut v: Vec<T>) -> Vec<U> {
-    v.clear();
-    v.into_iter()
-        .map(|_| unreachable!("the list is empty"))
-        .collect()
-}
-
-/// The tokenizer: a cursor over the input plus the open elements and namespace bindings.
-pub(crate) struct Tokenizer<'i> {
+/// The reader: quick-xml's namespace reader, the attributes of the last start tag, and the
+/// counts the limits need.
+pub(crate) struct Reader<'i> {
     src: &'i str,
-    pos: usize,
-    open: Vec<Open<'i>>,
-    /// (prefix, namespace) in declaration order; `""` is the default namespace, and an empty
-    /// namespace undeclares it.
-    bindings: Vec<(&'i str, Cow<'i, str>)>,
-    /// The attributes of the last start tag.
+    xml: NsReader<&'i [u8]>,
     attrs: Vec<Attr<'i>>,
-    /// The last event was an empty-element tag: its scope ends before the next event.
-    close_empty: Option<usize>,
-    /// Most attributes per element, and most namespace declarations in scope (a longer list
-    /// is an error: every attribute is checked against the others).
+    /// Per open element, the namespace declarations it made.
+    declared: Vec<usize>,
+    /// The namespace declarations in scope.
+    in_scope: usize,
+    /// The last event was an empty-element tag that made this many declarations: they go out
+    /// of scope before the next event.
+    empty_declared: usize,
+    /// Whether an element was read (a DOCTYPE may only come before one).
+    element_seen: bool,
     max_attributes: usize,
-    /// Deepest nesting of open elements.
     max_depth: usize,
 }
 
-impl<'i> Tokenizer<'i> {
-    /// A tokenizer at the start of `src` that uses `lists` (new ones, or from
-    /// [`Self::take_lists`]).
-    pub fn with_lists(src: &'i str, lists: Lists) -> Self {
-        Tokenizer {
+impl<'i> Reader<'i> {
+    /// A reader at the start of `src`, refusing elements with more than `limits.attributes`
+    /// attributes (or more namespace declarations in scope) and nesting deeper than
+    /// `limits.depth`.
+    pub fn new(src: &'i str, limits: &Limits) -> Self {
+        let mut xml = NsReader::from_str(src);
+        xml.config_mut().check_comments = true;
+        Reader {
             src,
-            pos: 0,
-            open: recycle(lists.open),
-            bindings: recycle(lists.bindings),
-            attrs: recycle(lists.attrs),
-            close_empty: None,
-            max_attributes: usize::MAX,
-            max_depth: usize::MAX,
-        }
-    }
-
-    /// The same tokenizer refusing elements with more than `attributes` attributes (or more
-    /// namespace declarations in scope) and nesting deeper than `depth`.
-    pub fn limited(mut self, attributes: usize, depth: usize) -> Self {
-        self.max_attributes = attributes;
-        self.max_depth = depth;
-        self
-    }
-
-    /// The lists, emptied, for the next tokenizer (this one is done with them; taken through
-    /// a reference, so that the tokenizer itself is not copied).
-    pub fn take_lists(&mut self) -> Lists {
-        Lists {
-            open: recycle(std::mem::take(&mut self.open)),
-            bindings: recycle(std::mem::take(&mut self.bindings)),
-            attrs: recycle(std::mem::take(&mut self.attrs)),
+            xml,
+            attrs: Vec::new(),
+            declared: Vec::new(),
+            in_scope: 0,
+            empty_declared: 0,
+            element_seen: false,
+            max_attributes: limits.attributes,
+            max_depth: limits.depth,
         }
     }
 
@@ -208,492 +171,390 @@ impl<'i> Tokenizer<'i> {
         &self.attrs
     }
 
-    /// The namespace a prefix is bound to here (`None` for no prefix: the default namespace);
-    /// `Ok(None)` when there is none, `Err(())` for a prefix that is not declared.
-    pub fn resolve(&self, prefix: Option<&str>) -> Result<Option<&str>, ()> {
-        let p = prefix.unwrap_or("");
-        match p {
-            "xml" => return Ok(Some(XML_URI)),
-            "xmlns" => return Ok(Some(XMLNS_URI)),
-            _ => {}
-        }
-        match self.bindings.iter().rev().find(|b| b.0 == p) {
-            Some((_, uri)) if uri.is_empty() => Ok(None),
-            Some((_, uri)) => Ok(Some(uri)),
-            None if p.is_empty() => Ok(None),
-            None => Err(()),
-        }
-    }
-
-    /// How many namespace bindings are in scope (a mark for [`Self::bound_since`]).
-    pub fn bindings_len(&self) -> usize {
-        self.bindings.len()
-    }
-
-    /// Whether `prefix` is bound by a declaration made after `mark` that is still in scope.
-    pub fn bound_since(&self, mark: usize, prefix: &str) -> bool {
-        self.bindings
-            .get(mark..)
-            .is_some_and(|b| b.iter().any(|(p, _)| *p == prefix))
-    }
-
-    /// The prefixed bindings in scope (innermost first for each prefix), `xml` excluded.
-    pub fn scope(&self) -> Vec<(String, String)> {
-        let mut out: Vec<(String, String)> = Vec::new();
-        for (p, uri) in self.bindings.iter().rev() {
-            if !p.is_empty() && *p != "xml" && !out.iter().any(|(q, _)| q == p) {
-                out.push((p.to_string(), uri.to_string()));
-            }
-        }
-        out
-    }
-
-    fn bytes(&self) -> &'i [u8] {
-        self.src.as_bytes()
-    }
-
-    /// Reads the next event.
-    pub fn next(&mut self) -> Result<Event<'i>, XmlError> {
-        if let Some(mark) = self.close_empty.take() {
-            self.bindings.truncate(mark);
-        }
-        loop {
-            let b = self.bytes();
-            let start = self.pos;
-            if start >= b.len() {
-                return Ok(Event::Eof);
-            }
-            match b[start] {
-                b'<' => match b.get(start + 1) {
-                    Some(b'/') => return self.end_tag(start),
-                    Some(b'!') => {
-                        if let Some(text) = self.bang(start)? {
-                            return Ok(Event::Text {
-                                text: Cow::Borrowed(text),
-                                offset: start,
-                            });
-                        }
-                    }
-                    Some(b'?') => self.skip_to(start, "?>", "processing instruction")?,
-                    _ => return self.start_tag(start),
-                },
-                b'&' => {
-                    let (c, next) = reference(self.src, start)?;
-                    self.pos = next;
-                    return Ok(Event::Text {
-                        text: c,
-                        offset: start,
-                    });
-                }
-                _ => {
-                    let end = find_near(&b[start..], [b'<', b'&']).map_or(b.len(), |i| start + i);
-                    self.pos = end;
-                    let s = &self.src[start..end];
-                    let text = if find_near(s.as_bytes(), [b'\r']).is_some() {
-                        Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n"))
-                    } else {
-                        Cow::Borrowed(s)
-                    };
-                    return Ok(Event::Text {
-                        text,
-                        offset: start,
-                    });
-                }
-            }
-        }
-    }
-
-    /// Skips past `close`, or fails with an unclosed `what`.
-    fn skip_to(&mut self, start: usize, close: &str, what: &str) -> Result<(), XmlError> {
-        match find(&self.bytes()[start + 2..], close.as_bytes()) {
-            Some(i) => {
-                self.pos = start + 2 + i + close.len();
-                Ok(())
-            }
-            None => err(start, format!("the {what} is never closed")),
-        }
-    }
-
-    /// `<!`: a comment or a DOCTYPE (skipped) or a CDATA section (its text).
-    fn bang(&mut self, start: usize) -> Result<Option<&'i str>, XmlError> {
-        let rest = &self.src[start..];
-        if let Some(body) = rest.strip_prefix("<!--") {
-            match find(body.as_bytes(), b"-->") {
-                Some(i) => self.pos = start + 4 + i + 3,
-                None => return err(start, "the comment is never closed"),
-            }
-            Ok(None)
-        } else if let Some(body) = rest.strip_prefix("<![CDATA[") {
-            match find(body.as_bytes(), b"]]>") {
-                Some(i) => {
-                    self.pos = start + 9 + i + 3;
-                    Ok(Some(&body[..i]))
-                }
-                None => err(start, "the CDATA section is never closed"),
-            }
-        } else if rest.starts_with("<!DOCTYPE") {
-            // the internal subset may contain '>' inside brackets and quotes
-            let (mut depth, mut quote) = (0usize, None);
-            for (i, &c) in rest.as_bytes().iter().enumerate().skip(9) {
-                match (quote, c) {
-                    (Some(q), _) if c == q => quote = None,
-                    (Some(_), _) => {}
-                    (None, b'"' | b'\'') => quote = Some(c),
-                    (None, b'[') => depth += 1,
-                    (None, b']') => depth = depth.saturating_sub(1),
-                    (None, b'>') if depth == 0 => {
-                        self.pos = start + i + 1;
-                        return Ok(None);
-                    }
-                    _ => {}
-                }
-            }
-            err(start, "the DOCTYPE declaration is never closed")
+    /// The namespace of an element name (`attribute` false: an unprefixed name is in the
+    /// default namespace) or an attribute name (unprefixed: in none), where the reader is;
+    /// `Ok(None)` for no namespace, `Err(())` for a prefix that is not declared.
+    pub fn resolve(&self, qname: &str, attribute: bool) -> Result<Option<&str>, ()> {
+        let name = QName(qname.as_bytes());
+        let resolver = self.xml.resolver();
+        let (ns, _) = if attribute {
+            resolver.resolve_attribute(name)
         } else {
-            err(
-                start,
-                "'<!' starts neither a comment, a CDATA section nor a DOCTYPE",
-            )
-        }
-    }
-
-    /// Scans a name from `at` up to whitespace, `/`, `>`, `=`, `<` or the end; with whether it
-    /// is a qualified name (`NCName` or `NCName:NCName`).
-    fn name_at(&self, at: usize) -> (&'i str, bool) {
-        let b = self.bytes();
-        // the common case in one pass: ASCII letters, digits, '_', '-', '.' and at most one ':'
-        // not at either end, starting with a letter or '_'
-        let mut i = at;
-        // plain name characters (nearly every byte of every name) in a tight loop first
-        while i < b.len() && NAME_CLASS[usize::from(b[i])] == NAME_CHAR {
-            i += 1;
-        }
-        let mut colon = None;
-        let mut ascii = true;
-        while i < b.len() {
-            match NAME_CLASS[usize::from(b[i])] {
-                NAME_CHAR => {}
-                NAME_END => break,
-                COLON if colon.is_none() => colon = Some(i),
-                _ => ascii = false,
-            }
-            i += 1;
-        }
-        let name = &self.src[at..i];
-        let starts = |j: usize| j < i && (b[j].is_ascii_alphabetic() || b[j] == b'_');
-        let valid = if ascii {
-            match colon {
-                Some(c) => starts(at) && starts(c + 1),
-                None => starts(at),
-            }
-        } else {
-            is_qname(name)
+            resolver.resolve_element(name)
         };
-        (name, valid)
-    }
-
-    fn skip_space(&mut self) {
-        let b = self.bytes();
-        while self.pos < b.len() && matches!(b[self.pos], b' ' | b'\t' | b'\n' | b'\r') {
-            self.pos += 1;
+        match ns {
+            ResolveResult::Bound(ns) => Ok(std::str::from_utf8(ns.into_inner()).ok()),
+            ResolveResult::Unbound => Ok(None),
+            ResolveResult::Unknown(_) => Err(()),
         }
     }
 
-    fn start_tag(&mut self, start: usize) -> Result<Event<'i>, XmlError> {
-        let (qname, valid) = self.name_at(start + 1);
-        if !valid {
-            return err(start, format!("<{qname}> is not a valid qualified name"));
+    /// How deep the namespace scope is (a mark for [`Self::bound_since`]).
+    pub fn level(&self) -> u16 {
+        self.xml.resolver().level()
+    }
+
+    /// Whether `prefix` is bound by a declaration deeper than `mark` that is still in scope.
+    pub fn bound_since(&self, mark: u16, prefix: &str) -> bool {
+        let resolver = self.xml.resolver();
+        (mark + 1..=resolver.level()).any(|level| {
+            resolver
+                .bindings_of(level)
+                .any(|(p, _)| p == PrefixDeclaration::Named(prefix.as_bytes()))
+        })
+    }
+
+    /// The prefixed bindings in scope (the innermost for each prefix), `xml` excluded.
+    pub fn scope(&self) -> Vec<(String, String)> {
+        let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+        self.xml
+            .resolver()
+            .bindings()
+            .filter_map(|(p, ns)| match p {
+                PrefixDeclaration::Named(p) if p != b"xml" => Some((text(p), text(ns.0))),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Reads the next event. After an error of [`Problem::Content`] or [`Problem::Limit`] the
+    /// next call goes on after the construct that had it.
+    pub fn next(&mut self) -> Result<Event<'i>, XmlError> {
+        self.in_scope -= std::mem::take(&mut self.empty_declared);
+        loop {
+            let at = self.xml.buffer_position() as usize;
+            let event = self.xml.read_event().map_err(|e| self.broken(e))?;
+            let after = self.xml.buffer_position() as usize;
+            return match event {
+                XmlEvent::Start(tag) => self.start_tag(&tag, at, after, false),
+                XmlEvent::Empty(tag) => self.start_tag(&tag, at, after, true),
+                XmlEvent::End(_) => {
+                    self.in_scope -= self.declared.pop().unwrap_or(0);
+                    Ok(Event::End { offset: at, after })
+                }
+                XmlEvent::Text(t) => {
+                    let text = t.xml10_content().map_err(|e| self.broken(e.into()))?;
+                    self.text(text, at)
+                }
+                XmlEvent::CData(t) => {
+                    let text = t.xml10_content().map_err(|e| self.broken(e.into()))?;
+                    Ok(Event::Text { text, offset: at })
+                }
+                XmlEvent::GeneralRef(r) => reference(&r, at),
+                XmlEvent::Decl(d) => {
+                    declaration(&d, at)?;
+                    continue;
+                }
+                XmlEvent::PI(pi) => {
+                    if pi.target().eq_ignore_ascii_case(b"xml") {
+                        return content(at, "the processing instruction target 'xml' is reserved (an XML declaration goes at the very start)");
+                    }
+                    continue;
+                }
+                XmlEvent::DocType(_) if self.element_seen => {
+                    content(at, "a DOCTYPE declaration after the first element")
+                }
+                XmlEvent::DocType(d) if open_quote(&d) => Err(XmlError {
+                    offset: at,
+                    message: "a '>' inside a quoted literal of a DOCTYPE's internal subset is not supported (BML needs no DTD)".into(),
+                    problem: Problem::Broken,
+                }),
+                XmlEvent::DocType(_) | XmlEvent::Comment(_) => continue,
+                XmlEvent::Eof => Ok(Event::Eof),
+            };
+        }
+    }
+
+    /// A quick-xml error as an [`XmlError`] at the position quick-xml gives for it.
+    fn broken(&self, e: quick_xml::Error) -> XmlError {
+        let problem = match e {
+            quick_xml::Error::Syntax(_) => Problem::Unclosed,
+            _ => Problem::Broken,
+        };
+        let message = match e {
+            quick_xml::Error::Syntax(s) => s.to_string(),
+            quick_xml::Error::IllFormed(e) => e.to_string(),
+            other => other.to_string(),
+        };
+        XmlError {
+            offset: self.xml.error_position() as usize,
+            message,
+            problem,
+        }
+    }
+
+    /// Character data outside a CDATA section: `]]>` may not appear in it.
+    fn text(&self, text: Cow<'i, str>, at: usize) -> Result<Event<'i>, XmlError> {
+        if let Some(i) = text.find("]]>") {
+            // line-end normalisation only shortens the text after a '\r'; the raw text says
+            let raw = self.src.get(at..).and_then(|s| s.find("]]>")).unwrap_or(i);
+            return content(at + raw, "']]>' in text (it may only end a CDATA section)");
+        }
+        Ok(Event::Text { text, offset: at })
+    }
+
+    /// Byte offset of `part`, a slice of the input, in it.
+    fn offset_of(&self, part: &[u8]) -> usize {
+        (part.as_ptr() as usize).wrapping_sub(self.src.as_ptr() as usize)
+    }
+
+    /// The input text at `part` (a slice of it), with its offset.
+    fn text_at(&self, part: &[u8]) -> (&'i str, usize) {
+        let at = self.offset_of(part);
+        (self.src.get(at..at + part.len()).unwrap_or(""), at)
+    }
+
+    /// A start or empty-element tag: its scope and attributes recorded first (so that reading
+    /// can go on after a content error), then its name and attributes checked.
+    fn start_tag(
+        &mut self,
+        tag: &BytesStart<'i>,
+        at: usize,
+        after: usize,
+        empty: bool,
+    ) -> Result<Event<'i>, XmlError> {
+        self.element_seen = true;
+        let (qname, _) = self.text_at(tag.name().as_ref());
+        let (declared, unread) = self.read_attributes(tag, qname);
+        self.in_scope += declared;
+        if empty {
+            self.empty_declared = declared;
+        } else {
+            self.declared.push(declared);
+        }
+        if !empty && self.declared.len() > self.max_depth {
+            let message = format!(
+                "<{qname}> is nested deeper than {} elements (the limit; --max-depth)",
+                self.max_depth
+            );
+            return over_limit(at, message);
+        }
+        if self.in_scope > self.max_attributes {
+            let message = format!(
+                "more than {} namespace declarations in scope (the limit; --max-attributes)",
+                self.max_attributes
+            );
+            return over_limit(at, message);
+        }
+        if let Some(e) = unread {
+            return Err(e);
+        }
+        if !is_qname(qname) {
+            return content(at, format!("<{qname}> is not a valid qualified name"));
         }
         if qname.starts_with("xmlns:") {
-            return err(
-                start,
-                format!("<{qname}>: the prefix xmlns is reserved for namespace declarations"),
-            );
+            let message =
+                format!("<{qname}>: the prefix xmlns is reserved for namespace declarations");
+            return content(at, message);
         }
-        self.pos = start + 1 + qname.len();
-        self.attrs.clear();
-        let mark = self.bindings.len();
-        let b = self.bytes();
-        let empty = loop {
-            let before = self.pos;
-            self.skip_space();
-            match b.get(self.pos) {
-                None => return err(start, format!("the tag <{qname}> is never closed")),
-                Some(b'>') => {
-                    self.pos += 1;
-                    break false;
-                }
-                Some(b'/') => {
-                    if b.get(self.pos + 1) == Some(&b'>') {
-                        self.pos += 2;
-                        break true;
-                    }
-                    return err(
-                        self.pos,
-                        format!("'/' in the tag <{qname}> is not followed by '>'"),
-                    );
-                }
-                Some(_) if before == self.pos => {
-                    return err(
-                        self.pos,
-                        format!("attributes of <{qname}> must be separated by white space"),
-                    )
-                }
-                Some(_) if self.attrs.len() >= self.max_attributes => {
-                    return over_limit(
-                        self.pos,
-                        format!(
-                            "<{qname}> has more than {} attributes (the limit; --max-attributes)",
-                            self.max_attributes
-                        ),
-                    )
-                }
-                Some(_) => self.attribute(qname)?,
-            }
-        };
-        // namespace declarations take effect for the element and its attributes
-        for i in 0..self.attrs.len() {
-            let a = self.attrs[i];
-            if let Some(prefix) = a.declares() {
-                if self.bindings[mark..].iter().any(|(p, _)| *p == prefix) {
-                    return err(
-                        a.offset,
-                        format!("attribute '{}' appears twice on <{qname}>", a.key),
-                    );
-                }
-                let uri = a.value().map_err(|e| XmlError {
-                    offset: a.offset,
-                    message: format!(
-                        "namespace declaration has a bad character or entity reference: {}",
-                        e.message
-                    ),
-                    limit: false,
-                })?;
-                if !prefix.is_empty() && uri.is_empty() {
-                    return err(
-                        a.offset,
-                        format!("'{}' cannot undeclare a prefix (XML 1.0 namespaces)", a.key),
-                    );
-                }
-                if matches!(prefix, "xml" | "xmlns") && uri != XML_URI {
-                    return err(a.offset, format!("the prefix {prefix} cannot be declared"));
-                }
-                if self.bindings.len() >= self.max_attributes {
-                    return over_limit(
-                        a.offset,
-                        format!(
-                            "more than {} namespace declarations in scope (the limit; --max-attributes)",
-                            self.max_attributes
-                        ),
-                    );
-                }
-                self.bindings.push((prefix, uri));
-            }
-        }
-        let end = self.pos;
-        if !empty && self.open.len() + 1 > self.max_depth {
-            return over_limit(
-                start,
-                format!(
-                    "<{qname}> is nested deeper than {} elements (the limit; --max-depth)",
-                    self.max_depth
-                ),
-            );
-        }
-        if empty {
-            self.close_empty = Some(mark);
-        } else {
-            self.open.push(Open {
-                qname,
-                bindings: mark,
-            });
+        for a in &self.attrs {
+            check_attribute(self.src, a, qname)?;
         }
         Ok(Event::Start(Tag {
             qname,
             empty,
-            offset: start,
-            end,
+            offset: at,
+            end: after,
         }))
     }
 
-    /// One `name = "value"` at the cursor.
-    fn attribute(&mut self, tag: &str) -> Result<(), XmlError> {
-        let b = self.bytes();
-        let offset = self.pos;
-        let (key, valid) = self.name_at(offset);
-        if !valid {
-            return err(
+    /// Reads the attributes of `tag` into [`Self::attrs`]: how many of them declare a
+    /// namespace, and why the rest could not be read (the list cannot be parsed, or it is too
+    /// long).
+    fn read_attributes(&mut self, tag: &BytesStart<'i>, qname: &str) -> (usize, Option<XmlError>) {
+        self.attrs.clear();
+        let base = self.offset_of(tag.as_ref());
+        let mut declared = 0;
+        for a in tag.attributes() {
+            let a = match a {
+                Ok(a) => a,
+                Err(e) => return (declared, Some(attr_error(&e, base, qname))),
+            };
+            let (key, offset) = self.text_at(a.key.as_ref());
+            if self.attrs.len() == self.max_attributes {
+                let message = format!(
+                    "<{qname}> has more than {} attributes (the limit; --max-attributes)",
+                    self.max_attributes
+                );
+                return (declared, over_limit::<()>(offset, message).err());
+            }
+            let (raw, value_offset) = self.text_at(&a.value);
+            let attr = Attr {
+                key,
                 offset,
-                format!("attribute '{key}' of <{tag}> is not a valid qualified name"),
-            );
+                raw,
+                value_offset,
+            };
+            declared += usize::from(attr.declares().is_some());
+            self.attrs.push(attr);
         }
-        self.pos += key.len();
-        self.skip_space();
-        if b.get(self.pos) != Some(&b'=') {
-            return err(offset, format!("attribute '{key}' of <{tag}> has no value"));
-        }
-        self.pos += 1;
-        self.skip_space();
-        let quote = match b.get(self.pos) {
-            Some(&q @ (b'"' | b'\'')) => q,
-            _ => {
-                return err(
-                    self.pos,
-                    format!("the value of attribute '{key}' of <{tag}> is not in quotes"),
-                )
-            }
-        };
-        let value_offset = self.pos + 1;
-        // one search for the closing quote, a '<' (not allowed) or a reference
-        let (mut end, mut references) = (value_offset, false);
-        loop {
-            match find_near(&b[end..], [quote, b'<', b'&']).map(|i| end + i) {
-                None => {
-                    return err(
-                        offset,
-                        format!("the value of attribute '{key}' of <{tag}> is never closed"),
-                    )
-                }
-                Some(i) if b[i] == quote => {
-                    end = i;
-                    break;
-                }
-                Some(i) if b[i] == b'<' => {
-                    return err(i, format!("'<' in the value of attribute '{key}'"))
-                }
-                Some(i) => {
-                    references = true;
-                    end = i + 1;
-                }
-            }
-        }
-        self.pos = end + 1;
-        self.attrs.push(Attr {
-            key,
-            offset,
-            raw: &self.src[value_offset..end],
-            value_offset,
-            references,
-        });
-        Ok(())
+        (declared, None)
     }
+}
 
-    fn end_tag(&mut self, start: usize) -> Result<Event<'i>, XmlError> {
-        let (qname, _) = self.name_at(start + 2);
-        self.pos = start + 2 + qname.len();
-        self.skip_space();
-        if self.bytes().get(self.pos) != Some(&b'>') {
-            return err(
-                start,
-                format!("the end tag </{qname}> is not closed by '>'"),
-            );
+/// The rules an attribute must keep that quick-xml does not check.
+fn check_attribute(src: &str, a: &Attr<'_>, tag: &str) -> Result<(), XmlError> {
+    let key = a.key;
+    if !preceded_by_space(src, a.offset) {
+        return content(
+            a.offset,
+            format!("attributes of <{tag}> must be separated by white space"),
+        );
+    }
+    if !is_qname(key) {
+        let message = format!("attribute '{key}' of <{tag}> is not a valid qualified name");
+        return content(a.offset, message);
+    }
+    if let Some(i) = a.raw.find('<') {
+        return content(
+            a.value_offset + i,
+            format!("'<' in the value of attribute '{key}'"),
+        );
+    }
+    match a.declares() {
+        Some(prefix) if !prefix.is_empty() && a.raw.is_empty() => content(
+            a.offset,
+            format!("'{key}' cannot undeclare a prefix (XML 1.0 namespaces)"),
+        ),
+        Some(_) if a.raw.contains('&') => content(
+            a.value_offset,
+            format!("the namespace name of '{key}' holds a reference, which this reader does not resolve"),
+        ),
+        _ => Ok(()),
+    }
+}
+
+/// Whether the byte before `at` is XML white space.
+fn preceded_by_space(src: &str, at: usize) -> bool {
+    at.checked_sub(1)
+        .and_then(|i| src.as_bytes().get(i))
+        .is_some_and(|b| matches!(b, b' ' | b'\t' | b'\n' | b'\r'))
+}
+
+/// An attribute list quick-xml cannot read, as an error in the words of this parser.
+fn attr_error(e: &AttrError, base: usize, tag: &str) -> XmlError {
+    let (at, message) = match *e {
+        AttrError::ExpectedEq(p) => (p, format!("an attribute of <{tag}> has no value")),
+        AttrError::ExpectedValue(p) => (p, format!("'=' in <{tag}> is not followed by a value")),
+        AttrError::UnquotedValue(p) => (
+            p,
+            format!("the value of an attribute of <{tag}> is not in quotes"),
+        ),
+        AttrError::ExpectedQuote(p, _) => (
+            p,
+            format!("the value of an attribute of <{tag}> is never closed"),
+        ),
+        AttrError::Duplicated(p, _) => (p, format!("an attribute appears twice on <{tag}>")),
+    };
+    XmlError {
+        offset: base + at,
+        message,
+        problem: Problem::Content,
+    }
+}
+
+/// The XML declaration: only at the very start, version 1.x, and (the input being text in
+/// UTF-8) no other encoding.
+fn declaration(d: &BytesDecl<'_>, at: usize) -> Result<(), XmlError> {
+    if at != 0 {
+        return content(at, "the XML declaration may only open the document");
+    }
+    let version = d.version().map_err(|e| XmlError {
+        offset: at,
+        message: format!("XML declaration: {e}"),
+        problem: Problem::Content,
+    })?;
+    if !version.starts_with(b"1.") {
+        let v = String::from_utf8_lossy(&version);
+        return content(at, format!("XML version '{v}' is not 1.0"));
+    }
+    match d.encoding() {
+        Some(Ok(enc)) if !enc.eq_ignore_ascii_case(b"utf-8") => {
+            let enc = String::from_utf8_lossy(&enc);
+            content(
+                at,
+                format!("the document declares encoding '{enc}', but BML is read as UTF-8"),
+            )
         }
-        self.pos += 1;
-        match self.open.pop() {
-            Some(o) if o.qname == qname => {
-                self.bindings.truncate(o.bindings);
-                Ok(Event::End {
-                    offset: start,
-                    after: self.pos,
-                })
-            }
-            Some(o) => err(
-                start,
-                format!(
-                    "end tag </{qname}> does not match the start tag <{}>",
-                    o.qname
-                ),
+        Some(Err(e)) => content(at, format!("XML declaration: {e}")),
+        _ => Ok(()),
+    }
+}
+
+/// A reference in text (`&name;` or `&#N;`), resolved to the text it stands for.
+fn reference<'i>(r: &BytesRef<'i>, at: usize) -> Result<Event<'i>, XmlError> {
+    let name = String::from_utf8_lossy(r);
+    let text = match r.resolve_char_ref() {
+        Ok(Some(c)) if is_forbidden_char(c) => {
+            let message = format!(
+                "'&{name};' refers to U+{:04X}, which is not allowed in XML",
+                c as u32
+            );
+            return content(at, message);
+        }
+        Ok(Some(c)) => Cow::Owned(c.to_string()),
+        Ok(None) => match resolve_predefined_entity(&name) {
+            Some(s) => Cow::Borrowed(s),
+            None => return content(at, format!("unknown entity '&{name};'")),
+        },
+        Err(_) => return content(at, format!("'&{name};' is not a valid character reference")),
+    };
+    Ok(Event::Text { text, offset: at })
+}
+
+/// An attribute value (starting at `offset`) with its references resolved; an unknown entity,
+/// a bad character reference or a reference to a character XML forbids is an error at the `&`.
+fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlError> {
+    if !raw.contains('&') {
+        return Ok(Cow::Borrowed(raw));
+    }
+    let first = offset + raw.find('&').unwrap_or(0);
+    let value = unescape_with(raw, resolve_predefined_entity).map_err(|e| {
+        let (at, message) = match e {
+            EscapeError::UnrecognizedEntity(range, name) => (
+                offset + range.start - 1,
+                format!("unknown entity '&{name};'"),
             ),
-            None => err(start, format!("end tag </{qname}> without a start tag")),
-        }
-    }
-}
-
-const NAME_OTHER: u8 = 0;
-const NAME_CHAR: u8 = 1;
-const NAME_END: u8 = 2;
-const COLON: u8 = 3;
-
-/// Bytes in and after a name: ASCII name characters (letters, digits, `_`, `-`, `.`), the
-/// bytes that end a name (white space, `/`, `>`, `=`, `<`), the colon, and the rest (checked by
-/// the general rule).
-static NAME_CLASS: [u8; 256] = {
-    let mut t = [NAME_OTHER; 256];
-    let mut b = 0;
-    while b < 128 {
-        let c = b as u8;
-        t[b] = match c {
-            b' ' | b'\t' | b'\n' | b'\r' | b'/' | b'>' | b'=' | b'<' => NAME_END,
-            b':' => COLON,
-            b'_' | b'-' | b'.' => NAME_CHAR,
-            _ if c.is_ascii_alphanumeric() => NAME_CHAR,
-            _ => NAME_OTHER,
+            EscapeError::UnterminatedEntity(range) => (
+                offset + range.start,
+                "'&' does not start a reference (write &amp;)".to_string(),
+            ),
+            EscapeError::InvalidCharRef(e) => (first, format!("bad character reference: {e}")),
         };
-        b += 1;
-    }
-    t
-};
-
-/// The first byte of `hay` that is one of `needles`. Matches in a BML document are mostly a few
-/// bytes away (the end of an attribute value, the next tag after white space), where a call into
-/// `memchr` costs more than the search itself; so the first [`NEAR`] bytes are searched here,
-/// eight at a time, and only the rest by `memchr`'s vector search (for one to three needles).
-#[inline]
-fn find_near<const K: usize>(hay: &[u8], needles: [u8; K]) -> Option<usize> {
-    let near = hay.len().min(NEAR);
-    let mut words = hay[..near].chunks_exact(8);
-    let mut at = 0;
-    for w in &mut words {
-        let x = u64::from_le_bytes(w.try_into().expect("eight bytes"));
-        // a byte equal to a needle is zero after the xor, and zero bytes get their high bit
-        // flagged; the lowest flag is exact (a false one only sits above a true one)
-        let mut found = 0;
-        for n in needles {
-            let y = x ^ (ONES * u64::from(n));
-            found |= y.wrapping_sub(ONES) & !y & HIGH;
+        XmlError {
+            offset: at,
+            message,
+            problem: Problem::Content,
         }
-        if found != 0 {
-            return Some(at + found.trailing_zeros() as usize / 8);
-        }
-        at += 8;
+    })?;
+    match value.chars().find(|&c| is_forbidden_char(c)) {
+        Some(c) => content(
+            first,
+            format!(
+                "a reference to U+{:04X}, which is not allowed in XML",
+                c as u32
+            ),
+        ),
+        None => Ok(value),
     }
-    if let Some(i) = words.remainder().iter().position(|b| needles.contains(b)) {
-        return Some(at + i);
-    }
-    if hay.len() <= NEAR {
-        return None;
-    }
-    let far = &hay[NEAR..];
-    match *needles.as_slice() {
-        [a] => memchr::memchr(a, far),
-        [a, b] => memchr::memchr2(a, b, far),
-        [a, b, c] => memchr::memchr3(a, b, c, far),
-        _ => far.iter().position(|b| needles.contains(b)),
-    }
-    .map(|i| NEAR + i)
 }
 
-/// A byte of 1 in every lane of a word read eight bytes at a time (this search, and the line
-/// index's scan).
-pub(super) const ONES: u64 = 0x0101_0101_0101_0101;
-/// The high bit of every lane of such a word.
-pub(super) const HIGH: u64 = 0x8080_8080_8080_8080;
-
-/// How many bytes [`find_near`] searches itself.
-const NEAR: usize = 64;
-
-/// The first occurrence of `needle` (a short closing delimiter) in `haystack`: a search for its
-/// first byte, then a comparison (no searcher to build for a comment of a few hundred bytes).
-fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
-    let mut from = 0;
-    while let Some(i) = memchr::memchr(needle[0], &haystack[from..]) {
-        let at = from + i;
-        if haystack[at..].starts_with(needle) {
-            return Some(at);
+/// Whether a DOCTYPE, as quick-xml read it, was cut short: quick-xml ends the declaration where
+/// its `<` and `>` balance, so a `>` inside a quoted literal ends it early, inside the internal
+/// subset's brackets or inside the quotes.
+fn open_quote(doctype: &[u8]) -> bool {
+    let (mut quote, mut brackets) = (None, 0i32);
+    for &b in doctype {
+        match (quote, b) {
+            (Some(q), _) if b == q => quote = None,
+            (Some(_), _) => {}
+            (None, b'"' | b'\'') => quote = Some(b),
+            (None, b'[') => brackets += 1,
+            (None, b']') => brackets -= 1,
+            _ => {}
         }
-        from = at + 1;
     }
-    None
+    quote.is_some() || brackets != 0
 }
 
 /// Whether `q` is `NCName` or `NCName:NCName`.
@@ -704,130 +565,13 @@ fn is_qname(q: &str) -> bool {
     }
 }
 
-/// The character or entity reference starting at the `&` at `at` in `src`, and the offset just
-/// after its `;`.
-fn reference(src: &str, at: usize) -> Result<(Cow<'static, str>, usize), XmlError> {
-    let rest = &src[at + 1..];
-    let Some(semi) = rest.bytes().take(32).position(|c| c == b';') else {
-        return err(
-            at,
-            "'&' does not start a reference (write &amp; for an ampersand)",
-        );
-    };
-    let name = &rest[..semi];
-    let after = at + 1 + semi + 1;
-    let c = match name {
-        "lt" => "<",
-        "gt" => ">",
-        "amp" => "&",
-        "apos" => "'",
-        "quot" => "\"",
-        _ => {
-            let code = if let Some(hex) = name.strip_prefix("#x") {
-                u32::from_str_radix(hex, 16)
-                    .ok()
-                    .filter(|_| !hex.starts_with('+'))
-            } else if let Some(dec) = name.strip_prefix('#') {
-                dec.parse::<u32>().ok().filter(|_| !dec.starts_with('+'))
-            } else {
-                return err(at, format!("unknown entity '&{name};'"));
-            };
-            return match code.and_then(char::from_u32) {
-                Some(c) if is_forbidden_char(c) => err(
-                    at,
-                    format!(
-                        "character reference to U+{:04X}, which XML does not allow",
-                        c as u32
-                    ),
-                ),
-                Some(c) => Ok((Cow::Owned(c.to_string()), after)),
-                None => err(at, format!("'&{name};' is not a valid character reference")),
-            };
-        }
-    };
-    Ok((Cow::Borrowed(c), after))
-}
-
-/// Resolves the references in an attribute value (`raw` starts at byte `offset` of the source);
-/// borrowed when there are none.
-fn unescape(raw: &str, offset: usize) -> Result<Cow<'_, str>, XmlError> {
-    let Some(first) = raw.bytes().position(|c| c == b'&') else {
-        return Ok(Cow::Borrowed(raw));
-    };
-    let mut out = String::with_capacity(raw.len());
-    out.push_str(&raw[..first]);
-    let mut i = first;
-    while i < raw.len() {
-        if raw.as_bytes()[i] == b'&' {
-            let (c, next) = reference(raw, i).map_err(|e| XmlError {
-                offset: offset + e.offset,
-                message: e.message,
-                limit: false,
-            })?;
-            out.push_str(&c);
-            i = next;
-        } else {
-            let end = memchr::memchr(b'&', &raw.as_bytes()[i..]).map_or(raw.len(), |j| i + j);
-            out.push_str(&raw[i..end]);
-            i = end;
-        }
-    }
-    Ok(Cow::Owned(out))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The short search finds the same first match as `memchr` for every length around its
-    /// word and near-window edges, with needles and other bytes at every place.
-    #[test]
-    fn short_search_agrees_with_memchr() {
-        let mut rng = crate::testrand::XorShift(0x2545_f491_4f6c_dd1d);
-        for len in 0..150 {
-            for _ in 0..40 {
-                let hay: Vec<u8> = (0..len)
-                    .map(|_| {
-                        let seed = rng.next_u64();
-                        // mostly ordinary bytes, sometimes a needle, a zero or a high byte
-                        match seed % 40 {
-                            0 => b'"',
-                            1 => b'<',
-                            2 => b'&',
-                            3 => 0,
-                            4 => 0xFF,
-                            5 => b'"' - 1,
-                            _ => b'a' + (seed % 26) as u8,
-                        }
-                    })
-                    .collect();
-                let three = super::find_near(&hay, [b'"', b'<', b'&']);
-                assert_eq!(three, memchr::memchr3(b'"', b'<', b'&', &hay), "{hay:?}");
-                let one = super::find_near(&hay, [0u8]);
-                assert_eq!(one, memchr::memchr(0, &hay), "{hay:?}");
-                let two = super::find_near(&hay, [b'<', 0xFF]);
-                assert_eq!(two, memchr::memchr2(b'<', 0xFF, &hay), "{hay:?}");
-            }
-        }
-    }
-
-    /// The kept lists are reused, not reallocated: `recycle` keeps the buffer.
-    #[test]
-    fn recycle_keeps_the_allocation() {
-        let mut v: Vec<Open<'_>> = Vec::with_capacity(8);
-        v.push(Open {
-            qname: "bml",
-            bindings: 0,
-        });
-        let (ptr, cap) = (v.as_ptr() as usize, v.capacity());
-        let w: Vec<Open<'static>> = recycle(v);
-        assert!(w.is_empty());
-        assert_eq!((w.as_ptr() as usize, w.capacity()), (ptr, cap));
-    }
-
     /// Every event of `src` as a short string, or the error as `!offset message`.
     fn events(src: &str) -> Vec<String> {
-        let mut t = Tokenizer::with_lists(src, Lists::default());
+        let mut t = Reader::new(src, &Limits::default());
         let mut out = Vec::new();
         loop {
             match t.next() {
@@ -838,7 +582,7 @@ mod tests {
                         .iter()
                         .map(|a| format!("{}={}@{}", a.key, a.raw, a.offset))
                         .collect();
-                    let ns = t.resolve(split_qname(tag.qname).0);
+                    let ns = t.resolve(tag.qname, false);
                     out.push(format!(
                         "<{}{} {}{:?}@{}",
                         tag.qname,
@@ -874,7 +618,7 @@ mod tests {
     #[test]
     fn references_cdata_comments_and_line_ends() {
         assert_eq!(
-            events("<?xml version=\"1.0\"?><!DOCTYPE a [<!ENTITY x \">\">]><a>1&lt;2&#x41;&#66;<!-- c --><![CDATA[<&>]]>\r\nz</a>"),
+            events("<?xml version=\"1.0\"?><!DOCTYPE a [<!ENTITY x \"}\">]><a>1&lt;2&#x41;&#66;<!-- c --><![CDATA[<&>]]>\r\nz</a>"),
             [
                 "<a Ok(None)@51",
                 "'1'@54",
@@ -889,16 +633,7 @@ mod tests {
         );
         assert_eq!(unescape("a&amp;b&quot;", 10).unwrap(), "a&b\"");
         assert_eq!(unescape("a&bogus;", 10).unwrap_err().offset, 11);
-    }
-
-    #[test]
-    fn closing_delimiters_are_found_after_partial_matches() {
-        assert_eq!(find(b"a - b -- c --->", b"-->"), Some(12));
-        assert_eq!(find(b"x]]]>", b"]]>"), Some(2));
-        assert_eq!(find(b"no end -- here", b"-->"), None);
-        assert_eq!(find(b"ends with --", b"-->"), None);
-        assert_eq!(find(b"", b"?>"), None);
-        assert_eq!(events("<a><!-- - -- ---><b/></a>")[1], "<b/ Ok(None)@17");
+        assert_eq!(events("<a><!-- -> - ->--><b/></a>")[1], "<b/ Ok(None)@18");
     }
 
     #[test]
@@ -913,76 +648,81 @@ mod tests {
         assert!(ev[1].ends_with(r#"Ok(Some("urn:q"))@33"#), "{}", ev[1]);
         assert!(ev[2].ends_with(r#"Ok(Some("urn:p"))@55"#), "{}", ev[2]);
         assert!(ev[3].ends_with("Ok(None)@61"), "{}", ev[3]);
-        let mut t = Tokenizer::with_lists(r#"<a xmlns:p="urn:p&amp;x"><b/></a>"#, Lists::default());
+        let mut t = Reader::new(r#"<a xmlns:p="urn:p"><b/></a>"#, &Limits::default());
         t.next().unwrap();
-        assert_eq!(t.resolve(Some("p")), Ok(Some("urn:p&x")));
-        assert_eq!(t.resolve(Some("q")), Err(()));
-        assert_eq!(t.scope(), [("p".to_string(), "urn:p&x".to_string())]);
+        assert_eq!(t.resolve("p:x", true), Ok(Some("urn:p")));
+        assert_eq!(t.resolve("x", true), Ok(None));
+        assert_eq!(t.resolve("q:x", false), Err(()));
+        assert_eq!(t.scope(), [("p".to_string(), "urn:p".to_string())]);
+        let mark = t.level();
+        t.next().unwrap();
+        assert!(!t.bound_since(mark, "p"));
     }
 
     #[test]
     fn attribute_values_are_resolved_only_when_they_hold_references() {
         let src = r#"<a x="plain" y='a&amp;b&lt;' z="&quot;" w="'"/>"#;
-        let mut t = Tokenizer::with_lists(src, Lists::default());
+        let mut t = Reader::new(src, &Limits::default());
         assert!(matches!(t.next(), Ok(Event::Start(_))));
-        let got: Vec<(&str, bool, String, bool)> = t
+        let got: Vec<(&str, String, bool)> = t
             .attrs()
             .iter()
             .map(|a| {
                 let v = a.value().unwrap();
                 let borrowed = matches!(v, Cow::Borrowed(_));
-                (a.key, a.references, v.into_owned(), borrowed)
+                (a.key, v.into_owned(), borrowed)
             })
             .collect();
         assert_eq!(
             got,
             [
-                ("x", false, "plain".to_string(), true),
-                ("y", true, "a&b<".to_string(), false),
-                ("z", true, "\"".to_string(), false),
-                ("w", false, "'".to_string(), true),
+                ("x", "plain".to_string(), true),
+                ("y", "a&b<".to_string(), false),
+                ("z", "\"".to_string(), false),
+                ("w", "'".to_string(), true),
             ]
         );
         // a bad reference is found when the value is asked for, at its offset
-        let mut t = Tokenizer::with_lists("<a x='1&bogus;'/>", Lists::default());
+        let mut t = Reader::new("<a x='1&bogus;'/>", &Limits::default());
         assert!(matches!(t.next(), Ok(Event::Start(_))));
         assert_eq!(t.attrs()[0].value().unwrap_err().offset, 7);
-        // a '<' after a reference, and a value left open after one, are still found
-        for (src, offset, words) in [
-            ("<a x='&amp;<'/>", 11, "'<' in the value"),
-            ("<a x='&amp;", 3, "never closed"),
-        ] {
-            let last = events(src).pop().unwrap();
-            assert!(
-                last.starts_with(&format!("!{offset} ")) && last.contains(words),
-                "{src}: {last}"
-            );
-        }
+        let mut t = Reader::new("<a x='&#1;'/>", &Limits::default());
+        assert!(matches!(t.next(), Ok(Event::Start(_))));
+        assert!(t.attrs()[0].value().unwrap_err().message.contains("U+0001"));
     }
 
     #[test]
     fn malformed_input_is_reported_where_it_is() {
         for (src, offset, words) in [
-            ("<a><b></a>", 6, "does not match the start tag <b>"),
-            ("</a>", 0, "without a start tag"),
+            ("<a><b></a>", 6, "expected `</b>`"),
+            ("</a>", 0, "does not match"),
             ("<a x=1/>", 5, "not in quotes"),
-            ("<a x/>", 3, "has no value"),
+            ("<a x/>", 4, "has no value"),
             ("<a x='1'y='2'/>", 8, "separated by white space"),
             ("<a x='<'/>", 6, "'<' in the value"),
-            ("<a x='1", 3, "never closed"),
-            ("<a", 0, "never closed"),
-            ("<a>&b</a>", 3, "does not start a reference"),
+            ("<a x='1", 0, "not closed"),
+            ("<a", 0, "not closed"),
+            ("<a>&b</a>", 3, ""),
             ("<a>&#1;</a>", 3, "U+0001"),
             ("<a>&#xD800;</a>", 3, "not a valid character reference"),
-            ("<a><!-- x</a>", 3, "comment is never closed"),
+            ("<a>&nbsp;</a>", 3, "unknown entity"),
+            ("<a><!-- x</a>", 3, "comment not closed"),
+            ("<a><!-- x -- y --></a>", 10, "--"),
+            ("<a>x ]]> y</a>", 5, "']]>' in text"),
             ("<1a/>", 0, "not a valid qualified name"),
             ("<p:/x/>", 0, "not a valid qualified name"),
             ("<xmlns:x/>", 0, "reserved"),
             ("<a xmlns:p='1' xmlns:p='2'/>", 15, "appears twice"),
             ("<a xmlns:p=''/>", 3, "cannot undeclare"),
             ("<a x:y:z='1'/>", 3, "not a valid qualified name"),
-            ("<a/ >", 2, "not followed by '>'"),
-            ("<!x>", 0, "neither a comment"),
+            ("<a/ >", 0, "not a valid qualified name"),
+            ("<!x>", 0, ""),
+            ("<?xml version='1.0' encoding='latin1'?><a/>", 0, "UTF-8"),
+            ("<?xml version='2.0'?><a/>", 0, "not 1.0"),
+            ("<a/><?xml version='1.0'?>", 4, "only open"),
+            ("<a/><!DOCTYPE a>", 4, "DOCTYPE"),
+            ("<!DOCTYPE a [<!ENTITY x '>'>]><a/>", 0, "not supported"),
+            ("<!DOCTYPE a [<!ENTITY x \">\">]><a/>", 0, "not supported"),
         ] {
             let ev = events(src);
             let last = ev.last().unwrap();
@@ -991,5 +731,60 @@ mod tests {
                 "{src}: {last}"
             );
         }
+    }
+
+    #[test]
+    fn limits_stop_deep_nesting_and_long_attribute_lists() {
+        let limits = Limits {
+            depth: 3,
+            attributes: 2,
+            ..Limits::default()
+        };
+        let read = |src: &str| {
+            let mut t = Reader::new(src, &limits);
+            loop {
+                match t.next() {
+                    Ok(Event::Eof) => return None,
+                    Ok(_) => {}
+                    Err(e) => return Some((e.offset, e.problem)),
+                }
+            }
+        };
+        assert_eq!(read("<a><b><c/></b></a>"), None);
+        assert_eq!(read("<a><b><c><d/></c></b></a>"), None);
+        assert_eq!(
+            read("<a><b><c><d></d></c></b></a>"),
+            Some((9, Problem::Limit))
+        );
+        assert_eq!(read("<a x='1' y='2'/>"), None);
+        assert_eq!(read("<a x='1' y='2' z='3'/>"), Some((15, Problem::Limit)));
+        assert_eq!(
+            read("<a xmlns:p='1' xmlns:q='2'><b xmlns:r='3'/></a>"),
+            Some((27, Problem::Limit))
+        );
+    }
+
+    #[test]
+    fn reading_goes_on_after_a_content_error_but_not_after_broken_markup() {
+        let mut t = Reader::new(
+            "<a><b x='&bogus;' y='<'/>&nope;<c/></a>",
+            &Limits::default(),
+        );
+        let mut kinds = Vec::new();
+        loop {
+            match t.next() {
+                Ok(Event::Eof) => break,
+                Ok(Event::Start(tag)) => kinds.push(tag.qname.to_string()),
+                Ok(_) => {}
+                Err(e) => kinds.push(format!("{:?}", e.problem)),
+            }
+        }
+        assert_eq!(kinds, ["a", "Content", "Content", "c"]);
+        let mut t = Reader::new("<a></b>", &Limits::default());
+        t.next().unwrap();
+        assert_eq!(t.next().unwrap_err().problem, Problem::Broken);
+        let mut t = Reader::new("<a><!-- x", &Limits::default());
+        t.next().unwrap();
+        assert_eq!(t.next().unwrap_err().problem, Problem::Unclosed);
     }
 }
