@@ -255,3 +255,62 @@ fn a_client_that_floods_and_never_reads_slows_no_one_and_grows_nothing() {
     let rss = peak_rss_kb(s.child.id());
     assert!(rss < 250_000, "the server grew to {rss} kB");
 }
+
+/// A chain of `n` gestures in one line, each starting at the previous one's end.
+fn chain(id: &str, n: usize) -> String {
+    let body: String = (0..n)
+        .map(|i| match i {
+            0 => r#"<gesture id="g0" lexeme="BEAT"/>"#.to_string(),
+            _ => format!(
+                r#"<gesture id="g{i}" lexeme="BEAT" start="g{}:end"/>"#,
+                i - 1
+            ),
+        })
+        .collect();
+    format!("<bml {NS} id=\"{id}\">{body}</bml>\n")
+}
+
+/// While one client sends blocks of 10 000 behaviours, another's small blocks start as soon as
+/// they arrive: the large blocks are read on their sender's thread, and only their scheduling
+/// (a few milliseconds) happens on the realizer's. Before, the realizer's thread read each large
+/// block twice and then scheduled it, holding every other client up for about 150 ms.
+#[test]
+fn large_blocks_from_one_client_hold_up_no_other() {
+    let _serial = one_at_a_time();
+    let s = server(&["--per-client"]);
+    let addr = s.addr.clone();
+    let big = std::thread::spawn(move || {
+        let mut conn = TcpStream::connect(&addr).unwrap();
+        for b in 0..6 {
+            conn.write_all(chain(&format!("big{b}"), 10_000).as_bytes())
+                .unwrap();
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        conn
+    });
+    let conn = TcpStream::connect(&s.addr).unwrap();
+    let mut writer = conn.try_clone().unwrap();
+    let mut reader = BufReader::new(conn);
+    let mut worst = Duration::ZERO;
+    for b in 0..60 {
+        let sent = Instant::now();
+        let line = format!(r#"<bml {NS} id="small{b}"><gesture id="g" lexeme="BEAT"/></bml>"#);
+        writer.write_all(format!("{line}\n").as_bytes()).unwrap();
+        let start = format!(r#"id="small{b}:start""#);
+        let lines = read_until(&mut reader, sent + Duration::from_secs(2), |l| {
+            l.contains(&start)
+        });
+        assert!(
+            lines.iter().any(|l| l.contains(&start)),
+            "small{b}: {lines:?}"
+        );
+        worst = worst.max(sent.elapsed());
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    drop(big.join().unwrap());
+    eprintln!("slowest start of a small block: {worst:?}");
+    assert!(
+        worst < Duration::from_millis(80),
+        "a small block waited {worst:?} for its start"
+    );
+}

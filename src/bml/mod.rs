@@ -57,6 +57,43 @@ pub fn check_with(src: &str, limits: &Limits) -> (Option<Block>, Vec<Diagnostic>
     (block, diags)
 }
 
+/// A block read and checked, ready to hand to a realizer
+/// ([`Realizer::perform_checked`](crate::realizer::Realizer::perform_checked)). Checking is the
+/// part of a submission that needs no realizer, so a port can do it on the thread that reads
+/// the text, and the realizer's thread only schedules and starts the block.
+#[derive(Debug, Clone)]
+pub struct Checked {
+    /// The block, if the text is a `<bml>` document.
+    pub block: Option<Block>,
+    /// Every diagnostic, in source order.
+    pub diagnostics: Vec<Diagnostic>,
+    /// For a block with errors: its id as far as the text can be read (see [`root_id`]).
+    pub id_hint: Option<String>,
+}
+
+impl Checked {
+    /// Parses and validates `src` within `limits`.
+    pub fn new(src: &str, limits: &Limits) -> Self {
+        let (block, diagnostics) = check_with(src, limits);
+        let failed = block.is_none() || diagnostics.iter().any(Diagnostic::is_error);
+        let id_hint = match &block {
+            Some(b) if failed => Some(b.id.to_string()),
+            None => root_id(src),
+            Some(_) => None,
+        };
+        Checked {
+            block,
+            diagnostics,
+            id_hint,
+        }
+    }
+
+    /// Whether the block can be performed (it was read and has no errors).
+    pub fn is_valid(&self) -> bool {
+        self.block.is_some() && !self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+}
+
 /// [`check_with`] with the block written into `block` (`None` before): the block is not copied
 /// up the return values. The diagnostics come sorted by position either way.
 fn check_into(src: &str, block: &mut Option<Block>, limits: &Limits) -> Vec<Diagnostic> {

@@ -5,7 +5,7 @@
 mod registry;
 pub mod timing;
 
-use std::collections::VecDeque;
+use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::Arc;
 
@@ -397,14 +397,39 @@ pub trait Engine {
 /// The units an engine holds, each with its key (shared with frame outputs) and current global
 /// sync times, in the order of their start times (ties: the order they were added). So frames
 /// are deterministic, a unit that starts later is applied later (and wins where two overlap),
-/// and the units that have started at some moment come first: a frame looks at those only, and
-/// the unit that ends first is near the front when it goes. Both matter when a block holds
-/// thousands of units (a chain of 10 000 gestures).
+/// and the units that have started at some moment come first: a frame looks at those only.
+/// Kept in a map ordered by start, so that adding one of thousands of units (a chain of 10 000
+/// gestures, or several such blocks whose units interleave) costs a logarithm, not a shift of
+/// the rest. A unit is found by key from the front: the units asked for (running, ending) are
+/// the ones that have started, which come first.
 #[derive(Debug, Clone)]
 pub struct Units<T> {
-    units: VecDeque<Held<T>>,
+    units: BTreeMap<Order, Held<T>>,
     /// How many units were ever added (the tie-break of equal starts).
     added: u64,
+}
+
+/// A unit's place: its start time (a unit without syncs sorts last), then when it was added.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Order {
+    start: f64,
+    added: u64,
+}
+
+impl Eq for Order {}
+
+impl PartialOrd for Order {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Order {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.start
+            .total_cmp(&other.start)
+            .then(self.added.cmp(&other.added))
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -412,16 +437,11 @@ struct Held<T> {
     key: Arc<UnitKey>,
     syncs: SyncTimes,
     data: T,
-    added: u64,
 }
 
 impl<T> Held<T> {
     fn start(&self) -> f64 {
         self.syncs.first().map_or(f64::INFINITY, |s| s.1)
-    }
-
-    fn order(&self) -> (f64, u64) {
-        (self.start(), self.added)
     }
 }
 
@@ -431,7 +451,7 @@ pub type SyncTimes = Vec<(SyncName, f64)>;
 impl<T> Default for Units<T> {
     fn default() -> Self {
         Units {
-            units: VecDeque::new(),
+            units: BTreeMap::new(),
             added: 0,
         }
     }
@@ -445,42 +465,44 @@ impl<T> Units<T> {
 
     /// Adds a unit with the engine's own data `data`.
     pub fn add(&mut self, unit: Unit<'_>, data: T) {
-        self.added += 1;
         let held = Held {
             key: Arc::new(unit.key.clone()),
             syncs: unit.syncs,
             data,
-            added: self.added,
         };
         self.insert(held);
     }
 
     fn insert(&mut self, held: Held<T>) {
-        let (start, added) = held.order();
-        let at = self.units.partition_point(|u| {
-            let (s, a) = u.order();
-            s.total_cmp(&start).then(a.cmp(&added)).is_lt()
-        });
-        self.units.insert(at, held);
+        self.added += 1;
+        let order = Order {
+            start: held.start(),
+            added: self.added,
+        };
+        self.units.insert(order, held);
     }
 
-    fn position(&self, key: &UnitKey) -> Option<usize> {
-        self.units.iter().position(|u| *u.key == *key)
+    /// Where the unit `key` is.
+    fn find(&self, key: &UnitKey) -> Option<Order> {
+        self.units
+            .iter()
+            .find(|(_, u)| *u.key == *key)
+            .map(|(order, _)| *order)
     }
 
     /// Forgets a unit.
     pub fn remove(&mut self, key: &UnitKey) {
-        if let Some(i) = self.position(key) {
-            self.units.remove(i);
+        if let Some(order) = self.find(key) {
+            self.units.remove(&order);
         }
     }
 
     /// New sync times for a unit.
     pub fn retime(&mut self, key: &UnitKey, times: &[f64]) {
-        let Some(i) = self.position(key) else {
+        let Some(order) = self.find(key) else {
             return;
         };
-        let Some(mut held) = self.units.remove(i) else {
+        let Some(mut held) = self.units.remove(&order) else {
             return;
         };
         for (s, t) in held.syncs.iter_mut().zip(times) {
@@ -491,13 +513,16 @@ impl<T> Units<T> {
 
     /// A unit's data.
     pub fn get(&self, key: &UnitKey) -> Option<&T> {
-        self.units.iter().find(|u| *u.key == *key).map(|u| &u.data)
+        self.units
+            .values()
+            .find(|u| *u.key == *key)
+            .map(|u| &u.data)
     }
 
     /// A unit's sync times and data.
     pub fn get_mut(&mut self, key: &UnitKey) -> Option<(&mut SyncTimes, &mut T)> {
         self.units
-            .iter_mut()
+            .values_mut()
             .find(|u| *u.key == *key)
             .map(|u| (&mut u.syncs, &mut u.data))
     }
@@ -514,19 +539,19 @@ impl<T> Units<T> {
 
     /// Every unit's sync times and data, in start order.
     pub fn all(&self) -> impl Iterator<Item = (&SyncTimes, &T)> + '_ {
-        self.units.iter().map(|u| (&u.syncs, &u.data))
+        self.units.values().map(|u| (&u.syncs, &u.data))
     }
 
     /// Every unit's sync times and data, the data mutable (engines that compile a unit lazily).
     pub fn all_mut(&mut self) -> impl Iterator<Item = (&SyncTimes, &mut T)> + '_ {
-        self.units.iter_mut().map(|u| (&u.syncs, &mut u.data))
+        self.units.values_mut().map(|u| (&u.syncs, &mut u.data))
     }
 
     /// The units that have started by `now` (start ≤ now), in start order, the data mutable:
     /// what a frame at `now` can show.
     pub fn started_mut(&mut self, now: f64) -> impl Iterator<Item = (&SyncTimes, &mut T)> + '_ {
         self.units
-            .iter_mut()
+            .values_mut()
             .take_while(move |u| u.start() <= now)
             .map(|u| (&u.syncs, &mut u.data))
     }
@@ -534,7 +559,7 @@ impl<T> Units<T> {
     /// The units running at `now` (start ≤ now < end) with their progress (0 at start, 1 at end;
     /// 0 for a unit without a finite end), in start order.
     pub fn running(&self, now: f64) -> impl Iterator<Item = (&Arc<UnitKey>, f64, &T)> + '_ {
-        let started = self.units.iter().take_while(move |u| u.start() <= now);
+        let started = self.units.values().take_while(move |u| u.start() <= now);
         started.filter_map(move |u| {
             let (start, end) = (u.syncs.first()?.1, u.syncs.last()?.1);
             if now >= end {

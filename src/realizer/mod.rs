@@ -189,10 +189,25 @@ impl Realizer {
     /// [`perform_bml`](Self::perform_bml) for a block read from `source` (a file name, say):
     /// a PARSING_FAILURE warning then names it before each position (`FILE:LINE:COL: ...`).
     pub fn perform_bml_from(&mut self, text: &str, source: Option<&str>) -> Result<(), BmlError> {
-        let (block, diagnostics) = bml::check_with(text, &self.limits);
-        let errors: Vec<&Diagnostic> = diagnostics.iter().filter(|d| d.is_error()).collect();
+        let checked = bml::Checked::new(text, &self.limits);
+        self.perform_checked(checked, source)
+    }
+
+    /// Submits a block already read and checked (by [`bml::Checked::new`], on any thread) at the
+    /// current time: what [`perform_bml_from`](Self::perform_bml_from) does after reading.
+    pub fn perform_checked(
+        &mut self,
+        checked: bml::Checked,
+        source: Option<&str>,
+    ) -> Result<(), BmlError> {
+        let valid = checked.is_valid();
+        let bml::Checked {
+            block,
+            diagnostics,
+            id_hint,
+        } = checked;
         match block {
-            Some(block) if errors.is_empty() => {
+            Some(block) if valid => {
                 let world = self.world.clone();
                 // the manager's feedback moves straight into the frame's list (no list per block)
                 let mut unframed = std::mem::take(&mut self.unframed);
@@ -206,40 +221,49 @@ impl Realizer {
                 Ok(())
             }
             block => {
-                // the id as far as it can be read, even from a block that is not well-formed
-                let id = block
-                    .as_ref()
-                    .map(|b| b.id.to_string())
-                    .or_else(|| bml::root_id(text))
-                    .filter(|id| !id.is_empty())
-                    .unwrap_or_else(|| NO_ID.to_string());
                 let character_id = block
                     .and_then(|b| b.character_id)
                     .or_else(|| self.default_character.clone());
-                let at = source.map_or(String::new(), |s| format!("{s}:"));
-                let text = errors
-                    .iter()
-                    .map(|d| format!("{at}{}:{}: {}", d.pos.line, d.pos.col, d.message))
-                    .collect::<Vec<_>>()
-                    .join("; ");
-                self.unframed.push(Feedback::Warning(WarningFeedback {
-                    id,
-                    kind: KnownWarning::ParsingFailure.into(),
-                    character_id,
-                    text: if text.is_empty() {
-                        format!("{at} the block could not be read")
-                            .trim_start()
-                            .to_string()
-                    } else {
-                        text
-                    },
-                }));
-                self.deliver(self.unframed.len() - 1);
-                let mut diagnostics = diagnostics;
-                diagnostics.retain(Diagnostic::is_error);
-                Err(BmlError(diagnostics))
+                let mut errors = diagnostics;
+                errors.retain(Diagnostic::is_error);
+                self.refuse_block(id_hint, character_id, &errors, source);
+                Err(BmlError(errors))
             }
         }
+    }
+
+    /// Reports a block that cannot be performed: a PARSING_FAILURE warning with its id (as far
+    /// as it could be read) and its errors, each at `SOURCE:LINE:COL`.
+    fn refuse_block(
+        &mut self,
+        id: Option<String>,
+        character_id: Option<String>,
+        errors: &[Diagnostic],
+        source: Option<&str>,
+    ) {
+        let id = id
+            .filter(|id| !id.is_empty())
+            .unwrap_or_else(|| NO_ID.to_string());
+        let at = source.map_or(String::new(), |s| format!("{s}:"));
+        let text = errors
+            .iter()
+            .map(|d| format!("{at}{}:{}: {}", d.pos.line, d.pos.col, d.message))
+            .collect::<Vec<_>>()
+            .join("; ");
+        let text = if text.is_empty() {
+            format!("{at} the block could not be read")
+                .trim_start()
+                .to_string()
+        } else {
+            text
+        };
+        self.unframed.push(Feedback::Warning(WarningFeedback {
+            id,
+            kind: KnownWarning::ParsingFailure.into(),
+            character_id,
+            text,
+        }));
+        self.deliver(self.unframed.len() - 1);
     }
 
     /// Reports input that could not even be read as text (a line that is not UTF-8, or too

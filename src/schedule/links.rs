@@ -100,36 +100,42 @@ pub(crate) fn items<'b>(
 /// Up to this many ids are searched one by one (see [`IdIndex`]).
 const ID_INDEX_LINEAR: usize = 16;
 
-/// Positions of ids in a list: a linear scan for the few behaviours of a typical block, a binary
-/// search over a sorted copy for large ones (cheaper than hashing either way).
+/// Positions of ids in a list: a linear scan for the few behaviours of a typical block (no
+/// allocation), a hash map for large ones.
 #[derive(Default)]
 pub(crate) struct IdIndex<'a> {
-    /// Inline for a typical block: building the index allocates nothing.
-    /// Sorted when there are more than [`ID_INDEX_LINEAR`].
-    ids: SmallVec<[(&'a str, usize); ID_INDEX_LINEAR]>,
+    /// The ids in list order, when there are at most [`ID_INDEX_LINEAR`].
+    few: SmallVec<[(&'a str, usize); ID_INDEX_LINEAR]>,
+    /// The position of each id (its first), when there are more.
+    many: rustc_hash::FxHashMap<&'a str, usize>,
 }
 
 impl<'a> IdIndex<'a> {
     /// Indexes `ids` (replacing what was indexed). (Filled in place: a constructor that
     /// returned the index would copy its inline list.)
     pub(crate) fn fill(&mut self, ids: impl Iterator<Item = &'a str>) {
-        self.ids.clear();
-        self.ids.extend(ids.enumerate().map(|(i, id)| (id, i)));
-        if self.ids.len() > ID_INDEX_LINEAR {
-            self.ids.sort_unstable();
+        self.few.clear();
+        self.many.clear();
+        for (i, id) in ids.enumerate() {
+            if self.many.is_empty() && self.few.len() < ID_INDEX_LINEAR {
+                self.few.push((id, i));
+                continue;
+            }
+            if self.many.is_empty() {
+                for (k, j) in self.few.drain(..) {
+                    self.many.entry(k).or_insert(j);
+                }
+            }
+            self.many.entry(id).or_insert(i);
         }
     }
 
     /// The position of `id` (the first, if it occurs twice).
     pub(crate) fn get(&self, id: &str) -> Option<usize> {
-        if self.ids.len() > ID_INDEX_LINEAR {
-            let at = self.ids.partition_point(|(k, _)| *k < id);
-            self.ids.get(at).filter(|(k, _)| *k == id).map(|(_, i)| *i)
+        if self.many.is_empty() {
+            self.few.iter().find(|(k, _)| *k == id).map(|(_, i)| *i)
         } else {
-            self.ids
-                .iter()
-                .find(|(k, _)| crate::xmlname::same_name(k, id))
-                .map(|(_, i)| *i)
+            self.many.get(id).copied()
         }
     }
 }

@@ -122,7 +122,7 @@ fn schedule(
             if behaviours.len() > 1 {
                 let mut pos = IdIndex::default();
                 pos.fill(block.behaviours.iter().map(|b| b.id.as_str()));
-                behaviours.sort_by_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
+                behaviours.sort_by_cached_key(|b| pos.get(&b.id).unwrap_or(usize::MAX));
             }
             return Ok(BlockSchedule {
                 behaviours,

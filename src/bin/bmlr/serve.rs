@@ -7,13 +7,13 @@ use std::process::ExitCode;
 use std::sync::mpsc;
 use std::time::Duration;
 
-use bml_realizer::bml::BadLine;
+use bml_realizer::bml::{BadLine, Checked};
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::conformance::InProcess;
 use bml_realizer::engine::timing::{DefaultTimingModels, SpeechTiming};
 use bml_realizer::engines::assets::Assets;
 use bml_realizer::engines::registry_with;
-use bml_realizer::feedback::Format;
+use bml_realizer::feedback::{Feedback, Format};
 use bml_realizer::realizer::Realizer;
 use clap::Args;
 use realizer_tests::{run, Outcome, ProcessPort, TestPort};
@@ -70,7 +70,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         .with_engines(move || registry_with(DefaultTimingModels { speech }, &assets))
         .with_posix_time(true)
         .with_limits(args.limits.limits());
-    let mut realizer = match crate::run::with_world(realizer, args.world.as_deref()) {
+    let realizer = match crate::run::with_world(realizer, args.world.as_deref()) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("bmlr serve: --world {e}");
@@ -80,34 +80,53 @@ pub fn serve(args: ServeArgs) -> ExitCode {
     if let Some(addr) = &args.tcp {
         return crate::tcp::serve(addr, args.per_client, args.fps, realizer);
     }
+    serve_stdio(realizer, Duration::from_secs_f64(1.0 / args.fps))
+}
+
+/// `bmlr serve --stdio`: one block per line, read and checked on a thread of its own (parsing
+/// and validation need no realizer), scheduled and played on this one; what is due is written
+/// out at least once a frame, also while a queue of blocks waits.
+fn serve_stdio(mut realizer: Realizer, period: Duration) -> ExitCode {
     let clock = WallClock::new();
-    // one block per line; a line that is not UTF-8 or too long costs only itself
     // bounded: the reader waits while the realizer is behind, and the pipe fills (backpressure)
-    let (tx, rx) = mpsc::sync_channel::<Option<Result<String, BadLine>>>(256);
-    let max_line = realizer.limits().block_bytes;
+    let (tx, rx) = mpsc::sync_channel::<Option<Result<Checked, BadLine>>>(256);
+    let limits = *realizer.limits();
     std::thread::spawn(move || {
-        for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
-            if tx.send(Some(line)).is_err() {
+        // a line that is not UTF-8 or too long costs only itself
+        for line in bml_realizer::bml::lines(std::io::stdin().lock(), limits.block_bytes) {
+            let item = match line {
+                Ok(text) if text.trim().is_empty() => continue,
+                // a live port has no use for clock advances: time passes by itself
+                Ok(text) if bml_realizer::bml::advance(text.trim()).is_some() => continue,
+                Ok(text) => Ok(Checked::new(&text, &limits)),
+                Err(bad) => Err(bad),
+            };
+            if tx.send(Some(item)).is_err() {
                 return;
             }
         }
         let _ = tx.send(None);
     });
-    let period = Duration::from_secs_f64(1.0 / args.fps);
     let mut out = std::io::stdout().lock();
+    let mut write = |feedback: Vec<Feedback>| -> bool {
+        feedback
+            .iter()
+            .all(|fb| writeln!(out, "{}", Format::Xml.encode(fb)).is_ok())
+            && out.flush().is_ok()
+    };
     let mut open = true;
     loop {
-        let mut lines = Vec::new();
+        let mut items = Vec::new();
         if open {
             match rx.recv_timeout(period) {
-                Ok(Some(line)) => lines.push(line),
+                Ok(Some(item)) => items.push(item),
                 Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => open = false,
                 Err(mpsc::RecvTimeoutError::Timeout) => {}
             }
             // and whatever else has arrived
             for more in rx.try_iter() {
                 match more {
-                    Some(line) => lines.push(line),
+                    Some(item) => items.push(item),
                     None => open = false,
                 }
             }
@@ -116,24 +135,24 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         }
         // bring the clock up to date before blocks arrive (they are planned at this time)
         let mut feedback = realizer.tick(clock.now()).feedback;
-        for line in lines {
-            match line {
-                Ok(text) if text.trim().is_empty() => {}
-                // a live port has no use for clock advances: time passes by itself
-                Ok(text) if bml_realizer::bml::advance(text.trim()).is_some() => {}
-                Ok(text) => {
-                    let _ = realizer.perform_bml_from(&text, Some("<stdin>"));
+        let mut frame_start = clock.now();
+        for item in items {
+            match item {
+                Ok(checked) => {
+                    let _ = realizer.perform_checked(checked, Some("<stdin>"));
                 }
                 Err(bad) => realizer.refuse_line("<stdin>", &bad),
             }
-        }
-        feedback.extend(realizer.tick(clock.now()).feedback);
-        for fb in &feedback {
-            if writeln!(out, "{}", Format::Xml.encode(fb)).is_err() {
-                return ExitCode::SUCCESS;
+            if clock.now() - frame_start >= period.as_secs_f64() {
+                feedback.extend(realizer.tick(clock.now()).feedback);
+                if !write(std::mem::take(&mut feedback)) {
+                    return ExitCode::SUCCESS;
+                }
+                frame_start = clock.now();
             }
         }
-        if out.flush().is_err() {
+        feedback.extend(realizer.tick(clock.now()).feedback);
+        if !write(feedback) {
             return ExitCode::SUCCESS;
         }
         if !open && realizer.next_event().is_none() {

@@ -3,8 +3,11 @@
 //! client whose block it is about). A malformed line gets a PARSING_FAILURE warning sent to its
 //! sender only; a client that disconnects disturbs neither the others nor the plan.
 //!
-//! Threads: one accepts connections, one reads each client's lines, one writes to each client; the
-//! main thread owns the realizer, ticks it on the wall clock and routes feedback. Every queue
+//! Threads: one accepts connections, one reads and checks each client's lines (parsing and
+//! validation need no realizer, so a large block is read on its sender's thread), one writes to
+//! each client; the main thread owns the realizer, schedules the checked blocks, ticks it on the
+//! wall clock and routes feedback, sending what is due at least once a frame even while a queue
+//! of blocks waits. Every queue
 //! between them is bounded: the readers wait when the realizer is behind (the clients' sockets
 //! then fill: backpressure), and a client whose unread feedback passes [`UNREAD_LIMIT`] lines is
 //! disconnected with a line on stderr, so that it cannot grow the server or slow the others.
@@ -14,9 +17,10 @@ use std::io::{BufReader, Write};
 use std::net::{TcpListener, TcpStream};
 use std::process::ExitCode;
 use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
+use std::sync::Arc;
 use std::time::Duration;
 
-use bml_realizer::bml;
+use bml_realizer::bml::{self, Checked, Limits};
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
 use bml_realizer::realizer::{Realizer, NO_ID};
@@ -31,20 +35,22 @@ const PENDING_LINES: usize = 1_024;
 
 /// A connected client: its feedback queue and its socket (to cut it off).
 struct Conn {
-    tx: SyncSender<String>,
+    /// Feedback for this client, encoded by its writer thread (not the realizer's).
+    tx: SyncSender<Arc<Feedback>>,
     socket: TcpStream,
 }
 
 enum Event {
     Connected(Client, Conn),
-    Line(Client, String),
+    /// A line read and checked on the client's thread.
+    Block(Client, Box<Checked>),
     /// A line that is not UTF-8 or too long: it costs only itself.
     BadLine(Client, bml::BadLine),
     Disconnected(Client),
 }
 
 /// Accepts connections and starts a reader and a writer thread for each.
-fn accept(listener: TcpListener, events: SyncSender<Event>, max_line: usize) {
+fn accept(listener: TcpListener, events: SyncSender<Event>, limits: Limits) {
     let mut next: Client = 0;
     for stream in listener.incoming() {
         let Ok(stream) = stream else { continue };
@@ -57,7 +63,7 @@ fn accept(listener: TcpListener, events: SyncSender<Event>, max_line: usize) {
         let Ok(socket) = stream.try_clone() else {
             continue;
         };
-        let (tx, rx) = mpsc::sync_channel::<String>(UNREAD_LIMIT);
+        let (tx, rx) = mpsc::sync_channel::<Arc<Feedback>>(UNREAD_LIMIT);
         std::thread::spawn(move || write_lines(write_half, rx));
         if events
             .send(Event::Connected(client, Conn { tx, socket }))
@@ -67,9 +73,10 @@ fn accept(listener: TcpListener, events: SyncSender<Event>, max_line: usize) {
         }
         let events = events.clone();
         std::thread::spawn(move || {
-            for line in bml::lines(BufReader::new(stream), max_line) {
+            for line in bml::lines(BufReader::new(stream), limits.block_bytes) {
                 let event = match line {
-                    Ok(line) => Event::Line(client, line),
+                    Ok(line) if line.trim().is_empty() => continue,
+                    Ok(line) => Event::Block(client, Box::new(Checked::new(&line, &limits))),
                     Err(bad) => Event::BadLine(client, bad),
                 };
                 if events.send(event).is_err() {
@@ -81,12 +88,11 @@ fn accept(listener: TcpListener, events: SyncSender<Event>, max_line: usize) {
     }
 }
 
-fn write_lines(mut stream: TcpStream, lines: Receiver<String>) {
-    while let Ok(first) = lines.recv() {
-        let mut batch = first;
-        batch.push('\n');
-        for more in lines.try_iter() {
-            batch.push_str(&more);
+fn write_lines(mut stream: TcpStream, feedback: Receiver<Arc<Feedback>>) {
+    while let Ok(first) = feedback.recv() {
+        let mut batch = String::new();
+        for fb in std::iter::once(first).chain(feedback.try_iter()) {
+            batch.push_str(&Format::Xml.encode(&fb));
             batch.push('\n');
         }
         if stream.write_all(batch.as_bytes()).is_err() {
@@ -122,144 +128,170 @@ pub fn serve(addr: &str, per_client: bool, fps: f64, realizer: Realizer) -> Exit
         }
     }
     let (tx, events) = mpsc::sync_channel(PENDING_LINES);
-    let max_line = realizer.limits().block_bytes;
-    std::thread::spawn(move || accept(listener, tx, max_line));
-    run(realizer, events, per_client, fps);
+    let limits = *realizer.limits();
+    std::thread::spawn(move || accept(listener, tx, limits));
+    Server::new(realizer, per_client, fps).run(events);
     ExitCode::SUCCESS
 }
 
-fn run(mut realizer: Realizer, events: Receiver<Event>, per_client: bool, fps: f64) {
-    let clock = WallClock::new();
-    let period = Duration::from_secs_f64(1.0 / fps);
-    let mut clients: HashMap<Client, Conn> = HashMap::new();
-    // per-client routing: block id → the client that sent it (until the block ends)
-    let mut owner: HashMap<String, Client> = HashMap::new();
-    let send = |clients: &mut HashMap<Client, Conn>, to: Option<Client>, line: String| {
-        let cut = |c: &Client, conn: &Conn| {
-            // (stderr may be closed: that is no reason to stop serving)
-            let _ = writeln!(
-                std::io::stderr(),
-                "bmlr serve: client {c} left {UNREAD_LIMIT} lines of feedback unread; disconnected"
-            );
-            let _ = conn.socket.shutdown(std::net::Shutdown::Both);
-        };
-        let deliver = |c: &Client, conn: &Conn, line: String| match conn.tx.try_send(line) {
+/// Feedback to send, with the client it is for (`None`: by the routing rule).
+type Routed = Vec<(Option<Client>, Feedback)>;
+
+/// The realizer's side of the port: the realizer, the clients and who sent which block.
+struct Server {
+    realizer: Realizer,
+    clock: WallClock,
+    period: Duration,
+    per_client: bool,
+    clients: HashMap<Client, Conn>,
+    /// Per-client routing: block id → the client that sent it (until the block ends).
+    owner: HashMap<String, Client>,
+}
+
+impl Server {
+    fn new(realizer: Realizer, per_client: bool, fps: f64) -> Self {
+        Server {
+            realizer,
+            clock: WallClock::new(),
+            period: Duration::from_secs_f64(1.0 / fps),
+            per_client,
+            clients: HashMap::new(),
+            owner: HashMap::new(),
+        }
+    }
+
+    /// Serves until every reader is gone: each frame, the events that arrived (at most a
+    /// queue's worth, so that a flood cannot hold the frame up), the feedback of each sent as
+    /// soon as it is handled (encoding is the writers' work), and the clock brought up to date
+    /// whenever a frame's time has passed.
+    fn run(mut self, events: Receiver<Event>) {
+        loop {
+            match events.recv_timeout(self.period) {
+                Ok(first) => {
+                    let mut frame_start = self.clock.now();
+                    let pending = events.try_iter().take(PENDING_LINES);
+                    for event in std::iter::once(first).chain(pending) {
+                        let mut routed = Routed::new();
+                        if self.clock.now() - frame_start >= self.period.as_secs_f64() {
+                            self.tick(&mut routed);
+                            frame_start = self.clock.now();
+                        }
+                        self.handle(event, &mut routed);
+                        self.send_all(routed);
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                Err(mpsc::RecvTimeoutError::Disconnected) => return,
+            }
+            let mut routed = Routed::new();
+            self.tick(&mut routed);
+            self.send_all(routed);
+        }
+    }
+
+    /// Brings the realizer up to the wall clock; its feedback goes by the routing rule.
+    fn tick(&mut self, routed: &mut Routed) {
+        let frame = self.realizer.tick(self.clock.now());
+        routed.extend(frame.feedback.into_iter().map(|f| (None, f)));
+    }
+
+    fn handle(&mut self, event: Event, routed: &mut Routed) {
+        match event {
+            Event::Connected(c, conn) => {
+                self.clients.insert(c, conn);
+            }
+            Event::Disconnected(c) => {
+                self.clients.remove(&c);
+            }
+            Event::BadLine(c, bad) => routed.push((
+                Some(c),
+                Feedback::Warning(WarningFeedback {
+                    id: NO_ID.into(),
+                    kind: KnownWarning::ParsingFailure.into(),
+                    character_id: None,
+                    text: format!("line {}: {}", bad.line, bad.reason),
+                }),
+            )),
+            Event::Block(c, checked) => self.submit(c, *checked, routed),
+        }
+    }
+
+    /// Schedules and starts a block from client `c`. What the submission produces right away
+    /// (its start, or a warning) is the sender's: warnings go to it alone.
+    fn submit(&mut self, c: Client, checked: Checked, routed: &mut Routed) {
+        // the clock up to date first: the block is planned at this time
+        self.tick(routed);
+        let block = checked
+            .block
+            .as_ref()
+            .filter(|_| checked.is_valid())
+            .map(|b| (b.id.to_string(), b.character_id.clone()));
+        if let Some((id, _)) = &block {
+            self.owner.entry(id.clone()).or_insert(c);
+        }
+        let _ = self.realizer.perform_checked(checked, None);
+        if let Some((id, character)) = block {
+            let live = self
+                .realizer
+                .character(character.as_deref().unwrap_or(""))
+                .and_then(|m| m.status(&id))
+                .is_some();
+            if !live {
+                self.owner.remove(&id); // rejected: it will never end
+            }
+        }
+        let frame = self.realizer.tick(self.clock.now());
+        routed.extend(frame.feedback.into_iter().map(|f| {
+            let to = matches!(f, Feedback::Warning(_)).then_some(c);
+            (to, f)
+        }));
+    }
+
+    /// Sends each message to its client(s).
+    fn send_all(&mut self, routed: Routed) {
+        for (to, fb) in routed {
+            let block = block_of(&fb).map(str::to_string);
+            let to = match (self.per_client, to) {
+                (_, Some(c)) => Some(c),
+                (true, None) => match block.as_ref().and_then(|b| self.owner.get(b)) {
+                    Some(&c) => Some(c),
+                    None => continue, // nobody's block (its sender left)
+                },
+                (false, None) => None,
+            };
+            let ended = matches!(&fb, Feedback::BlockProgress(p) if p.sync == "end");
+            self.send(to, Arc::new(fb));
+            if let (true, Some(b)) = (ended, &block) {
+                self.owner.remove(b);
+            }
+        }
+    }
+
+    /// Queues `fb` for client `to` (or every client); a client whose queue is full has left
+    /// too much unread and is cut off.
+    fn send(&mut self, to: Option<Client>, fb: Arc<Feedback>) {
+        let deliver = |c: &Client, conn: &Conn, fb: Arc<Feedback>| match conn.tx.try_send(fb) {
             Ok(()) => true,
             Err(TrySendError::Full(_)) => {
-                cut(c, conn);
+                // (stderr may be closed: that is no reason to stop serving)
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "bmlr serve: client {c} left {UNREAD_LIMIT} lines of feedback unread; disconnected"
+                );
+                let _ = conn.socket.shutdown(std::net::Shutdown::Both);
                 false
             }
             Err(TrySendError::Disconnected(_)) => false,
         };
         match to {
             Some(c) => {
-                if let Some(conn) = clients.get(&c) {
-                    if !deliver(&c, conn, line) {
-                        clients.remove(&c);
+                if let Some(conn) = self.clients.get(&c) {
+                    if !deliver(&c, conn, fb) {
+                        self.clients.remove(&c);
                     }
                 }
             }
-            None => clients.retain(|c, conn| deliver(c, conn, line.clone())),
-        }
-    };
-    loop {
-        let mut routed: Vec<(Option<Client>, Feedback)> = Vec::new();
-        match events.recv_timeout(period) {
-            Ok(first) => {
-                let frame = realizer.tick(clock.now());
-                routed.extend(frame.feedback.into_iter().map(|f| (None, f)));
-                // at most a queue's worth per frame, so that a flood cannot hold the frame up
-                let pending = events.try_iter().take(PENDING_LINES);
-                for event in std::iter::once(first).chain(pending) {
-                    match event {
-                        Event::Connected(c, conn) => {
-                            clients.insert(c, conn);
-                        }
-                        Event::Disconnected(c) => {
-                            clients.remove(&c);
-                        }
-                        Event::BadLine(c, bad) => routed.push((
-                            Some(c),
-                            Feedback::Warning(WarningFeedback {
-                                id: NO_ID.into(),
-                                kind: KnownWarning::ParsingFailure.into(),
-                                character_id: None,
-                                text: format!("line {}: {}", bad.line, bad.reason),
-                            }),
-                        )),
-                        Event::Line(c, line) => {
-                            if line.trim().is_empty() {
-                                continue;
-                            }
-                            let (block, diagnostics) = bml::check_with(&line, realizer.limits());
-                            let errors: Vec<String> = diagnostics
-                                .iter()
-                                .filter(|d| d.is_error())
-                                .map(|d| format!("{}:{}: {}", d.pos.line, d.pos.col, d.message))
-                                .collect();
-                            if !errors.is_empty() || block.is_none() {
-                                // the sender's problem: only the sender hears of it
-                                let id = block
-                                    .map(|b| b.id.to_string())
-                                    .or_else(|| bml::root_id(&line))
-                                    .filter(|id| !id.is_empty())
-                                    .unwrap_or_else(|| NO_ID.to_string());
-                                routed.push((
-                                    Some(c),
-                                    Feedback::Warning(WarningFeedback {
-                                        id,
-                                        kind: KnownWarning::ParsingFailure.into(),
-                                        character_id: None,
-                                        text: errors.join("; "),
-                                    }),
-                                ));
-                                continue;
-                            }
-                            let Some(block) = block else { continue };
-                            owner.entry(block.id.to_string()).or_insert(c);
-                            let _ = realizer.perform_bml(&line);
-                            let live = realizer
-                                .character(block.character_id.as_deref().unwrap_or(""))
-                                .and_then(|m| m.status(&block.id))
-                                .is_some();
-                            if !live {
-                                owner.remove(block.id.as_str()); // rejected: it will never end
-                            }
-                            let frame = realizer.tick(clock.now());
-                            // what this submission produced right away concerns its sender
-                            routed.extend(frame.feedback.into_iter().map(|f| {
-                                let to = match &f {
-                                    Feedback::Warning(_) => Some(c),
-                                    _ => None,
-                                };
-                                (to, f)
-                            }));
-                        }
-                    }
-                }
-            }
-            Err(mpsc::RecvTimeoutError::Timeout) => {}
-            Err(mpsc::RecvTimeoutError::Disconnected) => return,
-        }
-        let frame = realizer.tick(clock.now());
-        routed.extend(frame.feedback.into_iter().map(|f| (None, f)));
-        for (to, fb) in routed {
-            let line = Format::Xml.encode(&fb);
-            let block = block_of(&fb).map(str::to_string);
-            let to = match (per_client, to) {
-                (_, Some(c)) => Some(c),
-                (true, None) => match block.as_ref().and_then(|b| owner.get(b)) {
-                    Some(&c) => Some(c),
-                    None => continue, // nobody's block (its sender left)
-                },
-                (false, None) => None,
-            };
-            send(&mut clients, to, line);
-            if let (Feedback::BlockProgress(p), Some(b)) = (&fb, &block) {
-                if p.sync == "end" {
-                    owner.remove(b);
-                }
-            }
+            None => self.clients.retain(|c, conn| deliver(c, conn, fb.clone())),
         }
     }
 }
