@@ -11,7 +11,8 @@
 //! - [`engine`]: the engine interface, registry and timing models; [`engines`]: built-in engines;
 //! - [`body`]: the skeleton (H-Anim), poses and forward kinematics;
 //! - [`clock`]: virtual and wall clocks;
-//! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`);
+//! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`;
+//!   feature `conformance`, on by default);
 //! - [`timeline`]: timeline pictures (SVG) of plans and logs;
 //! - [`world`]: named target points the host places.
 
@@ -21,6 +22,7 @@ pub mod blocks;
 pub mod bml;
 pub mod body;
 pub mod clock;
+#[cfg(feature = "conformance")]
 pub mod conformance;
 pub mod engine;
 pub mod engines;

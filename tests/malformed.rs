@@ -376,3 +376,26 @@ fn a_namespace_name_with_a_reference_and_a_quoted_doctype_gt_are_refused_clearly
         e.first().message
     );
 }
+
+/// Found by the fuzzer with the quick-xml reader: a namespace name with a raw line break was
+/// accepted, written back as a character reference, and then refused. A namespace name is a URI
+/// reference, which holds no white space: it is refused when read.
+#[test]
+fn a_namespace_name_with_white_space_is_refused_when_read() {
+    let src = format!("<bml {NS} xmlns:b=\"http://x\n/bmla\" id=\"b2\" b:interrupt=\"b1\"/>");
+    let e = bml::load(&src).unwrap_err();
+    assert_eq!(e.first().code, Code::NotXml);
+    assert!(
+        e.first().message.contains("U+000A"),
+        "{}",
+        e.first().message
+    );
+    // a namespace name with characters a URI may hold goes through a write unchanged
+    let src = format!("<bml {NS} xmlns:b=\"urn:a'b(c)\" id=\"b2\" b:x=\"1\"/>");
+    let block = bml::load(&src).unwrap().block;
+    assert!(
+        bml::write(&block).contains("=\"urn:a'b(c)\""),
+        "{}",
+        bml::write(&block)
+    );
+}

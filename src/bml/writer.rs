@@ -38,7 +38,18 @@ pub fn write(block: &Block) -> String {
 /// Declares the namespaces raw content relies on, on the element that wraps it.
 fn xmlns(out: &mut String, namespaces: &[(String, String)]) {
     for (p, u) in namespaces {
-        let _ = write!(out, " xmlns:{p}=\"{}\"", escape(u));
+        let _ = write!(out, " xmlns:{p}=\"{}\"", namespace_name(u));
+    }
+}
+
+/// A namespace name for a declaration: as it is (the parser accepts no namespace name with a
+/// reference, and none it accepts needs one inside double quotes), escaped only if it holds
+/// what a double-quoted value cannot (a block built in code may).
+fn namespace_name(u: &str) -> std::borrow::Cow<'_, str> {
+    if u.contains(['&', '<', '"']) {
+        escape(u)
+    } else {
+        u.into()
     }
 }
 
@@ -100,7 +111,7 @@ impl Writer {
         self.out.push_str("<bml");
         self.attr("xmlns", NS_BML);
         for (p, u) in self.prefixes.clone() {
-            self.attr(&format!("xmlns:{p}"), &u);
+            let _ = write!(self.out, " xmlns:{p}=\"{}\"", namespace_name(&u));
         }
         self.attr("id", &b.id);
         if let Some(c) = &b.character_id {
@@ -166,7 +177,7 @@ impl Writer {
         let ext = self.prefix(b.kind.namespace()).to_string();
         let _ = write!(self.out, "{indent}<{q}");
         if let BehaviourKind::Unknown(u) = &b.kind {
-            self.attr("xmlns", &u.ns);
+            let _ = write!(self.out, " xmlns=\"{}\"", namespace_name(&u.ns));
             xmlns(&mut self.out, &u.namespaces);
         }
         if let BehaviourKind::ProcAnimation(a)

@@ -420,8 +420,26 @@ fn check_attribute(src: &str, a: &Attr<'_>, tag: &str) -> Result<(), XmlError> {
             a.value_offset,
             format!("the namespace name of '{key}' holds a reference, which this reader does not resolve"),
         ),
-        _ => Ok(()),
+        Some(_) => match a.raw.char_indices().find(|&(_, c)| not_in_uri(c)) {
+            Some((i, c)) => content(
+                a.value_offset + i,
+                format!(
+                    "the namespace name of '{key}' holds U+{:04X}, which no URI reference may hold",
+                    c as u32
+                ),
+            ),
+            None => Ok(()),
+        },
+        None => Ok(()),
     }
+}
+
+/// Whether `c` may appear in no URI reference (nor IRI): white space, controls and the ASCII
+/// characters RFC 3986 leaves out. A namespace name is a URI reference.
+fn not_in_uri(c: char) -> bool {
+    c.is_whitespace()
+        || c.is_control()
+        || matches!(c, '"' | '<' | '>' | '\\' | '^' | '`' | '{' | '|' | '}')
 }
 
 /// Whether the byte before `at` is XML white space.
@@ -714,6 +732,8 @@ mod tests {
             ("<xmlns:x/>", 0, "reserved"),
             ("<a xmlns:p='1' xmlns:p='2'/>", 15, "appears twice"),
             ("<a xmlns:p=''/>", 3, "cannot undeclare"),
+            ("<a xmlns:p='urn:a\nb'/>", 17, "U+000A"),
+            ("<a xmlns='urn:a b'/>", 15, "U+0020"),
             ("<a x:y:z='1'/>", 3, "not a valid qualified name"),
             ("<a/ >", 0, "not a valid qualified name"),
             ("<!x>", 0, ""),
