@@ -21,6 +21,7 @@
 
 pub mod assets;
 pub mod control;
+pub mod expr;
 pub mod gaze;
 pub mod gesture;
 pub mod head;

@@ -1,6 +1,6 @@
 //! Procedural motion units from data: joint rotations and end-effector positions
 //! given as expressions in the unit's canonical time α ∈ [0, 1] and named parameters, compiled
-//! once (the `fasteval` crate) and evaluated every frame.
+//! once (the expression language of [`super::expr`]) and evaluated every frame.
 //!
 //! A library file (`fixtures/procedural/units.json`, embedded as the default library) names each
 //! unit with its keys (sync name → α), its preferred/min/max duration, default parameters,
@@ -41,10 +41,8 @@
 //! the defaults; every parameter can change while the unit runs (`parametervaluechange`).
 
 use std::collections::HashMap;
-use std::fmt;
 use std::sync::Arc;
 
-use fasteval::{Compiler, EvalNamespace, Evaler, Instruction, Slab};
 use glam::{EulerRot, Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind, Id, Param};
@@ -62,113 +60,25 @@ use crate::world::World;
 /// The embedded default library.
 const DEFAULT: &str = include_str!("../../fixtures/procedural/units.json");
 
-/// One compiled expression.
-struct Expr {
-    text: String,
-    slab: Slab,
-    code: Instruction,
-}
-
-impl fmt::Debug for Expr {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{:?}", self.text)
-    }
-}
-
-impl Expr {
-    fn compile(text: &str) -> Result<Expr, String> {
-        // fasteval's print(…) writes to stderr: not in motion data
-        let calls_print = text.match_indices("print").any(|(i, _)| {
-            let before = text[..i].chars().next_back();
-            let after = text[i + 5..].trim_start().chars().next();
-            !before.is_some_and(|c| c.is_alphanumeric() || c == '_') && after == Some('(')
-        });
-        if calls_print {
-            return Err(format!("'{text}': print is not allowed"));
-        }
-        let mut slab = Slab::new();
-        let parsed = fasteval::Parser::new()
-            .parse(text, &mut slab.ps)
-            .map_err(|e| format!("'{text}' is not an expression: {e:?}"))?;
-        let code = parsed.from(&slab.ps).compile(&slab.ps, &mut slab.cs);
-        Ok(Expr {
-            text: text.to_string(),
-            slab,
-            code,
-        })
-    }
-
-    fn eval(&self, ns: &mut Names) -> Result<f64, String> {
-        match self.code.eval(&self.slab, ns) {
-            Ok(v) if v.is_finite() => Ok(v),
-            Ok(v) => Err(format!("'{}' gives {v}", self.text)),
-            Err(e) => Err(format!("'{}': {e:?}", self.text)),
-        }
-    }
-}
+use super::expr::Expr;
+pub use super::expr::{hermite, perlin, tcb};
 
 /// Names expressions give a meaning of their own (parameters cannot take them).
 const RESERVED: &[&str] = &["t", "alpha", "pi", "if", "hermite", "tcb", "perlin"];
 
-/// What expressions can name: the unit's time, its parameters and the macros.
+/// What expressions can name: the unit's time (`t` or `alpha`) and its parameters.
 struct Names<'a> {
     alpha: f64,
     params: &'a [(String, f64)],
 }
 
-impl EvalNamespace for Names<'_> {
-    fn lookup(&mut self, name: &str, args: Vec<f64>, _keybuf: &mut String) -> Option<f64> {
-        match (name, args.as_slice()) {
-            ("t" | "alpha", []) => Some(self.alpha),
-            ("pi", []) => Some(std::f64::consts::PI),
-            ("if", &[c, a, b]) => Some(if c != 0.0 { a } else { b }),
-            ("hermite", &[p0, p1, m0, m1, s]) => Some(hermite(p0, p1, m0, m1, s)),
-            ("tcb", &[p0, p1, p2, p3, t, c, b, s]) => Some(tcb([p0, p1, p2, p3], t, c, b, s)),
-            ("perlin", &[x]) => Some(perlin(x, 0.0)),
-            ("perlin", &[x, seed]) => Some(perlin(x, seed)),
-            (_, []) => self.params.iter().find(|p| p.0 == name).map(|p| p.1),
-            _ => None,
+impl Names<'_> {
+    fn get(&self, name: &str) -> Option<f64> {
+        match name {
+            "t" | "alpha" => Some(self.alpha),
+            _ => self.params.iter().find(|p| p.0 == name).map(|p| p.1),
         }
     }
-}
-
-/// The cubic Hermite curve from `p0` (tangent `m0`) to `p1` (tangent `m1`) at `s` ∈ [0, 1].
-pub fn hermite(p0: f64, p1: f64, m0: f64, m1: f64, s: f64) -> f64 {
-    let (s2, s3) = (s * s, s * s * s);
-    (2.0 * s3 - 3.0 * s2 + 1.0) * p0
-        + (s3 - 2.0 * s2 + s) * m0
-        + (-2.0 * s3 + 3.0 * s2) * p1
-        + (s3 - s2) * m1
-}
-
-/// The Kochanek–Bartels (TCB) spline segment from `p[1]` to `p[2]` at `s` ∈ [0, 1], with `p[0]` and
-/// `p[3]` as neighbours; tension, continuity and bias 0 give Catmull–Rom.
-pub fn tcb(p: [f64; 4], tension: f64, continuity: f64, bias: f64, s: f64) -> f64 {
-    let (t, c, b) = (tension, continuity, bias);
-    let out1 = (1.0 - t) * (1.0 + b) * (1.0 + c) / 2.0 * (p[1] - p[0])
-        + (1.0 - t) * (1.0 - b) * (1.0 - c) / 2.0 * (p[2] - p[1]);
-    let in2 = (1.0 - t) * (1.0 + b) * (1.0 - c) / 2.0 * (p[2] - p[1])
-        + (1.0 - t) * (1.0 - b) * (1.0 + c) / 2.0 * (p[3] - p[2]);
-    hermite(p[1], p[2], out1, in2, s)
-}
-
-/// One-dimensional gradient (Perlin) noise: smooth (C²), zero at every integer, within [−1, 1];
-/// `seed` picks an independent sequence.
-pub fn perlin(x: f64, seed: f64) -> f64 {
-    // a gradient in [-1, 1] per lattice point, from an integer hash of (point, seed)
-    let gradient = |i: f64| {
-        let mut h = (i as i64 as u64) ^ (seed.to_bits().rotate_left(17));
-        h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        h ^= h >> 31;
-        (h >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    };
-    let i = x.floor();
-    let f = x - i;
-    let fade = f * f * f * (f * (f * 6.0 - 15.0) + 10.0);
-    let (a, b) = (gradient(i) * f, gradient(i + 1.0) * (f - 1.0));
-    // the two ramps meet at most 0.5 apart: doubling keeps the result within [-1, 1]
-    2.0 * (a + fade * (b - a))
 }
 
 /// Where an end effector's position is measured from.
@@ -409,12 +319,12 @@ impl ProcUnit {
 
     /// Evaluates every expression at `alpha` with `params` (an error names the failing one).
     fn evaluate(&self, alpha: f64, params: &[(String, f64)]) -> Result<(), String> {
-        let mut names = Names { alpha, params };
+        let names = Names { alpha, params };
         for (_, e) in &self.rotations {
-            three(e, &mut names)?;
+            three(e, &names)?;
         }
         for f in &self.effectors {
-            three(&f.position, &mut names)?;
+            three(&f.position, &names)?;
         }
         Ok(())
     }
@@ -488,12 +398,12 @@ impl ProcUnit {
                 from.slerp(to, weight.max(0.0)).normalize()
             }
         };
-        let mut names = Names {
+        let names = Names {
             alpha: alpha.clamp(0.0, 1.0),
             params,
         };
         for (joint, e) in &self.rotations {
-            let [z, x, y] = three(e, &mut names)?;
+            let [z, x, y] = three(e, &names)?;
             let q = Quat::from_euler(
                 EulerRot::ZXY,
                 z.to_radians() as f32,
@@ -510,7 +420,7 @@ impl ProcUnit {
             }
         }
         for f in &self.effectors {
-            let p = three(&f.position, &mut names)?;
+            let p = three(&f.position, &names)?;
             let mut goal = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
             if mirrored {
                 goal.x = -goal.x;
@@ -528,8 +438,9 @@ impl ProcUnit {
 }
 
 /// The values of three expressions.
-fn three(e: &[Expr; 3], names: &mut Names) -> Result<[f64; 3], String> {
-    Ok([e[0].eval(names)?, e[1].eval(names)?, e[2].eval(names)?])
+fn three(e: &[Expr; 3], names: &Names) -> Result<[f64; 3], String> {
+    let var = |name: &str| names.get(name);
+    Ok([e[0].eval(&var)?, e[1].eval(&var)?, e[2].eval(&var)?])
 }
 
 /// The other side's joint name: `l_…` ↔ `r_…`; other joints are their own mirror image.
@@ -862,33 +773,30 @@ mod tests {
         let e = Expr::compile("if(t < 0.5, a * sin(pi * t), cos(pi) + max(a, 2)) + alpha").unwrap();
         let params = [("a".to_string(), 3.0)];
         let at = |t: f64| {
-            e.eval(&mut Names {
+            let names = Names {
                 alpha: t,
                 params: &params,
-            })
-            .unwrap()
+            };
+            e.eval(&|n: &str| names.get(n)).unwrap()
         };
         assert!((at(0.25) - (3.0 * (std::f64::consts::PI * 0.25).sin() + 0.25)).abs() < 1e-12);
         assert!((at(0.75) - (-1.0 + 3.0 + 0.75)).abs() < 1e-12);
+        let names = Names {
+            alpha: 0.0,
+            params: &params,
+        };
         let unknown = Expr::compile("b + 1").unwrap();
-        assert!(unknown
-            .eval(&mut Names {
-                alpha: 0.0,
-                params: &params
-            })
-            .is_err());
+        assert!(unknown.eval(&|n: &str| names.get(n)).is_err());
         assert!(Expr::compile("print(1)").is_err());
         assert!(Expr::compile("2 * print (t)").is_err());
         // a name that merely contains "print" is fine
         let footprint = [("footprint".to_string(), 2.0)];
+        let names = Names {
+            alpha: 0.0,
+            params: &footprint,
+        };
         let e = Expr::compile("footprint * 3").unwrap();
-        assert_eq!(
-            e.eval(&mut Names {
-                alpha: 0.0,
-                params: &footprint
-            }),
-            Ok(6.0)
-        );
+        assert_eq!(e.eval(&|n: &str| names.get(n)), Ok(6.0));
         assert!(Expr::compile("1 +").is_err());
     }
 
