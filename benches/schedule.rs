@@ -125,9 +125,6 @@ fn anticipator_move(c: &mut Criterion) {
 /// plan of every block through the runtime, the shape of AsapRealizer's chained-block bench.
 fn chained_blocks(c: &mut Criterion) {
     use bml_realizer::realizer::Realizer;
-    // the next realizer reuses the memory the last one freed (else the heap layout decides
-    // whether its pages must be faulted in again; see `common::keep_freed_memory`)
-    common::keep_freed_memory();
     let mut g = c.benchmark_group("schedule/chained-blocks");
     g.sample_size(10);
     for n in [10usize, 100, 1000, 10_000] {

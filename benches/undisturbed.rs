@@ -8,8 +8,8 @@
 //! the best of 100 batches of 2000, the files taking turns), and N chained blocks through the
 //! whole runtime as in
 //! `schedule/chained-blocks` (per run, the best of 200 runs at N = 1000 and of 20 at N = 10 000;
-//! building and dropping the realizer are not timed), first with glibc's default policy for
-//! freed memory (`glibc-default`), then with the memory the last run freed kept for the next.
+//! building and dropping the realizer are not timed), with the allocator's default settings (what a
+//! host gets).
 //!
 //! Run: `cargo bench --bench undisturbed` (an argument filters by name).
 
@@ -66,34 +66,22 @@ fn main() {
         println!("{name:<48} {:>9.3} µs", t.as_secs_f64() * 1e6);
     }
 
-    // first with glibc's default policy, which gives the memory a dropped realizer frees back
-    // to the OS or not depending on the heap's layout (the next run then faults its pages in
-    // again, or not); then with that memory kept for the next run (the steady state of a
-    // running host, and the reference), see `common::keep_freed_memory`
-    for kept in [false, true] {
-        if kept {
-            common::keep_freed_memory();
+    for (n, runs) in [(1000usize, 200usize), (10_000, 20)] {
+        let name = format!("chained-blocks/{n}");
+        if !wanted(&name) {
+            continue;
         }
-        for (n, runs) in [(1000usize, 200usize), (10_000, 20)] {
-            let name = format!(
-                "chained-blocks/{n}{}",
-                if kept { "" } else { "/glibc-default" }
-            );
-            if !wanted(&name) {
-                continue;
+        let blocks = common::chain_texts(n);
+        let t = best(runs, || {
+            let mut r = Realizer::new();
+            let start = Instant::now();
+            for text in &blocks {
+                r.perform_bml(text).expect("a valid block");
             }
-            let blocks = common::chain_texts(n);
-            let t = best(runs, || {
-                let mut r = Realizer::new();
-                let start = Instant::now();
-                for text in &blocks {
-                    r.perform_bml(text).expect("a valid block");
-                }
-                let took = start.elapsed();
-                drop(black_box(r));
-                took
-            });
-            println!("{name:<48} {:>9.3} ms", t.as_secs_f64() * 1e3);
-        }
+            let took = start.elapsed();
+            drop(black_box(r));
+            took
+        });
+        println!("{name:<48} {:>9.3} ms", t.as_secs_f64() * 1e3);
     }
 }

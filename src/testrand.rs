@@ -1,5 +1,5 @@
-//! The deterministic generator of the tests that check a fast path against a plain reading on
-//! many generated inputs (xorshift64: the same sequence on every run and machine).
+//! The deterministic generator of the tests that check code on many generated inputs
+//! (xorshift64: the same sequence on every run and machine).
 
 /// Xorshift64 state (any seed but 0).
 pub(crate) struct XorShift(pub(crate) u64);
@@ -13,10 +13,5 @@ impl XorShift {
         x ^= x << 17;
         self.0 = x;
         x
-    }
-
-    /// A number below `n` (from the next 64 bits).
-    pub(crate) fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
     }
 }

@@ -1,5 +1,5 @@
 //! XML name rules (the NCName production of Namespaces in XML), shared by the BML parser and the
-//! feedback codecs, and the comparison of short names used in lookups.
+//! feedback codecs.
 
 /// Whether `c` is outside XML 1.0's `Char` production (C0 controls but tab, LF, CR; U+FFFE, U+FFFF),
 /// i.e. may appear in an XML document neither literally nor as a character reference.
@@ -7,20 +7,10 @@ pub(crate) fn is_forbidden_char(c: char) -> bool {
     ((c as u32) < 0x20 && !matches!(c, '\t' | '\n' | '\r')) || c == '\u{FFFE}' || c == '\u{FFFF}'
 }
 
-/// Whether two short names (ids, sync names, element names) are equal: length and first byte
-/// first, then the bytes inline. Most candidates in a lookup differ there, and no call to
-/// `memcmp` is made per candidate.
-#[inline]
-pub(crate) fn same_name(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    a.len() == b.len() && a.first() == b.first() && a.iter().zip(b).all(|(x, y)| x == y)
-}
-
-/// Splits a qualified name `prefix:local` at its first colon (`None` for an unprefixed name). A
-/// plain byte loop: names are a few bytes, too short for a searcher to pay off.
+/// Splits a qualified name `prefix:local` at its first colon (`None` for an unprefixed name).
 pub(crate) fn split_qname(q: &str) -> (Option<&str>, &str) {
-    match q.bytes().position(|b| b == b':') {
-        Some(i) => (Some(&q[..i]), &q[i + 1..]),
+    match q.split_once(':') {
+        Some((prefix, local)) => (Some(prefix), local),
         None => (None, q),
     }
 }
@@ -54,23 +44,6 @@ pub(crate) fn is_ncname(s: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::is_ncname;
-
-    #[test]
-    fn same_names() {
-        use super::same_name;
-        for (a, b, same) in [
-            ("start", "start", true),
-            ("start", "stArt", false),
-            ("start", "ready", false),
-            ("stroke", "strokeEnd", false),
-            ("", "", true),
-            ("é", "é", true),
-            ("é", "è", false),
-        ] {
-            assert_eq!(same_name(a, b), same, "{a} {b}");
-            assert_eq!(same_name(a, b), a == b);
-        }
-    }
 
     #[test]
     fn qualified_names_split_at_their_first_colon() {

@@ -13,8 +13,7 @@ fn messages() -> Vec<Feedback> {
                 global_start: Some(0.0),
                 global_end: None,
                 status: Some(BlockStatus::InPrep),
-            }]
-            .into(),
+            }],
             behaviours: vec![],
         }),
         Feedback::Prediction(PredictionFeedback {
@@ -24,8 +23,7 @@ fn messages() -> Vec<Feedback> {
                 global_start: Some(0.0),
                 global_end: Some(3.25),
                 status: Some(BlockStatus::Pending),
-            }]
-            .into(),
+            }],
             behaviours: vec![BehaviourPrediction {
                 kind: "gesture".into(),
                 block: "bml1".into(),

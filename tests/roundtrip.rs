@@ -514,7 +514,7 @@ fn feedback() -> impl Strategy<Value = Feedback> {
             .prop_map(|(character_id, blocks, behaviours)| Feedback::Prediction(
                 PredictionFeedback {
                     character_id,
-                    blocks: blocks.into(),
+                    blocks,
                     behaviours
                 }
             )),

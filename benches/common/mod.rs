@@ -42,24 +42,3 @@ pub fn core_files() -> Vec<(String, String)> {
         })
         .collect()
 }
-
-/// Makes glibc keep the memory that a dropped realizer frees, so that the next timed run reuses
-/// pages the process already has: the steady state of a long-running host, and the conditions
-/// of AsapRealizer's bench (the JVM keeps its heap). No-op elsewhere.
-///
-/// By default glibc gives the free memory at the top of its heap back to the OS once it exceeds
-/// a threshold (128 KiB, moved at run time by large frees), and serves large lists from
-/// mappings of their own that are unmapped when freed. Whether a dropped realizer's memory sits
-/// at the top depends on which small allocations happen to live above it, so by default a
-/// chained run (N = 1000) costs 3.6 or 5.4 ms by the luck of the heap layout: the difference is
-/// about 600 page faults of about 2.7 µs each on this VM. See `docs/performance.md`.
-pub fn keep_freed_memory() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: mallopt only sets a tuning parameter of the allocator.
-    unsafe {
-        libc::mallopt(libc::M_TRIM_THRESHOLD, libc::c_int::MAX);
-        // large lists (the plan's list of blocks at N = 10 000) from the heap too, not from
-        // mappings of their own that are unmapped when freed (32 MiB is glibc's maximum)
-        libc::mallopt(libc::M_MMAP_THRESHOLD, 32 << 20);
-    }
-}

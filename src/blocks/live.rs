@@ -9,7 +9,6 @@ use crate::feedback::BlockStatus;
 use crate::plan::pegs::PegBoard;
 use crate::schedule::to_pegs::{Anticipators, PlannedBlock};
 use crate::schedule::{BlockSchedule, SyncName};
-use crate::xmlname::same_name;
 
 /// Where a behaviour is in its life.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -227,7 +226,7 @@ impl LiveBlock {
         let mut from = 0;
         for s in schedule.behaviours {
             let source = &self.source.behaviours;
-            let found = source[from..].iter().position(|b| same_name(&b.id, &s.id));
+            let found = source[from..].iter().position(|b| b.id == s.id);
             let Some(index) = found.map(|i| from + i) else {
                 continue;
             };
@@ -283,7 +282,7 @@ impl LiveBlock {
     }
 
     pub(crate) fn behaviour(&self, id: &str) -> Option<&LiveBehaviour> {
-        self.behaviours.iter().find(|b| same_name(&b.id, id))
+        self.behaviours.iter().find(|b| b.id == id)
     }
 
     /// Whether the block has started (IN_EXEC or SUBSIDING).

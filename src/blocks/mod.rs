@@ -310,7 +310,7 @@ impl BlockManager {
         };
         let fb = PredictionFeedback {
             character_id: self.character.clone(),
-            blocks: smallvec::smallvec![BlockPrediction {
+            blocks: vec![BlockPrediction {
                 id: b.id.clone(),
                 global_start: Some(b.start),
                 // unknown while scheduling (the harness waits for a known end)

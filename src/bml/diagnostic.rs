@@ -295,11 +295,10 @@ impl BmlError {
 mod tests {
     use super::*;
 
-    /// The eight-bytes-at-a-time scan finds what a byte-by-byte reading finds: every line start,
-    /// the first forbidden control character, and whether the text is ASCII (through the
-    /// columns), wherever in a word those bytes fall.
+    /// The scan finds every line start, the first forbidden control character, and (through the
+    /// columns) character positions on lines with and without text outside ASCII.
     #[test]
-    fn one_pass_scan_agrees_with_byte_by_byte_reading() {
+    fn the_scan_finds_line_starts_forbidden_characters_and_columns() {
         let pieces = [
             "a", "bc", "\n", "\t", "\r\n", "\u{1}", "\u{1f}", " ", "é", "€", "~", "\u{7f}",
         ];

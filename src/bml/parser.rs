@@ -11,7 +11,7 @@ use super::limits::Limits;
 use super::model::*;
 use super::syncref::{parse_seconds, SyncRef};
 use super::xml::{Event, Problem, Reader, Tag, XmlError};
-use crate::xmlname::{same_name, split_qname};
+use crate::xmlname::split_qname;
 
 /// A parsed block together with the warnings found while reading it.
 #[derive(Debug, Clone, PartialEq)]
@@ -184,7 +184,7 @@ impl<'i> Attrs<'i> {
     fn take(&mut self, name: &str) -> Option<RawAttr<'i>> {
         self.items
             .iter_mut()
-            .find(|a| matches!(a, Some(a) if a.ns == Ns::None && same_name(a.name, name)))
+            .find(|a| matches!(a, Some(a) if a.ns == Ns::None && a.name == name))
             .and_then(Option::take)
     }
 
@@ -974,7 +974,7 @@ impl<'i> Parser<'i> {
     ) -> Vec<SyncAttr> {
         let sync_name = |a: &RawAttr| {
             (a.ns == Ns::None)
-                .then(|| names.iter().find(|n| same_name(n, a.name)).copied())
+                .then(|| names.iter().find(|n| **n == a.name).copied())
                 .flatten()
         };
         // in document order; the list is kept with the behaviour, so it gets its exact size

@@ -18,7 +18,6 @@ use crate::engines::motion::{hands, min_jerk, sides};
 use crate::engines::procedural::{mirror_name, mirror_rotation, Library, ProcUnit};
 use crate::schedule::SyncName;
 use crate::world::World;
-use crate::xmlname::same_name;
 
 /// The embedded default lexicon.
 const DEFAULT: &str = include_str!("../../fixtures/bindings/gestures.json");
@@ -161,8 +160,7 @@ impl Lexicon {
         self.bindings
             .iter()
             .find(|b| {
-                same_name(&b.lexeme, &g.lexeme)
-                    && b.when.iter().all(|(k, v)| attr(k) == Some(v.as_str()))
+                b.lexeme == g.lexeme && b.when.iter().all(|(k, v)| attr(k) == Some(v.as_str()))
             })
             .map(|b| &b.bound)
     }

@@ -8,9 +8,6 @@ mod xml;
 
 use std::fmt;
 
-/// The list type of [`PredictionFeedback::blocks`] (inline for one block).
-pub use smallvec::SmallVec;
-
 pub use json::{from_json, to_json};
 pub use xml::{from_xml, to_xml};
 
@@ -189,7 +186,7 @@ pub struct PredictionFeedback {
     pub character_id: Option<String>,
     /// Block predictions: in practice one (the realizer sends one per block), so it is kept
     /// inline.
-    pub blocks: SmallVec<[BlockPrediction; 1]>,
+    pub blocks: Vec<BlockPrediction>,
     /// Behaviour predictions.
     pub behaviours: Vec<BehaviourPrediction>,
 }

@@ -150,14 +150,7 @@ impl DiffSystem {
         // that gave each variable its value (n), and a ring queue of variables (n) in which each
         // variable is at most once (`queued`, n)
         let need = (n + 1) + n + m + 3 * n;
-        // most blocks are small: their scratch lives on the stack
-        let (mut small, mut large) = ([0usize; 128], Vec::new());
-        let scratch: &mut [usize] = if need <= small.len() {
-            &mut small[..need]
-        } else {
-            large.resize(need, 0);
-            &mut large
-        };
+        let mut scratch = vec![0usize; need];
         let (start, rest) = scratch.split_at_mut(n + 1);
         let (fill, rest) = rest.split_at_mut(n);
         let (out, rest) = rest.split_at_mut(m);

@@ -3,7 +3,6 @@
 
 use smallvec::SmallVec;
 
-use super::room::room;
 use super::strategy::{Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour};
 use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, Source, SyncPoint};
 use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
@@ -46,11 +45,7 @@ pub(crate) fn items<'b>(
     dropped: &mut Vec<Dropped>,
 ) -> Vec<Item<'b>> {
     // positions of the behaviours, sorted by id
-    let (mut stack, mut heap) = ([0; 8], Vec::new());
-    let order = room(block.behaviours.len(), &mut stack, &mut heap);
-    for (i, at) in order.iter_mut().enumerate() {
-        *at = i;
-    }
+    let mut order: Vec<usize> = (0..block.behaviours.len()).collect();
     order.sort_by(|&a, &b| block.behaviours[a].id.cmp(&block.behaviours[b].id));
     let mut items = Vec::with_capacity(order.len());
     for beh in order.iter().map(|&i| &block.behaviours[i]) {

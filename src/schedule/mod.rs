@@ -13,7 +13,6 @@ pub mod greedy;
 mod links;
 mod offsets;
 pub mod optimal;
-mod room;
 pub mod strategy;
 pub mod to_pegs;
 

@@ -29,7 +29,6 @@ use good_lp::{
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{self, is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
 use super::offsets::Offsets;
-use super::room::room;
 use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
 use crate::bml::{extract, Block, Constraint, Relation};
 use crate::engine::timing::{Flexibility, TimingModels, MIN_DURATION};
@@ -346,9 +345,8 @@ fn at_preferred_timing(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     let mut groups = Offsets::default();
     groups.reset(items.len() + 1);
     join_at_links(&mut groups, links, var)?;
-    let (mut stack, mut heap) = ([0.0; 16], Vec::new());
     let starts = (1..=items.len()).map(|v| (v, 0.0));
-    let x = least_solution(links, var, starts, &mut groups, &mut stack, &mut heap)?;
+    let x = least_solution(links, var, starts, &mut groups)?;
     let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
     for (i, it) in items.iter().enumerate() {
         times.extend(it.model.keys[..it.len].iter().map(|k| x[i + 1] + k.at));
@@ -375,20 +373,17 @@ fn join_at_links(
 /// the links (through `node`, as in [`join_at_links`], which `groups` has been through) and, for
 /// item i, `value(node) >= bound` for the i-th `(node, bound)` of `starts` (nothing before the
 /// block). With only `at` links the joined groups hold it; otherwise the difference system is
-/// searched. `None` if there is none, or if the block start would have to move. Written into
-/// `stack` when it fits, else into `heap`.
-fn least_solution<'a>(
+/// searched. `None` if there is none, or if the block start would have to move.
+fn least_solution(
     links: &[Link],
     node: impl Fn(Term) -> (usize, f64),
     starts: impl Iterator<Item = (usize, f64)>,
     groups: &mut Offsets,
-    stack: &'a mut [f64; 16],
-    heap: &'a mut Vec<f64>,
-) -> Option<&'a mut [f64]> {
+) -> Option<Vec<f64>> {
     let n = groups.len();
     if links.iter().all(|l| l.relation == Relation::At) {
-        let x = room(n, stack, heap);
-        groups.least(starts, x)?;
+        let mut x = vec![0.0; n];
+        groups.least(starts, &mut x)?;
         return Some(x);
     }
     let mut s = DiffSystem::with_capacity(n, 2 * links.len() + n);
@@ -402,8 +397,8 @@ fn least_solution<'a>(
     for (i, (v, bound)) in starts.enumerate() {
         s.at_least(v, 0, bound, links.len() + i);
     }
-    *heap = s.into_least()?;
-    (heap[0] <= EPSILON).then_some(heap.as_mut_slice())
+    let x = s.into_least()?;
+    (x[0] <= EPSILON).then_some(x)
 }
 
 /// Whether some behaviour has two keys set `at` fixed times that its preferred timing cannot
@@ -411,9 +406,7 @@ fn least_solution<'a>(
 /// An exact shortcut, found without building a difference system.
 fn pinned_apart(items: &[Item], links: &[Link]) -> bool {
     // (item, the start that the fixed time implies for it)
-    let (mut stack, mut heap) = ([(0, 0.0); 8], Vec::new());
-    let starts = room(links.len(), &mut stack, &mut heap);
-    let mut len = 0;
+    let mut starts = Vec::new();
     for l in links.iter().filter(|l| l.relation == Relation::At) {
         // left = right + offset
         let implied = match (l.left, l.right) {
@@ -422,13 +415,11 @@ fn pinned_apart(items: &[Item], links: &[Link]) -> bool {
             _ => continue,
         };
         let (i, k, at) = implied;
-        starts[len] = (i, at - items[i].model.keys[k].at);
-        len += 1;
+        starts.push((i, at - items[i].model.keys[k].at));
     }
-    if len < 2 {
+    if starts.len() < 2 {
         return false;
     }
-    let starts = &mut starts[..len];
     starts.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     starts
         .windows(2)
@@ -486,8 +477,7 @@ fn separable(items: &[Item], links: &[Link]) -> Option<Vec<f64>> {
     }
     // nothing before the block: a stretched item's start lies before its first anchor
     let starts = (0..items.len()).map(|i| (base[i], shapes[i].first().map_or(0.0, |s| -s)));
-    let (mut stack, mut heap) = ([0.0; 16], Vec::new());
-    let x = least_solution(links, term, starts, &mut groups, &mut stack, &mut heap)?;
+    let x = least_solution(links, term, starts, &mut groups)?;
     let mut times = Vec::with_capacity(items.iter().map(|it| it.len).sum());
     for (i, it) in items.iter().enumerate() {
         let at = x[base[i]];
