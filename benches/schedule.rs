@@ -9,9 +9,9 @@ mod common;
 use std::hint::black_box;
 
 use bml_realizer::bml;
-use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::schedule::diff::DiffSystem;
 use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy, SortedGreedy};
+use bml_realizer::timing::DefaultTimingModels;
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
 
 fn chain(n: usize) -> DiffSystem {

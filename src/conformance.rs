@@ -7,10 +7,10 @@ use std::rc::Rc;
 
 use realizer_tests::{Fixture, TestPort};
 
-use crate::engine::timing::{DefaultTimingModels, SpeechTiming};
 use crate::engines::default_registry;
 use crate::feedback::{Feedback, Format};
 use crate::realizer::Realizer;
+use crate::timing::{DefaultTimingModels, SpeechTiming};
 
 /// A fresh [`Realizer`] per test on a virtual clock; tests of the incremental-speech fixture get
 /// retimable speech.

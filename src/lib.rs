@@ -33,6 +33,7 @@ pub mod schedule;
 #[cfg(test)]
 mod testrand;
 pub mod timeline;
+pub mod timing;
 pub mod world;
 mod xmlname;
 

@@ -975,9 +975,9 @@ fn a_murml_keyframed_gesture_turns_its_joints_exactly_at_its_frames() {
 
 #[test]
 fn every_motion_behaviour_declares_the_joints_it_steers() {
-    use bml_realizer::engine::timing::DefaultTimingModels;
     use bml_realizer::engine::MotionKind;
     use bml_realizer::engines::default_registry;
+    use bml_realizer::timing::DefaultTimingModels;
     let skeleton = Skeleton::adult();
     let registry = default_registry(DefaultTimingModels::default());
     let block = bml_realizer::bml::load(&format!(

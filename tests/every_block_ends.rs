@@ -154,3 +154,28 @@ fn settles(blocks: &Blocks, limits: Limits) -> Result<(), TestCaseError> {
     }
     Ok(())
 }
+
+/// Found by the proptest: a locomotion ending 1e308 s after a nod tied at 0 and a wait at
+/// 999 999 s made the simplex stall for ever (without the time limit on the block). Numbers that
+/// far out never reach the linear program now; the block is scheduled at once and ends.
+#[test]
+fn a_block_with_huge_and_tiny_times_does_not_stall_the_scheduler() {
+    let blocks: Blocks = vec![(
+        2,
+        0.0,
+        vec![
+            (5, vec![(1, 9, None)]),
+            (4, vec![(0, 6, None)]),
+            (1, vec![(2, 12, None)]),
+        ],
+    )];
+    assert_eq!(
+        block(0, 2, &blocks[0].2),
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b0" composition="REPLACE"><locomotion target="user" id="x0" end="1e308"/><wait max-wait="1e6" id="x1" start="999999"/><head lexeme="NOD" repetition="1000" id="x2" stroke="-0"/></bml>"#
+    );
+    let limits = Limits {
+        time: f64::MAX,
+        ..Limits::default()
+    };
+    settles(&blocks, limits).unwrap();
+}

@@ -7,11 +7,11 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use bml_realizer::bml::{Behaviour, BehaviourKind, NS_BML};
-use bml_realizer::engine::timing::{DefaultTimingModels, TimingModel};
 use bml_realizer::engine::{Engine, EngineError, KindKey, Unit, UnitKey};
 use bml_realizer::engines::default_registry;
 use bml_realizer::feedback::{BlockStatus, Feedback, Format};
 use bml_realizer::realizer::Realizer;
+use bml_realizer::timing::{DefaultTimingModels, TimingModel};
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmla="http://www.asap-project.org/bmla" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
 

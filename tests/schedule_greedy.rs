@@ -3,11 +3,11 @@
 //! with `Optimal`, which schedules all of them.
 
 use bml_realizer::bml;
-use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::feedback::KnownWarning;
 use bml_realizer::schedule::{
     BlockSchedule, NoExternal, Optimal, SchedulingStrategy, SortedGreedy,
 };
+use bml_realizer::timing::DefaultTimingModels;
 
 fn run(strategy: &dyn SchedulingStrategy, file: &str) -> BlockSchedule {
     let src =

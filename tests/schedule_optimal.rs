@@ -2,9 +2,9 @@
 //! expected timings), before/after constraints, conflicts and order invariance.
 
 use bml_realizer::bml;
-use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::feedback::KnownWarning;
 use bml_realizer::schedule::{BlockSchedule, NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::timing::DefaultTimingModels;
 
 fn fixture(path: &str) -> String {
     std::fs::read_to_string(format!("{}/fixtures/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
@@ -328,7 +328,7 @@ fn persistent_controller_has_no_end_unless_a_constraint_names_it() {
 
 #[test]
 fn an_invalid_engine_timing_model_drops_the_behaviour_instead_of_panicking() {
-    use bml_realizer::engine::timing::{TimingModel, TimingModels};
+    use bml_realizer::timing::{TimingModel, TimingModels};
     struct Broken;
     impl TimingModels for Broken {
         fn model(&self, b: &bml::Behaviour) -> Option<TimingModel> {

@@ -9,10 +9,10 @@
 //! `|σ − 1| · preferred duration + 2 · Σ |phase − σ · preferred phase|`.
 
 use bml_realizer::bml;
-use bml_realizer::engine::timing::{DefaultTimingModels, Flexibility, TimingModels};
 use bml_realizer::schedule::{
     BlockSchedule, LinearProgram, NoExternal, Optimal, SchedulingStrategy,
 };
+use bml_realizer::timing::{DefaultTimingModels, Flexibility, TimingModels};
 use proptest::prelude::*;
 
 const WORDS: &[&str] = &[

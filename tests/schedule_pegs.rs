@@ -3,12 +3,12 @@
 //! validity check after them, and before/after as pushing order links.
 
 use bml_realizer::bml;
-use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::plan::pegs::{PegBoard, SyncAddr};
 use bml_realizer::schedule::to_pegs::{
     invalid, plan_block, Anticipators, BoardTimes, PlannedBlock,
 };
 use bml_realizer::schedule::{Optimal, SchedulingStrategy};
+use bml_realizer::timing::DefaultTimingModels;
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9

@@ -4,8 +4,8 @@
 //! order of the behaviours.
 
 use bml_realizer::bml::{self, Anchor, Relation, SyncPoint};
-use bml_realizer::engine::timing::{DefaultTimingModels, Flexibility, TimingModels};
 use bml_realizer::schedule::{BlockSchedule, NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::timing::{DefaultTimingModels, Flexibility, TimingModels};
 use proptest::prelude::*;
 
 const KINDS: &[&str] = &[

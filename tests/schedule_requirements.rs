@@ -3,10 +3,10 @@
 //! `Optimal` strategy and the default timing models.
 
 use bml_realizer::bml::{self, SyncPoint};
-use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::schedule::{
     BlockSchedule, ExternalTimes, NoExternal, Optimal, SchedulingStrategy,
 };
+use bml_realizer::timing::DefaultTimingModels;
 
 fn block(body: &str) -> String {
     format!(

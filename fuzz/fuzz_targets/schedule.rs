@@ -4,7 +4,7 @@
 #![no_main]
 
 use bml_realizer::bml::{self, Anchor, Relation, SyncPoint};
-use bml_realizer::engine::timing::DefaultTimingModels;
+use bml_realizer::timing::DefaultTimingModels;
 use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy, SortedGreedy};
 use libfuzzer_sys::fuzz_target;
 

@@ -6,7 +6,7 @@
 #![no_main]
 
 use bml_realizer::bml::{self, BlockStream, Code};
-use bml_realizer::engine::timing::DefaultTimingModels;
+use bml_realizer::timing::DefaultTimingModels;
 use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy};
 use libfuzzer_sys::arbitrary::Unstructured;
 use libfuzzer_sys::fuzz_target;

@@ -20,7 +20,6 @@ use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use crate::bml::{self, Diagnostic, SyncPoint};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::TimingModels;
 use crate::engine::{Action, CharacterPose, Frame, ParameterChange, Registry, Unit, UnitKey};
 use crate::feedback::{
     BehaviourPrediction, BlockPrediction, BlockProgress, BlockStatus, Feedback, KnownWarning,
@@ -30,6 +29,7 @@ use crate::plan::anticipator::Anticipator;
 use crate::plan::pegs::PegBoard;
 use crate::schedule::to_pegs::{self, Anticipators};
 use crate::schedule::{ExternalTimes, SchedulingStrategy};
+use crate::timing::TimingModels;
 use crate::world::World;
 use live::{anticipator_refs, referenced_points, BlockPegs, LiveBlock, Phase};
 

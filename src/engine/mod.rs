@@ -1,9 +1,9 @@
 //! The engine layer: what an engine is to the realizer (the `Engine` trait), the registry that
 //! maps behaviour kinds to engines, and what engines produce (actions for the runtime, frame
-//! output). Timing models, the scheduler's view of an engine, are in [`timing`].
+//! output). Timing models, the scheduler's view of an engine, are in [`crate::timing`], a layer
+//! below both.
 
 mod registry;
-pub mod timing;
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -14,9 +14,9 @@ pub use registry::{KindKey, Registry};
 use crate::bml::{Behaviour, TrajectoryType};
 use crate::body::{Pose, Skeleton};
 use crate::feedback::Feedback;
-use crate::schedule::SyncName;
+use crate::timing::SyncName;
+use crate::timing::TimingModel;
 use crate::world::World;
-use timing::TimingModel;
 
 /// One behaviour of one block: how the runtime and the engines name a plan unit.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -583,7 +583,7 @@ macro_rules! units_retime_len {
         fn retime(
             &mut self,
             key: &$crate::engine::UnitKey,
-            syncs: &[($crate::schedule::SyncName, f64)],
+            syncs: &[($crate::timing::SyncName, f64)],
         ) {
             let times: Vec<f64> = syncs.iter().map(|s| s.1).collect();
             self.units.retime(key, &times);
@@ -644,7 +644,7 @@ macro_rules! units_interrupt {
             &mut self,
             key: &$crate::engine::UnitKey,
             now: f64,
-            syncs: &[($crate::schedule::SyncName, f64)],
+            syncs: &[($crate::timing::SyncName, f64)],
         ) -> Vec<f64> {
             let times = $how(now, syncs);
             self.units.retime(key, &times);

@@ -2,9 +2,9 @@
 //! several kinds; registering a kind again hands it to the newer engine. New kinds and engines
 //! register from outside the core.
 
-use super::timing::{TimingModel, TimingModels};
 use super::Engine;
 use crate::bml::{Behaviour, BUILTIN_KINDS};
+use crate::timing::{TimingModel, TimingModels};
 
 /// A behaviour kind as written: namespace URI and element name.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -135,8 +135,8 @@ impl TimingModels for Registry {
 mod tests {
     use super::*;
     use crate::bml::{NS_BML, NS_BMLT};
-    use crate::engine::timing::DefaultTimingModels;
     use crate::engines::timing_only::TimingOnlyEngine;
+    use crate::timing::DefaultTimingModels;
 
     #[test]
     fn kinds_are_found_by_name_and_namespace_and_the_newest_registration_wins() {

@@ -5,8 +5,8 @@
 use std::collections::HashMap;
 
 use crate::bml::{Behaviour, BehaviourKind};
-use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Action, Engine, EngineError, ParameterChange, Unit, UnitKey};
+use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 
 /// What a control unit does when it starts.
 #[derive(Debug, Clone)]

@@ -26,10 +26,10 @@ use glam::{Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
-use crate::schedule::SyncName;
+use crate::timing::SyncName;
+use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// Saccade duration at zero amplitude (seconds).

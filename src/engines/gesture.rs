@@ -12,11 +12,11 @@ use glam::{EulerRot, Quat};
 
 use crate::bml::{Behaviour, BehaviourKind, Param};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{hands, min_jerk, sides};
 use crate::engines::procedural::{mirror_name, mirror_rotation, Library, ProcUnit};
-use crate::schedule::SyncName;
+use crate::timing::SyncName;
+use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// The embedded default lexicon.

@@ -11,9 +11,9 @@ use glam::{Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
-use crate::schedule::SyncName;
+use crate::timing::SyncName;
+use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// The embedded default head lexicon.

@@ -11,10 +11,10 @@ use glam::{Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::gaze::{donders, eyes_at_rest, yaw_pitch};
 use crate::engines::motion::{envelope, finished_shift};
+use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// (joint, share of the turn).

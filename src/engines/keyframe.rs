@@ -23,9 +23,9 @@ use quick_xml::Reader;
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
-use crate::schedule::SyncName;
+use crate::timing::SyncName;
+use crate::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
 use crate::world::World;
 
 /// Keys read from a `<SkeletonInterpolator>`.

@@ -38,8 +38,8 @@ pub mod timing_only;
 pub mod transition;
 
 use crate::bml::{NS_BML, NS_BMLA, NS_BMLT, NS_CORE_EXT};
-use crate::engine::timing::DefaultTimingModels;
 use crate::engine::{KindKey, Registry};
+use crate::timing::DefaultTimingModels;
 
 /// Kinds the timing-only motion engine realizes (namespace, element).
 pub const MOTION_KINDS: &[(&str, &str)] = &[

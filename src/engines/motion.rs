@@ -5,7 +5,7 @@
 
 use crate::bml::Mode;
 use crate::engine::Units;
-use crate::schedule::SyncName;
+use crate::timing::SyncName;
 
 /// Minimum-jerk profile: 0 at 0, 1 at 1, zero velocity and acceleration at both ends.
 pub fn min_jerk(u: f64) -> f64 {

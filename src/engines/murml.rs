@@ -20,9 +20,9 @@ use glam::{EulerRot, Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::TimingModel;
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::keyframe::{play, Interpolation, Keys};
+use crate::timing::TimingModel;
 use crate::world::World;
 
 /// The MURML namespace.

@@ -20,13 +20,13 @@ use glam::{EulerRot, Quat};
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{Flexibility, TimingModel, MIN_DURATION};
 use crate::engine::{
     named_param, named_params, set_named_param, Engine, EngineError, Params, Steering, Unit,
     UnitKey, Units,
 };
 use crate::engines::motion::min_jerk;
 use crate::engines::procedural::perlin;
+use crate::timing::{Flexibility, TimingModel, MIN_DURATION};
 use crate::world::World;
 
 /// Parameter names and defaults.

@@ -11,9 +11,9 @@ use glam::Vec3;
 use crate::bml::{Behaviour, BehaviourKind, Mode};
 use crate::body::ik::{arc, place_limb, LimbRoot, ARM_POLE};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{envelope, hands};
+use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// How far along its reach the wrist goes.

@@ -16,10 +16,10 @@ use glam::{Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind, PosePart, StanceType};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
 use crate::engines::procedural::{Library, ProcUnit};
+use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// A stance: pitch of the hips and knees and ankles (degrees, about +x), and the root's drop

@@ -48,13 +48,13 @@ use glam::{EulerRot, Quat, Vec3};
 use crate::bml::{Behaviour, BehaviourKind, Id, Param};
 use crate::body::ik::{place_limb, LimbRoot, ARM_POLE, LEG_POLE};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
 use crate::engine::{
     named_param, named_params, set_named_param, Engine, EngineError, Steering, SyncTimes, Unit,
     UnitKey, Units,
 };
 use crate::engines::motion::min_jerk;
-use crate::schedule::SyncName;
+use crate::timing::SyncName;
+use crate::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
 use crate::world::World;
 
 /// The embedded default library.

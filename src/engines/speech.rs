@@ -10,9 +10,9 @@
 //! speaks cuts the filler (co-articulation on the voice).
 
 use crate::bml::{Behaviour, BehaviourKind};
-use crate::engine::timing::SyncKey;
-use crate::engine::timing::{SpeechTiming, TimingModel, TimingModels};
 use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::timing::SyncKey;
+use crate::timing::{SpeechTiming, TimingModel, TimingModels};
 
 /// Volume of a speech that no one changed.
 pub const DEFAULT_VOLUME: f64 = 100.0;
@@ -65,7 +65,7 @@ impl Engine for SpeechEngine {
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         let mut model = match behaviour.kind {
             BehaviourKind::Speech(_) | BehaviourKind::Text(_) => {
-                crate::engine::timing::DefaultTimingModels {
+                crate::timing::DefaultTimingModels {
                     speech: self.timing,
                 }
                 .model(behaviour)?

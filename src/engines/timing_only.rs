@@ -6,9 +6,9 @@
 //! support table (`docs/bml-support.md`) marks these kinds "timing only".
 
 use crate::bml::{Behaviour, BehaviourKind};
-use crate::engine::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::engine::{relax_now, stop_now, Engine, EngineError, Unit, UnitKey, Units};
-use crate::schedule::SyncName;
+use crate::timing::SyncName;
+use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 
 /// The timing-only engine (see the module documentation).
 #[derive(Debug)]

@@ -16,9 +16,9 @@
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::engine::timing::{TimingModel, MIN_DURATION};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::min_jerk;
+use crate::timing::{TimingModel, MIN_DURATION};
 use crate::world::World;
 
 #[derive(Debug, Clone)]

@@ -9,12 +9,12 @@ use std::time::{SystemTime, UNIX_EPOCH};
 use crate::blocks::BlockManager;
 use crate::bml::{self, BmlError, Diagnostic};
 use crate::body::Skeleton;
-use crate::engine::timing::DefaultTimingModels;
 use crate::engine::{Frame, Registry};
 use crate::engines::default_registry;
 use crate::feedback::{Feedback, FeedbackListener, KnownWarning, WarningFeedback};
 use crate::plan::anticipator::Anticipator;
 use crate::schedule::{Optimal, SchedulingStrategy};
+use crate::timing::DefaultTimingModels;
 use crate::world::World;
 
 /// The id used in warnings about a block whose id could not be read.

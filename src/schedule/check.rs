@@ -8,7 +8,7 @@
 use super::optimal::Optimal;
 use super::strategy::{NoExternal, SchedulingStrategy};
 use crate::bml::{Block, Code, Diagnostic};
-use crate::engine::timing::TimingModels;
+use crate::timing::TimingModels;
 
 /// Errors for the constraints of `block` that no timing satisfies.
 pub fn timing_diagnostics(block: &Block, models: &dyn TimingModels) -> Vec<Diagnostic> {

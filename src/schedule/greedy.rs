@@ -23,8 +23,8 @@ use super::strategy::{
     BlockSchedule, ExternalTimes, ScheduleError, ScheduledBehaviour, SchedulingStrategy,
 };
 use crate::bml::{extract, Behaviour, BehaviourKind, Block, Relation};
-use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
 use crate::feedback::KnownWarning;
+use crate::timing::{Flexibility, TimingModel, TimingModels};
 
 /// The sorted greedy baseline (see the module documentation).
 #[derive(Debug, Clone, Copy, Default)]

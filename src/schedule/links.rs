@@ -5,8 +5,8 @@ use smallvec::SmallVec;
 
 use super::strategy::{Dropped, ExternalTimes, ScheduleError, ScheduledBehaviour};
 use crate::bml::{Anchor, Behaviour, Block, Constraint, Relation, Source, SyncPoint};
-use crate::engine::timing::{Flexibility, TimingModel, TimingModels};
 use crate::feedback::KnownWarning;
+use crate::timing::{Flexibility, TimingModel, TimingModels};
 
 /// A behaviour being scheduled.
 pub(crate) struct Item<'b> {

@@ -22,6 +22,7 @@
 //!    kept at that minimum. The program is built in a canonical order (behaviours sorted by id), so the
 //!    same block in any order gives the same program and the same answer.
 
+use good_lp::solvers::WithTimeLimit;
 use good_lp::{
     constraint, microlp, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
 };
@@ -29,10 +30,12 @@ use good_lp::{
 use super::diff::{DiffSystem, EPSILON};
 use super::links::{self, is_required, items, resolve_all, scheduled, IdIndex, Item, Link, Term};
 use super::offsets::Offsets;
-use super::strategy::{BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy};
+use super::strategy::{
+    BlockSchedule, Dropped, ExternalTimes, ScheduleError, SchedulingStrategy, MAX_SCHEDULED_TIME,
+};
 use crate::bml::{extract, Block, Constraint, Relation};
-use crate::engine::timing::{Flexibility, TimingModels, MIN_DURATION};
 use crate::feedback::KnownWarning;
+use crate::timing::{Flexibility, TimingModels, MIN_DURATION};
 
 /// Cost of one second of non-uniform phase change relative to one second of uniform stretch: above
 /// 1, so a behaviour that must change length stretches all its phases alike (as Elckerlyc's
@@ -689,8 +692,30 @@ fn within_bounds(item: &Item, offsets: &[f64]) -> bool {
     ordered && bounded
 }
 
+/// The longest the linear program may take before the earliest feasible times are used instead.
+/// No block within the limits comes near it (the slowest seen take milliseconds); it is there so
+/// that no input can hold the realizer, should the simplex stall.
+const LP_TIME_LIMIT_SECS: f64 = 2.0;
+
+/// Whether the numbers of a block's system are within what the simplex handles: no time, offset
+/// or duration further than [`MAX_SCHEDULED_TIME`] from zero. Beyond that a behaviour is dropped
+/// after scheduling anyway, and such magnitudes next to ones of 1e-9 s can make the simplex stall.
+fn tame(items: &[Item], links: &[Link]) -> bool {
+    let small = |v: f64| v.abs() <= MAX_SCHEDULED_TIME;
+    let keys = items.iter().flat_map(|it| it.model.keys.iter());
+    links.iter().all(|l| {
+        small(l.offset)
+            && [l.left, l.right]
+                .iter()
+                .all(|t| !matches!(t, Term::Fixed(v) if !small(*v)))
+    }) && keys.clone().all(|k| small(k.at))
+}
+
 /// The two-stage linear program for blocks where some behaviour must stretch.
 fn optimise(items: &[Item], links: &[Link]) -> Vec<f64> {
+    if !tame(items, links) {
+        return earliest(items, links);
+    }
     let build = |deviation_bound: Option<f64>| {
         let mut vars = ProblemVariables::new();
         let t: Vec<Vec<Variable>> = items
@@ -762,7 +787,10 @@ fn optimise(items: &[Item], links: &[Link]) -> Vec<f64> {
                 t.iter().flatten().map(|&v| Expression::from(v)).sum()
             }
         };
-        let mut problem = vars.minimise(objective.clone()).using(microlp);
+        let mut problem = vars
+            .minimise(objective.clone())
+            .using(microlp)
+            .with_time_limit(LP_TIME_LIMIT_SECS);
         for c in constraints {
             problem = problem.with(c);
         }
@@ -797,9 +825,9 @@ fn earliest(items: &[Item], links: &[Link]) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::bml;
-    use crate::engine::timing::{DefaultTimingModels, TimingModel};
     use crate::schedule::links::resolve;
     use crate::schedule::strategy::NoExternal;
+    use crate::timing::{DefaultTimingModels, TimingModel};
 
     fn prepared(src: &str) -> (Vec<TimingModel>, Block) {
         let block = bml::load(src).unwrap().block;

@@ -3,8 +3,8 @@
 //! that leave the block.
 
 use crate::bml::{Block, SyncPoint};
-use crate::engine::timing::TimingModels;
 use crate::feedback::KnownWarning;
+use crate::timing::TimingModels;
 
 /// A way of turning a block into sync times; strategies plug in from outside the core.
 pub trait SchedulingStrategy {
@@ -37,8 +37,7 @@ impl ExternalTimes for NoExternal {
     }
 }
 
-/// A sync point's name: static for the standard names, owned for a speech's inline syncs.
-pub type SyncName = crate::bml::Id;
+pub use crate::timing::SyncName;
 
 /// One behaviour's scheduled sync times (block-local seconds; a persistent end is infinite).
 #[derive(Debug, Clone, PartialEq)]

@@ -9,9 +9,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use bml_realizer::bml::{self, Diagnostic, Severity};
-use bml_realizer::engine::timing::DefaultTimingModels;
 use bml_realizer::engine::Registry;
 use bml_realizer::schedule::check::timing_diagnostics;
+use bml_realizer::timing::DefaultTimingModels;
 use clap::{Parser, Subcommand};
 
 /// The BML realizer command line.

@@ -122,7 +122,7 @@ pub fn with_assets(realizer: Realizer, dir: Option<&Path>) -> Result<Realizer, S
     let assets = bml_realizer::engines::assets::Assets::from_dir(dir)?;
     Ok(realizer.with_engines(move || {
         bml_realizer::engines::registry_with(
-            bml_realizer::engine::timing::DefaultTimingModels::default(),
+            bml_realizer::timing::DefaultTimingModels::default(),
             &assets,
         )
     }))

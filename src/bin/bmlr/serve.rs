@@ -10,11 +10,11 @@ use std::time::Duration;
 use bml_realizer::bml::{BadLine, Checked};
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::conformance::InProcess;
-use bml_realizer::engine::timing::{DefaultTimingModels, SpeechTiming};
 use bml_realizer::engines::assets::Assets;
 use bml_realizer::engines::registry_with;
 use bml_realizer::feedback::{Feedback, Format};
 use bml_realizer::realizer::Realizer;
+use bml_realizer::timing::{DefaultTimingModels, SpeechTiming};
 use clap::Args;
 use realizer_tests::{run, Outcome, ProcessPort, TestPort};
 

@@ -6,6 +6,9 @@
 
 use crate::bml::{Behaviour, BehaviourKind, Speech, TextPart};
 
+/// A sync point's name: static for the standard names, owned for a speech's inline syncs.
+pub type SyncName = crate::bml::Id;
+
 /// Duration of behaviours that act once and end (interrupt, activate, parametervaluechange): the
 /// smallest step feedback can show (1 ms), so that `end > start` holds.
 pub const INSTANT: f64 = 0.001;
