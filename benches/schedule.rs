@@ -91,7 +91,7 @@ fn optimal(c: &mut Criterion) {
 
 fn anticipator_move(c: &mut Criterion) {
     use bml_realizer::plan::pegs::PegBoard;
-    use bml_realizer::schedule::to_pegs::{invalid, plan_block, Anticipators, BoardTimes};
+    use bml_realizer::plan::to_pegs::{invalid, plan_block, Anticipators, BoardTimes};
     let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1">
         <head id="nod1" lexeme="NOD" start="anticipators:beat:b1"/>
         <gesture id="g1" lexeme="BEAT" stroke="anticipators:beat:b1+0.5"/>

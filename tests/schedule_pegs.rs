@@ -4,9 +4,7 @@
 
 use bml_realizer::bml;
 use bml_realizer::plan::pegs::{PegBoard, SyncAddr};
-use bml_realizer::schedule::to_pegs::{
-    invalid, plan_block, Anticipators, BoardTimes, PlannedBlock,
-};
+use bml_realizer::plan::to_pegs::{invalid, plan_block, Anticipators, BoardTimes, PlannedBlock};
 use bml_realizer::schedule::{Optimal, SchedulingStrategy};
 use bml_realizer::timing::DefaultTimingModels;
 

@@ -7,8 +7,7 @@ use crate::bml;
 use crate::engine::UnitKey;
 use crate::feedback::KnownWarning;
 use crate::plan::anticipator::Anticipator;
-use crate::plan::pegs::PegId;
-use crate::schedule::to_pegs;
+use crate::plan::to_pegs;
 
 impl BlockManager {
     /// Registers an anticipator (replacing one with the same id). Blocks scheduled from now on
@@ -51,31 +50,15 @@ impl BlockManager {
             .collect();
         for id in ids {
             let Some(i) = self.pos(&id) else { continue };
-            let (mut moved, mut refused) = (false, None);
-            if let Some(p) = self.blocks[i].pegs.as_mut() {
-                let pegs: Vec<(String, String, PegId)> = p
-                    .anticipators
-                    .iter()
-                    .filter(|(a, _, _)| changed.iter().any(|c| c == a))
-                    .map(|(a, s, peg)| (a.to_string(), s.to_string(), peg))
-                    .collect();
-                for (a, sync, peg) in pegs {
-                    let prediction = self
-                        .anticipators
-                        .iter()
-                        .find(|x| x.id() == a)
-                        .and_then(|x| x.predict(&sync));
-                    let Some(prediction) = prediction.filter(|p| p.is_finite()) else {
-                        continue;
-                    };
-                    if (p.board.global(peg) - prediction).abs() > 1e-12 {
-                        match p.board.move_to(peg, prediction) {
-                            Ok(_) => moved = true,
-                            Err(e) => refused = Some(format!("anticipators:{a}:{sync}: {e}")),
-                        }
-                    }
-                }
-            }
+            let anticipators = &self.anticipators;
+            let predict = |a: &str, sync: &str| {
+                let x = anticipators.iter().find(|x| x.id() == a)?;
+                x.predict(sync)
+            };
+            let (moved, refused) = match self.blocks[i].pegs.as_mut() {
+                Some(p) => p.follow(&changed, predict),
+                None => (false, None),
+            };
             if let Some(reason) = refused {
                 self.warn(id.clone(), KnownWarning::InvalidTiming, reason);
             }

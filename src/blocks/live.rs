@@ -6,8 +6,7 @@ use smallvec::SmallVec;
 use crate::bml::{self, ConstraintItem, SyncPoint, SyncRef};
 use crate::engine::Registry;
 use crate::feedback::BlockStatus;
-use crate::plan::pegs::PegBoard;
-use crate::schedule::to_pegs::{Anticipators, PlannedBlock};
+use crate::plan::to_pegs::BlockPegs;
 use crate::schedule::{BlockSchedule, SyncName};
 
 /// Where a behaviour is in its life.
@@ -135,14 +134,6 @@ pub(crate) struct LiveBlock {
     ended_before: std::cell::Cell<usize>,
     /// The behaviours before this index have all passed `relax`.
     relaxed_before: std::cell::Cell<usize>,
-}
-
-/// A block on its own peg board (only blocks that refer to anticipators have one).
-#[derive(Debug, Clone)]
-pub(crate) struct BlockPegs {
-    pub(crate) board: PegBoard,
-    pub(crate) anticipators: Anticipators,
-    pub(crate) plan: PlannedBlock,
 }
 
 /// Every sync point outside the block (of another block, or of an anticipator) that a sync

@@ -27,11 +27,12 @@ use crate::feedback::{
 };
 use crate::plan::anticipator::Anticipator;
 use crate::plan::pegs::PegBoard;
-use crate::schedule::to_pegs::{self, Anticipators};
+use crate::plan::to_pegs::BlockPegs;
+use crate::plan::to_pegs::{self, Anticipators};
 use crate::schedule::{ExternalTimes, SchedulingStrategy};
 use crate::timing::TimingModels;
 use crate::world::World;
-use live::{anticipator_refs, referenced_points, BlockPegs, LiveBlock, Phase};
+use live::{anticipator_refs, referenced_points, LiveBlock, Phase};
 
 /// How late a block may start so that its references to other blocks' sync points that have just
 /// passed still hold exactly (a block sent a frame after the moment it refers to): it starts that

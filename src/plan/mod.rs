@@ -1,5 +1,7 @@
-//! The flexible multimodal plan: the peg board ([`pegs`]) and the anticipators whose predictions
-//! pegs can hang on ([`anticipator`]). Schedules are put on the board by `schedule::to_pegs`.
+//! The flexible multimodal plan: the peg board ([`pegs`]), schedules put on it and checked after
+//! run-time changes ([`to_pegs`]), and the anticipators whose predictions pegs can hang on
+//! ([`anticipator`]).
 
 pub mod anticipator;
 pub mod pegs;
+pub mod to_pegs;

@@ -4,17 +4,17 @@
 //! - [`optimal`]: the default, order-invariant strategy;
 //! - [`greedy`]: Elckerlyc's sorted greedy algorithm, the baseline;
 //! - [`diff`]: the difference-constraint solver under it;
-//! - [`check`]: what the scheduler would refuse, as diagnostics (`bmlr validate`);
-//! - [`to_pegs`]: a schedule put on the peg board, and validity after run-time changes.
+//! - [`check`]: what the scheduler would refuse, as diagnostics (`bmlr validate`).
+//!
+//! A schedule goes on the peg board in [`crate::plan::to_pegs`].
 
 pub mod check;
 pub mod diff;
 pub mod greedy;
 mod links;
-mod offsets;
+pub(crate) mod offsets;
 pub mod optimal;
 pub mod strategy;
-pub mod to_pegs;
 
 pub use greedy::SortedGreedy;
 pub use optimal::{LinearProgram, Optimal};

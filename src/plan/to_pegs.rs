@@ -16,10 +16,11 @@
 
 use std::collections::HashMap;
 
-use super::offsets::Offsets;
-use super::{BlockSchedule, ExternalTimes, SyncName};
 use crate::bml::{extract, Anchor, Block, Id, Relation, SyncPoint};
 use crate::plan::pegs::{BlockPegId, PegBoard, PegId, SyncAddr};
+use crate::schedule::offsets::Offsets;
+use crate::schedule::{BlockSchedule, ExternalTimes};
+use crate::timing::SyncName;
 
 /// Where a planned sync's time comes from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -344,4 +345,44 @@ pub fn invalid(board: &PegBoard, planned: &PlannedBlock) -> Vec<Id> {
         })
         .map(|(id, _)| id.clone())
         .collect()
+}
+
+/// A block on its own peg board (only blocks that refer to anticipators have one): moving an
+/// anticipator's peg retimes what hangs on it.
+#[derive(Debug, Clone)]
+pub(crate) struct BlockPegs {
+    pub(crate) board: PegBoard,
+    pub(crate) anticipators: Anticipators,
+    pub(crate) plan: PlannedBlock,
+}
+
+impl BlockPegs {
+    /// Moves the pegs of the syncs of the anticipators in `changed` to their new predictions
+    /// (`predict(anticipator, sync)`; a missing or infinite one leaves its peg): whether a peg
+    /// moved, and why the last move the board refused was refused.
+    pub(crate) fn follow(
+        &mut self,
+        changed: &[String],
+        predict: impl Fn(&str, &str) -> Option<f64>,
+    ) -> (bool, Option<String>) {
+        let pegs: Vec<(String, String, PegId)> = self
+            .anticipators
+            .iter()
+            .filter(|(a, _, _)| changed.iter().any(|c| c == a))
+            .map(|(a, s, peg)| (a.to_string(), s.to_string(), peg))
+            .collect();
+        let (mut moved, mut refused) = (false, None);
+        for (a, sync, peg) in pegs {
+            let Some(prediction) = predict(&a, &sync).filter(|p| p.is_finite()) else {
+                continue;
+            };
+            if (self.board.global(peg) - prediction).abs() > 1e-12 {
+                match self.board.move_to(peg, prediction) {
+                    Ok(_) => moved = true,
+                    Err(e) => refused = Some(format!("anticipators:{a}:{sync}: {e}")),
+                }
+            }
+        }
+        (moved, refused)
+    }
 }
