@@ -24,6 +24,7 @@ pub mod body;
 pub mod clock;
 #[cfg(feature = "conformance")]
 pub mod conformance;
+mod data;
 pub mod engine;
 pub mod engines;
 pub mod feedback;

@@ -71,7 +71,7 @@ impl World {
     /// default ones of the same name). Returns the world and how many obstacles the file lists
     /// (they are not used yet). The error says what is wrong.
     pub fn from_json(text: &str) -> Result<(World, usize), String> {
-        let file: WorldFile = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        let file: WorldFile = crate::data::from_json(text)?;
         let mut w = World::default();
         for (name, at) in file.points {
             w.set(&name, vec3(&name, at)?);

@@ -309,8 +309,11 @@ fn large_blocks_from_one_client_hold_up_no_other() {
     }
     drop(big.join().unwrap());
     eprintln!("slowest start of a small block: {worst:?}");
+    // (a debug build reads about 20 ms here on an idle machine and the build before the change
+    // 820 ms; the bound leaves room for a busy machine. The release figure, under a frame, is in
+    // docs/performance.md.)
     assert!(
-        worst < Duration::from_millis(80),
+        worst < Duration::from_millis(400),
         "a small block waited {worst:?} for its start"
     );
 }

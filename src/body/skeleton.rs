@@ -45,6 +45,35 @@ pub(crate) fn three_numbers(v: &serde_json::Value) -> Option<[f32; 3]> {
     Some(out)
 }
 
+/// A skeleton file as written.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkeletonFile {
+    #[serde(default = "unnamed")]
+    name: String,
+    /// For people reading the file.
+    #[serde(default)]
+    #[allow(dead_code)]
+    units: Option<String>,
+    /// For people reading the file.
+    #[serde(default)]
+    #[allow(dead_code)]
+    description: Option<String>,
+    joints: Vec<JointFile>,
+}
+
+fn unnamed() -> String {
+    "unnamed".into()
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JointFile {
+    name: String,
+    parent: Option<String>,
+    offset: [f32; 3],
+}
+
 impl Skeleton {
     /// The default adult (read from its embedded JSON once per process, then copied).
     pub fn adult() -> Skeleton {
@@ -57,48 +86,41 @@ impl Skeleton {
     /// Reads a skeleton from JSON (see the module documentation).
     pub fn from_json(text: &str) -> Result<Skeleton, SkeletonError> {
         let e = |m: String| SkeletonError(m);
-        let v: serde_json::Value =
-            serde_json::from_str(text).map_err(|x| e(format!("not JSON: {x}")))?;
-        let name = v["name"].as_str().unwrap_or("unnamed").to_string();
-        let list = v["joints"]
-            .as_array()
-            .ok_or_else(|| e("no \"joints\" list".into()))?;
+        let file: SkeletonFile = crate::data::from_json(text).map_err(e)?;
         let mut s = Skeleton {
-            name,
+            name: file.name,
             joints: Vec::new(),
             index: HashMap::new(),
         };
-        for (i, j) in list.iter().enumerate() {
-            let jname = j["name"]
-                .as_str()
-                .filter(|n| !n.is_empty())
-                .ok_or_else(|| e(format!("joint {i} has no name")))?;
-            let parent = match &j["parent"] {
-                serde_json::Value::Null => None,
-                p => {
-                    let p = p.as_str().ok_or_else(|| {
-                        e(format!("joint '{jname}': parent must be a name or null"))
-                    })?;
-                    Some(*s.index.get(p).ok_or_else(|| {
-                        e(format!(
-                            "joint '{jname}': parent '{p}' is not defined before it"
-                        ))
-                    })?)
-                }
+        for (i, j) in file.joints.into_iter().enumerate() {
+            if j.name.is_empty() {
+                return Err(e(format!("joint {i} has no name")));
+            }
+            let parent = match &j.parent {
+                None => None,
+                Some(p) => Some(*s.index.get(p).ok_or_else(|| {
+                    e(format!(
+                        "joint '{}': parent '{p}' is not defined before it",
+                        j.name
+                    ))
+                })?),
             };
             if parent.is_none() && !s.joints.is_empty() {
-                return Err(e(format!("joint '{jname}' is a second root")));
+                return Err(e(format!("joint '{}' is a second root", j.name)));
             }
-            let Some(o) = three_numbers(&j["offset"]) else {
-                return Err(e(format!("joint '{jname}': offset must be three numbers")));
-            };
-            if s.index.insert(jname.to_string(), s.joints.len()).is_some() {
-                return Err(e(format!("joint '{jname}' is defined twice")));
+            if !j.offset.iter().all(|v| v.is_finite()) {
+                return Err(e(format!(
+                    "joint '{}': offset must be three numbers",
+                    j.name
+                )));
+            }
+            if s.index.insert(j.name.clone(), s.joints.len()).is_some() {
+                return Err(e(format!("joint '{}' is defined twice", j.name)));
             }
             s.joints.push(Joint {
-                name: jname.to_string(),
+                name: j.name,
                 parent,
-                offset: Vec3::from_array(o),
+                offset: Vec3::from_array(j.offset),
             });
         }
         if s.joints.is_empty() {
@@ -202,7 +224,7 @@ mod tests {
     #[test]
     fn bad_skeleton_files_are_refused_with_a_reason() {
         let bad = |t: &str| Skeleton::from_json(t).unwrap_err().0;
-        assert!(bad("{").starts_with("not JSON"));
+        assert!(bad("{").contains("EOF while parsing"), "{}", bad("{"));
         assert_eq!(bad(r#"{"joints": []}"#), "no joints");
         assert!(
             bad(r#"{"joints": [{"name": "a", "parent": "b", "offset": [0,0,0]}]}"#)
@@ -210,7 +232,7 @@ mod tests {
         );
         assert!(
             bad(r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0]}]}"#)
-                .contains("three numbers")
+                .starts_with("joints[0].offset: invalid length 2")
         );
         assert!(bad(
             r#"{"joints": [{"name": "a", "parent": null, "offset": [0,0,0]},
@@ -222,5 +244,10 @@ mod tests {
                                     {"name": "b", "parent": null, "offset": [0,0,0]}]}"#
         )
         .contains("second root"));
+        // a misspelled field is named, not ignored
+        assert!(
+            bad(r#"{"joints": [{"name": "a", "parnet": null, "offset": [0,0,0]}]}"#)
+                .starts_with("joints[0].parnet: unknown field `parnet`")
+        );
     }
 }

@@ -44,6 +44,8 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use glam::{EulerRot, Quat, Vec3};
+use indexmap::IndexMap;
+use serde::Deserialize;
 
 use crate::bml::{Behaviour, BehaviourKind, Id, Param};
 use crate::body::ik::{place_limb, LimbRoot, ARM_POLE, LEG_POLE};
@@ -119,26 +121,87 @@ pub struct ProcUnit {
     effectors: Vec<Effector>,
 }
 
-fn number(v: &serde_json::Value, what: &str) -> Result<f64, String> {
-    v.as_f64()
-        .filter(|x| x.is_finite())
-        .ok_or_else(|| format!("{what} must be a number"))
+/// A library file as written (see the module documentation); [`ProcUnit::from_file`] checks
+/// what the types cannot.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LibraryFile {
+    #[serde(default)]
+    #[allow(dead_code)] // for people reading the file
+    description: Option<String>,
+    units: IndexMap<String, UnitFile>,
 }
 
-fn three_exprs(v: &serde_json::Value, what: &str) -> Result<[Expr; 3], String> {
-    let list = v
-        .as_array()
-        .filter(|a| a.len() == 3)
-        .ok_or_else(|| format!("{what}: three expressions"))?;
-    let one = |i: usize| -> Result<Expr, String> {
-        match &list[i] {
-            serde_json::Value::String(s) => Expr::compile(s),
-            serde_json::Value::Number(n) => Expr::compile(&n.to_string()),
-            _ => Err(format!("{what}: an expression is a string or a number")),
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UnitFile {
+    #[serde(default)]
+    parameters: IndexMap<String, f64>,
+    /// Sync name → α, in time order.
+    keys: IndexMap<String, f64>,
+    duration: DurationFile,
+    #[serde(default)]
+    rotations: IndexMap<String, [ExprText; 3]>,
+    #[serde(default)]
+    effectors: IndexMap<String, EffectorFile>,
+    #[serde(default)]
+    additive: bool,
+    #[serde(default)]
+    blend: f64,
+    group: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DurationFile {
+    preferred: f64,
+    #[serde(default = "min_duration")]
+    min: f64,
+    #[serde(default = "unbounded")]
+    max: f64,
+}
+
+fn min_duration() -> f64 {
+    MIN_DURATION
+}
+
+fn unbounded() -> f64 {
+    f64::INFINITY
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EffectorFile {
+    #[serde(default)]
+    frame: FrameName,
+    position: [ExprText; 3],
+}
+
+#[derive(Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum FrameName {
+    #[default]
+    Body,
+    Limb,
+}
+
+/// An expression as written: text, or a plain number.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ExprText {
+    Text(String),
+    Number(f64),
+}
+
+fn three_exprs(e: &[ExprText; 3], what: &str) -> Result<[Expr; 3], String> {
+    let one = |e: &ExprText| {
+        match e {
+            ExprText::Text(s) => Expr::compile(s),
+            ExprText::Number(n) => Expr::compile(&n.to_string()),
         }
         .map_err(|e| format!("{what}: {e}"))
     };
-    Ok([one(0)?, one(1)?, one(2)?])
+    Ok([one(&e[0])?, one(&e[1])?, one(&e[2])?])
 }
 
 impl ProcUnit {
@@ -148,29 +211,25 @@ impl ProcUnit {
         rotated.chain(self.effectors.iter().map(|e| e.joint.as_str()))
     }
 
-    fn from_json(name: &str, v: &serde_json::Value) -> Result<ProcUnit, String> {
+    fn from_file(name: &str, u: UnitFile) -> Result<ProcUnit, String> {
         let at = |what: &str| format!("unit '{name}': {what}");
-        let mut params = Vec::new();
-        if let Some(p) = v.get("parameters") {
-            let p = p
-                .as_object()
-                .ok_or_else(|| at("parameters must be an object"))?;
-            for (k, x) in p {
-                if RESERVED.contains(&k.as_str()) {
-                    return Err(at(&format!(
-                        "parameter '{k}' is a reserved name {RESERVED:?}"
-                    )));
-                }
-                params.push((k.clone(), number(x, &at(&format!("parameter '{k}'")))?));
+        let finite = |v: f64, what: &str| {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(at(&format!("{what} must be a finite number")))
             }
+        };
+        let mut params = Vec::new();
+        for (k, x) in u.parameters {
+            if RESERVED.contains(&k.as_str()) {
+                return Err(at(&format!(
+                    "parameter '{k}' is a reserved name {RESERVED:?}"
+                )));
+            }
+            params.push((k, x));
         }
-        let keys_v = v["keys"]
-            .as_object()
-            .ok_or_else(|| at("no \"keys\" object (sync name → α)"))?;
-        let mut keys = Vec::new();
-        for (k, x) in keys_v {
-            keys.push((Id::new(k), number(x, &at(&format!("key '{k}'")))?));
-        }
+        let keys: Vec<(Id, f64)> = u.keys.iter().map(|(k, &a)| (Id::new(k), a)).collect();
         let ordered = keys.windows(2).all(|w| w[1].1 >= w[0].1);
         let ends = keys.first().is_some_and(|k| k.0 == "start" && k.1 == 0.0)
             && keys.last().is_some_and(|k| k.0 == "end" && k.1 == 1.0);
@@ -179,70 +238,32 @@ impl ProcUnit {
                 "keys must go from start at 0 to end at 1, α not decreasing",
             ));
         }
-        let d = &v["duration"];
-        let preferred = number(&d["preferred"], &at("duration.preferred"))?;
-        let min = d
-            .get("min")
-            .map_or(Ok(MIN_DURATION), |x| number(x, &at("duration.min")))?;
-        let max = d
-            .get("max")
-            .map_or(Ok(f64::INFINITY), |x| number(x, &at("duration.max")))?;
+        let preferred = finite(u.duration.preferred, "duration.preferred")?;
+        let (min, max) = (u.duration.min, u.duration.max);
         if !(min.max(MIN_DURATION) <= preferred && preferred <= max) {
             return Err(at("duration: min ≤ preferred ≤ max, all positive"));
         }
         let mut rotations = Vec::new();
-        if let Some(r) = v.get("rotations") {
-            let r = r
-                .as_object()
-                .ok_or_else(|| at("rotations must be an object"))?;
-            for (joint, e) in r {
-                rotations.push((
-                    joint.clone(),
-                    three_exprs(e, &at(&format!("rotation of {joint}")))?,
-                ));
-            }
+        for (joint, e) in &u.rotations {
+            let what = at(&format!("rotation of {joint}"));
+            rotations.push((joint.clone(), three_exprs(e, &what)?));
         }
         let mut effectors = Vec::new();
-        if let Some(r) = v.get("effectors") {
-            let r = r
-                .as_object()
-                .ok_or_else(|| at("effectors must be an object"))?;
-            for (joint, e) in r {
-                let frame = match e["frame"].as_str().unwrap_or("body") {
-                    "body" => Frame::Body,
-                    "limb" => Frame::Limb,
-                    other => {
-                        return Err(at(&format!(
-                            "effector {joint}: frame '{other}' (body or limb)"
-                        )))
-                    }
-                };
-                let position = three_exprs(&e["position"], &at(&format!("effector {joint}")))?;
-                effectors.push(Effector {
-                    joint: joint.clone(),
-                    frame,
-                    position,
-                });
-            }
+        for (joint, e) in &u.effectors {
+            let frame = match e.frame {
+                FrameName::Body => Frame::Body,
+                FrameName::Limb => Frame::Limb,
+            };
+            let position = three_exprs(&e.position, &at(&format!("effector {joint}")))?;
+            effectors.push(Effector {
+                joint: joint.clone(),
+                frame,
+                position,
+            });
         }
-        let additive = match v.get("additive") {
-            None => false,
-            Some(b) => b
-                .as_bool()
-                .ok_or_else(|| at("additive must be true or false"))?,
-        };
-        let blend = v
-            .get("blend")
-            .map_or(Ok(0.0), |b| number(b, &at("blend")))?
-            .max(0.0);
-        let group = match v.get("group") {
-            None => None,
-            Some(g) => Some(
-                g.as_str()
-                    .ok_or_else(|| at("group must be a string"))?
-                    .to_string(),
-            ),
-        };
+        let additive = u.additive;
+        let blend = finite(u.blend, "blend")?.max(0.0);
+        let group = u.group;
         let unit = ProcUnit {
             name: name.to_string(),
             params,
@@ -526,12 +547,11 @@ impl Library {
 
     /// Reads a library file: `{"units": {NAME: UNIT, …}}` (see the module documentation).
     pub fn from_json(text: &str) -> Result<Library, String> {
-        let v: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
-        let list = v["units"].as_object().ok_or("no \"units\" object")?;
+        let file: LibraryFile = crate::data::from_json(text)?;
         let mut units = HashMap::new();
-        for (name, u) in list {
-            units.insert(name.clone(), Arc::new(ProcUnit::from_json(name, u)?));
+        for (name, u) in file.units {
+            let unit = ProcUnit::from_file(&name, u)?;
+            units.insert(name, Arc::new(unit));
         }
         Ok(Library { units })
     }
@@ -934,7 +954,7 @@ mod tests {
         assert!(bad(&format!(
             r#"{{{keys}, "rotations": {{"r_elbow": ["1", "0"]}}}}"#
         ))
-        .contains("three expressions"));
+        .contains("units.u.rotations.r_elbow: invalid length 2"));
         assert!(bad(
             r#"{"keys": {"start": 0, "end": 1}, "duration": {"preferred": 1, "max": 0.5}}"#
         )
@@ -942,7 +962,7 @@ mod tests {
         assert!(bad(&format!(
             r#"{{{keys}, "effectors": {{"r_wrist": {{"frame": "moon", "position": [0, 0, 0]}}}}}}"#
         ))
-        .contains("frame 'moon'"));
+        .contains("units.u.effectors.r_wrist.frame: unknown variant `moon`"));
         let lib = Library::default_library();
         let u = lib.get("lift").unwrap();
         let p = |n: &str, v: &str| Param {
