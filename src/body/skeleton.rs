@@ -35,16 +35,6 @@ pub struct Skeleton {
 #[error("skeleton: {0}")]
 pub struct SkeletonError(pub String);
 
-/// A JSON array of exactly three finite numbers (data files: offsets, angles).
-pub(crate) fn three_numbers(v: &serde_json::Value) -> Option<[f32; 3]> {
-    let a = v.as_array().filter(|a| a.len() == 3)?;
-    let mut out = [0.0f32; 3];
-    for (o, x) in out.iter_mut().zip(a) {
-        *o = x.as_f64().filter(|x| x.is_finite())? as f32;
-    }
-    Some(out)
-}
-
 /// A skeleton file as written.
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]

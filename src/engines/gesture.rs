@@ -9,6 +9,7 @@
 use std::sync::Arc;
 
 use glam::{EulerRot, Quat};
+use indexmap::IndexMap;
 
 use crate::bml::{Behaviour, BehaviourKind, Param};
 use crate::body::{Pose, Skeleton};
@@ -67,55 +68,40 @@ impl Lexicon {
     /// filter `"when": {ATTRIBUTE: VALUE}`, and either `"keys": {SYNC: {JOINT: [z, x, y]}}` or
     /// `"procedural": UNIT` (a unit of `library`) with optional `"parameters": {NAME: NUMBER}`.
     pub fn from_json(text: &str, library: &Library) -> Result<Lexicon, String> {
-        let v: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
-        let list = v["gestures"].as_array().ok_or("no \"gestures\" list")?;
+        let file: LexiconFile = crate::data::from_json(text)?;
         let mut bindings = Vec::new();
-        for g in list {
-            let lexeme = g["lexeme"].as_str().ok_or("a gesture without \"lexeme\"")?;
-            let mut when = Vec::new();
-            if let Some(w) = g.get("when") {
-                let w = w
-                    .as_object()
-                    .ok_or_else(|| format!("{lexeme}: \"when\" must be an object"))?;
-                for (k, x) in w {
-                    let x = x
-                        .as_str()
-                        .ok_or_else(|| format!("{lexeme}: when.{k} must be a string"))?;
-                    when.push((k.clone(), x.to_string()));
-                }
-            }
-            let bound = match (g.get("keys"), g.get("procedural")) {
-                (Some(keys), None) => Bound::Keys(Arc::new(read_keys(lexeme, keys)?)),
+        for (i, g) in file.gestures.into_iter().enumerate() {
+            let lexeme = g.lexeme;
+            let bound = match (g.keys, g.procedural) {
+                (Some(keys), None) => Bound::Keys(Arc::new(
+                    key_rotations(keys).map_err(|e| format!("gestures[{i}] ({lexeme}): {e}"))?,
+                )),
                 (None, Some(name)) => {
-                    let name = name
-                        .as_str()
-                        .ok_or_else(|| format!("{lexeme}: \"procedural\" names a unit"))?;
-                    let unit = library.get(name).ok_or_else(|| {
+                    let unit = library.get(&name).ok_or_else(|| {
                         format!("{lexeme}: no procedural unit '{name}' in the library")
                     })?;
-                    let mut overrides = Vec::new();
-                    if let Some(p) = g.get("parameters") {
-                        let p = p
-                            .as_object()
-                            .ok_or_else(|| format!("{lexeme}: parameters must be an object"))?;
-                        for (k, x) in p {
-                            overrides.push(Param {
-                                name: k.clone(),
-                                value: x.to_string(),
-                            });
-                        }
-                    }
+                    let overrides: Vec<Param> = g
+                        .parameters
+                        .iter()
+                        .map(|(k, x)| Param {
+                            name: k.clone(),
+                            value: x.to_string(),
+                        })
+                        .collect();
                     let params = unit
                         .parameters(&overrides)
                         .map_err(|e| format!("{lexeme}: {e}"))?;
                     Bound::Procedural(unit.clone(), params)
                 }
-                _ => return Err(format!("{lexeme}: either \"keys\" or \"procedural\"")),
+                _ => {
+                    return Err(format!(
+                        "gestures[{i}] ({lexeme}): either \"keys\" or \"procedural\""
+                    ))
+                }
             };
             bindings.push(Binding {
-                lexeme: lexeme.to_string(),
-                when,
+                lexeme,
+                when: g.when.into_iter().collect(),
                 bound,
             });
         }
@@ -199,28 +185,46 @@ impl Lexicon {
     }
 }
 
-fn read_keys(lexeme: &str, keys: &serde_json::Value) -> Result<GestureKeys, String> {
-    let keys = keys
-        .as_object()
-        .ok_or_else(|| format!("{lexeme}: \"keys\" must be an object"))?;
-    let mut out: GestureKeys = Vec::new();
+/// A bindings file as written (see [`Lexicon::from_json`]).
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LexiconFile {
+    #[serde(default)]
+    #[allow(dead_code)] // for people reading the file
+    description: Option<String>,
+    gestures: Vec<BindingFile>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BindingFile {
+    lexeme: String,
+    #[serde(default)]
+    when: IndexMap<String, String>,
+    /// Sync → joint → `[z, x, y]` degrees.
+    keys: Option<IndexMap<String, IndexMap<String, [f32; 3]>>>,
+    procedural: Option<String>,
+    #[serde(default)]
+    parameters: IndexMap<String, f64>,
+}
+
+/// The rotations of bound keys, from `[z, x, y]` degrees (each a finite number).
+fn key_rotations(
+    keys: IndexMap<String, IndexMap<String, [f32; 3]>>,
+) -> Result<GestureKeys, String> {
+    let mut out = GestureKeys::new();
     for (sync, joints) in keys {
-        let joints = joints
-            .as_object()
-            .ok_or_else(|| format!("{lexeme}:{sync}: joints must be an object"))?;
         let mut rot = Vec::new();
-        for (joint, angles) in joints {
-            let a = crate::body::skeleton::three_numbers(angles)
-                .ok_or_else(|| format!("{lexeme}:{sync}:{joint}: three angles (z, x, y)"))?;
-            let q = Quat::from_euler(
-                EulerRot::ZXY,
-                a[0].to_radians(),
-                a[1].to_radians(),
-                a[2].to_radians(),
-            );
-            rot.push((joint.clone(), q));
+        for (joint, a) in joints {
+            if !a.iter().all(|v| v.is_finite()) {
+                return Err(format!(
+                    "keys.{sync}.{joint}: three finite angles (z, x, y)"
+                ));
+            }
+            let [z, x, y] = a.map(f32::to_radians);
+            rot.push((joint, Quat::from_euler(EulerRot::ZXY, z, x, y)));
         }
-        out.push((sync.clone(), rot));
+        out.push((sync, rot));
     }
     Ok(out)
 }
@@ -504,7 +508,11 @@ mod tests {
         let bad = |j: &str| Lexicon::from_json(j, &lib).unwrap_err();
         assert!(
             bad(r#"{"gestures": [{"lexeme": "X", "keys": {"stroke": {"r_elbow": [1, 2]}}}]}"#)
-                .contains("three angles")
+                .starts_with("gestures[0].keys.stroke.r_elbow: invalid length 2")
+        );
+        assert!(
+            bad(r#"{"gestures": [{"lexeme": "X", "kyes": {}}]}"#)
+                .starts_with("gestures[0].kyes: unknown field")
         );
         assert!(
             bad(r#"{"gestures": [{"lexeme": "X", "procedural": "nope"}]}"#)

@@ -58,36 +58,48 @@ impl HeadLexicon {
 
     /// Reads `{"heads": [{"lexeme", "axis": x|y|z, "degrees", "alternate"?}]}`.
     pub fn from_json(text: &str) -> Result<HeadLexicon, String> {
-        let v: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
-        let list = v["heads"].as_array().ok_or("no \"heads\" list")?;
-        let mut motions = Vec::new();
-        for h in list {
-            let lexeme = h["lexeme"]
-                .as_str()
-                .ok_or("a head binding without \"lexeme\"")?;
-            let axis = match h["axis"].as_str() {
-                Some("x") => Vec3::X,
-                Some("y") => Vec3::Y,
-                Some("z") => Vec3::Z,
-                other => return Err(format!("{lexeme}: axis {other:?} (x, y or z)")),
-            };
-            let degrees = h["degrees"]
-                .as_f64()
-                .filter(|d| d.is_finite())
-                .ok_or_else(|| format!("{lexeme}: degrees must be a number"))?;
-            let alternate = h
-                .get("alternate")
-                .is_some_and(|a| a.as_bool() == Some(true));
-            motions.push((
-                lexeme.to_string(),
-                Motion {
-                    axis,
-                    degrees,
-                    alternate,
-                },
-            ));
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct File {
+            #[serde(default)]
+            #[allow(dead_code)] // for people reading the file
+            description: Option<String>,
+            heads: Vec<Head>,
         }
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Head {
+            lexeme: String,
+            axis: Axis,
+            degrees: f64,
+            #[serde(default)]
+            alternate: bool,
+        }
+        #[derive(serde::Deserialize)]
+        #[serde(rename_all = "lowercase")]
+        enum Axis {
+            X,
+            Y,
+            Z,
+        }
+        let file: File = crate::data::from_json(text)?;
+        let motions = file
+            .heads
+            .into_iter()
+            .map(|h| {
+                let axis = match h.axis {
+                    Axis::X => Vec3::X,
+                    Axis::Y => Vec3::Y,
+                    Axis::Z => Vec3::Z,
+                };
+                let motion = Motion {
+                    axis,
+                    degrees: h.degrees,
+                    alternate: h.alternate,
+                };
+                (h.lexeme, motion)
+            })
+            .collect();
         Ok(HeadLexicon { motions })
     }
 

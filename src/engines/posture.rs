@@ -80,30 +80,44 @@ impl PoseBindings {
 
     /// Reads `{"poses": [{"part", "lexeme", "procedural", "sides": right|left|both}]}`.
     pub fn from_json(text: &str, library: &Library) -> Result<PoseBindings, String> {
-        let v: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
-        let list = v["poses"].as_array().ok_or("no \"poses\" list")?;
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct File {
+            #[serde(default)]
+            #[allow(dead_code)] // for people reading the file
+            description: Option<String>,
+            poses: Vec<Pose>,
+        }
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Pose {
+            part: String,
+            lexeme: String,
+            procedural: String,
+            sides: Sides,
+        }
+        #[derive(serde::Deserialize)]
+        #[serde(rename_all = "lowercase")]
+        enum Sides {
+            Right,
+            Left,
+            Both,
+        }
+        let file: File = crate::data::from_json(text)?;
         let mut poses = Vec::new();
-        for p in list {
-            let field = |k: &str| {
-                p[k].as_str()
-                    .ok_or_else(|| format!("a pose binding needs \"{k}\" ({p})"))
-            };
-            let part = PosePart::parse(field("part")?)
-                .ok_or_else(|| format!("unknown pose part '{}'", field("part").unwrap_or("")))?;
-            let lexeme = field("lexeme")?.to_string();
-            let unit = field("procedural")?;
+        for (i, p) in file.poses.into_iter().enumerate() {
+            let part = PosePart::parse(&p.part)
+                .ok_or_else(|| format!("poses[{i}].part: unknown pose part '{}'", p.part))?;
             let unit = library
-                .get(unit)
-                .ok_or_else(|| format!("{lexeme}: no procedural unit '{unit}'"))?
+                .get(&p.procedural)
+                .ok_or_else(|| format!("{}: no procedural unit '{}'", p.lexeme, p.procedural))?
                 .clone();
-            let sides: &'static [bool] = match field("sides")? {
-                "right" => &[false],
-                "left" => &[true],
-                "both" => &[false, true],
-                other => return Err(format!("{lexeme}: sides '{other}' (right, left or both)")),
+            let sides: &'static [bool] = match p.sides {
+                Sides::Right => &[false],
+                Sides::Left => &[true],
+                Sides::Both => &[false, true],
             };
-            poses.push((part, lexeme, (unit, sides)));
+            poses.push((part, p.lexeme, (unit, sides)));
         }
         Ok(PoseBindings { poses })
     }
