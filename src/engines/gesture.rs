@@ -510,10 +510,8 @@ mod tests {
             bad(r#"{"gestures": [{"lexeme": "X", "keys": {"stroke": {"r_elbow": [1, 2]}}}]}"#)
                 .starts_with("gestures[0].keys.stroke.r_elbow: invalid length 2")
         );
-        assert!(
-            bad(r#"{"gestures": [{"lexeme": "X", "kyes": {}}]}"#)
-                .starts_with("gestures[0].kyes: unknown field")
-        );
+        assert!(bad(r#"{"gestures": [{"lexeme": "X", "kyes": {}}]}"#)
+            .starts_with("gestures[0].kyes: unknown field"));
         assert!(
             bad(r#"{"gestures": [{"lexeme": "X", "procedural": "nope"}]}"#)
                 .contains("no procedural unit 'nope'")

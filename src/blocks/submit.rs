@@ -1,0 +1,283 @@
+//! Submitting a block: an id in use is refused; interrupts and REPLACE take blocks out of the plan;
+//! composition and the BMLA attributes decide what the block waits for; it is scheduled against
+//! the other blocks' times (`OtherBlocks`), and then waits, lurks or starts.
+
+use super::*;
+
+/// Times of other blocks' syncs relative to the start of a block being scheduled.
+pub(super) struct OtherBlocks<'a> {
+    pub(super) blocks: &'a [LiveBlock],
+    pub(super) seqs: &'a [u64],
+    pub(super) index: &'a HashMap<bml::Id, u64>,
+    pub(super) anticipators: &'a [Box<dyn Anticipator>],
+    pub(super) start: f64,
+}
+
+/// Where block `id` is among the blocks whose `seq`s are `seqs` (increasing).
+pub(super) fn position(seqs: &[u64], index: &HashMap<bml::Id, u64>, id: &str) -> Option<usize> {
+    seqs.binary_search(index.get(id)?).ok()
+}
+
+impl ExternalTimes for OtherBlocks<'_> {
+    fn time(&self, point: &SyncPoint) -> Option<f64> {
+        match point {
+            SyncPoint::External {
+                block,
+                behaviour,
+                sync,
+            } => {
+                let b = &self.blocks[position(self.seqs, self.index, block)?];
+                let local = b.behaviour(behaviour)?.time(sync)?;
+                Some(b.start + local - self.start)
+            }
+            SyncPoint::Anticipator { anticipator, sync } => {
+                let a = self.anticipators.iter().find(|a| a.id() == anticipator)?;
+                Some(a.predict(sync)? - self.start)
+            }
+            SyncPoint::Local { .. } => None,
+        }
+    }
+}
+
+impl BlockManager {
+    /// Plans `block` at the current time: interrupts, composition, scheduling, and its start if
+    /// nothing holds it back. Every problem becomes a warning; the block is rejected only if its
+    /// id is in use or its required behaviours cannot be scheduled.
+    pub fn submit(&mut self, block: bml::Block, warnings: &[Diagnostic]) {
+        self.touch();
+        let now = self.now;
+        if let Some(i) = self.pos(&block.id) {
+            let status = self.blocks[i].status;
+            self.warn(
+                block.id.to_string(),
+                KnownWarning::ImpossibleToSchedule,
+                format!(
+                    "block id '{}' is still in use (status {status}); the new block is ignored",
+                    block.id
+                ),
+            );
+            return;
+        }
+        self.parse_warnings(&block, warnings);
+        // blocks named in bmla:interrupt leave the plan first, then REPLACE removes everything;
+        // what waited for them starts only once all of them are gone
+        for target in &block.ext.interrupt {
+            self.interrupt_block_by_id(target, now, &block.id);
+        }
+        if block.composition == bml::Composition::Replace {
+            let ids: Vec<bml::Id> = self.blocks.iter().map(|b| b.id.clone()).collect();
+            for id in ids {
+                self.interrupt_block_by_id(&id, now, &block.id);
+            }
+        }
+        self.start_ready(now);
+        // blocks this one waits for
+        let mut waits_for: Vec<bml::Id> = match &block.composition {
+            bml::Composition::Append => self
+                .blocks
+                .iter()
+                .filter(|b| b.status != BlockStatus::Pending)
+                .map(|b| b.id.clone())
+                .collect(),
+            bml::Composition::AppendAfter(ids) => self.existing(ids, &block.id),
+            _ => Vec::new(),
+        };
+        for id in self.existing(&block.ext.append_after, &block.id) {
+            if !waits_for.contains(&id) {
+                waits_for.push(id);
+            }
+        }
+        let chunk_after = self.existing(&block.ext.chunk_after, &block.id);
+        let mut start = self.predicted_start(now, &waits_for, &chunk_after);
+        // a block tied to another block's sync point that passed a moment ago starts then
+        let mut on_anticipators = false;
+        for p in referenced_points(&block) {
+            on_anticipators |= matches!(p, SyncPoint::Anticipator { .. });
+            if let SyncPoint::External {
+                block: b,
+                behaviour,
+                sync,
+            } = p
+            {
+                let t = self.pos(b).and_then(|i| {
+                    let other = &self.blocks[i];
+                    Some(other.start + other.behaviour(behaviour)?.time(sync)?)
+                });
+                if let Some(t) = t.filter(|t| *t < start && start - *t <= LATE_START) {
+                    start = t;
+                }
+            }
+        }
+
+        // scheduling starts
+        self.seq += 1;
+        let mut live = LiveBlock::new(block, self.seq, start, waits_for, chunk_after);
+        let fb = self.prediction(&live, false);
+        self.emit(fb);
+
+        let schedule = {
+            let external = OtherBlocks {
+                blocks: &self.blocks,
+                seqs: &self.seqs,
+                index: &self.index,
+                anticipators: &self.anticipators,
+                start,
+            };
+            self.strategy
+                .schedule(&live.source, &self.registry, &external)
+        };
+        let schedule = match schedule {
+            Ok(mut s) => {
+                // (asked only of a behaviour whose end is infinite)
+                s.drop_unreachable(|id| {
+                    let b = live.source.behaviours.iter().find(|b| b.id == *id);
+                    b.and_then(|b| TimingModels::model(&self.registry, b))
+                        .is_some_and(|m| m.persistent)
+                });
+                s
+            }
+            Err(e) => {
+                let id = live.id.clone();
+                self.warn(id, KnownWarning::CannotSatisfyConstraints, e.to_string());
+                return;
+            }
+        };
+        for d in &schedule.dropped {
+            self.warn(
+                format!("{}:{}", live.id, d.behaviour),
+                d.warning,
+                d.reason.clone(),
+            );
+        }
+        let refs = if on_anticipators {
+            anticipator_refs(&live.source)
+        } else {
+            Vec::new()
+        };
+        if !refs.is_empty() {
+            // its own peg board: anticipator moves retime it without rescheduling
+            let (mut board, mut anticipators) = (PegBoard::new(), Anticipators::default());
+            for (a, sync) in refs {
+                let predicted = self
+                    .anticipators
+                    .iter()
+                    .find(|x| x.id() == a)
+                    .and_then(|x| x.predict(sync));
+                if let Some(t) = predicted.filter(|t| t.is_finite()) {
+                    anticipators.peg(&mut board, a, sync, t);
+                }
+            }
+            let plan = to_pegs::plan_block(
+                &mut board,
+                &mut anticipators,
+                &live.source,
+                &schedule,
+                start,
+            );
+            live.pegs = Some(Box::new(BlockPegs {
+                board,
+                anticipators,
+                plan,
+            }));
+        }
+        live.set_schedule(schedule, &self.registry);
+        for (beh, reason) in live.resolve_exclusive_ties(&self.registry) {
+            self.warn(
+                format!("{}:{beh}", live.id),
+                KnownWarning::ImpossibleToSchedule,
+                reason,
+            );
+        }
+        // chunkBefore / prependBefore: make other blocks wait for this one
+        let id = live.id.clone();
+        let ext = &live.source.ext;
+        for (targets, chunk) in [(&ext.chunk_before, true), (&ext.prepend_before, false)] {
+            for t in targets {
+                match self.pos(t).map(|i| &mut self.blocks[i]) {
+                    Some(b) if !b.started() => {
+                        let list = if chunk {
+                            &mut b.chunk_after
+                        } else {
+                            &mut b.waits_for
+                        };
+                        list.push(id.clone());
+                    }
+                    Some(_) => self.warn(
+                        id.clone(),
+                        KnownWarning::ImpossibleToSchedule,
+                        format!("block '{t}' has already started; '{id}' cannot go before it"),
+                    ),
+                    None => self.warn(
+                        id.clone(),
+                        KnownWarning::NoSuchTarget,
+                        format!("no block '{t}' to go before"),
+                    ),
+                }
+            }
+        }
+        // scheduled: PENDING, and pre-planned blocks wait for an activation
+        let preplan = ext.preplan;
+        live.status = BlockStatus::Pending;
+        live.preplan = preplan;
+        self.index.insert(live.id.clone(), live.seq);
+        self.seqs.push(live.seq);
+        self.blocks.push(live);
+        let i = self.blocks.len() - 1;
+        self.predict(i, true);
+        if !preplan {
+            if self.ready(i) {
+                // at its planned start: now, or a moment ago (LATE_START)
+                let t = self.blocks[i].start.min(now);
+                self.start_block(i, t);
+            } else {
+                self.release(i, now);
+            }
+        }
+        self.start_ready(now);
+    }
+
+    /// The ids of `ids` that name live blocks. Unknown ids that never existed get a warning.
+    pub(super) fn existing(&mut self, ids: &[String], by: &str) -> Vec<bml::Id> {
+        let mut v = Vec::new();
+        for id in ids {
+            if self.pos(id).is_some() {
+                v.push(bml::Id::new(id));
+            } else if !self.finished_set.contains(id.as_str()) {
+                self.warn(
+                    by.to_string(),
+                    KnownWarning::NoSuchTarget,
+                    format!("block '{by}' refers to block '{id}', which does not exist"),
+                );
+            }
+        }
+        v
+    }
+
+    pub(super) fn predicted_start(
+        &self,
+        now: f64,
+        waits_for: &[bml::Id],
+        chunk_after: &[bml::Id],
+    ) -> f64 {
+        let mut start = now;
+        for (ids, subsiding) in [(waits_for, false), (chunk_after, true)] {
+            for b in ids
+                .iter()
+                .filter_map(|id| self.pos(id))
+                .map(|i| &self.blocks[i])
+            {
+                let t = if subsiding {
+                    b.predicted_subsiding()
+                } else {
+                    b.predicted_end()
+                };
+                start = start.max(t.unwrap_or(now));
+            }
+        }
+        if start.is_finite() {
+            start
+        } else {
+            now
+        }
+    }
+}
