@@ -3,6 +3,7 @@
 //! the other blocks' times (`OtherBlocks`), and then waits, lurks or starts.
 
 use super::*;
+use crate::schedule::BlockSchedule;
 
 /// Times of other blocks' syncs relative to the start of a block being scheduled.
 pub(super) struct OtherBlocks<'a> {
@@ -48,19 +49,45 @@ impl BlockManager {
         let now = self.now;
         if let Some(i) = self.pos(&block.id) {
             let status = self.blocks[i].status;
+            let text = format!(
+                "block id '{}' is still in use (status {status}); the new block is ignored",
+                block.id
+            );
             self.warn(
                 block.id.to_string(),
                 KnownWarning::ImpossibleToSchedule,
-                format!(
-                    "block id '{}' is still in use (status {status}); the new block is ignored",
-                    block.id
-                ),
+                text,
             );
             return;
         }
         self.parse_warnings(&block, warnings);
-        // blocks named in bmla:interrupt leave the plan first, then REPLACE removes everything;
-        // what waited for them starts only once all of them are gone
+        // composition: what leaves the plan, what the block waits for, when it may start
+        self.make_room_for(&block, now);
+        let (waits_for, chunk_after) = self.waits_for(&block);
+        let start = self.start_of(&block, now, &waits_for, &chunk_after);
+        self.seq += 1;
+        let mut live = LiveBlock::new(block, self.seq, start, waits_for, chunk_after);
+        let fb = self.prediction(&live, false);
+        self.emit(fb);
+        // schedule
+        let Some(schedule) = self.schedule(&live) else {
+            return;
+        };
+        // pegs, for a block that hangs on anticipators
+        live.pegs = self.pegs_for(&live, &schedule);
+        live.set_schedule(schedule, &self.registry);
+        for (beh, reason) in live.resolve_exclusive_ties(&self.registry) {
+            let id = format!("{}:{beh}", live.id);
+            self.warn(id, KnownWarning::ImpossibleToSchedule, reason);
+        }
+        self.go_before(&live);
+        // start, or wait
+        self.admit(live, now);
+    }
+
+    /// Takes out of the plan the blocks `block` interrupts (its `bmla:interrupt` list first, then
+    /// every block for REPLACE); what waited for them starts once all of them are gone.
+    fn make_room_for(&mut self, block: &bml::Block, now: f64) {
         for target in &block.ext.interrupt {
             self.interrupt_block_by_id(target, now, &block.id);
         }
@@ -71,7 +98,12 @@ impl BlockManager {
             }
         }
         self.start_ready(now);
-        // blocks this one waits for
+    }
+
+    /// The blocks `block` waits for (APPEND: every block but pre-planned ones not activated;
+    /// APPEND-AFTER and `appendAfter`: the ones named) and those it waits to subside
+    /// (`chunkAfter`).
+    fn waits_for(&mut self, block: &bml::Block) -> (Vec<bml::Id>, Vec<bml::Id>) {
         let mut waits_for: Vec<bml::Id> = match &block.composition {
             bml::Composition::Append => self
                 .blocks
@@ -88,11 +120,20 @@ impl BlockManager {
             }
         }
         let chunk_after = self.existing(&block.ext.chunk_after, &block.id);
-        let mut start = self.predicted_start(now, &waits_for, &chunk_after);
-        // a block tied to another block's sync point that passed a moment ago starts then
-        let mut on_anticipators = false;
-        for p in referenced_points(&block) {
-            on_anticipators |= matches!(p, SyncPoint::Anticipator { .. });
+        (waits_for, chunk_after)
+    }
+
+    /// When `block` is predicted to start: after what it waits for, or up to [`LATE_START`]
+    /// earlier than now when it is tied to another block's sync point that passed a moment ago.
+    fn start_of(
+        &self,
+        block: &bml::Block,
+        now: f64,
+        waits_for: &[bml::Id],
+        chunk_after: &[bml::Id],
+    ) -> f64 {
+        let mut start = self.predicted_start(now, waits_for, chunk_after);
+        for p in referenced_points(block) {
             if let SyncPoint::External {
                 block: b,
                 behaviour,
@@ -108,88 +149,75 @@ impl BlockManager {
                 }
             }
         }
+        start
+    }
 
-        // scheduling starts
-        self.seq += 1;
-        let mut live = LiveBlock::new(block, self.seq, start, waits_for, chunk_after);
-        let fb = self.prediction(&live, false);
-        self.emit(fb);
-
-        let schedule = {
-            let external = OtherBlocks {
-                blocks: &self.blocks,
-                seqs: &self.seqs,
-                index: &self.index,
-                anticipators: &self.anticipators,
-                start,
-            };
-            self.strategy
-                .schedule(&live.source, &self.registry, &external)
+    /// Schedules `live` against the other blocks' times: the schedule with its dropped
+    /// behaviours reported, or `None` (with a warning) when the block cannot be scheduled.
+    fn schedule(&mut self, live: &LiveBlock) -> Option<BlockSchedule> {
+        let external = OtherBlocks {
+            blocks: &self.blocks,
+            seqs: &self.seqs,
+            index: &self.index,
+            anticipators: &self.anticipators,
+            start: live.start,
         };
-        let schedule = match schedule {
-            Ok(mut s) => {
-                // (asked only of a behaviour whose end is infinite)
-                s.drop_unreachable(|id| {
-                    let b = live.source.behaviours.iter().find(|b| b.id == *id);
-                    b.and_then(|b| TimingModels::model(&self.registry, b))
-                        .is_some_and(|m| m.persistent)
-                });
-                s
-            }
+        let schedule = self
+            .strategy
+            .schedule(&live.source, &self.registry, &external);
+        let mut schedule = match schedule {
+            Ok(s) => s,
             Err(e) => {
                 let id = live.id.clone();
                 self.warn(id, KnownWarning::CannotSatisfyConstraints, e.to_string());
-                return;
+                return None;
             }
         };
+        // (asked only of a behaviour whose end is infinite)
+        schedule.drop_unreachable(|id| {
+            let b = live.source.behaviours.iter().find(|b| b.id == *id);
+            b.and_then(|b| TimingModels::model(&self.registry, b))
+                .is_some_and(|m| m.persistent)
+        });
         for d in &schedule.dropped {
-            self.warn(
-                format!("{}:{}", live.id, d.behaviour),
-                d.warning,
-                d.reason.clone(),
-            );
+            let id = format!("{}:{}", live.id, d.behaviour);
+            self.warn(id, d.warning, d.reason.clone());
         }
-        let refs = if on_anticipators {
-            anticipator_refs(&live.source)
-        } else {
-            Vec::new()
-        };
-        if !refs.is_empty() {
-            // its own peg board: anticipator moves retime it without rescheduling
-            let (mut board, mut anticipators) = (PegBoard::new(), Anticipators::default());
-            for (a, sync) in refs {
-                let predicted = self
-                    .anticipators
-                    .iter()
-                    .find(|x| x.id() == a)
-                    .and_then(|x| x.predict(sync));
-                if let Some(t) = predicted.filter(|t| t.is_finite()) {
-                    anticipators.peg(&mut board, a, sync, t);
-                }
+        Some(schedule)
+    }
+
+    /// The peg board of a block that refers to anticipators (`None` for the others): its
+    /// schedule on pegs, the anticipators' pegs at their current predictions.
+    fn pegs_for(&self, live: &LiveBlock, schedule: &BlockSchedule) -> Option<Box<BlockPegs>> {
+        let refs = anticipator_refs(&live.source);
+        if refs.is_empty() {
+            return None;
+        }
+        let (mut board, mut anticipators) = (PegBoard::new(), Anticipators::default());
+        for (a, sync) in refs {
+            let predicted = self
+                .anticipators
+                .iter()
+                .find(|x| x.id() == a)
+                .and_then(|x| x.predict(sync));
+            if let Some(t) = predicted.filter(|t| t.is_finite()) {
+                anticipators.peg(&mut board, a, sync, t);
             }
-            let plan = to_pegs::plan_block(
-                &mut board,
-                &mut anticipators,
-                &live.source,
-                &schedule,
-                start,
-            );
-            live.pegs = Some(Box::new(BlockPegs {
-                board,
-                anticipators,
-                plan,
-            }));
         }
-        live.set_schedule(schedule, &self.registry);
-        for (beh, reason) in live.resolve_exclusive_ties(&self.registry) {
-            self.warn(
-                format!("{}:{beh}", live.id),
-                KnownWarning::ImpossibleToSchedule,
-                reason,
-            );
-        }
-        // chunkBefore / prependBefore: make other blocks wait for this one
-        let id = live.id.clone();
+        let start = live.start;
+        let plan =
+            to_pegs::plan_block(&mut board, &mut anticipators, &live.source, schedule, start);
+        Some(Box::new(BlockPegs {
+            board,
+            anticipators,
+            plan,
+        }))
+    }
+
+    /// `chunkBefore` / `prependBefore`: the blocks `live` names wait for it (to subside, or to
+    /// end), unless they have started.
+    fn go_before(&mut self, live: &LiveBlock) {
+        let id = &live.id;
         let ext = &live.source.ext;
         for (targets, chunk) in [(&ext.chunk_before, true), (&ext.prepend_before, false)] {
             for t in targets {
@@ -203,20 +231,24 @@ impl BlockManager {
                         list.push(id.clone());
                     }
                     Some(_) => self.warn(
-                        id.clone(),
+                        id.to_string(),
                         KnownWarning::ImpossibleToSchedule,
                         format!("block '{t}' has already started; '{id}' cannot go before it"),
                     ),
                     None => self.warn(
-                        id.clone(),
+                        id.to_string(),
                         KnownWarning::NoSuchTarget,
                         format!("no block '{t}' to go before"),
                     ),
                 }
             }
         }
-        // scheduled: PENDING, and pre-planned blocks wait for an activation
-        let preplan = ext.preplan;
+    }
+
+    /// A scheduled block joins the plan PENDING: a pre-planned one waits for an activation,
+    /// another starts now if nothing holds it back, or lurks.
+    fn admit(&mut self, mut live: LiveBlock, now: f64) {
+        let preplan = live.source.ext.preplan;
         live.status = BlockStatus::Pending;
         live.preplan = preplan;
         self.index.insert(live.id.clone(), live.seq);
