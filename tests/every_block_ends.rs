@@ -179,3 +179,43 @@ fn a_block_with_huge_and_tiny_times_does_not_stall_the_scheduler() {
     };
     settles(&blocks, limits).unwrap();
 }
+
+/// A block that waits for a pre-planned block and asks that block to wait for it
+/// (`appendAfter` and `prependBefore` naming the same block) made a cycle: once the first was
+/// activated, neither ever started. The second request is refused with a warning and both end.
+#[test]
+fn blocks_cannot_be_made_to_wait_for_each_other() {
+    const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmla="http://www.asap-project.org/bmla""#;
+    let mut r = Realizer::new();
+    let mut feedback = Vec::new();
+    for text in [
+        format!(
+            r#"<bml {NS} id="a" bmla:preplan="true"><speech id="s"><text>Hello there.</text></speech></bml>"#
+        ),
+        format!(
+            r#"<bml {NS} id="n" bmla:appendAfter="a" bmla:prependBefore="a"><speech id="s"><text>Me first.</text></speech></bml>"#
+        ),
+        format!(r#"<bml {NS} id="go" bmla:onStart="a"/>"#),
+    ] {
+        r.perform_bml(&text).unwrap();
+    }
+    feedback.extend(r.tick(0.0).feedback);
+    while let Some(t) = r.next_event() {
+        feedback.extend(r.tick(t).feedback);
+    }
+    let progress: Vec<String> = feedback
+        .iter()
+        .filter_map(|f| match f {
+            Feedback::BlockProgress(p) => Some(format!("{}:{}", p.block, p.sync)),
+            _ => None,
+        })
+        .collect();
+    for id in ["a", "n"] {
+        assert!(
+            progress.contains(&format!("{id}:end")),
+            "{id} never ends: {progress:?}"
+        );
+    }
+    assert!(feedback.iter().any(|f| matches!(f, Feedback::Warning(w)
+        if w.id == "n" && w.text.contains("wait for each other"))));
+}

@@ -15,6 +15,7 @@
 //! `feedback.rs`; `live.rs` is a block in the plan.
 
 mod anticipation;
+mod dependencies;
 mod event_loop;
 mod feedback;
 mod interrupt;

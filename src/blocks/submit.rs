@@ -215,12 +215,20 @@ impl BlockManager {
     }
 
     /// `chunkBefore` / `prependBefore`: the blocks `live` names wait for it (to subside, or to
-    /// end), unless they have started.
+    /// end), unless they have started, or `live` itself waits for them (a cycle: neither would
+    /// ever start).
     fn go_before(&mut self, live: &LiveBlock) {
         let id = &live.id;
         let ext = &live.source.ext;
         for (targets, chunk) in [(&ext.chunk_before, true), (&ext.prepend_before, false)] {
             for t in targets {
+                if dependencies::waits_on(&self.blocks, live, t) {
+                    let text = format!(
+                        "'{id}' waits for block '{t}', so '{t}' cannot wait for it; the two would wait for each other for ever"
+                    );
+                    self.warn(id.to_string(), KnownWarning::ImpossibleToSchedule, text);
+                    continue;
+                }
                 match self.pos(t).map(|i| &mut self.blocks[i]) {
                     Some(b) if !b.started() => {
                         let list = if chunk {
