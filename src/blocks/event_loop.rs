@@ -155,7 +155,8 @@ impl BlockManager {
     /// Gives every engine that asks for them the poses the predictable units will have at the
     /// times it names.
     pub(super) fn predict_poses(&mut self, now: f64) {
-        for i in 0..self.registry.len() {
+        let ids: Vec<_> = self.registry.ids().collect();
+        for i in ids {
             let times = self.registry.engine(i).prediction_times(now);
             if times.is_empty() {
                 continue;

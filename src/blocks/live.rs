@@ -31,7 +31,7 @@ pub(crate) struct LiveBehaviour {
     /// Index in the block's `behaviours` (document order).
     pub(crate) index: usize,
     /// Registry index of its engine.
-    pub(crate) engine: usize,
+    pub(crate) engine: crate::engine::EngineId,
     /// (sync, block-local time) in sync order.
     pub(crate) syncs: Vec<(SyncName, f64)>,
     /// The next sync to pass.

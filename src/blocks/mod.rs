@@ -92,7 +92,7 @@ pub struct BlockManager {
     anticipators: Vec<Box<dyn Anticipator>>,
     /// Units whose end passed during this advance: engines drop them after the frame, so that
     /// the frame at their end still shows their last moment.
-    retiring: Vec<(usize, UnitKey)>,
+    retiring: Vec<(crate::engine::EngineId, UnitKey)>,
     skeleton: Skeleton,
     /// The world as of the last advance (shared with the realizer).
     world: std::sync::Arc<World>,

@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::Arc;
 
-pub use registry::{KindKey, Registry};
+pub use registry::{EngineId, KindKey, Registry};
 
 use crate::bml::{Behaviour, TrajectoryType};
 use crate::body::{Pose, Skeleton};

@@ -30,15 +30,19 @@ impl KindKey {
     }
 }
 
+/// An engine of a [`Registry`], as [`Registry::register`] returned it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct EngineId(usize);
+
 /// Engines and the kinds each realizes.
 #[derive(Default)]
 pub struct Registry {
     engines: Vec<Box<dyn Engine>>,
-    /// (kind, engine index) for every registered kind, in registration order.
-    kinds: Vec<(KindKey, usize)>,
+    /// (kind, engine) for every registered kind, in registration order.
+    kinds: Vec<(KindKey, EngineId)>,
     /// The engine of each built-in kind, by [`BehaviourKind::builtin_slot`]: found without
     /// comparing names.
-    builtin: [Option<usize>; BUILTIN_KINDS.len()],
+    builtin: [Option<EngineId>; BUILTIN_KINDS.len()],
 }
 
 impl Registry {
@@ -47,10 +51,10 @@ impl Registry {
         Self::default()
     }
 
-    /// Adds `engine` for `kinds`; returns its index. Kinds registered before go to this engine.
-    pub fn register(&mut self, engine: Box<dyn Engine>, kinds: &[KindKey]) -> usize {
+    /// Adds `engine` for `kinds`; returns its id. Kinds registered before go to this engine.
+    pub fn register(&mut self, engine: Box<dyn Engine>, kinds: &[KindKey]) -> EngineId {
         self.engines.push(engine);
-        let index = self.engines.len() - 1;
+        let index = EngineId(self.engines.len() - 1);
         for k in kinds {
             if let Some(slot) = BUILTIN_KINDS
                 .iter()
@@ -66,8 +70,8 @@ impl Registry {
         index
     }
 
-    /// The index of the engine that realizes `behaviour`'s kind.
-    pub fn engine_for(&self, behaviour: &Behaviour) -> Option<usize> {
+    /// The engine that realizes `behaviour`'s kind.
+    pub fn engine_for(&self, behaviour: &Behaviour) -> Option<EngineId> {
         if let Some(slot) = behaviour.kind.builtin_slot() {
             return self.builtin[slot];
         }
@@ -89,9 +93,14 @@ impl Registry {
         self.engines.is_empty()
     }
 
-    /// Engine `i`.
-    pub fn engine(&self, i: usize) -> &dyn Engine {
-        self.engines[i].as_ref()
+    /// Engine `id`.
+    pub fn engine(&self, id: EngineId) -> &dyn Engine {
+        self.engines[id.0].as_ref()
+    }
+
+    /// The ids of every engine, in registration order.
+    pub fn ids(&self) -> impl Iterator<Item = EngineId> {
+        (0..self.engines.len()).map(EngineId)
     }
 
     /// Why the engine of `behaviour` would move nothing for it (see [`Engine::unanimated`]).
@@ -100,9 +109,9 @@ impl Registry {
             .unanimated(behaviour)
     }
 
-    /// Engine `i`, mutably.
-    pub fn engine_mut(&mut self, i: usize) -> &mut dyn Engine {
-        self.engines[i].as_mut()
+    /// Engine `id`, mutably.
+    pub fn engine_mut(&mut self, id: EngineId) -> &mut dyn Engine {
+        self.engines[id.0].as_mut()
     }
 
     /// Every engine.
@@ -127,7 +136,7 @@ impl Registry {
 impl TimingModels for Registry {
     fn model(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         self.engine_for(behaviour)
-            .and_then(|i| self.engines[i].timing(behaviour))
+            .and_then(|i| self.engines[i.0].timing(behaviour))
     }
 }
 
@@ -167,7 +176,8 @@ mod tests {
         )
         .unwrap()
         .block;
-        let found: Vec<Option<usize>> = block.behaviours.iter().map(|b| r.engine_for(b)).collect();
+        let found: Vec<Option<EngineId>> =
+            block.behaviours.iter().map(|b| r.engine_for(b)).collect();
         assert_eq!(found, [Some(a), Some(c), Some(a), Some(b), Some(b), None]);
         assert_eq!(r.kinds().len(), 5);
         // an extension kind registered again goes to the newer engine too
