@@ -4,6 +4,9 @@
 
 use serde::de::DeserializeOwned;
 
+/// A data file's free-text field for people (`"description"`): accepted, not kept.
+pub(crate) type Note = Option<serde::de::IgnoredAny>;
+
 /// `text` read as a `T`; the error names the field path, says what is wrong and where.
 pub(crate) fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, String> {
     let mut de = serde_json::Deserializer::from_str(text);

@@ -76,6 +76,27 @@ fn read_until(
     lines
 }
 
+/// Sends `line` and reads until the block progress `sync` (`block:start` or `block:end`)
+/// arrives, which must be within 2 s; how long that took.
+fn await_sync(
+    writer: &mut TcpStream,
+    reader: &mut BufReader<TcpStream>,
+    line: &str,
+    sync: &str,
+) -> Duration {
+    let sent = Instant::now();
+    writer.write_all(format!("{line}\n").as_bytes()).unwrap();
+    let wanted = format!(r#"id="{sync}""#);
+    let lines = read_until(reader, sent + Duration::from_secs(2), |l| {
+        l.contains(&wanted)
+    });
+    assert!(
+        lines.iter().any(|l| l.contains(&wanted)),
+        "{sync} did not come within 2 s: {lines:?}"
+    );
+    sent.elapsed()
+}
+
 #[test]
 fn fifty_clients_times_200_blocks_lose_no_feedback() {
     let _serial = one_at_a_time();
@@ -238,15 +259,7 @@ fn a_client_that_floods_and_never_reads_slows_no_one_and_grows_nothing() {
         let line = format!(
             r#"<bml {NS} id="calm{b}"><head id="h" lexeme="NOD" start="0" end="0.3"/></bml>"#
         );
-        writer.write_all(format!("{line}\n").as_bytes()).unwrap();
-        let end = format!(r#"id="calm{b}:end""#);
-        let lines = read_until(&mut reader, sent + Duration::from_secs(2), |l| {
-            l.contains(&end)
-        });
-        assert!(
-            lines.iter().any(|l| l.contains(&end)),
-            "calm{b} did not end within 2 s: {lines:?}"
-        );
+        await_sync(&mut writer, &mut reader, &line, &format!("calm{b}:end"));
         std::thread::sleep(Duration::from_millis(500).saturating_sub(sent.elapsed()));
     }
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
@@ -293,18 +306,9 @@ fn large_blocks_from_one_client_hold_up_no_other() {
     let mut reader = BufReader::new(conn);
     let mut worst = Duration::ZERO;
     for b in 0..60 {
-        let sent = Instant::now();
         let line = format!(r#"<bml {NS} id="small{b}"><gesture id="g" lexeme="BEAT"/></bml>"#);
-        writer.write_all(format!("{line}\n").as_bytes()).unwrap();
-        let start = format!(r#"id="small{b}:start""#);
-        let lines = read_until(&mut reader, sent + Duration::from_secs(2), |l| {
-            l.contains(&start)
-        });
-        assert!(
-            lines.iter().any(|l| l.contains(&start)),
-            "small{b}: {lines:?}"
-        );
-        worst = worst.max(sent.elapsed());
+        let waited = await_sync(&mut writer, &mut reader, &line, &format!("small{b}:start"));
+        worst = worst.max(waited);
         std::thread::sleep(Duration::from_millis(10));
     }
     drop(big.join().unwrap());

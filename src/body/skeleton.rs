@@ -41,14 +41,11 @@ pub struct SkeletonError(pub String);
 struct SkeletonFile {
     #[serde(default = "unnamed")]
     name: String,
+    #[serde(default, rename = "units")]
+    _units: crate::data::Note,
     /// For people reading the file.
-    #[serde(default)]
-    #[allow(dead_code)]
-    units: Option<String>,
-    /// For people reading the file.
-    #[serde(default)]
-    #[allow(dead_code)]
-    description: Option<String>,
+    #[serde(default, rename = "description")]
+    _description: crate::data::Note,
     joints: Vec<JointFile>,
 }
 

@@ -189,9 +189,8 @@ impl Lexicon {
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LexiconFile {
-    #[serde(default)]
-    #[allow(dead_code)] // for people reading the file
-    description: Option<String>,
+    #[serde(default, rename = "description")]
+    _description: crate::data::Note,
     gestures: Vec<BindingFile>,
 }
 

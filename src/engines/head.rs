@@ -61,9 +61,8 @@ impl HeadLexicon {
         #[derive(serde::Deserialize)]
         #[serde(deny_unknown_fields)]
         struct File {
-            #[serde(default)]
-            #[allow(dead_code)] // for people reading the file
-            description: Option<String>,
+            #[serde(default, rename = "description")]
+            _description: crate::data::Note,
             heads: Vec<Head>,
         }
         #[derive(serde::Deserialize)]

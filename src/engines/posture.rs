@@ -83,9 +83,8 @@ impl PoseBindings {
         #[derive(serde::Deserialize)]
         #[serde(deny_unknown_fields)]
         struct File {
-            #[serde(default)]
-            #[allow(dead_code)] // for people reading the file
-            description: Option<String>,
+            #[serde(default, rename = "description")]
+            _description: crate::data::Note,
             poses: Vec<Pose>,
         }
         #[derive(serde::Deserialize)]

@@ -126,9 +126,8 @@ pub struct ProcUnit {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LibraryFile {
-    #[serde(default)]
-    #[allow(dead_code)] // for people reading the file
-    description: Option<String>,
+    #[serde(default, rename = "description")]
+    _description: crate::data::Note,
     units: IndexMap<String, UnitFile>,
 }
 

@@ -111,17 +111,11 @@ impl<'a> IdIndex<'a> {
     pub(crate) fn fill(&mut self, ids: impl Iterator<Item = &'a str>) {
         self.few.clear();
         self.many.clear();
-        for (i, id) in ids.enumerate() {
-            if self.many.is_empty() && self.few.len() < ID_INDEX_LINEAR {
-                self.few.push((id, i));
-                continue;
+        self.few.extend(ids.enumerate().map(|(i, id)| (id, i)));
+        if self.few.len() > ID_INDEX_LINEAR {
+            for (id, i) in self.few.drain(..) {
+                self.many.entry(id).or_insert(i);
             }
-            if self.many.is_empty() {
-                for (k, j) in self.few.drain(..) {
-                    self.many.entry(k).or_insert(j);
-                }
-            }
-            self.many.entry(id).or_insert(i);
         }
     }
 

@@ -702,13 +702,14 @@ const LP_TIME_LIMIT_SECS: f64 = 2.0;
 /// after scheduling anyway, and such magnitudes next to ones of 1e-9 s can make the simplex stall.
 fn tame(items: &[Item], links: &[Link]) -> bool {
     let small = |v: f64| v.abs() <= MAX_SCHEDULED_TIME;
-    let keys = items.iter().flat_map(|it| it.model.keys.iter());
-    links.iter().all(|l| {
-        small(l.offset)
-            && [l.left, l.right]
-                .iter()
-                .all(|t| !matches!(t, Term::Fixed(v) if !small(*v)))
-    }) && keys.clone().all(|k| small(k.at))
+    let term = |t: Term| !matches!(t, Term::Fixed(v) if !small(v));
+    let links_small = links
+        .iter()
+        .all(|l| small(l.offset) && term(l.left) && term(l.right));
+    links_small
+        && items
+            .iter()
+            .all(|it| it.model.keys.iter().all(|k| small(k.at)))
 }
 
 /// The two-stage linear program for blocks where some behaviour must stretch.
