@@ -47,3 +47,8 @@ pub struct ReadmeDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/embedding.md")]
 pub struct EmbeddingDoctests;
+
+/// The engine guide's complete engine compiles and runs as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/engines.md")]
+pub struct EngineGuideDoctests;

@@ -979,7 +979,7 @@ fn every_motion_behaviour_declares_the_joints_it_steers() {
     use bml_realizer::engines::default_registry;
     use bml_realizer::timing::DefaultTimingModels;
     let skeleton = Skeleton::adult();
-    let registry = default_registry(DefaultTimingModels::default());
+    let mut registry = default_registry(DefaultTimingModels::default());
     let block = bml_realizer::bml::load(&format!(
         r#"<bml {BMLT} xmlns:m="http://www.techfak.uni-bielefeld.de/ags/soa/murml" id="b">
         <head id="nod" lexeme="NOD"/>
@@ -999,11 +999,11 @@ fn every_motion_behaviour_declares_the_joints_it_steers() {
     ))
     .unwrap()
     .block;
-    let names = |id: &str| -> Vec<String> {
+    let mut names = |id: &str| -> Vec<String> {
         let b = block.behaviour(id).unwrap();
-        let e = registry.engine(registry.engine_for(b).unwrap());
-        let s = e
-            .steers(b, &skeleton)
+        let e = registry.engine_mut(registry.engine_for(b).unwrap());
+        let s = (e.as_motion())
+            .and_then(|m| m.steers(b, &skeleton))
             .unwrap_or_else(|| panic!("{id} steers nothing"));
         assert_eq!(s.kind, MotionKind::Kinematic);
         s.joints
@@ -1011,7 +1011,7 @@ fn every_motion_behaviour_declares_the_joints_it_steers() {
             .map(|&j| skeleton.joints()[j].name.clone())
             .collect()
     };
-    let has = |id: &str, joints: &[&str]| {
+    let mut has = |id: &str, joints: &[&str]| {
         let n = names(id);
         for j in joints {
             assert!(n.iter().any(|x| x == j), "{id}: {j} not in {n:?}");
@@ -1039,10 +1039,8 @@ fn every_motion_behaviour_declares_the_joints_it_steers() {
     assert_eq!(names("tr"), ["l_elbow"]);
     assert_eq!(names("mg"), ["l_shoulder"]);
     let s = block.behaviour("s").unwrap();
-    assert!(registry
-        .engine(registry.engine_for(s).unwrap())
-        .steers(s, &skeleton)
-        .is_none());
+    let speech = registry.engine_mut(registry.engine_for(s).unwrap());
+    assert!(speech.as_motion().is_none(), "speech moves no joints");
 }
 
 #[test]

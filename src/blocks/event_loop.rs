@@ -3,6 +3,7 @@
 //! poses.
 
 use super::*;
+use crate::engine::EngineError;
 
 /// A behaviour's next sync in the heap of [`BlockManager::next_sync`], ordered by time (in whole
 /// nanoseconds, so that float noise makes ties), then block arrival, then document order.
@@ -141,7 +142,9 @@ impl BlockManager {
         let mut pose = Pose::rest(&self.skeleton);
         for e in self.registry.engines_mut() {
             e.play(to, frame);
-            e.animate(to, &self.skeleton, &self.world, &mut pose);
+            if let Some(m) = e.as_motion() {
+                m.animate(to, &self.skeleton, &self.world, &mut pose);
+            }
         }
         frame.poses.push(CharacterPose {
             character: self.character.clone(),
@@ -157,7 +160,10 @@ impl BlockManager {
     pub(super) fn predict_poses(&mut self, now: f64) {
         let ids: Vec<_> = self.registry.ids().collect();
         for i in ids {
-            let times = self.registry.engine(i).prediction_times(now);
+            let engine = self.registry.engine_mut(i);
+            let Some(times) = engine.as_prediction().map(|p| p.prediction_times(now)) else {
+                continue;
+            };
             if times.is_empty() {
                 continue;
             }
@@ -165,13 +171,17 @@ impl BlockManager {
                 .into_iter()
                 .map(|t| {
                     let mut pose = Pose::rest(&self.skeleton);
-                    for e in self.registry.engines() {
-                        e.predict(t, &self.skeleton, &self.world, &mut pose);
+                    for e in self.registry.engines_mut() {
+                        if let Some(p) = e.as_prediction() {
+                            p.predict(t, &self.skeleton, &self.world, &mut pose);
+                        }
                     }
                     (t, pose)
                 })
                 .collect();
-            self.registry.engine_mut(i).predicted(poses);
+            if let Some(p) = self.registry.engine_mut(i).as_prediction() {
+                p.predicted(poses);
+            }
         }
     }
 
@@ -199,9 +209,9 @@ impl BlockManager {
         self.sync_feedback(&block_id, &beh_id, &sync, local, t, skipped);
         let key = UnitKey::new(block_id.clone(), beh_id.clone());
         let mut actions = Vec::new();
-        self.registry
-            .engine_mut(engine)
-            .sync_passed(&key, &sync, t, &mut actions);
+        if let Some(control) = self.registry.engine_mut(engine).as_control() {
+            control.sync_passed(&key, &sync, t, &mut actions);
+        }
         if last {
             self.blocks[bi].behaviours[xi].phase = Phase::Ended;
             self.retiring.push((engine, key.clone()));
@@ -248,7 +258,8 @@ impl BlockManager {
                 };
                 if c.initial.is_none() {
                     // start from the target's current value
-                    c.initial = self.registry.engine(engine).parameter(&c.target, &c.param);
+                    c.initial = (self.registry.engine_mut(engine).as_parameters())
+                        .and_then(|p| p.parameter(&c.target, &c.param));
                     if c.initial.is_none() {
                         self.warn(
                             c.by.to_string(),
@@ -286,11 +297,14 @@ impl BlockManager {
             }
             let value = c.value_at(c.initial.unwrap_or(c.target_value), t.max(c.start));
             let engine = x.engine;
-            match self
-                .registry
-                .engine_mut(engine)
-                .set_parameter(&c.target, &c.param, value, t)
-            {
+            let set = match self.registry.engine_mut(engine).as_parameters() {
+                Some(p) => p.set_parameter(&c.target, &c.param, value, t),
+                None => Err(EngineError(format!(
+                    "{} has no parameter '{}' that can change while it runs",
+                    c.target, c.param
+                ))),
+            };
+            match set {
                 Ok(retimed) => {
                     if let Some(times) = retimed {
                         let start = self.blocks[bi].start;

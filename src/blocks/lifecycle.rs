@@ -144,7 +144,7 @@ impl BlockManager {
             .filter(|x| x.phase != Phase::Removed)
         {
             let b = &self.blocks[i].source.behaviours[x.index];
-            used.extend(self.registry.engine(x.engine).resources(b));
+            used.extend(self.registry.resources(x.engine, b));
         }
         if used.is_empty() {
             return;
@@ -158,8 +158,7 @@ impl BlockManager {
                 let b = &self.blocks[j].source.behaviours[x.index];
                 let shares = self
                     .registry
-                    .engine(x.engine)
-                    .resources(b)
+                    .resources(x.engine, b)
                     .iter()
                     .any(|r| used.contains(r));
                 if !(retracting && shares) {

@@ -245,16 +245,14 @@ impl LiveBlock {
         for i in 0..self.behaviours.len() {
             let a = &self.behaviours[i];
             let b = &self.source.behaviours[a.index];
-            let Some(group) = registry.engine(a.engine).exclusive_group(b) else {
+            let Some(group) = registry.exclusive_group(a.engine, b) else {
                 continue;
             };
             let span =
                 |x: &LiveBehaviour| (x.syncs.first().map(|s| s.1), x.syncs.last().map(|s| s.1));
             let tie = self.behaviours[..i].iter().find(|p| {
                 p.phase != Phase::Removed
-                    && registry
-                        .engine(p.engine)
-                        .exclusive_group(&self.source.behaviours[p.index])
+                    && registry.exclusive_group(p.engine, &self.source.behaviours[p.index])
                         == Some(group)
                     && span(p) == span(a)
             });

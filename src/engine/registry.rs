@@ -109,6 +109,22 @@ impl Registry {
             .unanimated(behaviour)
     }
 
+    /// The body resources `behaviour` occupies on engine `id` (see [`Resources`](super::Resources)).
+    pub fn resources(&self, id: EngineId, behaviour: &Behaviour) -> &'static [&'static str] {
+        self.engine(id)
+            .as_resources()
+            .map_or(&[], |r| r.resources(behaviour))
+    }
+
+    /// The exclusive group of `behaviour` on engine `id` (see [`Resources`](super::Resources)).
+    pub fn exclusive_group<'a>(
+        &'a self,
+        id: EngineId,
+        behaviour: &'a Behaviour,
+    ) -> Option<&'a str> {
+        self.engine(id).as_resources()?.exclusive_group(behaviour)
+    }
+
     /// Engine `id`, mutably.
     pub fn engine_mut(&mut self, id: EngineId) -> &mut dyn Engine {
         self.engines[id.0].as_mut()

@@ -86,6 +86,16 @@ impl Engine for ControlEngine {
         self.units.remove(key);
     }
 
+    fn len(&self) -> usize {
+        self.units.len()
+    }
+
+    fn as_control(&mut self) -> Option<&mut dyn crate::engine::Control> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Control for ControlEngine {
     fn sync_passed(&mut self, key: &UnitKey, sync: &str, time: f64, actions: &mut Vec<Action>) {
         if sync != "start" {
             return;
@@ -127,9 +137,5 @@ impl Engine for ControlEngine {
                 by: key.clone(),
             }),
         });
-    }
-
-    fn len(&self) -> usize {
-        self.units.len()
     }
 }

@@ -201,24 +201,6 @@ impl Engine for GazeEngine {
         self.models.model(behaviour)
     }
 
-    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
-        matches!(behaviour.kind, BehaviourKind::Gaze(_)).then_some("gaze")
-    }
-
-    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
-        &["eyes"]
-    }
-
-    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
-        let (_, influence, _, _) = gaze(behaviour)?;
-        let eyes = ["l_eyeball_joint", "r_eyeball_joint"];
-        Some(Steering::kinematic(
-            skeleton,
-            shares(influence).iter().map(|s| s.0).chain(eyes),
-            true,
-        ))
-    }
-
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         let (target, influence, shift, offset) = gaze(unit.behaviour)
             .ok_or_else(|| EngineError("the gaze engine realizes gaze and gazeShift".into()))?;
@@ -239,6 +221,26 @@ impl Engine for GazeEngine {
             },
         );
         Ok(())
+    }
+
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+
+    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for GazeEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let (_, influence, _, _) = gaze(behaviour)?;
+        let eyes = ["l_eyeball_joint", "r_eyeball_joint"];
+        Some(Steering::kinematic(
+            skeleton,
+            shares(influence).iter().map(|s| s.0).chain(eyes),
+            true,
+        ))
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
@@ -348,6 +350,16 @@ impl Engine for GazeEngine {
             let pitch = rp + we * (tp - rp);
             pose.rotate(e, donders(yaw, pitch));
         }
+    }
+}
+
+impl crate::engine::Resources for GazeEngine {
+    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
+        matches!(behaviour.kind, BehaviourKind::Gaze(_)).then_some("gaze")
+    }
+
+    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
+        &["eyes"]
     }
 }
 

@@ -407,6 +407,42 @@ impl Engine for GestureEngine {
         })
     }
 
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let BehaviourKind::Gesture(g) = &unit.behaviour.kind else {
+            return Err(EngineError("the gesture engine realizes <gesture>".into()));
+        };
+        let sides = sides(g.mode);
+        let played = match self.lexicon.find(unit.behaviour) {
+            Some(Bound::Procedural(p, params)) => GestureUnit::Procedural {
+                unit: p.clone(),
+                params: params.clone(),
+                sides,
+            },
+            Some(Bound::Keys(k)) => GestureUnit::Keys {
+                keys: k.clone(),
+                sides,
+                compiled: None,
+            },
+            None => GestureUnit::Keys {
+                keys: Arc::default(),
+                sides,
+                compiled: None,
+            },
+        };
+        self.units.add(unit, played);
+        Ok(())
+    }
+
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+
+    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for GestureEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let BehaviourKind::Gesture(g) = &behaviour.kind else {
             return None;
@@ -434,39 +470,6 @@ impl Engine for GestureEngine {
         }
     }
 
-    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
-        match &behaviour.kind {
-            BehaviourKind::Gesture(g) => hands(g.mode),
-            _ => &[],
-        }
-    }
-
-    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        let BehaviourKind::Gesture(g) = &unit.behaviour.kind else {
-            return Err(EngineError("the gesture engine realizes <gesture>".into()));
-        };
-        let sides = sides(g.mode);
-        let played = match self.lexicon.find(unit.behaviour) {
-            Some(Bound::Procedural(p, params)) => GestureUnit::Procedural {
-                unit: p.clone(),
-                params: params.clone(),
-                sides,
-            },
-            Some(Bound::Keys(k)) => GestureUnit::Keys {
-                keys: k.clone(),
-                sides,
-                compiled: None,
-            },
-            None => GestureUnit::Keys {
-                keys: Arc::default(),
-                sides,
-                compiled: None,
-            },
-        };
-        self.units.add(unit, played);
-        Ok(())
-    }
-
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         // a unit that has not started shows nothing yet
         for (syncs, u) in self.units.started_mut(now) {
@@ -487,6 +490,15 @@ impl Engine for GestureEngine {
                     unit.play(syncs, now, params, sides, skeleton, pose);
                 }
             }
+        }
+    }
+}
+
+impl crate::engine::Resources for GestureEngine {
+    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
+        match &behaviour.kind {
+            BehaviourKind::Gesture(g) => hands(g.mode),
+            _ => &[],
         }
     }
 }

@@ -212,18 +212,9 @@ impl Engine for HeadEngine {
         "head"
     }
 
-    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
-        matches!(behaviour.kind, BehaviourKind::Head(_))
-            .then(|| Steering::kinematic(skeleton, ["vc4", "skullbase"], true))
-    }
-
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         self.head(behaviour)?;
         self.models.model(behaviour)
-    }
-
-    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
-        &["head"]
     }
 
     fn unanimated(&self, behaviour: &Behaviour) -> Option<String> {
@@ -255,6 +246,21 @@ impl Engine for HeadEngine {
         Ok(())
     }
 
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+
+    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for HeadEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        matches!(behaviour.kind, BehaviourKind::Head(_))
+            .then(|| Steering::kinematic(skeleton, ["vc4", "skullbase"], true))
+    }
+
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         let (Some(skull), Some(neck)) = (skeleton.joint("skullbase"), skeleton.joint("vc4")) else {
             return;
@@ -267,6 +273,12 @@ impl Engine for HeadEngine {
                 pose.rotate(skull, Quat::from_axis_angle(axis, a * SKULL_SHARE));
             }
         }
+    }
+}
+
+impl crate::engine::Resources for HeadEngine {
+    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
+        &["head"]
     }
 }
 

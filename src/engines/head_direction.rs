@@ -46,11 +46,6 @@ impl Engine for HeadDirectionEngine {
         "headDirection"
     }
 
-    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
-        matches!(behaviour.kind, BehaviourKind::HeadDirectionShift { .. })
-            .then(|| Steering::kinematic(skeleton, SHARES.iter().map(|s| s.0), true))
-    }
-
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         matches!(behaviour.kind, BehaviourKind::HeadDirectionShift { .. })
             .then(|| self.models.model(behaviour))?
@@ -72,6 +67,17 @@ impl Engine for HeadDirectionEngine {
         let target = target.clone();
         self.units.add(unit, DirectionUnit { target });
         Ok(())
+    }
+
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for HeadDirectionEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        matches!(behaviour.kind, BehaviourKind::HeadDirectionShift { .. })
+            .then(|| Steering::kinematic(skeleton, SHARES.iter().map(|s| s.0), true))
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {

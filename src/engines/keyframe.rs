@@ -309,15 +309,6 @@ impl Engine for KeyframeEngine {
         "keyframe"
     }
 
-    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
-        let keys = read_keys(content(behaviour)?).ok()?;
-        let mut s = Steering::kinematic(skeleton, keys.parts.iter().map(String::as_str), false);
-        if keys.root_translation && !s.joints.contains(&0) {
-            s.joints.insert(0, 0);
-        }
-        Some(s)
-    }
-
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         let c = content(behaviour)?;
         // a keyframe that cannot be read is refused when it starts, with the reason
@@ -370,6 +361,25 @@ impl Engine for KeyframeEngine {
         Ok(())
     }
 
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+
+    fn as_prediction(&mut self) -> Option<&mut dyn crate::engine::Prediction> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for KeyframeEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let keys = read_keys(content(behaviour)?).ok()?;
+        let mut s = Steering::kinematic(skeleton, keys.parts.iter().map(String::as_str), false);
+        if keys.root_translation && !s.joints.contains(&0) {
+            s.joints.insert(0, 0);
+        }
+        Some(s)
+    }
+
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         for (syncs, u) in self.units.all_mut() {
             let k = &u.keys;
@@ -379,7 +389,9 @@ impl Engine for KeyframeEngine {
             play((k, u.how, &u.controls), joints, syncs, now, pose);
         }
     }
+}
 
+impl crate::engine::Prediction for KeyframeEngine {
     fn predict(&self, t: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) -> bool {
         let mut any = false;
         for (syncs, u) in self.units.all() {

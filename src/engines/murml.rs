@@ -232,26 +232,6 @@ impl Engine for MurmlEngine {
         })
     }
 
-    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
-        let (Kind::Gesture, content) = kind(behaviour)? else {
-            return None;
-        };
-        let keys = body_keys(content).ok()??;
-        Some(Steering::kinematic(
-            skeleton,
-            keys.parts.iter().map(String::as_str),
-            false,
-        ))
-    }
-
-    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
-        match kind(behaviour) {
-            Some((Kind::Gesture, _)) => &["left_hand", "right_hand"],
-            Some((Kind::Face, _)) => &["face"],
-            None => &[],
-        }
-    }
-
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         let (k, content) = kind(unit.behaviour).ok_or_else(|| {
             EngineError("the MURML engine realizes murmlgesture and murmlface".into())
@@ -267,6 +247,28 @@ impl Engine for MurmlEngine {
         Ok(())
     }
 
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+
+    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for MurmlEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let (Kind::Gesture, content) = kind(behaviour)? else {
+            return None;
+        };
+        let keys = body_keys(content).ok()??;
+        Some(Steering::kinematic(
+            skeleton,
+            keys.parts.iter().map(String::as_str),
+            false,
+        ))
+    }
+
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         for (syncs, u) in self.units.all_mut() {
             let Some(k) = &u.keys else { continue };
@@ -274,6 +276,16 @@ impl Engine for MurmlEngine {
                 .joints
                 .get_or_insert_with(|| k.parts.iter().map(|p| skeleton.joint(p)).collect());
             play((k, Interpolation::Slerp, &[]), joints, syncs, now, pose);
+        }
+    }
+}
+
+impl crate::engine::Resources for MurmlEngine {
+    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
+        match kind(behaviour) {
+            Some((Kind::Gesture, _)) => &["left_hand", "right_hand"],
+            Some((Kind::Face, _)) => &["face"],
+            None => &[],
         }
     }
 }

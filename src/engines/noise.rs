@@ -90,13 +90,6 @@ impl Engine for NoiseEngine {
         "noise"
     }
 
-    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
-        let BehaviourKind::Noise(n) = &behaviour.kind else {
-            return None;
-        };
-        Some(Steering::kinematic(skeleton, [n.joint.as_str()], true))
-    }
-
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         matches!(behaviour.kind, BehaviourKind::Noise(_)).then(|| {
             let mut m = TimingModel::new(
@@ -128,19 +121,21 @@ impl Engine for NoiseEngine {
         Ok(())
     }
 
-    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
-        named_param(&self.units.get(key)?.params, name)
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
     }
 
-    fn set_parameter(
-        &mut self,
-        key: &UnitKey,
-        name: &str,
-        value: f64,
-        _now: f64,
-    ) -> Result<Option<Vec<f64>>, EngineError> {
-        let params = self.units.get_mut(key).map(|(_, u)| &mut u.params);
-        set_named_param(key, "noise", params, name, value)
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for NoiseEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let BehaviourKind::Noise(n) = &behaviour.kind else {
+            return None;
+        };
+        Some(Steering::kinematic(skeleton, [n.joint.as_str()], true))
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
@@ -170,5 +165,22 @@ impl Engine for NoiseEngine {
             );
             pose.rotate(j, q);
         }
+    }
+}
+
+impl crate::engine::Parameters for NoiseEngine {
+    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
+        named_param(&self.units.get(key)?.params, name)
+    }
+
+    fn set_parameter(
+        &mut self,
+        key: &UnitKey,
+        name: &str,
+        value: f64,
+        _now: f64,
+    ) -> Result<Option<Vec<f64>>, EngineError> {
+        let params = self.units.get_mut(key).map(|(_, u)| &mut u.params);
+        set_named_param(key, "noise", params, name, value)
     }
 }

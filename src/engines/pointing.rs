@@ -95,6 +95,35 @@ impl Engine for PointingEngine {
             .then(|| self.models.model(behaviour))?
     }
 
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let BehaviourKind::Pointing(p) = &unit.behaviour.kind else {
+            return Err(EngineError(
+                "the pointing engine realizes <pointing>".into(),
+            ));
+        };
+        if unit.world.get(&p.target).is_none() {
+            return Err(EngineError(format!(
+                "{}: {}",
+                unit.key,
+                unit.world.unknown_target(&p.target)
+            )));
+        }
+        let target = p.target.clone();
+        let mode = p.mode;
+        self.units.add(unit, PointingUnit { target, mode });
+        Ok(())
+    }
+
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+
+    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for PointingEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let BehaviourKind::Pointing(p) = &behaviour.kind else {
             return None;
@@ -121,32 +150,6 @@ impl Engine for PointingEngine {
         })
     }
 
-    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
-        match &behaviour.kind {
-            BehaviourKind::Pointing(p) => hands(p.mode),
-            _ => &[],
-        }
-    }
-
-    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        let BehaviourKind::Pointing(p) = &unit.behaviour.kind else {
-            return Err(EngineError(
-                "the pointing engine realizes <pointing>".into(),
-            ));
-        };
-        if unit.world.get(&p.target).is_none() {
-            return Err(EngineError(format!(
-                "{}: {}",
-                unit.key,
-                unit.world.unknown_target(&p.target)
-            )));
-        }
-        let target = p.target.clone();
-        let mode = p.mode;
-        self.units.add(unit, PointingUnit { target, mode });
-        Ok(())
-    }
-
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
         for (syncs, u) in self.units.all() {
             let (Some(w), Some(target)) = (
@@ -166,6 +169,15 @@ impl Engine for PointingEngine {
             for side in sides {
                 point(skeleton, pose, side, target, w);
             }
+        }
+    }
+}
+
+impl crate::engine::Resources for PointingEngine {
+    fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
+        match &behaviour.kind {
+            BehaviourKind::Pointing(p) => hands(p.mode),
+            _ => &[],
         }
     }
 }

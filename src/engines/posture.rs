@@ -244,10 +244,40 @@ impl Engine for PostureEngine {
         self.models.model(behaviour)
     }
 
-    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
-        matches!(behaviour.kind, BehaviourKind::Posture(_)).then_some("posture")
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let (stance, shift) = posture(unit.behaviour).ok_or_else(|| {
+            EngineError("the posture engine realizes posture and postureShift".into())
+        })?;
+        let written = match &unit.behaviour.kind {
+            BehaviourKind::Posture(p) | BehaviourKind::PostureShift(p) => &p.poses,
+            _ => return Err(EngineError("not a posture".into())),
+        };
+        let poses = written
+            .iter()
+            .map(|p| self.bindings.get(p.part, &p.lexeme))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
+        self.units.add(
+            unit,
+            PostureUnit {
+                stance,
+                shift,
+                poses,
+            },
+        );
+        Ok(())
     }
 
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+
+    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for PostureEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let poses = match &behaviour.kind {
             BehaviourKind::Posture(p) | BehaviourKind::PostureShift(p) => &p.poses,
@@ -271,34 +301,6 @@ impl Engine for PostureEngine {
         s.joints.sort_unstable();
         s.joints.dedup();
         Some(s)
-    }
-
-    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
-        &["legs"]
-    }
-
-    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
-        let (stance, shift) = posture(unit.behaviour).ok_or_else(|| {
-            EngineError("the posture engine realizes posture and postureShift".into())
-        })?;
-        let written = match &unit.behaviour.kind {
-            BehaviourKind::Posture(p) | BehaviourKind::PostureShift(p) => &p.poses,
-            _ => return Err(EngineError("not a posture".into())),
-        };
-        let poses = written
-            .iter()
-            .map(|p| self.bindings.get(p.part, &p.lexeme))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
-        self.units.add(
-            unit,
-            PostureUnit {
-                stance,
-                shift,
-                poses,
-            },
-        );
-        Ok(())
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
@@ -334,5 +336,15 @@ impl Engine for PostureEngine {
             }
             None => hold(skeleton, pose, rest_poses, 1.0),
         }
+    }
+}
+
+impl crate::engine::Resources for PostureEngine {
+    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
+        matches!(behaviour.kind, BehaviourKind::Posture(_)).then_some("posture")
+    }
+
+    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
+        &["legs"]
     }
 }

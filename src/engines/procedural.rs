@@ -647,11 +647,6 @@ impl Engine for ProceduralEngine {
         "procedural"
     }
 
-    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
-        let r = self.library.for_behaviour(behaviour)?.ok()?;
-        Some(r.unit.steering(skeleton, &[false]))
-    }
-
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         match self.library.for_behaviour(behaviour)? {
             Ok(r) => Some(r.unit.timing()),
@@ -670,38 +665,35 @@ impl Engine for ProceduralEngine {
         Ok(())
     }
 
-    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
-        named_param(&self.units.get(key)?.params, name)
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
     }
 
-    fn set_parameter(
-        &mut self,
-        key: &UnitKey,
-        name: &str,
-        value: f64,
-        _now: f64,
-    ) -> Result<Option<Vec<f64>>, EngineError> {
-        let running = self.units.get_mut(key).map(|(_, r)| r);
-        let owner = running
-            .as_ref()
-            .map_or(String::new(), |r| format!("unit '{}'", r.unit.name));
-        set_named_param(key, &owner, running.map(|r| &mut r.params), name, value)
+    fn as_prediction(&mut self) -> Option<&mut dyn crate::engine::Prediction> {
+        Some(self)
     }
 
-    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
-        let name = match &behaviour.kind {
-            BehaviourKind::ProcAnimation(a) | BehaviourKind::ProcAnimationGesture(a) => {
-                a.name.as_deref()?
-            }
-            _ => return None,
-        };
-        self.library.get(name)?.group.as_deref()
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+        Some(self)
+    }
+
+    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for ProceduralEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let r = self.library.for_behaviour(behaviour)?.ok()?;
+        Some(r.unit.steering(skeleton, &[false]))
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
-        self.predict(now, skeleton, world, pose);
+        crate::engine::Prediction::predict(self, now, skeleton, world, pose);
     }
+}
 
+impl crate::engine::Prediction for ProceduralEngine {
     fn predict(&self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) -> bool {
         // active from start to end; the end frame shows α = 1
         let active: Vec<(&SyncTimes, &Running, f64, f64)> = self
@@ -731,9 +723,42 @@ impl Engine for ProceduralEngine {
     }
 }
 
+impl crate::engine::Parameters for ProceduralEngine {
+    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
+        named_param(&self.units.get(key)?.params, name)
+    }
+
+    fn set_parameter(
+        &mut self,
+        key: &UnitKey,
+        name: &str,
+        value: f64,
+        _now: f64,
+    ) -> Result<Option<Vec<f64>>, EngineError> {
+        let running = self.units.get_mut(key).map(|(_, r)| r);
+        let owner = running
+            .as_ref()
+            .map_or(String::new(), |r| format!("unit '{}'", r.unit.name));
+        set_named_param(key, &owner, running.map(|r| &mut r.params), name, value)
+    }
+}
+
+impl crate::engine::Resources for ProceduralEngine {
+    fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
+        let name = match &behaviour.kind {
+            BehaviourKind::ProcAnimation(a) | BehaviourKind::ProcAnimationGesture(a) => {
+                a.name.as_deref()?
+            }
+            _ => return None,
+        };
+        self.library.get(name)?.group.as_deref()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::Motion;
 
     fn ids(v: &[(&'static str, f64)]) -> Vec<(Id, f64)> {
         v.iter().map(|&(n, t)| (Id::new_static(n), t)).collect()

@@ -84,10 +84,6 @@ impl Engine for SpeechEngine {
         Some(model)
     }
 
-    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
-        &["voice"]
-    }
-
     fn interprets(&self, ns: &str, name: &str) -> bool {
         ns == NS_BMLIS && name == "generatefiller"
     }
@@ -115,6 +111,16 @@ impl Engine for SpeechEngine {
         }
     }
 
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+        Some(self)
+    }
+
+    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Parameters for SpeechEngine {
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
         let u = self.units.get(key)?;
         match name {
@@ -158,5 +164,11 @@ impl Engine for SpeechEngine {
                 "speech {key} has no parameter '{name}' (it has volume and rate)"
             ))),
         }
+    }
+}
+
+impl crate::engine::Resources for SpeechEngine {
+    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
+        &["voice"]
     }
 }

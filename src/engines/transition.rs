@@ -1,7 +1,7 @@
 //! The transition engine: BMLT `transition` units. Given only a start, an end and the
 //! joints to move, a transition starts at the pose the body had when it began and ends at the
 //! pose the animation predictor computes for its end from the predictable units (keyframes,
-//! procedural units: [`Engine::predict`]), so that the motion that follows starts without a jump:
+//! procedural units: [`Prediction::predict`](crate::engine::Prediction::predict)), so that the motion that follows starts without a jump:
 //!
 //! ```xml
 //! <bmlt:transition id="t1" class="SlerpTransition" start="kf1:end" end="p1:start">
@@ -49,21 +49,6 @@ impl Engine for TransitionEngine {
         "transition"
     }
 
-    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
-        let BehaviourKind::Transition(t) = &behaviour.kind else {
-            return None;
-        };
-        let named = t.params.iter().find(|p| p.name == "joints");
-        Some(match named {
-            Some(p) => Steering::kinematic(skeleton, p.value.split_whitespace(), false),
-            None => Steering {
-                joints: (0..skeleton.len()).collect(),
-                kind: crate::engine::MotionKind::Kinematic,
-                additive: false,
-            },
-        })
-    }
-
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         matches!(behaviour.kind, BehaviourKind::Transition(_))
             .then(|| TimingModel::stretchable(&[("start", 0.0), ("end", 0.5)]))
@@ -97,18 +82,29 @@ impl Engine for TransitionEngine {
         Ok(())
     }
 
-    fn prediction_times(&self, now: f64) -> Vec<f64> {
-        self.units
-            .all()
-            .filter_map(|(syncs, _)| {
-                let (start, end) = (syncs.first()?.1, syncs.last()?.1);
-                (start <= now && now <= end).then_some(end)
-            })
-            .collect()
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
     }
 
-    fn predicted(&mut self, poses: Vec<(f64, Pose)>) {
-        self.predictions = poses;
+    fn as_prediction(&mut self) -> Option<&mut dyn crate::engine::Prediction> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Motion for TransitionEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let BehaviourKind::Transition(t) = &behaviour.kind else {
+            return None;
+        };
+        let named = t.params.iter().find(|p| p.name == "joints");
+        Some(match named {
+            Some(p) => Steering::kinematic(skeleton, p.value.split_whitespace(), false),
+            None => Steering {
+                joints: (0..skeleton.len()).collect(),
+                kind: crate::engine::MotionKind::Kinematic,
+                additive: false,
+            },
+        })
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
@@ -154,5 +150,21 @@ impl Engine for TransitionEngine {
             Some(last) => last.clone_from(pose),
             None => self.last = Some(pose.clone()),
         }
+    }
+}
+
+impl crate::engine::Prediction for TransitionEngine {
+    fn prediction_times(&self, now: f64) -> Vec<f64> {
+        self.units
+            .all()
+            .filter_map(|(syncs, _)| {
+                let (start, end) = (syncs.first()?.1, syncs.last()?.1);
+                (start <= now && now <= end).then_some(end)
+            })
+            .collect()
+    }
+
+    fn predicted(&mut self, poses: Vec<(f64, Pose)>) {
+        self.predictions = poses;
     }
 }

@@ -36,13 +36,13 @@ enum Command {
     Timeline(run::TimelineArgs),
     /// Compare two feedback logs (XML or JSON lines) modulo clock origin, posix times and jitter.
     Diff(diff::DiffArgs),
-    /// Serve the realizer port: one <bml> block per input line, one feedback element per output line.
+    /// Serve the realizer port: one `<bml>` block per input line, one feedback element per output line.
     Serve(serve::ServeArgs),
     /// Run the RealizerTester conformance suite; last line "N passed, M failed".
     Conformance(serve::ConformanceArgs),
     /// Parse and check BML files; print file:line:col diagnostics. Exit 1 if any file is invalid.
     Validate {
-        /// BML files (one <bml> block each).
+        /// BML files (one `<bml>` block each).
         #[arg(required = true)]
         files: Vec<PathBuf>,
         /// Print nothing for valid files.

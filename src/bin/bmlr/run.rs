@@ -75,7 +75,7 @@ pub struct RunArgs {
 /// The limits on one block (`docs/cli.md`, "Limits"), shared by the commands that read BML.
 #[derive(Args, Clone, Copy)]
 pub struct LimitArgs {
-    /// Deepest nesting of elements in a block (the <bml> root counts as 1).
+    /// Deepest nesting of elements in a block (the `<bml>` root counts as 1).
     #[arg(long, value_name = "N", default_value_t = Limits::default().depth)]
     max_depth: usize,
     /// Most attributes on one element (and namespace declarations in scope).

@@ -1,0 +1,151 @@
+//! What only some engines do, one trait per capability: moving the body ([`Motion`]), taking
+//! part in animation prediction ([`Prediction`]), parameters that change while a unit runs
+//! ([`Parameters`]), body resources and exclusive groups ([`Resources`]) and actions on the plan
+//! ([`Control`]). An engine offers one by returning itself from the matching `as_…` method of
+//! [`Engine`](super::Engine).
+
+use super::{EngineError, ParameterChange, UnitKey};
+use crate::bml::Behaviour;
+use crate::body::{Pose, Skeleton};
+use crate::world::World;
+
+/// An engine that moves the body.
+pub trait Motion {
+    /// Applies the units running at `now` to `pose` (joint rotations on top of what earlier
+    /// engines set), with targets from `world`.
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose);
+
+    /// The joints a unit for `behaviour` steers on `skeleton`, how, and whether additively;
+    /// `None` for behaviours that move no joints.
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering>;
+}
+
+/// An engine's part in animation prediction: predictable engines say what they will have set
+/// at a future time; others (a transition) ask for those predicted poses.
+pub trait Prediction {
+    /// Writes what this engine's *predictable* units (whose motion is a function of time
+    /// alone, such as keyframes and procedural units) will have set at global time `t` into
+    /// `pose`, without changing any state. Returns whether any of its units is running then.
+    fn predict(&self, _t: f64, _skeleton: &Skeleton, _world: &World, _pose: &mut Pose) -> bool {
+        false
+    }
+
+    /// Global times at which this engine needs the predicted pose for its frame at `now` (a
+    /// transition's end); the runtime then calls [`predicted`](Prediction::predicted) before
+    /// [`Motion::animate`].
+    fn prediction_times(&self, _now: f64) -> Vec<f64> {
+        Vec::new()
+    }
+
+    /// The predicted poses (rest pose plus every engine's [`predict`](Prediction::predict)) at
+    /// the times [`prediction_times`](Prediction::prediction_times) asked for.
+    fn predicted(&mut self, _poses: Vec<(f64, Pose)>) {}
+}
+
+/// An engine whose units have parameters that can be read and changed while they run (BMLA
+/// `parametervaluechange`).
+pub trait Parameters {
+    /// Current value of parameter `name` of unit `key`.
+    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64>;
+
+    /// Sets parameter `name` of a running unit at global time `now`. A parameter that changes
+    /// timing (a speech's `rate`) returns the unit's new sync times (as for
+    /// [`Engine::interrupt`](super::Engine::interrupt)); others return `None`.
+    fn set_parameter(
+        &mut self,
+        key: &UnitKey,
+        name: &str,
+        value: f64,
+        now: f64,
+    ) -> Result<Option<Vec<f64>>, EngineError>;
+}
+
+/// An engine whose behaviours occupy parts of the body or exclude each other.
+pub trait Resources {
+    /// Behaviours of the same exclusive group cannot run at once (gaze, posture; the
+    /// replacement groups of procedural units).
+    fn exclusive_group(&self, _behaviour: &Behaviour) -> Option<&str> {
+        None
+    }
+
+    /// Body resources the behaviour occupies (e.g. `left_hand`, `voice`): a chunked block
+    /// co-articulates with the block before it where they share one (the earlier behaviour skips
+    /// the rest of its retraction).
+    fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
+        &[]
+    }
+}
+
+/// An engine of control behaviours: it acts on the plan when its units' syncs pass.
+pub trait Control {
+    /// The sync point `sync` of `key` passed at global time `time`; push what follows to
+    /// `actions`.
+    fn sync_passed(&mut self, key: &UnitKey, sync: &str, time: f64, actions: &mut Vec<Action>);
+}
+
+/// How a motion unit moves its joints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionKind {
+    /// It sets or changes joint rotations directly.
+    Kinematic,
+    /// It applies torques to a physically simulated body (mixed dynamics).
+    Physical,
+}
+
+/// What a motion unit steers: its joints, how, and whether it layers over other units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Steering {
+    /// Joints whose rotation it sets or changes (the root joint also for its translation), in
+    /// the skeleton's joint order.
+    pub joints: Vec<usize>,
+    /// Kinematic or physical.
+    pub kind: MotionKind,
+    /// Whether it adds to what other units set (a layer) rather than replacing it.
+    pub additive: bool,
+}
+
+impl Steering {
+    /// Kinematic steering of the joints of `skeleton` named `names` (unknown names are left out).
+    pub fn kinematic<'a>(
+        skeleton: &Skeleton,
+        names: impl IntoIterator<Item = &'a str>,
+        additive: bool,
+    ) -> Steering {
+        let mut joints: Vec<usize> = names
+            .into_iter()
+            .filter_map(|n| skeleton.joint(n))
+            .collect();
+        joints.sort_unstable();
+        joints.dedup();
+        Steering {
+            joints,
+            kind: MotionKind::Kinematic,
+            additive,
+        }
+    }
+}
+
+/// What a control engine asks the runtime to do (control behaviours act on blocks and other engines).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Interrupt behaviours of block `target`: those in `include` (all if empty) except `exclude`.
+    Interrupt {
+        /// The behaviour asking (for warnings).
+        by: UnitKey,
+        /// Block to interrupt.
+        target: String,
+        /// Behaviours to interrupt (empty: all).
+        include: Vec<String>,
+        /// Behaviours to spare.
+        exclude: Vec<String>,
+    },
+    /// Activate the pre-planned block `target`.
+    Activate {
+        /// The behaviour asking (for warnings).
+        by: UnitKey,
+        /// Block to activate.
+        target: String,
+    },
+    /// Change a parameter of another behaviour over time.
+    ChangeParameter(ParameterChange),
+}
