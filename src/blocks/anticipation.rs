@@ -2,7 +2,7 @@
 //! them following their pegs without rescheduling, losing behaviours whose timing broke.
 
 use super::live::Phase;
-use super::BlockManager;
+use super::{BlockKey, BlockManager};
 use crate::bml;
 use crate::engine::UnitKey;
 use crate::feedback::KnownWarning;
@@ -49,7 +49,9 @@ impl BlockManager {
             .map(|b| b.id.clone())
             .collect();
         for id in ids {
-            let Some(i) = self.pos(&id) else { continue };
+            let Some(i) = self.blocks.find(&id) else {
+                continue;
+            };
             let anticipators = &self.anticipators;
             let predict = |a: &str, sync: &str| {
                 let x = anticipators.iter().find(|x| x.id() == a)?;
@@ -73,7 +75,7 @@ impl BlockManager {
     /// timing broke (order, block start, a future sync moved into the past) leaves the plan with
     /// an INVALID_TIMING warning; if it was running, it ends now as its engine ends interrupted
     /// units.
-    pub(super) fn follow_pegs(&mut self, i: usize, t: f64) {
+    pub(super) fn follow_pegs(&mut self, i: BlockKey, t: f64) {
         let block_id = self.blocks[i].id.clone();
         let Some(p) = self.blocks[i].pegs.as_ref() else {
             return;

@@ -7,10 +7,11 @@ use petgraph::algo::has_path_connecting;
 use petgraph::graphmap::DiGraphMap;
 
 use super::live::LiveBlock;
+use super::store::Blocks;
 
 /// Whether `from` (a block about to join `blocks`) waits, directly or through other blocks, for
 /// the block `to`: then `to` may not be made to wait for `from`.
-pub(super) fn waits_on(blocks: &[LiveBlock], from: &LiveBlock, to: &str) -> bool {
+pub(super) fn waits_on(blocks: &Blocks, from: &LiveBlock, to: &str) -> bool {
     let mut graph: DiGraphMap<&str, ()> = DiGraphMap::new();
     for b in blocks.iter().chain(std::iter::once(from)) {
         graph.add_node(b.id.as_str());

@@ -15,6 +15,8 @@ pub(super) struct Due {
     /// The behaviour's position in its block, and the sync's position in the behaviour.
     pub(super) xi: usize,
     pub(super) k: usize,
+    /// The block's handle (`seq` orders; this finds it).
+    pub(super) block: BlockKey,
 }
 
 /// A global time in whole nanoseconds.
@@ -23,7 +25,7 @@ pub(super) fn due_ns(t: f64) -> i64 {
 }
 
 impl BlockManager {
-    /// The next sync point due: (global time, block index, behaviour index). Ties (times within
+    /// The next sync point due: (global time, block, behaviour index). Ties (times within
     /// a nanosecond: float noise of the solver) go to the earlier block, then document order.
     ///
     /// Every live behaviour's next sync waits in a heap. It is rebuilt after a change of the plan
@@ -31,7 +33,7 @@ impl BlockManager {
     /// only queues the behaviour's next one ([`queue_next`](Self::queue_next)). An entry whose
     /// behaviour has moved on is dropped when it comes up. So an event costs a heap operation,
     /// not a scan of every live behaviour (a chain of 10 000 behaviours passes 70 000 syncs).
-    pub(super) fn next_sync(&self) -> Option<(f64, usize, usize)> {
+    pub(super) fn next_sync(&self) -> Option<(f64, BlockKey, usize)> {
         if self.due_stale.get() {
             self.rebuild_due();
         }
@@ -51,7 +53,7 @@ impl BlockManager {
     }
 
     /// The entry of behaviour `xi` of block `bi`'s next sync, if it has one to report.
-    pub(super) fn due_of(&self, bi: usize, xi: usize) -> Option<Due> {
+    pub(super) fn due_of(&self, bi: BlockKey, xi: usize) -> Option<Due> {
         let b = &self.blocks[bi];
         let x = &b.behaviours[xi];
         let live = b.started() && matches!(x.phase, Phase::Added | Phase::Running);
@@ -62,11 +64,12 @@ impl BlockManager {
             index: x.index,
             xi,
             k: x.next,
+            block: bi,
         })
     }
 
     /// Queues the next sync of behaviour `xi` of block `bi` (after one of its syncs passed).
-    pub(super) fn queue_next(&self, bi: usize, xi: usize) {
+    pub(super) fn queue_next(&self, bi: BlockKey, xi: usize) {
         if let Some(d) = self.due_of(bi, xi) {
             self.due.borrow_mut().push(Reverse(d));
         }
@@ -74,7 +77,7 @@ impl BlockManager {
 
     pub(super) fn rebuild_due(&self) {
         let mut all = Vec::new();
-        for (bi, b) in self.blocks.iter().enumerate() {
+        for (bi, b) in self.blocks.with_keys() {
             if b.started() {
                 all.extend((0..b.behaviours.len()).filter_map(|xi| self.due_of(bi, xi)));
             }
@@ -84,9 +87,10 @@ impl BlockManager {
     }
 
     /// Whether an entry still stands for its behaviour's next sync: its global time and its
-    /// block's index then.
-    pub(super) fn still_due(&self, d: Due) -> Option<(f64, usize)> {
-        let bi = self.seqs.binary_search(&d.seq).ok()?;
+    /// block.
+    pub(super) fn still_due(&self, d: Due) -> Option<(f64, BlockKey)> {
+        let bi = d.block;
+        self.blocks.get(bi)?;
         let now = self.due_of(bi, d.xi)?;
         (now == d).then(|| {
             let b = &self.blocks[bi];
@@ -125,10 +129,9 @@ impl BlockManager {
                 }
                 (Some((t, bi, xi)), _) => {
                     self.now = t;
-                    let seq = self.blocks[bi].seq;
                     if self.pass_sync(bi, xi, t) {
                         self.touch();
-                    } else if let Ok(bi) = self.seqs.binary_search(&seq) {
+                    } else if self.blocks.get(bi).is_some() {
                         self.queue_next(bi, xi);
                     }
                 }
@@ -188,7 +191,7 @@ impl BlockManager {
     /// Reports the next sync of behaviour `xi` of block `bi`, passed at `t`, and what follows
     /// from it. Returns whether the plan changed beyond that behaviour (an action, a block that
     /// ended or started).
-    pub(super) fn pass_sync(&mut self, bi: usize, xi: usize, t: f64) -> bool {
+    pub(super) fn pass_sync(&mut self, bi: BlockKey, xi: usize, t: f64) -> bool {
         let (block_id, beh_id, sync, local, engine, last, skipped) = {
             let b = &mut self.blocks[bi];
             let x = &mut b.behaviours[xi];
@@ -224,7 +227,7 @@ impl BlockManager {
         for a in actions {
             self.act(a, t);
         }
-        if let Some(bi) = self.pos(&block_id) {
+        if let Some(bi) = self.blocks.find(&block_id) {
             changed |= self.finish_if_done(bi, t);
         }
         changed
@@ -241,7 +244,8 @@ impl BlockManager {
             Action::Activate { by, target } => self.activate(&target, t, &by.to_string()),
             Action::ChangeParameter(mut c) => {
                 let engine = self
-                    .pos(&c.target.block)
+                    .blocks
+                    .find(&c.target.block)
                     .and_then(|i| self.blocks[i].behaviour(&c.target.behaviour))
                     .filter(|x| matches!(x.phase, Phase::Added | Phase::Running))
                     .map(|x| x.engine);
@@ -283,7 +287,7 @@ impl BlockManager {
         }
         let changes = std::mem::take(&mut self.changes);
         for c in changes {
-            let found = self.pos(&c.target.block).and_then(|bi| {
+            let found = self.blocks.find(&c.target.block).and_then(|bi| {
                 let xi = self.blocks[bi]
                     .behaviours
                     .iter()

@@ -18,7 +18,7 @@ impl BlockManager {
         }));
     }
 
-    pub(super) fn predict(&mut self, i: usize, with_behaviours: bool) {
+    pub(super) fn predict(&mut self, i: BlockKey, with_behaviours: bool) {
         let fb = self.prediction(&self.blocks[i], with_behaviours);
         self.emit(fb);
     }

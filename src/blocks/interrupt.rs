@@ -6,8 +6,8 @@ use super::*;
 impl BlockManager {
     /// The live block `target` of an interrupt by `by`. A block that finished a moment ago is a
     /// quiet no-op; one that never existed gets a NO_SUCH_TARGET warning.
-    pub(super) fn interrupt_target(&mut self, target: &str, by: &str) -> Option<usize> {
-        let i = self.pos(target);
+    pub(super) fn interrupt_target(&mut self, target: &str, by: &str) -> Option<BlockKey> {
+        let i = self.blocks.find(target);
         if i.is_none() && !self.finished_set.contains(target) {
             self.warn(
                 by.to_string(),
@@ -51,7 +51,7 @@ impl BlockManager {
 
     /// Ends running behaviour `xi` of block `bi` at `t` the way its engine ends interrupted units
     /// (speech stops, motion retracts from now); its remaining syncs take the engine's times.
-    pub(super) fn interrupt_unit(&mut self, bi: usize, xi: usize, t: f64) {
+    pub(super) fn interrupt_unit(&mut self, bi: BlockKey, xi: usize, t: f64) {
         let b = &self.blocks[bi];
         let (start, x) = (b.start, &b.behaviours[xi]);
         let key = UnitKey::new(b.id.clone(), x.id.clone());

@@ -6,9 +6,9 @@ use super::*;
 
 impl BlockManager {
     /// A PENDING block that may run: it starts now if nothing holds it back, else it is LURKING
-    /// (with its prediction) until [`start_ready`](Self::start_ready) starts it. Block indices may
-    /// change (a block that starts can end at once).
-    pub(super) fn release(&mut self, i: usize, now: f64) {
+    /// (with its prediction) until [`start_ready`](Self::start_ready) starts it. A block that
+    /// starts can end at once (its handle then finds nothing).
+    pub(super) fn release(&mut self, i: BlockKey, now: f64) {
         self.blocks[i].preplan = false;
         if self.blocks[i].status == BlockStatus::Lurking {
             return;
@@ -28,9 +28,9 @@ impl BlockManager {
     }
 
     /// every append target is done and every chunk target subsiding or done.
-    pub(super) fn ready(&self, i: usize) -> bool {
+    pub(super) fn ready(&self, i: BlockKey) -> bool {
         let b = &self.blocks[i];
-        let live = |id: &bml::Id| self.pos(id).map(|i| &self.blocks[i]);
+        let live = |id: &bml::Id| self.blocks.named(id);
         b.waits_for.iter().all(|id| live(id).is_none())
             && b.chunk_after.iter().all(|id| {
                 live(id)
@@ -42,7 +42,7 @@ impl BlockManager {
     /// block at once, which can make others ready).
     pub(super) fn start_ready(&mut self, t: f64) {
         while self.lurking > 0 {
-            let next = (0..self.blocks.len())
+            let next = (self.blocks.keys())
                 .find(|&i| self.blocks[i].status == BlockStatus::Lurking && self.ready(i));
             match next {
                 Some(i) => self.start_block(i, t),
@@ -52,7 +52,7 @@ impl BlockManager {
     }
 
     /// the block peg moves to `t`, start feedback, onStart activations, units to engines.
-    pub(super) fn start_block(&mut self, i: usize, t: f64) {
+    pub(super) fn start_block(&mut self, i: BlockKey, t: f64) {
         if self.blocks[i].status == BlockStatus::Lurking {
             self.lurking -= 1;
         }
@@ -120,12 +120,12 @@ impl BlockManager {
         if !self.blocks[i].all_ended() {
             self.predict(i, false);
         }
-        // activations may start (and end) other blocks: find this one again by id afterwards
+        // activations may start (and end) other blocks, this one among them
         let on_start = self.blocks[i].source.ext.on_start.clone();
         for target in on_start {
             self.activate(&target, t, &id);
         }
-        if let Some(i) = self.pos(&id) {
+        if self.blocks.get(i).is_some() {
             self.finish_if_done(i, t);
         }
     }
@@ -133,7 +133,7 @@ impl BlockManager {
     /// A chunked block starting at `t` takes over from the blocks it is chunked after: their
     /// behaviours that are retracting (past `relax`) on a body resource this block uses (a hand,
     /// the voice) skip the rest of the retraction and end now.
-    pub(super) fn coarticulate(&mut self, i: usize, t: f64) {
+    pub(super) fn coarticulate(&mut self, i: BlockKey, t: f64) {
         if self.blocks[i].chunk_after.is_empty() {
             return;
         }
@@ -150,7 +150,9 @@ impl BlockManager {
             return;
         }
         for target in self.blocks[i].chunk_after.clone() {
-            let Some(j) = self.pos(&target) else { continue };
+            let Some(j) = self.blocks.find(&target) else {
+                continue;
+            };
             for xi in 0..self.blocks[j].behaviours.len() {
                 let x = &self.blocks[j].behaviours[xi];
                 let relax = x.syncs.iter().position(|(n, _)| n == "relax");
@@ -171,7 +173,7 @@ impl BlockManager {
 
     /// Activates pre-planned block `target` (by `activate` or onStart).
     pub(super) fn activate(&mut self, target: &str, t: f64, by: &str) {
-        match self.pos(target) {
+        match self.blocks.find(target) {
             Some(j) if self.blocks[j].status == BlockStatus::Pending => {
                 self.release(j, t);
                 self.start_ready(t);
@@ -188,7 +190,7 @@ impl BlockManager {
 
     /// Ends block `i` with DONE (INTERRUPTED if an interrupt cut it) if every behaviour still in
     /// its plan has ended, and starts what waited for it.
-    pub(super) fn finish_if_done(&mut self, i: usize, t: f64) -> bool {
+    pub(super) fn finish_if_done(&mut self, i: BlockKey, t: f64) -> bool {
         if !self.blocks[i].all_ended() {
             return false;
         }
@@ -205,10 +207,10 @@ impl BlockManager {
     /// Removes block `i` from the plan with end feedback of `status`. What waited for it is
     /// started by the caller, once it has removed all it removes (a queued block that REPLACE is
     /// about to remove must not start first).
-    pub(super) fn end_block(&mut self, i: usize, t: f64, status: BlockStatus) {
-        let b = self.blocks.remove(i);
-        self.seqs.remove(i);
-        self.index.remove(&b.id);
+    pub(super) fn end_block(&mut self, i: BlockKey, t: f64, status: BlockStatus) {
+        let Some(b) = self.blocks.remove(i) else {
+            return; // it has left the plan already
+        };
         if b.status == BlockStatus::Lurking {
             self.lurking -= 1;
         }

@@ -12,7 +12,7 @@
 //! One `impl BlockManager` spread over the phases: `submit.rs` (composition → schedule → start or
 //! wait), `lifecycle.rs` (starting, activation, ending), `event_loop.rs` (syncs in time order,
 //! control actions, parameter changes), `interrupt.rs`, `anticipation.rs` (blocks on pegs),
-//! `feedback.rs`; `live.rs` is a block in the plan.
+//! `feedback.rs`; `live.rs` is a block in the plan, `store.rs` the live blocks by stable handle.
 
 mod anticipation;
 mod dependencies;
@@ -21,13 +21,14 @@ mod feedback;
 mod interrupt;
 mod lifecycle;
 mod live;
+mod store;
 mod submit;
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};
 
-// block ids come from the host: a fast hash (rustc's) instead of SipHash for the block index
-use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
+// block ids come from the host: a fast hash (rustc's) instead of SipHash
+use rustc_hash::FxHashSet as HashSet;
 
 use crate::bml::{self, Diagnostic, SyncPoint};
 use crate::body::{Pose, Skeleton};
@@ -45,7 +46,7 @@ use crate::timing::TimingModels;
 use crate::world::World;
 use event_loop::Due;
 use live::{anticipator_refs, referenced_points, LiveBlock, Phase};
-use submit::position;
+use store::{BlockKey, Blocks};
 
 /// How late a block may start so that its references to other blocks' sync points that have just
 /// passed still hold exactly (a block sent a frame after the moment it refers to): it starts that
@@ -78,12 +79,8 @@ pub struct BlockManager {
     registry: Registry,
     strategy: Box<dyn SchedulingStrategy>,
     character: Option<String>,
-    /// Live blocks in arrival order (so sorted by `seq`).
-    blocks: Vec<LiveBlock>,
-    /// The blocks' `seq`s, in the same order: searched instead of the large blocks themselves.
-    seqs: Vec<u64>,
-    /// Block id → seq, to find a block without scanning.
-    index: HashMap<bml::Id, u64>,
+    /// Live blocks in arrival order, by handle and by id.
+    blocks: Blocks,
     /// How many blocks are LURKING (nothing to check when none is).
     lurking: usize,
     finished: VecDeque<bml::Id>,
@@ -114,9 +111,7 @@ impl BlockManager {
             registry,
             strategy,
             character,
-            blocks: Vec::new(),
-            seqs: Vec::new(),
-            index: HashMap::default(),
+            blocks: Blocks::default(),
             lurking: 0,
             finished: VecDeque::new(),
             finished_set: HashSet::default(),
@@ -177,8 +172,8 @@ impl BlockManager {
 
     /// Status of block `id`: its live status, DONE if it finished recently, `None` if unknown.
     pub fn status(&self, id: &str) -> Option<BlockStatus> {
-        match self.pos(id) {
-            Some(i) => Some(self.blocks[i].status),
+        match self.blocks.named(id) {
+            Some(b) => Some(b.status),
             None => self.finished_set.contains(id).then_some(BlockStatus::Done),
         }
     }
@@ -209,11 +204,6 @@ impl BlockManager {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         }
-    }
-
-    /// Where block `id` is in `self.blocks`.
-    fn pos(&self, id: &str) -> Option<usize> {
-        position(&self.seqs, &self.index, id)
     }
 }
 

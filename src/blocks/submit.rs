@@ -7,16 +7,9 @@ use crate::schedule::BlockSchedule;
 
 /// Times of other blocks' syncs relative to the start of a block being scheduled.
 pub(super) struct OtherBlocks<'a> {
-    pub(super) blocks: &'a [LiveBlock],
-    pub(super) seqs: &'a [u64],
-    pub(super) index: &'a HashMap<bml::Id, u64>,
+    pub(super) blocks: &'a Blocks,
     pub(super) anticipators: &'a [Box<dyn Anticipator>],
     pub(super) start: f64,
-}
-
-/// Where block `id` is among the blocks whose `seq`s are `seqs` (increasing).
-pub(super) fn position(seqs: &[u64], index: &HashMap<bml::Id, u64>, id: &str) -> Option<usize> {
-    seqs.binary_search(index.get(id)?).ok()
 }
 
 impl ExternalTimes for OtherBlocks<'_> {
@@ -27,7 +20,7 @@ impl ExternalTimes for OtherBlocks<'_> {
                 behaviour,
                 sync,
             } => {
-                let b = &self.blocks[position(self.seqs, self.index, block)?];
+                let b = self.blocks.named(block)?;
                 let local = b.behaviour(behaviour)?.time(sync)?;
                 Some(b.start + local - self.start)
             }
@@ -47,7 +40,7 @@ impl BlockManager {
     pub fn submit(&mut self, block: bml::Block, warnings: &[Diagnostic]) {
         self.touch();
         let now = self.now;
-        if let Some(i) = self.pos(&block.id) {
+        if let Some(i) = self.blocks.find(&block.id) {
             let status = self.blocks[i].status;
             let text = format!(
                 "block id '{}' is still in use (status {status}); the new block is ignored",
@@ -140,7 +133,7 @@ impl BlockManager {
                 sync,
             } = p
             {
-                let t = self.pos(b).and_then(|i| {
+                let t = self.blocks.find(b).and_then(|i| {
                     let other = &self.blocks[i];
                     Some(other.start + other.behaviour(behaviour)?.time(sync)?)
                 });
@@ -157,8 +150,6 @@ impl BlockManager {
     fn schedule(&mut self, live: &LiveBlock) -> Option<BlockSchedule> {
         let external = OtherBlocks {
             blocks: &self.blocks,
-            seqs: &self.seqs,
-            index: &self.index,
             anticipators: &self.anticipators,
             start: live.start,
         };
@@ -229,7 +220,7 @@ impl BlockManager {
                     self.warn(id.to_string(), KnownWarning::ImpossibleToSchedule, text);
                     continue;
                 }
-                match self.pos(t).map(|i| &mut self.blocks[i]) {
+                match self.blocks.find(t).map(|i| &mut self.blocks[i]) {
                     Some(b) if !b.started() => {
                         let list = if chunk {
                             &mut b.chunk_after
@@ -259,10 +250,7 @@ impl BlockManager {
         let preplan = live.source.ext.preplan;
         live.status = BlockStatus::Pending;
         live.preplan = preplan;
-        self.index.insert(live.id.clone(), live.seq);
-        self.seqs.push(live.seq);
-        self.blocks.push(live);
-        let i = self.blocks.len() - 1;
+        let i = self.blocks.insert(live);
         self.predict(i, true);
         if !preplan {
             if self.ready(i) {
@@ -280,7 +268,7 @@ impl BlockManager {
     pub(super) fn existing(&mut self, ids: &[String], by: &str) -> Vec<bml::Id> {
         let mut v = Vec::new();
         for id in ids {
-            if self.pos(id).is_some() {
+            if self.blocks.find(id).is_some() {
                 v.push(bml::Id::new(id));
             } else if !self.finished_set.contains(id.as_str()) {
                 self.warn(
@@ -301,11 +289,7 @@ impl BlockManager {
     ) -> f64 {
         let mut start = now;
         for (ids, subsiding) in [(waits_for, false), (chunk_after, true)] {
-            for b in ids
-                .iter()
-                .filter_map(|id| self.pos(id))
-                .map(|i| &self.blocks[i])
-            {
+            for b in ids.iter().filter_map(|id| self.blocks.named(id)) {
                 let t = if subsiding {
                     b.predicted_subsiding()
                 } else {

@@ -2,31 +2,39 @@
 
 use super::*;
 
-/// A block is found where it is, whether or not blocks before or after it have left (the guess
-/// from the newest block's seq, then the binary search), and an unknown or gone block is not.
+fn live(id: &str, seq: u64) -> LiveBlock {
+    let text = format!(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="{id}"/>"#);
+    let block = bml::load(&text).unwrap().block;
+    LiveBlock::new(block, seq, 0.0, Vec::new(), Vec::new())
+}
+
+/// A block's handle keeps finding it while blocks before and after it leave; a gone block's
+/// handle finds nothing, also after a block of the same id arrives again; order is arrival order.
 #[test]
-fn position_finds_blocks_with_and_without_gaps() {
-    let ids = ["a", "b", "c", "d", "e", "f"];
-    let index: HashMap<bml::Id, u64> = ids
+fn handles_stay_valid_while_other_blocks_come_and_go() {
+    let mut blocks = Blocks::default();
+    let keys: Vec<BlockKey> = ["a", "b", "c", "d"]
         .iter()
         .enumerate()
-        .map(|(i, id)| (bml::Id::new(id), i as u64 + 10))
+        .map(|(i, id)| blocks.insert(live(id, i as u64)))
         .collect();
-    for live in [
-        vec![10u64, 11, 12, 13, 14, 15], // none left
-        vec![12, 13, 14, 15],            // the first two left
-        vec![10, 12, 15],                // gaps inside
-        vec![11, 12, 13],                // the newest left
-    ] {
-        for (i, id) in ids.iter().enumerate() {
-            let seq = i as u64 + 10;
-            assert_eq!(
-                position(&live, &index, id),
-                live.iter().position(|&s| s == seq),
-                "{id} in {live:?}"
-            );
-        }
-        assert_eq!(position(&live, &index, "z"), None);
-    }
-    assert_eq!(position(&[], &index, "a"), None);
+    assert!(blocks.remove(keys[0]).is_some());
+    assert!(blocks.remove(keys[2]).is_some());
+    assert_eq!(blocks[keys[1]].id, "b");
+    assert_eq!(blocks[keys[3]].id, "d");
+    assert!(blocks.get(keys[2]).is_none());
+    assert!(
+        blocks.remove(keys[2]).is_none(),
+        "removing twice does nothing"
+    );
+    let again = blocks.insert(live("c", 9));
+    assert!(
+        blocks.get(keys[2]).is_none(),
+        "the old handle does not find the new 'c'"
+    );
+    assert_eq!(blocks.find("c"), Some(again));
+    assert_eq!(blocks.find("a"), None);
+    let order: Vec<&str> = blocks.iter().map(|b| b.id.as_str()).collect();
+    assert_eq!(order, ["b", "d", "c"]);
+    assert_eq!(blocks.len(), 3);
 }
