@@ -67,6 +67,16 @@ fn malformed_json_lines_are_rejected_with_a_reason() {
         r#"{"feedback":"blockProgress","id":"b:start","globalTime":1,"bmla:posixTime":-5}"#
     )
     .contains("posixTime"));
+    // a wrong value deep inside names its place
+    let e = err(
+        r#"{"feedback":"predictionFeedback","bml":[{"feedback":"bml","id":"b","globalStart":"x"}]}"#,
+    );
+    assert!(e.contains("bml[0].globalStart: invalid type"), "{e}");
+    let e = err(
+        r#"{"feedback":"predictionFeedback","behaviors":[{"feedback":"gesture","id":"b:g","stroke":"soon"}]}"#,
+    );
+    assert!(e.contains("behaviors[0]") && e.contains("soon"), "{e}");
+    assert!(err(r#"{"feedback":"applause"}"#).contains("unknown feedback \"applause\""));
 }
 
 #[test]

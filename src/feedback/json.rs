@@ -1,261 +1,369 @@
 //! The JSON-lines codec of feedback: one object per line, `"feedback"` naming the element, the
 //! other keys being the XML attribute names verbatim (`"bmla:status"`, ...), times as numbers
 //! rounded to the millisecond, a warning's text under `"text"`, a prediction's children under
-//! `"bml"` and `"behaviors"` (objects of the same shape).
+//! `"bml"` and `"behaviors"` (objects of the same shape). The wire shape is the serde types
+//! below; decoding errors name the field.
 
-use serde_json::{json, Map, Value};
+use indexmap::IndexMap;
+use serde::{Deserialize, Serialize, Serializer};
 
 use super::*;
 
-fn time(v: f64) -> Value {
-    json!(round_ms(v))
+/// One feedback line as it is written: one struct per element, each with its `"feedback"` key
+/// first.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Line {
+    BlockProgress(BlockProgressLine),
+    SyncPointProgress(SyncPointLine),
+    Prediction(PredictionLine),
+    Warning(WarningLine),
 }
 
-fn put_opt(m: &mut Map<String, Value>, k: &str, v: Option<Value>) {
-    if let Some(v) = v {
-        m.insert(k.to_string(), v);
+#[derive(Serialize, Deserialize)]
+struct BlockProgressLine {
+    feedback: String,
+    /// `block:sync`.
+    id: String,
+    #[serde(rename = "globalTime", serialize_with = "ms")]
+    global_time: f64,
+    #[serde(
+        rename = "characterId",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    character_id: Option<String>,
+    #[serde(
+        rename = "bmla:status",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    status: Option<String>,
+    #[serde(
+        rename = "bmla:posixTime",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    posix_time: Option<u64>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct SyncPointLine {
+    feedback: String,
+    /// `block:behaviour:sync`.
+    id: String,
+    #[serde(serialize_with = "ms")]
+    time: f64,
+    #[serde(rename = "globalTime", serialize_with = "ms")]
+    global_time: f64,
+    #[serde(
+        rename = "characterId",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    character_id: Option<String>,
+    #[serde(
+        rename = "bmla:posixTime",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    posix_time: Option<u64>,
+    #[serde(rename = "bmla:skipped", default, skip_serializing_if = "is_false")]
+    skipped: bool,
+}
+
+#[derive(Serialize, Deserialize)]
+struct PredictionLine {
+    feedback: String,
+    #[serde(
+        rename = "characterId",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    character_id: Option<String>,
+    #[serde(default)]
+    bml: Vec<BlockLine>,
+    #[serde(default)]
+    behaviors: Vec<BehaviourLine>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct WarningLine {
+    feedback: String,
+    id: String,
+    #[serde(rename = "type")]
+    kind: String,
+    #[serde(
+        rename = "characterId",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    character_id: Option<String>,
+    #[serde(default)]
+    text: String,
+}
+
+/// A `<bml>` child of a prediction.
+#[derive(Serialize, Deserialize)]
+struct BlockLine {
+    /// Always `bml`.
+    feedback: String,
+    id: String,
+    #[serde(rename = "globalStart", default, serialize_with = "opt_ms")]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    global_start: Option<f64>,
+    #[serde(rename = "globalEnd", default, serialize_with = "opt_ms")]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    global_end: Option<f64>,
+    #[serde(
+        rename = "bmla:status",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    status: Option<String>,
+}
+
+/// A behaviour child of a prediction: its element name, `block:behaviour`, and a key per sync.
+#[derive(Serialize, Deserialize)]
+struct BehaviourLine {
+    feedback: String,
+    id: String,
+    #[serde(flatten, serialize_with = "syncs_ms")]
+    syncs: IndexMap<String, f64>,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
+}
+
+fn ms<S: Serializer>(t: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(round_ms(*t))
+}
+
+fn opt_ms<S: Serializer>(t: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match t {
+        Some(t) => s.serialize_some(&round_ms(*t)),
+        None => s.serialize_none(),
     }
 }
 
-fn to_value(fb: &Feedback) -> Value {
-    let mut m = Map::new();
-    m.insert("feedback".into(), json!(fb.element_name()));
-    match fb {
-        Feedback::BlockProgress(b) => {
-            m.insert("id".into(), json!(format!("{}:{}", b.block, b.sync)));
-            m.insert("globalTime".into(), time(b.global_time));
-            put_opt(
-                &mut m,
-                "characterId",
-                b.character_id.as_ref().map(|c| json!(c)),
-            );
-            put_opt(&mut m, "bmla:status", b.status.map(|s| json!(s.as_str())));
-            put_opt(&mut m, "bmla:posixTime", b.posix_time.map(|p| json!(p)));
-        }
-        Feedback::SyncPointProgress(s) => {
-            m.insert(
-                "id".into(),
-                json!(format!("{}:{}:{}", s.block, s.behaviour, s.sync)),
-            );
-            m.insert("time".into(), time(s.time));
-            m.insert("globalTime".into(), time(s.global_time));
-            put_opt(
-                &mut m,
-                "characterId",
-                s.character_id.as_ref().map(|c| json!(c)),
-            );
-            put_opt(&mut m, "bmla:posixTime", s.posix_time.map(|p| json!(p)));
-            if s.skipped {
-                m.insert("bmla:skipped".into(), json!(true));
-            }
-        }
-        Feedback::Prediction(p) => {
-            put_opt(
-                &mut m,
-                "characterId",
-                p.character_id.as_ref().map(|c| json!(c)),
-            );
-            let blocks: Vec<Value> = p
-                .blocks
-                .iter()
-                .map(|b| {
-                    let mut o = Map::new();
-                    o.insert("feedback".into(), json!("bml"));
-                    o.insert("id".into(), json!(b.id.as_str()));
-                    put_opt(&mut o, "globalStart", b.global_start.map(time));
-                    put_opt(&mut o, "globalEnd", b.global_end.map(time));
-                    put_opt(&mut o, "bmla:status", b.status.map(|s| json!(s.as_str())));
-                    Value::Object(o)
-                })
-                .collect();
-            let behaviours: Vec<Value> = p
-                .behaviours
-                .iter()
-                .map(|b| {
-                    let mut o = Map::new();
-                    o.insert("feedback".into(), json!(b.kind.as_str()));
-                    o.insert("id".into(), json!(format!("{}:{}", b.block, b.behaviour)));
-                    for (sync, t) in &b.syncs {
-                        o.insert(sync.to_string(), time(*t));
-                    }
-                    Value::Object(o)
-                })
-                .collect();
-            m.insert("bml".into(), Value::Array(blocks));
-            m.insert("behaviors".into(), Value::Array(behaviours));
-        }
-        Feedback::Warning(w) => {
-            m.insert("id".into(), json!(w.id));
-            m.insert("type".into(), json!(w.kind.as_str()));
-            put_opt(
-                &mut m,
-                "characterId",
-                w.character_id.as_ref().map(|c| json!(c)),
-            );
-            m.insert("text".into(), json!(w.text));
-        }
-    }
-    Value::Object(m)
+fn syncs_ms<S: Serializer>(syncs: &IndexMap<String, f64>, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_map(syncs.iter().map(|(k, t)| (k, round_ms(*t))))
 }
 
 /// Encodes one message as one JSON line (no trailing newline).
 pub fn to_json(fb: &Feedback) -> String {
-    to_value(fb).to_string()
+    serde_json::to_string(&Line::of(fb)).expect("feedback always encodes")
 }
 
-fn str_of<'a>(m: &'a Map<String, Value>, k: &str) -> Result<&'a str, FeedbackError> {
-    m.get(k)
-        .and_then(Value::as_str)
-        .ok_or_else(|| FeedbackError(format!("missing or non-string \"{k}\"")))
+/// Decodes one JSON feedback line.
+pub fn from_json(line: &str) -> Result<Feedback, FeedbackError> {
+    let value: serde_json::Value =
+        serde_json::from_str(line).map_err(|e| FeedbackError(format!("not JSON: {e}")))?;
+    let kind = value.get("feedback").ok_or_else(|| {
+        FeedbackError("a feedback element is a JSON object with a \"feedback\" key".into())
+    })?;
+    let line = match kind.as_str() {
+        Some("blockProgress") => Line::BlockProgress(field_checked(value)?),
+        Some("syncPointProgress") => Line::SyncPointProgress(field_checked(value)?),
+        Some("predictionFeedback") => Line::Prediction(field_checked(value)?),
+        Some("warningFeedback") => Line::Warning(field_checked(value)?),
+        _ => return Err(FeedbackError(format!("unknown feedback {kind}"))),
+    };
+    line.feedback()
 }
 
-fn opt_str(m: &Map<String, Value>, k: &str) -> Result<Option<String>, FeedbackError> {
-    match m.get(k) {
-        None | Some(Value::Null) => Ok(None),
-        Some(Value::String(s)) => Ok(Some(s.clone())),
-        Some(_) => Err(FeedbackError(format!("\"{k}\" should be a string"))),
+/// `value` read as a `T`; the error names the field (`bml[0].globalStart: ...`).
+fn field_checked<T: serde::de::DeserializeOwned>(
+    value: serde_json::Value,
+) -> Result<T, FeedbackError> {
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        match path.as_str() {
+            "." => FeedbackError(e.into_inner().to_string()),
+            _ => FeedbackError(format!("{path}: {}", e.into_inner())),
+        }
+    })
+}
+
+impl Line {
+    fn of(fb: &Feedback) -> Line {
+        match fb {
+            Feedback::BlockProgress(b) => Line::BlockProgress(BlockProgressLine {
+                feedback: fb.element_name().into(),
+                id: format!("{}:{}", b.block, b.sync),
+                global_time: b.global_time,
+                character_id: b.character_id.clone(),
+                status: b.status.map(|s| s.as_str().to_string()),
+                posix_time: b.posix_time,
+            }),
+            Feedback::SyncPointProgress(s) => Line::SyncPointProgress(SyncPointLine {
+                feedback: fb.element_name().into(),
+                id: format!("{}:{}:{}", s.block, s.behaviour, s.sync),
+                time: s.time,
+                global_time: s.global_time,
+                character_id: s.character_id.clone(),
+                posix_time: s.posix_time,
+                skipped: s.skipped,
+            }),
+            Feedback::Prediction(p) => Line::Prediction(PredictionLine {
+                feedback: fb.element_name().into(),
+                character_id: p.character_id.clone(),
+                bml: p.blocks.iter().map(BlockLine::of).collect(),
+                behaviors: p.behaviours.iter().map(BehaviourLine::of).collect(),
+            }),
+            Feedback::Warning(w) => Line::Warning(WarningLine {
+                feedback: fb.element_name().into(),
+                id: w.id.clone(),
+                kind: w.kind.as_str().to_string(),
+                character_id: w.character_id.clone(),
+                text: w.text.clone(),
+            }),
+        }
+    }
+
+    fn feedback(self) -> Result<Feedback, FeedbackError> {
+        Ok(match self {
+            Line::BlockProgress(BlockProgressLine {
+                id,
+                global_time,
+                character_id,
+                status,
+                posix_time,
+                ..
+            }) => {
+                let (block, sync) = id
+                    .rsplit_once(':')
+                    .filter(|(b, s)| !b.is_empty() && !s.is_empty())
+                    .ok_or_else(|| {
+                        FeedbackError(format!("blockProgress id '{id}' should be block:sync"))
+                    })?;
+                Feedback::BlockProgress(BlockProgress {
+                    block: block.into(),
+                    sync: sync.into(),
+                    global_time,
+                    character_id,
+                    status: status_of(status)?,
+                    posix_time,
+                })
+            }
+            Line::SyncPointProgress(SyncPointLine {
+                id,
+                time,
+                global_time,
+                character_id,
+                posix_time,
+                skipped,
+                ..
+            }) => {
+                let p = split_id(&id, 3, "syncPointProgress")?;
+                let [block, behaviour, sync] = <[String; 3]>::try_from(p).expect("three parts");
+                Feedback::SyncPointProgress(SyncPointProgress {
+                    block: block.into(),
+                    behaviour: behaviour.into(),
+                    sync: sync.into(),
+                    time,
+                    global_time,
+                    character_id,
+                    posix_time,
+                    skipped,
+                })
+            }
+            Line::Prediction(PredictionLine {
+                character_id,
+                bml,
+                behaviors,
+                ..
+            }) => Feedback::Prediction(PredictionFeedback {
+                character_id,
+                blocks: bml
+                    .into_iter()
+                    .map(BlockLine::prediction)
+                    .collect::<Result<_, _>>()?,
+                behaviours: (behaviors.into_iter())
+                    .map(BehaviourLine::prediction)
+                    .collect::<Result<_, _>>()?,
+            }),
+            Line::Warning(WarningLine {
+                id,
+                kind,
+                character_id,
+                text,
+                ..
+            }) => Feedback::Warning(WarningFeedback {
+                id,
+                kind: WarningType::parse(&kind),
+                character_id,
+                text,
+            }),
+        })
     }
 }
 
-fn num_of(m: &Map<String, Value>, k: &str) -> Result<f64, FeedbackError> {
-    m.get(k)
-        .and_then(Value::as_f64)
-        .ok_or_else(|| FeedbackError(format!("missing or non-numeric \"{k}\"")))
-}
+impl BlockLine {
+    fn of(b: &BlockPrediction) -> BlockLine {
+        BlockLine {
+            feedback: "bml".into(),
+            id: b.id.to_string(),
+            global_start: b.global_start,
+            global_end: b.global_end,
+            status: b.status.map(|s| s.as_str().to_string()),
+        }
+    }
 
-fn opt_num(m: &Map<String, Value>, k: &str) -> Result<Option<f64>, FeedbackError> {
-    match m.get(k) {
-        None | Some(Value::Null) => Ok(None),
-        Some(v) => v
-            .as_f64()
-            .map(Some)
-            .ok_or_else(|| FeedbackError(format!("\"{k}\" should be a number"))),
+    fn prediction(self) -> Result<BlockPrediction, FeedbackError> {
+        if self.feedback != "bml" {
+            return Err(FeedbackError(format!(
+                "a block prediction under \"bml\" is a \"bml\" element, not \"{}\"",
+                self.feedback
+            )));
+        }
+        Ok(BlockPrediction {
+            id: self.id.into(),
+            global_start: self.global_start,
+            global_end: self.global_end,
+            status: status_of(self.status)?,
+        })
     }
 }
 
-fn opt_posix(m: &Map<String, Value>) -> Result<Option<u64>, FeedbackError> {
-    match m.get("bmla:posixTime") {
-        None | Some(Value::Null) => Ok(None),
-        Some(v) => v.as_u64().map(Some).ok_or_else(|| {
-            FeedbackError("\"bmla:posixTime\" should be a whole number of ms".into())
-        }),
+impl BehaviourLine {
+    fn of(b: &BehaviourPrediction) -> BehaviourLine {
+        BehaviourLine {
+            feedback: b.kind.to_string(),
+            id: format!("{}:{}", b.block, b.behaviour),
+            syncs: (b.syncs.iter()).map(|(s, t)| (s.to_string(), *t)).collect(),
+        }
+    }
+
+    fn prediction(self) -> Result<BehaviourPrediction, FeedbackError> {
+        let parts = split_id(&self.id, 2, "behaviour prediction")?;
+        let [block, behaviour] = <[String; 2]>::try_from(parts).expect("two parts");
+        check_name(&self.feedback)?;
+        if self.feedback == "bml" {
+            return Err(FeedbackError(
+                "a behaviour prediction cannot be named 'bml'".into(),
+            ));
+        }
+        let mut syncs = Vec::with_capacity(self.syncs.len());
+        for (sync, t) in self.syncs {
+            check_name(&sync)?;
+            syncs.push((sync.as_str().into(), t));
+        }
+        Ok(BehaviourPrediction {
+            kind: self.feedback.as_str().into(),
+            block: block.into(),
+            behaviour: behaviour.into(),
+            syncs,
+        })
     }
 }
 
-fn opt_status(m: &Map<String, Value>) -> Result<Option<BlockStatus>, FeedbackError> {
-    opt_str(m, "bmla:status")?
+fn status_of(status: Option<String>) -> Result<Option<BlockStatus>, FeedbackError> {
+    status
         .map(|s| {
             BlockStatus::parse(&s)
                 .ok_or_else(|| FeedbackError(format!("unknown bmla:status '{s}'")))
         })
         .transpose()
-}
-
-fn objects<'a>(
-    m: &'a Map<String, Value>,
-    k: &str,
-) -> Result<Vec<&'a Map<String, Value>>, FeedbackError> {
-    match m.get(k) {
-        None => Ok(Vec::new()),
-        Some(Value::Array(a)) => a
-            .iter()
-            .map(|v| {
-                v.as_object()
-                    .ok_or_else(|| FeedbackError(format!("\"{k}\" should hold objects")))
-            })
-            .collect(),
-        Some(_) => Err(FeedbackError(format!("\"{k}\" should be a list"))),
-    }
-}
-
-/// Decodes one JSON feedback line.
-pub fn from_json(line: &str) -> Result<Feedback, FeedbackError> {
-    let v: Value =
-        serde_json::from_str(line).map_err(|e| FeedbackError(format!("not JSON: {e}")))?;
-    let m = v
-        .as_object()
-        .ok_or_else(|| FeedbackError("a feedback line must be a JSON object".into()))?;
-    let character_id = opt_str(m, "characterId")?;
-    match str_of(m, "feedback")? {
-        "blockProgress" => {
-            let id = str_of(m, "id")?;
-            let (block, sync) = id
-                .rsplit_once(':')
-                .filter(|(b, s)| !b.is_empty() && !s.is_empty())
-                .ok_or_else(|| {
-                    FeedbackError(format!("blockProgress id '{id}' should be block:sync"))
-                })?;
-            Ok(Feedback::BlockProgress(BlockProgress {
-                block: block.into(),
-                sync: sync.into(),
-                global_time: num_of(m, "globalTime")?,
-                character_id,
-                status: opt_status(m)?,
-                posix_time: opt_posix(m)?,
-            }))
-        }
-        "syncPointProgress" => {
-            let p = split_id(str_of(m, "id")?, 3, "syncPointProgress")?;
-            let [block, behaviour, sync] = <[String; 3]>::try_from(p).expect("three parts");
-            Ok(Feedback::SyncPointProgress(SyncPointProgress {
-                block: block.into(),
-                behaviour: behaviour.into(),
-                sync: sync.into(),
-                time: num_of(m, "time")?,
-                global_time: num_of(m, "globalTime")?,
-                character_id,
-                posix_time: opt_posix(m)?,
-                skipped: m.get("bmla:skipped") == Some(&Value::Bool(true)),
-            }))
-        }
-        "warningFeedback" => Ok(Feedback::Warning(WarningFeedback {
-            id: str_of(m, "id")?.into(),
-            kind: WarningType::parse(str_of(m, "type")?),
-            character_id,
-            text: opt_str(m, "text")?.unwrap_or_default(),
-        })),
-        "predictionFeedback" => {
-            let mut p = PredictionFeedback {
-                character_id,
-                ..Default::default()
-            };
-            for b in objects(m, "bml")? {
-                p.blocks.push(BlockPrediction {
-                    id: str_of(b, "id")?.into(),
-                    global_start: opt_num(b, "globalStart")?,
-                    global_end: opt_num(b, "globalEnd")?,
-                    status: opt_status(b)?,
-                });
-            }
-            for b in objects(m, "behaviors")? {
-                let parts = split_id(str_of(b, "id")?, 2, "behaviour prediction")?;
-                let [block, behaviour] = <[String; 2]>::try_from(parts).expect("two parts");
-                let mut syncs = Vec::new();
-                for (k, v) in b {
-                    if k != "id" && k != "feedback" {
-                        check_name(k)?;
-                        let t = v.as_f64().ok_or_else(|| {
-                            FeedbackError(format!("predicted time \"{k}\" should be a number"))
-                        })?;
-                        syncs.push((k.as_str().into(), t));
-                    }
-                }
-                let kind = str_of(b, "feedback")?;
-                check_name(kind)?;
-                if kind == "bml" {
-                    return Err(FeedbackError(
-                        "a behaviour prediction cannot be named 'bml'".into(),
-                    ));
-                }
-                p.behaviours.push(BehaviourPrediction {
-                    kind: kind.into(),
-                    block: block.into(),
-                    behaviour: behaviour.into(),
-                    syncs,
-                });
-            }
-            Ok(Feedback::Prediction(p))
-        }
-        other => Err(FeedbackError(format!("unknown feedback \"{other}\""))),
-    }
 }
