@@ -1038,6 +1038,9 @@ impl<'i> Parser<'i> {
     }
 
     /// Reads the children of a known behaviour into `kind`; returns its descriptions.
+    /// The children of behaviour element `el` (already read as `kind`): descriptions (returned),
+    /// and the children each kind has (`<text>`, `<stance>` and `<pose>`, `<lexeme>`,
+    /// `<trajectory>`, `<parameter>`, animation content). One arm per child; each reads itself.
     fn behaviour_children(
         &mut self,
         el: &El<'i>,
@@ -1045,59 +1048,15 @@ impl<'i> Parser<'i> {
         on: &dyn fmt::Display,
     ) -> Result<Vec<Description>, Fatal> {
         let mut descriptions = Vec::new();
-        let mut saw_text = false;
-        let mut saw_stance = false;
-        let mut saw_trajectory = false;
+        let mut seen = Seen::default();
         self.children(el, |p, mut c| {
             let core = c.ns.is_core();
             match (&mut *kind, c.name) {
-                (_, "description") if core => {
-                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
-                    let priority = attrs.take("priority").and_then(|a| {
-                        match a.value.trim_ascii().parse::<i64>() {
-                            Ok(v) => Some(v),
-                            Err(_) => {
-                                p.error(
-                                    Code::InvalidNumber,
-                                    a.offset,
-                                    format!("description priority '{}' is not an integer", a.value),
-                                );
-                                None
-                            }
-                        }
-                    });
-                    let kind_attr = attrs.take("type");
-                    if kind_attr.is_none() {
-                        p.error(
-                            Code::MissingAttribute,
-                            c.offset,
-                            format!("<description> in {on} needs a type attribute"),
-                        );
-                    }
-                    let _ = p.leftover_attrs(attrs, &"<description>");
-                    let scope = p.scope();
-                    let Skipped {
-                        content, prefixes, ..
-                    } = p.skip(&c)?;
-                    descriptions.push(Description {
-                        priority,
-                        kind: kind_attr.map(|a| a.value.into_owned()).unwrap_or_default(),
-                        namespaces: used_prefixes(scope, &prefixes, &[]),
-                        content,
-                        pos: p.pos(c.offset),
-                    });
-                }
+                (_, "description") if core => descriptions.push(p.description_child(&mut c, on)?),
                 (BehaviourKind::Speech(s) | BehaviourKind::Text(s), "text")
                     if core || c.ns == Ns::Bmlt =>
                 {
-                    if saw_text {
-                        p.error(
-                            Code::UnknownElement,
-                            c.offset,
-                            format!("{on} has more than one <text>"),
-                        );
-                    }
-                    saw_text = true;
+                    p.only_one(&mut seen.text, &c, "text", on);
                     for a in c.attrs.iter().flatten() {
                         p.error(
                             Code::UnknownAttribute,
@@ -1110,46 +1069,13 @@ impl<'i> Parser<'i> {
                 (BehaviourKind::Posture(post) | BehaviourKind::PostureShift(post), "stance")
                     if core =>
                 {
-                    if saw_stance {
-                        p.error(
-                            Code::UnknownElement,
-                            c.offset,
-                            format!("{on} has more than one <stance>"),
-                        );
-                    }
-                    saw_stance = true;
-                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
-                    if let Some(t) = p.req_enum(
-                        &mut attrs,
-                        "type",
-                        &"<stance>",
-                        c.offset,
-                        StanceType::parse,
-                        StanceType::expected,
-                    ) {
-                        post.stance = t;
-                    }
-                    let _ = p.leftover_attrs(attrs, &"<stance>");
-                    p.skip(&c)?;
+                    p.only_one(&mut seen.stance, &c, "stance", on);
+                    p.stance_child(&mut c, post)?;
                 }
                 (BehaviourKind::Posture(post) | BehaviourKind::PostureShift(post), "pose")
                     if core =>
                 {
-                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
-                    let part = p.req_enum(
-                        &mut attrs,
-                        "part",
-                        &"<pose>",
-                        c.offset,
-                        PosePart::parse,
-                        PosePart::expected,
-                    );
-                    let lexeme = p.req_str(&mut attrs, "lexeme", &"<pose>", c.offset);
-                    let _ = p.leftover_attrs(attrs, &"<pose>");
-                    if let (Some(part), Some(lexeme)) = (part, lexeme) {
-                        post.poses.push(Pose { part, lexeme });
-                    }
-                    p.skip(&c)?;
+                    p.pose_child(&mut c, post)?;
                 }
                 (BehaviourKind::Face(_) | BehaviourKind::FaceShift(_), "lexeme") if core => {
                     p.face_lexeme_child(&mut c, kind, on)?;
@@ -1157,41 +1083,8 @@ impl<'i> Parser<'i> {
                 (BehaviourKind::ParameterValueChange(pvc), "trajectory")
                     if c.ns.is_ext() || c.ns == Ns::None =>
                 {
-                    if saw_trajectory {
-                        p.error(
-                            Code::UnknownElement,
-                            c.offset,
-                            format!("{on} has more than one <trajectory>"),
-                        );
-                    }
-                    saw_trajectory = true;
-                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
-                    let t = p.req_enum(
-                        &mut attrs,
-                        "type",
-                        &"<trajectory>",
-                        c.offset,
-                        TrajectoryType::parse,
-                        TrajectoryType::expected,
-                    );
-                    let initial = p.opt_f64(&mut attrs, "initialValue");
-                    let target = p.req_str(&mut attrs, "targetValue", &"<trajectory>", c.offset);
-                    let _ = p.leftover_attrs(attrs, &"<trajectory>");
-                    if let Some(t) = t {
-                        pvc.trajectory.kind = t;
-                    }
-                    pvc.trajectory.initial_value = initial;
-                    if let Some(v) = target {
-                        match parse_seconds(&v) {
-                            Some(v) => pvc.trajectory.target_value = v,
-                            None => p.error(
-                                Code::InvalidNumber,
-                                c.offset,
-                                format!("<trajectory> targetValue '{v}' is not a number"),
-                            ),
-                        }
-                    }
-                    p.skip(&c)?;
+                    p.only_one(&mut seen.trajectory, &c, "trajectory", on);
+                    p.trajectory_child(&mut c, pvc)?;
                 }
                 (
                     BehaviourKind::ProcAnimation(Animation { params, .. })
@@ -1201,63 +1094,222 @@ impl<'i> Parser<'i> {
                     | BehaviourKind::Noise(Noise { params, .. })
                     | BehaviourKind::Transition(Transition { params, .. }),
                     "parameter",
-                ) if c.ns == Ns::Bmlt || c.ns == Ns::None => {
-                    let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
-                    let name = p.req_str(&mut attrs, "name", &"<parameter>", c.offset);
-                    let value = p.req_str(&mut attrs, "value", &"<parameter>", c.offset);
-                    let _ = p.leftover_attrs(attrs, &"<parameter>");
-                    if let (Some(name), Some(value)) = (name, value) {
-                        params.push(Param { name, value });
-                    }
-                    p.skip(&c)?;
-                }
+                ) if c.ns == Ns::Bmlt || c.ns == Ns::None => p.parameter_child(&mut c, params)?,
                 (
                     BehaviourKind::ProcAnimation(a)
                     | BehaviourKind::ProcAnimationGesture(a)
                     | BehaviourKind::Keyframe(a),
                     _,
-                ) => {
-                    let scope = p.scope();
-                    let Skipped {
-                        after,
-                        mut prefixes,
-                        ..
-                    } = p.skip(&c)?;
-                    prefixes.extend(c.prefixes.iter().cloned());
-                    a.content.push_str(&p.src[c.offset..after]);
-                    a.namespaces = used_prefixes(scope, &prefixes, &a.namespaces);
-                }
-                _ => {
-                    if core {
-                        p.error(
-                            Code::UnknownElement,
-                            c.offset,
-                            format!("<{}> is not allowed in {on}", c.qname),
-                        );
-                    } else {
-                        p.warn(
-                            Code::UnsupportedExtension,
-                            c.offset,
-                            format!(
-                                "extension element <{}> in {on} is not supported and is ignored",
-                                c.qname
-                            ),
-                        );
-                    }
-                    p.skip(&c)?;
-                }
+                ) => p.animation_content(&c, a)?,
+                _ => p.unknown_child(&c, core, on)?,
             }
             Ok(())
         })?;
+        self.missing_children(el, kind, &seen, on);
+        Ok(descriptions)
+    }
+
+    /// Reports a second `<name>` child where only one is allowed.
+    fn only_one(&mut self, seen: &mut bool, c: &El<'i>, name: &str, on: &dyn fmt::Display) {
+        if *seen {
+            self.error(
+                Code::UnknownElement,
+                c.offset,
+                format!("{on} has more than one <{name}>"),
+            );
+        }
+        *seen = true;
+    }
+
+    /// A `<description priority type>` child: kept as written, with the namespaces it uses.
+    fn description_child(
+        &mut self,
+        c: &mut El<'i>,
+        on: &dyn fmt::Display,
+    ) -> Result<Description, Fatal> {
+        let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
+        let priority =
+            attrs
+                .take("priority")
+                .and_then(|a| match a.value.trim_ascii().parse::<i64>() {
+                    Ok(v) => Some(v),
+                    Err(_) => {
+                        self.error(
+                            Code::InvalidNumber,
+                            a.offset,
+                            format!("description priority '{}' is not an integer", a.value),
+                        );
+                        None
+                    }
+                });
+        let kind_attr = attrs.take("type");
+        if kind_attr.is_none() {
+            self.error(
+                Code::MissingAttribute,
+                c.offset,
+                format!("<description> in {on} needs a type attribute"),
+            );
+        }
+        let _ = self.leftover_attrs(attrs, &"<description>");
+        let scope = self.scope();
+        let Skipped {
+            content, prefixes, ..
+        } = self.skip(c)?;
+        Ok(Description {
+            priority,
+            kind: kind_attr.map(|a| a.value.into_owned()).unwrap_or_default(),
+            namespaces: used_prefixes(scope, &prefixes, &[]),
+            content,
+            pos: self.pos(c.offset),
+        })
+    }
+
+    /// A posture's `<stance type>`.
+    fn stance_child(&mut self, c: &mut El<'i>, post: &mut Posture) -> Result<(), Fatal> {
+        let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
+        if let Some(t) = self.req_enum(
+            &mut attrs,
+            "type",
+            &"<stance>",
+            c.offset,
+            StanceType::parse,
+            StanceType::expected,
+        ) {
+            post.stance = t;
+        }
+        let _ = self.leftover_attrs(attrs, &"<stance>");
+        self.skip(c)?;
+        Ok(())
+    }
+
+    /// A posture's `<pose part lexeme>`.
+    fn pose_child(&mut self, c: &mut El<'i>, post: &mut Posture) -> Result<(), Fatal> {
+        let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
+        let part = self.req_enum(
+            &mut attrs,
+            "part",
+            &"<pose>",
+            c.offset,
+            PosePart::parse,
+            PosePart::expected,
+        );
+        let lexeme = self.req_str(&mut attrs, "lexeme", &"<pose>", c.offset);
+        let _ = self.leftover_attrs(attrs, &"<pose>");
+        if let (Some(part), Some(lexeme)) = (part, lexeme) {
+            post.poses.push(Pose { part, lexeme });
+        }
+        self.skip(c)?;
+        Ok(())
+    }
+
+    /// A parameter value change's `<trajectory type initialValue targetValue>`.
+    fn trajectory_child(
+        &mut self,
+        c: &mut El<'i>,
+        pvc: &mut ParameterValueChange,
+    ) -> Result<(), Fatal> {
+        let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
+        let t = self.req_enum(
+            &mut attrs,
+            "type",
+            &"<trajectory>",
+            c.offset,
+            TrajectoryType::parse,
+            TrajectoryType::expected,
+        );
+        let initial = self.opt_f64(&mut attrs, "initialValue");
+        let target = self.req_str(&mut attrs, "targetValue", &"<trajectory>", c.offset);
+        let _ = self.leftover_attrs(attrs, &"<trajectory>");
+        if let Some(t) = t {
+            pvc.trajectory.kind = t;
+        }
+        pvc.trajectory.initial_value = initial;
+        if let Some(v) = target {
+            match parse_seconds(&v) {
+                Some(v) => pvc.trajectory.target_value = v,
+                None => self.error(
+                    Code::InvalidNumber,
+                    c.offset,
+                    format!("<trajectory> targetValue '{v}' is not a number"),
+                ),
+            }
+        }
+        self.skip(c)?;
+        Ok(())
+    }
+
+    /// A `<parameter name value>` of an animation, controller, noise or transition.
+    fn parameter_child(&mut self, c: &mut El<'i>, params: &mut Vec<Param>) -> Result<(), Fatal> {
+        let mut attrs = Attrs::new(std::mem::take(&mut c.attrs));
+        let name = self.req_str(&mut attrs, "name", &"<parameter>", c.offset);
+        let value = self.req_str(&mut attrs, "value", &"<parameter>", c.offset);
+        let _ = self.leftover_attrs(attrs, &"<parameter>");
+        if let (Some(name), Some(value)) = (name, value) {
+            params.push(Param { name, value });
+        }
+        self.skip(c)?;
+        Ok(())
+    }
+
+    /// Any other child of an animation: kept as raw content with the namespaces it uses.
+    fn animation_content(&mut self, c: &El<'i>, a: &mut Animation) -> Result<(), Fatal> {
+        let scope = self.scope();
+        let Skipped {
+            after,
+            mut prefixes,
+            ..
+        } = self.skip(c)?;
+        prefixes.extend(c.prefixes.iter().cloned());
+        a.content.push_str(&self.src[c.offset..after]);
+        a.namespaces = used_prefixes(scope, &prefixes, &a.namespaces);
+        Ok(())
+    }
+
+    /// A child the behaviour does not have: an error in the core namespaces, a warning for an
+    /// extension; skipped either way.
+    fn unknown_child(
+        &mut self,
+        c: &El<'i>,
+        core: bool,
+        on: &dyn fmt::Display,
+    ) -> Result<(), Fatal> {
+        if core {
+            self.error(
+                Code::UnknownElement,
+                c.offset,
+                format!("<{}> is not allowed in {on}", c.qname),
+            );
+        } else {
+            self.warn(
+                Code::UnsupportedExtension,
+                c.offset,
+                format!(
+                    "extension element <{}> in {on} is not supported and is ignored",
+                    c.qname
+                ),
+            );
+        }
+        self.skip(c)?;
+        Ok(())
+    }
+
+    /// Reports the children `kind` needs and did not get.
+    fn missing_children(
+        &mut self,
+        el: &El<'i>,
+        kind: &BehaviourKind,
+        seen: &Seen,
+        on: &dyn fmt::Display,
+    ) {
         match kind {
-            BehaviourKind::Speech(_) | BehaviourKind::Text(_) if !saw_text => {
+            BehaviourKind::Speech(_) | BehaviourKind::Text(_) if !seen.text => {
                 self.error(
                     Code::MissingElement,
                     el.offset,
                     format!("{on} has no <text> child"),
                 );
             }
-            BehaviourKind::Posture(_) | BehaviourKind::PostureShift(_) if !saw_stance => {
+            BehaviourKind::Posture(_) | BehaviourKind::PostureShift(_) if !seen.stance => {
                 self.error(
                     Code::MissingElement,
                     el.offset,
@@ -1278,7 +1330,7 @@ impl<'i> Parser<'i> {
                 el.offset,
                 format!("{on} needs a lexeme attribute or a <lexeme> child"),
             ),
-            BehaviourKind::ParameterValueChange(_) if !saw_trajectory => {
+            BehaviourKind::ParameterValueChange(_) if !seen.trajectory => {
                 self.error(
                     Code::MissingElement,
                     el.offset,
@@ -1287,7 +1339,6 @@ impl<'i> Parser<'i> {
             }
             _ => {}
         }
-        Ok(descriptions)
     }
 
     fn speech_text(&mut self, el: &El<'i>, out: &mut Vec<TextPart>) -> Result<(), Fatal> {
@@ -1753,4 +1804,12 @@ fn abbreviate(s: &str) -> String {
         out.push('…');
     }
     out
+}
+
+/// The children of a behaviour that may appear once, as seen so far.
+#[derive(Default)]
+struct Seen {
+    text: bool,
+    stance: bool,
+    trajectory: bool,
 }
