@@ -147,185 +147,278 @@ pub fn plan_block(
     start: f64,
 ) -> PlannedBlock {
     let block_peg = board.add_block(&block.id, start);
-    // one node per scheduled (finite) sync
-    let mut node: HashMap<(&str, &str), usize> = HashMap::new();
-    let mut times = Vec::new();
-    for b in &schedule.behaviours {
-        for (sync, t) in b.syncs.iter().filter(|(_, t)| t.is_finite()) {
-            node.insert((b.id.as_str(), sync.as_ref()), times.len());
-            times.push(*t);
-        }
-    }
-    let n = times.len();
-    let mut joined = Offsets::default();
-    joined.reset(n);
-    let mut named = vec![false; n];
-    let mut on_anticipator: Vec<Option<(Id, Id, f64)>> = vec![None; n];
-    let mut orders = Vec::new();
-    let mut ant_orders = Vec::new();
+    let mut p = Planner::new(board, anticipators, schedule, block_peg, start);
     let constraints = extract(block);
-    for c in &constraints {
-        let l = local(&c.left).and_then(|k| node.get(&k).copied());
-        let r = local(&c.right).and_then(|k| node.get(&k).copied());
-        for v in [l, r].into_iter().flatten() {
-            named[v] = true;
-        }
-        match (c.relation, l, r, &c.right) {
-            (Relation::At, Some(a), Some(b), _) => {
-                // (the schedule satisfies every constraint: no conflict to report here)
-                joined.join(a, b, c.offset);
-            }
-            (
-                Relation::At,
-                Some(a),
-                None,
-                Anchor::Point(SyncPoint::Anticipator { anticipator, sync }),
-            ) => {
-                on_anticipator[a] = Some((anticipator.clone(), sync.clone(), c.offset));
-            }
-            (Relation::Before | Relation::After, Some(a), Some(b), _) => {
-                orders.push((c.relation, a, b, c.offset))
-            }
-            (
-                Relation::Before | Relation::After,
-                Some(a),
-                None,
-                Anchor::Point(SyncPoint::Anticipator { anticipator, sync }),
-            ) => ant_orders.push((c.relation, a, anticipator, sync, c.offset)),
-            _ => {}
-        }
-    }
-    // a rigid behaviour's named syncs keep their distances: one cluster
-    for b in schedule.behaviours.iter().filter(|b| b.rigid) {
-        let ids: Vec<usize> = b
-            .syncs
-            .iter()
-            .filter_map(|(s, _)| node.get(&(b.id.as_str(), s.as_ref())).copied())
-            .filter(|&v| named[v])
-            .collect();
-        for w in ids.windows(2) {
-            joined.join(w[1], w[0], times[w[1]] - times[w[0]]);
-        }
-    }
-    // one time peg per cluster of named syncs, offset pegs for the others in it
-    let mut root_peg: HashMap<usize, PegId> = HashMap::new();
-    let mut peg = vec![None; n];
-    for v in 0..n {
-        if !named[v] {
-            continue;
-        }
-        let (root, off) = joined.find(v);
-        let tp = *root_peg.entry(root).or_insert_with(|| {
-            // a cluster at-linked to an anticipator hangs on its peg
-            let linked = (0..n).find(|&w| on_anticipator[w].is_some() && joined.find(w).0 == root);
-            match linked.and_then(|w| on_anticipator[w].clone().map(|a| (w, a))) {
-                Some((w, (anticipator, sync, o))) => {
-                    let ap = anticipators.peg(board, &anticipator, &sync, start + times[w] - o);
-                    let (_, wo) = joined.find(w);
-                    // time(root) = time(w) - wo = anticipator + o - wo
-                    board.offset_peg(ap, o - wo)
-                }
-                None => board.time_peg(block_peg, times[root] - joined.find(root).1),
-            }
-        });
-        peg[v] = Some(if off == 0.0 {
-            tp
-        } else {
-            board.offset_peg(tp, off)
-        });
-    }
-    // unnamed syncs: between named ones proportionally, outside them as offset pegs
-    let mut behaviours = Vec::new();
-    for b in &schedule.behaviours {
-        let ids: Vec<(SyncName, usize)> = b
-            .syncs
-            .iter()
-            .filter_map(|(s, _)| {
-                node.get(&(b.id.as_str(), s.as_ref()))
-                    .map(|&v| (s.clone(), v))
-            })
-            .collect();
-        let named_ids: Vec<(usize, PegId)> = ids
-            .iter()
-            .filter_map(|(_, v)| peg[*v].map(|p| (*v, p)))
-            .collect();
-        let mut syncs = Vec::new();
-        for (name, v) in &ids {
-            let v = *v;
-            let placement = if let Some(p) = peg[v] {
-                Placement::Peg(p)
-            } else {
-                let before = named_ids
-                    .iter()
-                    .copied()
-                    .rfind(|&(w, _)| times[w] <= times[v]);
-                let after = named_ids
-                    .iter()
-                    .copied()
-                    .find(|&(w, _)| times[w] >= times[v]);
-                match (before, after) {
-                    (Some((a, pa)), Some((z, pz))) if a != z => Placement::Between {
-                        from: pa,
-                        to: pz,
-                        fraction: if times[z] > times[a] {
-                            (times[v] - times[a]) / (times[z] - times[a])
-                        } else {
-                            0.0
-                        },
-                    },
-                    (Some((w, pw)), _) | (_, Some((w, pw))) => {
-                        Placement::Peg(board.offset_peg(pw, times[v] - times[w]))
-                    }
-                    (None, None) => {
-                        // no sync of this behaviour is named: a time peg for its first sync, the
-                        // others offset from it
-                        let first = ids[0].1;
-                        let p = match peg[first] {
-                            Some(p) => p,
-                            None => {
-                                let p = board.time_peg(block_peg, times[first]);
-                                peg[first] = Some(p);
-                                p
-                            }
-                        };
-                        if first == v {
-                            Placement::Peg(p)
-                        } else {
-                            Placement::Peg(board.offset_peg(p, times[v] - times[first]))
-                        }
-                    }
-                }
-            };
-            if let Placement::Peg(p) = placement {
-                peg[v] = Some(p);
-                board.attach(SyncAddr::new(&block.id, &b.id, name), p);
-            }
-            syncs.push((name.clone(), placement));
-        }
-        behaviours.push((b.id.clone(), syncs));
-    }
-    for (relation, a, b, offset) in orders {
-        if let (Some(pa), Some(pb)) = (peg[a], peg[b]) {
-            match relation {
-                // a <= b + offset: b is later by at least -offset
-                Relation::Before => board.order(pa, pb, -offset),
-                // a >= b + offset
-                _ => board.order(pb, pa, offset),
-            }
-        }
-    }
-    // before/after an anticipator's prediction: order links with its peg, if it is on the board
-    for (relation, a, anticipator, sync, offset) in ant_orders {
-        if let (Some(pa), Some(ap)) = (peg[a], anticipators.get(anticipator, sync)) {
-            match relation {
-                Relation::Before => board.order(pa, ap, -offset),
-                _ => board.order(ap, pa, offset),
-            }
-        }
-    }
+    let orders = p.read_constraints(&constraints);
+    p.join_rigid();
+    p.cluster_pegs();
+    let behaviours = (schedule.behaviours.iter())
+        .map(|b| (b.id.clone(), p.place_behaviour(&block.id, b)))
+        .collect();
+    p.link_orders(orders);
     PlannedBlock {
         block: block_peg,
         behaviours,
+    }
+}
+
+/// A before/after constraint between two syncs of the block (by node), or between a sync and an
+/// anticipator's prediction.
+enum Order<'c> {
+    Local(Relation, usize, usize, f64),
+    Anticipator(Relation, usize, &'c Id, &'c Id, f64),
+}
+
+/// The state of [`plan_block`]: one node per scheduled (finite) sync, the clusters `at`
+/// constraints and rigid behaviours join them into, and each node's peg once it has one.
+struct Planner<'a> {
+    board: &'a mut PegBoard,
+    anticipators: &'a mut Anticipators,
+    schedule: &'a BlockSchedule,
+    block_peg: BlockPegId,
+    start: f64,
+    /// (behaviour, sync) → node.
+    node: HashMap<(&'a str, &'a str), usize>,
+    /// Each node's block-local time in the schedule.
+    times: Vec<f64>,
+    /// Clusters of nodes with fixed offsets between them.
+    joined: Offsets,
+    /// Whether a constraint names the node.
+    named: Vec<bool>,
+    /// The anticipator sync a node is `at`-linked to (with the constraint's offset).
+    on_anticipator: Vec<Option<(Id, Id, f64)>>,
+    /// Each node's peg, once placed.
+    peg: Vec<Option<PegId>>,
+}
+
+impl<'a> Planner<'a> {
+    fn new(
+        board: &'a mut PegBoard,
+        anticipators: &'a mut Anticipators,
+        schedule: &'a BlockSchedule,
+        block_peg: BlockPegId,
+        start: f64,
+    ) -> Self {
+        let mut node = HashMap::new();
+        let mut times = Vec::new();
+        for b in &schedule.behaviours {
+            for (sync, t) in b.syncs.iter().filter(|(_, t)| t.is_finite()) {
+                node.insert((b.id.as_str(), sync.as_ref()), times.len());
+                times.push(*t);
+            }
+        }
+        let n = times.len();
+        let mut joined = Offsets::default();
+        joined.reset(n);
+        Planner {
+            board,
+            anticipators,
+            schedule,
+            block_peg,
+            start,
+            node,
+            times,
+            joined,
+            named: vec![false; n],
+            on_anticipator: vec![None; n],
+            peg: vec![None; n],
+        }
+    }
+
+    fn node_of(&self, a: &Anchor) -> Option<usize> {
+        local(a).and_then(|k| self.node.get(&k).copied())
+    }
+
+    /// Marks the syncs the constraints name, joins `at`-linked ones, notes links to
+    /// anticipators, and returns the before/after constraints for [`link_orders`](Self::link_orders).
+    fn read_constraints<'c>(
+        &mut self,
+        constraints: &'c [crate::bml::Constraint],
+    ) -> Vec<Order<'c>> {
+        let mut orders = Vec::new();
+        for c in constraints {
+            let (l, r) = (self.node_of(&c.left), self.node_of(&c.right));
+            for v in [l, r].into_iter().flatten() {
+                self.named[v] = true;
+            }
+            let anticipator = match &c.right {
+                Anchor::Point(SyncPoint::Anticipator { anticipator, sync }) => {
+                    Some((anticipator, sync))
+                }
+                _ => None,
+            };
+            match (c.relation, l, r, anticipator) {
+                // (the schedule satisfies every constraint: no conflict to report here)
+                (Relation::At, Some(a), Some(b), _) => {
+                    self.joined.join(a, b, c.offset);
+                }
+                (Relation::At, Some(a), None, Some((ant, sync))) => {
+                    self.on_anticipator[a] = Some((ant.clone(), sync.clone(), c.offset));
+                }
+                (Relation::Before | Relation::After, Some(a), Some(b), _) => {
+                    orders.push(Order::Local(c.relation, a, b, c.offset))
+                }
+                (Relation::Before | Relation::After, Some(a), None, Some((ant, sync))) => {
+                    orders.push(Order::Anticipator(c.relation, a, ant, sync, c.offset))
+                }
+                _ => {}
+            }
+        }
+        orders
+    }
+
+    /// A rigid behaviour's named syncs keep their distances: one cluster.
+    fn join_rigid(&mut self) {
+        for b in self.schedule.behaviours.iter().filter(|b| b.rigid) {
+            let ids: Vec<usize> = (b.syncs.iter())
+                .filter_map(|(s, _)| self.node.get(&(b.id.as_str(), s.as_ref())).copied())
+                .filter(|&v| self.named[v])
+                .collect();
+            for w in ids.windows(2) {
+                let (a, z) = (w[0], w[1]);
+                self.joined.join(z, a, self.times[z] - self.times[a]);
+            }
+        }
+    }
+
+    /// One time peg per cluster of named syncs (on an anticipator's peg if the cluster is
+    /// `at`-linked to one), offset pegs for the others in it.
+    fn cluster_pegs(&mut self) {
+        let mut root_peg: HashMap<usize, PegId> = HashMap::new();
+        for v in 0..self.times.len() {
+            if !self.named[v] {
+                continue;
+            }
+            let (root, off) = self.joined.find(v);
+            let tp = match root_peg.get(&root) {
+                Some(&tp) => tp,
+                None => {
+                    let tp = self.cluster_peg(root);
+                    root_peg.insert(root, tp);
+                    tp
+                }
+            };
+            self.peg[v] = Some(if off == 0.0 {
+                tp
+            } else {
+                self.board.offset_peg(tp, off)
+            });
+        }
+    }
+
+    /// The peg of the cluster whose root is `root`.
+    fn cluster_peg(&mut self, root: usize) -> PegId {
+        let n = self.times.len();
+        let linked = (0..n)
+            .find(|&w| self.on_anticipator[w].is_some() && self.joined.find(w).0 == root)
+            .and_then(|w| self.on_anticipator[w].clone().map(|a| (w, a)));
+        match linked {
+            Some((w, (anticipator, sync, o))) => {
+                let predicted = self.start + self.times[w] - o;
+                let ap = (self.anticipators).peg(self.board, &anticipator, &sync, predicted);
+                let (_, wo) = self.joined.find(w);
+                // time(root) = time(w) - wo = anticipator + o - wo
+                self.board.offset_peg(ap, o - wo)
+            }
+            None => {
+                let t = self.times[root] - self.joined.find(root).1;
+                self.board.time_peg(self.block_peg, t)
+            }
+        }
+    }
+
+    /// Places every sync of behaviour `b` and attaches the ones with a peg of their own.
+    fn place_behaviour(
+        &mut self,
+        block: &Id,
+        b: &crate::schedule::ScheduledBehaviour,
+    ) -> Vec<(SyncName, Placement)> {
+        let ids: Vec<(SyncName, usize)> = (b.syncs.iter())
+            .filter_map(|(s, _)| {
+                let v = self.node.get(&(b.id.as_str(), s.as_ref()))?;
+                Some((s.clone(), *v))
+            })
+            .collect();
+        let named: Vec<(usize, PegId)> = (ids.iter())
+            .filter_map(|(_, v)| self.peg[*v].map(|p| (*v, p)))
+            .collect();
+        let mut syncs = Vec::with_capacity(ids.len());
+        for (name, v) in &ids {
+            let placement = match self.peg[*v] {
+                Some(p) => Placement::Peg(p),
+                None => self.place_unnamed(*v, &named, ids[0].1),
+            };
+            if let Placement::Peg(p) = placement {
+                self.peg[*v] = Some(p);
+                self.board.attach(SyncAddr::new(block, &b.id, name), p);
+            }
+            syncs.push((name.clone(), placement));
+        }
+        syncs
+    }
+
+    /// An unnamed sync `v`: between the behaviour's `named` syncs around it proportionally,
+    /// outside them an offset peg on the nearest; in a behaviour nothing names, offset from a
+    /// time peg for its `first` sync.
+    fn place_unnamed(&mut self, v: usize, named: &[(usize, PegId)], first: usize) -> Placement {
+        let times = &self.times;
+        let before = named.iter().copied().rfind(|&(w, _)| times[w] <= times[v]);
+        let after = named.iter().copied().find(|&(w, _)| times[w] >= times[v]);
+        match (before, after) {
+            (Some((a, pa)), Some((z, pz))) if a != z => Placement::Between {
+                from: pa,
+                to: pz,
+                fraction: if times[z] > times[a] {
+                    (times[v] - times[a]) / (times[z] - times[a])
+                } else {
+                    0.0
+                },
+            },
+            (Some((w, pw)), _) | (_, Some((w, pw))) => {
+                Placement::Peg(self.board.offset_peg(pw, times[v] - times[w]))
+            }
+            (None, None) => {
+                let p = match self.peg[first] {
+                    Some(p) => p,
+                    None => {
+                        let p = self.board.time_peg(self.block_peg, self.times[first]);
+                        self.peg[first] = Some(p);
+                        p
+                    }
+                };
+                if first == v {
+                    Placement::Peg(p)
+                } else {
+                    let offset = self.times[v] - self.times[first];
+                    Placement::Peg(self.board.offset_peg(p, offset))
+                }
+            }
+        }
+    }
+
+    /// Before/after constraints become order links; against an anticipator's prediction only if
+    /// its peg is on the board.
+    fn link_orders(&mut self, orders: Vec<Order<'_>>) {
+        for order in orders {
+            let (relation, pa, pb, offset) = match order {
+                Order::Local(relation, a, b, offset) => {
+                    (relation, self.peg[a], self.peg[b], offset)
+                }
+                Order::Anticipator(relation, a, anticipator, sync, offset) => {
+                    let ap = self.anticipators.get(anticipator, sync);
+                    (relation, self.peg[a], ap, offset)
+                }
+            };
+            let (Some(pa), Some(pb)) = (pa, pb) else {
+                continue;
+            };
+            match relation {
+                // a <= b + offset: b is later by at least -offset
+                Relation::Before => self.board.order(pa, pb, -offset),
+                // a >= b + offset
+                _ => self.board.order(pb, pa, offset),
+            }
+        }
     }
 }
 
