@@ -23,6 +23,19 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
             .map(|(i, b)| (b.id.as_str(), i)),
     );
     ids.sort_unstable();
+    duplicate_ids(block, &ids, &mut diags);
+    for b in &block.behaviours {
+        check_behaviour(block, b, &mut diags);
+    }
+    check_shorthands(block, &ids, &mut diags);
+    check_anticipator_links(block, &mut diags);
+    check_constraint_elements(block, &ids, &mut diags);
+    diags.sort_by_key(|d| (d.pos.line, d.pos.col));
+    diags
+}
+
+/// Two behaviours with one id (`ids` sorted, so duplicates are neighbours).
+fn duplicate_ids(block: &Block, ids: &Ids, diags: &mut Vec<Diagnostic>) {
     for pair in ids.windows(2) {
         let [(id, first), (next, dup)] = [pair[0], pair[1]];
         if id == next {
@@ -38,50 +51,56 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
             ));
         }
     }
-    for b in &block.behaviours {
-        match &b.kind {
-            BehaviourKind::Speech(s) | BehaviourKind::Text(s) => {
-                for (i, part) in s.text.iter().enumerate() {
-                    let TextPart::Sync(id) = part else { continue };
-                    let earlier = &s.text[..i];
-                    if earlier
-                        .iter()
-                        .any(|p| matches!(p, TextPart::Sync(e) if e == id))
-                    {
-                        diags.push(Diagnostic::error(
-                            Code::DuplicateId,
-                            b.pos,
-                            format!("speech '{}' has two inline syncs with id '{id}'", b.id),
-                        ));
-                    } else if id == "start" || id == "end" {
-                        diags.push(Diagnostic::error(Code::InvalidId, b.pos, format!("speech '{}' has an inline sync named '{id}', which clashes with its standard sync point", b.id)));
-                    } else if id.contains(['+', '-', ':']) || id.chars().any(char::is_whitespace) {
-                        diags.push(Diagnostic::error(Code::InvalidId, b.pos, format!("inline sync id '{id}' of speech '{}' contains '+', '-', ':' or whitespace, so it cannot be referred to", b.id)));
-                    }
+}
+
+/// What one behaviour's own content can get wrong: inline sync ids, lexemes outside BML 1.0,
+/// a parameter change's target.
+fn check_behaviour(block: &Block, b: &crate::bml::Behaviour, diags: &mut Vec<Diagnostic>) {
+    match &b.kind {
+        BehaviourKind::Speech(s) | BehaviourKind::Text(s) => {
+            for (i, part) in s.text.iter().enumerate() {
+                let TextPart::Sync(id) = part else { continue };
+                let earlier = &s.text[..i];
+                if earlier
+                    .iter()
+                    .any(|p| matches!(p, TextPart::Sync(e) if e == id))
+                {
+                    diags.push(Diagnostic::error(
+                        Code::DuplicateId,
+                        b.pos,
+                        format!("speech '{}' has two inline syncs with id '{id}'", b.id),
+                    ));
+                } else if id == "start" || id == "end" {
+                    diags.push(Diagnostic::error(Code::InvalidId, b.pos, format!("speech '{}' has an inline sync named '{id}', which clashes with its standard sync point", b.id)));
+                } else if id.contains(['+', '-', ':']) || id.chars().any(char::is_whitespace) {
+                    diags.push(Diagnostic::error(Code::InvalidId, b.pos, format!("inline sync id '{id}' of speech '{}' contains '+', '-', ':' or whitespace, so it cannot be referred to", b.id)));
                 }
             }
-            BehaviourKind::Head(h) if !HEAD_LEXEMES.contains(&h.lexeme.as_str()) => {
-                diags.push(Diagnostic::warning(Code::UnknownLexeme, b.pos, format!("head lexeme '{}' of '{}' is not a BML 1.0 lexeme (NOD, SHAKE); it is realized only if a binding defines it", h.lexeme, b.id)));
-            }
-            BehaviourKind::FaceLexeme(f) | BehaviourKind::FaceShift(f)
-                if !f.lexeme.is_empty() && !FACE_LEXEMES.contains(&f.lexeme.as_str()) =>
-            {
-                diags.push(Diagnostic::warning(Code::UnknownLexeme, b.pos, format!("face lexeme '{}' of '{}' is not a BML 1.0 lexeme; it is realized only if a binding defines it", f.lexeme, b.id)));
-            }
-            BehaviourKind::ParameterValueChange(p)
-                if p.target_block.as_deref().is_none_or(|t| t == block.id)
-                    && block.behaviour(&p.target_behaviour).is_none() =>
-            {
-                diags.push(Diagnostic::error(Code::UnknownBehaviour, b.pos, format!("parametervaluechange '{}' targets '{}', which is not a behaviour of block '{}'", b.id, p.target_behaviour, block.id)));
-            }
-            _ => {}
         }
+        BehaviourKind::Head(h) if !HEAD_LEXEMES.contains(&h.lexeme.as_str()) => {
+            diags.push(Diagnostic::warning(Code::UnknownLexeme, b.pos, format!("head lexeme '{}' of '{}' is not a BML 1.0 lexeme (NOD, SHAKE); it is realized only if a binding defines it", h.lexeme, b.id)));
+        }
+        BehaviourKind::FaceLexeme(f) | BehaviourKind::FaceShift(f)
+            if !f.lexeme.is_empty() && !FACE_LEXEMES.contains(&f.lexeme.as_str()) =>
+        {
+            diags.push(Diagnostic::warning(Code::UnknownLexeme, b.pos, format!("face lexeme '{}' of '{}' is not a BML 1.0 lexeme; it is realized only if a binding defines it", f.lexeme, b.id)));
+        }
+        BehaviourKind::ParameterValueChange(p)
+            if p.target_block.as_deref().is_none_or(|t| t == block.id)
+                && block.behaviour(&p.target_behaviour).is_none() =>
+        {
+            diags.push(Diagnostic::error(Code::UnknownBehaviour, b.pos, format!("parametervaluechange '{}' targets '{}', which is not a behaviour of block '{}'", b.id, p.target_behaviour, block.id)));
+        }
+        _ => {}
     }
+}
 
-    // Shorthand attributes (the bulk): checked in place, without building constraints.
+/// The sync attributes of every behaviour: references that resolve, no time before the block.
+fn check_shorthands(block: &Block, ids: &Ids, diags: &mut Vec<Diagnostic>) {
+    // (the bulk of a block: checked in place, without building constraints)
     for b in &block.behaviours {
         for s in &b.syncs {
-            check_ref(block, &ids, &s.value, s.pos, &mut diags);
+            check_ref(block, ids, &s.value, s.pos, diags);
             if matches!(s.value, SyncRef::Time(t) if t < 0.0) {
                 diags.push(Diagnostic::error(
                     Code::InvalidConstraint,
@@ -94,8 +113,12 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
             }
         }
     }
-    // a sync point may be at-linked to at most one anticipator sync (checked only when
-    // the block names an anticipator, to keep validation allocation-free otherwise)
+}
+
+/// A sync point may be at-linked to at most one anticipator sync.
+fn check_anticipator_links(block: &Block, diags: &mut Vec<Diagnostic>) {
+    // (checked only when the block names an anticipator, to keep validation allocation-free
+    // otherwise)
     let anticipator = |r: &SyncRef| {
         matches!(
             r,
@@ -154,7 +177,10 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
             ));
         }
     }
-    // <constraint> elements: checked on their normalised form.
+}
+
+/// `<constraint>` elements, checked on their normalised form.
+fn check_constraint_elements(block: &Block, ids: &Ids, diags: &mut Vec<Diagnostic>) {
     for c in extract_elements(block) {
         if c.is_constant() {
             diags.push(Diagnostic::error(
@@ -166,7 +192,7 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
         }
         for side in [&c.left, &c.right] {
             if let Anchor::Point(p) = side {
-                check_point(block, &ids, p, c.pos, &mut diags);
+                check_point(block, ids, p, c.pos, diags);
             }
         }
         // normalisation puts the block start on the right: left REL block + offset
@@ -178,8 +204,6 @@ pub fn validate(block: &Block) -> Vec<Diagnostic> {
             ));
         }
     }
-    diags.sort_by_key(|d| (d.pos.line, d.pos.col));
-    diags
 }
 
 /// The behaviours' (id, position) pairs, sorted: found by binary search, so that checking every
