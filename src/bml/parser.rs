@@ -1594,6 +1594,9 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
         }
     }
 
+    /// The behaviour kind of the element being read, from its attributes. Long on purpose: one
+    /// arm per BML element, each a few lines, so the whole attribute grammar reads as one table
+    /// (and beside `Writer::kind_attrs`, which writes it back).
     fn build(&mut self) -> Option<BehaviourKind> {
         let placeholder_posture = || Posture {
             stance: StanceType::Standing,

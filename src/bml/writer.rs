@@ -210,6 +210,8 @@ impl Writer {
         }
     }
 
+    /// The attributes of a behaviour kind. Long on purpose: one arm per BML element, the mirror
+    /// of the parser's `build`, kept as one table so that the two compare side by side.
     fn kind_attrs(&mut self, kind: &BehaviourKind) {
         let opt = |w: &mut Writer, name: &str, v: &Option<String>| {
             if let Some(v) = v {

@@ -25,7 +25,8 @@ fn attr(out: &mut String, name: &str, value: &str) {
     let _ = write!(out, " {name}=\"{}\"", escape(value));
 }
 
-/// Encodes one message as a single line of XML (no trailing newline).
+/// Encodes one message as a single line of XML (no trailing newline). One arm per feedback
+/// element, written attribute by attribute in the order of docs/cli.md: long, but a flat table.
 pub fn to_xml(fb: &Feedback) -> String {
     let mut o = String::with_capacity(160);
     match fb {
@@ -199,7 +200,8 @@ fn is_feedback_ns(res: &ResolveResult) -> bool {
     }
 }
 
-/// Decodes one XML feedback element (one log line).
+/// Decodes one XML feedback element (one log line). One arm per feedback element, the mirror of
+/// [`to_xml`]: long, but a flat table.
 pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
     let mut r = NsReader::from_str(line);
     let xml_err = |e: quick_xml::Error| FeedbackError(format!("not well-formed XML: {e}"));
