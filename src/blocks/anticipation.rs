@@ -3,11 +3,13 @@
 
 use super::live::Phase;
 use super::{BlockKey, BlockManager};
-use crate::bml;
 use crate::engine::UnitKey;
 use crate::feedback::KnownWarning;
 use crate::plan::anticipator::Anticipator;
 use crate::plan::to_pegs;
+
+/// A behaviour (by position in its block) and the new global times of its syncs.
+type Retimed = (usize, Vec<f64>);
 
 impl BlockManager {
     /// Registers an anticipator (replacing one with the same id). Blocks scheduled from now on
@@ -42,16 +44,15 @@ impl BlockManager {
             return;
         }
         self.touch();
-        let ids: Vec<bml::Id> = self
-            .blocks
-            .iter()
-            .filter(|b| b.pegs.is_some())
-            .map(|b| b.id.clone())
+        let hanging: Vec<BlockKey> = (self.blocks.with_keys())
+            .filter(|(_, b)| b.pegs.is_some())
+            .map(|(k, _)| k)
             .collect();
-        for id in ids {
-            let Some(i) = self.blocks.find(&id) else {
+        for i in hanging {
+            // following one block's pegs can end another that hung on the same anticipator
+            if self.blocks.get(i).is_none() {
                 continue;
-            };
+            }
             let anticipators = &self.anticipators;
             let predict = |a: &str, sync: &str| {
                 let x = anticipators.iter().find(|x| x.id() == a)?;
@@ -62,7 +63,11 @@ impl BlockManager {
                 None => (false, None),
             };
             if let Some(reason) = refused {
-                self.warn(id.clone(), KnownWarning::InvalidTiming, reason);
+                self.warn(
+                    self.blocks[i].id.clone(),
+                    KnownWarning::InvalidTiming,
+                    reason,
+                );
             }
             if moved {
                 self.follow_pegs(i, t);
@@ -76,15 +81,28 @@ impl BlockManager {
     /// an INVALID_TIMING warning; if it was running, it ends now as its engine ends interrupted
     /// units.
     pub(super) fn follow_pegs(&mut self, i: BlockKey, t: f64) {
-        let block_id = self.blocks[i].id.clone();
-        let Some(p) = self.blocks[i].pegs.as_ref() else {
-            return;
+        let (updates, dropped) = self.judge_pegs(i, t);
+        for (xi, global) in updates {
+            self.retime_behaviour(i, xi, &global);
+        }
+        for xi in dropped {
+            self.drop_broken(i, xi, t);
+        }
+        if self.blocks[i].started() {
+            self.finish_if_done(i, t);
+        }
+    }
+
+    /// The behaviours of block `i` that can take their new times from its pegs (with those
+    /// global times), and those whose timing broke.
+    fn judge_pegs(&self, i: BlockKey, t: f64) -> (Vec<Retimed>, Vec<usize>) {
+        let b = &self.blocks[i];
+        let (mut updates, mut dropped) = (Vec::new(), Vec::new());
+        let Some(p) = b.pegs.as_ref() else {
+            return (updates, dropped);
         };
         let invalid = to_pegs::invalid(&p.board, &p.plan);
-        let start = self.blocks[i].start;
-        let started = self.blocks[i].started();
-        let (mut dropped, mut updates) = (Vec::new(), Vec::new());
-        for (xi, x) in self.blocks[i].behaviours.iter().enumerate() {
+        for (xi, x) in b.behaviours.iter().enumerate() {
             if !matches!(x.phase, Phase::Planned | Phase::Added | Phase::Running)
                 || (x.rigid && x.phase == Phase::Running)
             {
@@ -93,71 +111,66 @@ impl BlockManager {
             let Some(global) = p.plan.times(&p.board, &x.id) else {
                 continue;
             };
-            let into_past = started
-                && global
-                    .iter()
-                    .enumerate()
-                    .any(|(k, g)| k >= x.next && *g < t - 1e-9);
-            let named: Vec<_> = x
-                .syncs
-                .iter()
-                .zip(&global)
+            let into_past = b.started()
+                && (global.iter().enumerate()).any(|(k, g)| k >= x.next && *g < t - 1e-9);
+            let named: Vec<_> = (x.syncs.iter().zip(&global))
                 .map(|((n, _), g)| (n.clone(), *g))
                 .collect();
-            let behaviour = &self.blocks[i].source.behaviours[x.index];
-            let engine_refuses = self
-                .registry
-                .engine(x.engine)
-                .check_timing(behaviour, &named)
-                .is_err();
+            let behaviour = &b.source.behaviours[x.index];
+            let engine = self.registry.engine(x.engine);
+            let engine_refuses = engine.check_timing(behaviour, &named).is_err();
             if invalid.contains(&x.id) || into_past || engine_refuses {
                 dropped.push(xi);
             } else {
                 updates.push((xi, global));
             }
         }
-        for (xi, global) in updates {
-            let x = &mut self.blocks[i].behaviours[xi];
-            for (k, s) in x.syncs.iter_mut().enumerate().skip(x.next) {
-                if let Some(g) = global.get(k) {
-                    s.1 = g - start;
-                }
+        (updates, dropped)
+    }
+
+    /// Behaviour `xi` of block `i` takes the global times `global` for its syncs still ahead.
+    fn retime_behaviour(&mut self, i: BlockKey, xi: usize, global: &[f64]) {
+        let b = &mut self.blocks[i];
+        let (start, block_id) = (b.start, b.id.clone());
+        let x = &mut b.behaviours[xi];
+        for (k, s) in x.syncs.iter_mut().enumerate().skip(x.next) {
+            if let Some(g) = global.get(k) {
+                s.1 = g - start;
             }
-            if matches!(x.phase, Phase::Added | Phase::Running) {
+        }
+        if matches!(x.phase, Phase::Added | Phase::Running) {
+            let key = UnitKey::new(block_id, x.id.clone());
+            (self.registry.engine_mut(x.engine)).retime(&key, &x.global(start));
+        }
+    }
+
+    /// Behaviour `xi` of block `i` no longer fits its constraints: a running one stops now,
+    /// another leaves the plan; either way with a warning.
+    fn drop_broken(&mut self, i: BlockKey, xi: usize, t: f64) {
+        let block_id = self.blocks[i].id.clone();
+        let x = &self.blocks[i].behaviours[xi];
+        let behaviour = x.id.clone();
+        let running = x.phase == Phase::Running;
+        if running {
+            self.interrupt_unit(i, xi, t);
+        } else {
+            if x.phase == Phase::Added {
                 let key = UnitKey::new(block_id.clone(), x.id.clone());
-                self.registry
-                    .engine_mut(x.engine)
-                    .retime(&key, &x.global(start));
+                self.registry.engine_mut(x.engine).remove(&key);
             }
+            self.blocks[i].behaviours[xi].phase = Phase::Removed;
         }
-        for xi in dropped {
-            let x = &self.blocks[i].behaviours[xi];
-            let behaviour = x.id.clone();
-            let running = x.phase == Phase::Running;
-            if running {
-                self.interrupt_unit(i, xi, t);
-            } else {
-                if x.phase == Phase::Added {
-                    let key = UnitKey::new(block_id.clone(), x.id.clone());
-                    self.registry.engine_mut(x.engine).remove(&key);
-                }
-                self.blocks[i].behaviours[xi].phase = Phase::Removed;
-            }
-            self.warn(
-                format!("{block_id}:{behaviour}"),
-                KnownWarning::InvalidTiming,
-                format!(
-                    "'{behaviour}' no longer fits its constraints after an anticipator moved; {}",
-                    if running {
-                        "it stops now"
-                    } else {
-                        "it is dropped"
-                    }
-                ),
-            );
-        }
-        if self.blocks[i].started() {
-            self.finish_if_done(i, t);
-        }
+        let what = if running {
+            "it stops now"
+        } else {
+            "it is dropped"
+        };
+        self.warn(
+            format!("{block_id}:{behaviour}"),
+            KnownWarning::InvalidTiming,
+            format!(
+                "'{behaviour}' no longer fits its constraints after an anticipator moved; {what}"
+            ),
+        );
     }
 }
