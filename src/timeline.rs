@@ -267,82 +267,78 @@ fn tick_step(px_per_s: f64, min_px: f64) -> f64 {
     600.0
 }
 
-fn svg(t: &Timeline) -> String {
-    let times: Vec<f64> = t
-        .blocks
-        .iter()
+/// The time range the picture shows: every finite time of the timeline (one second if there is
+/// only one; 0–1 s if there is none).
+fn time_range(t: &Timeline) -> (f64, f64) {
+    let times = (t.blocks.iter())
         .flat_map(|b| {
-            b.start
-                .into_iter()
-                .chain(b.end)
+            (b.start.into_iter().chain(b.end))
                 .chain(b.lanes.iter().flat_map(|l| l.syncs.iter().map(|s| s.1)))
         })
-        .filter(|v| v.is_finite())
-        .collect();
-    let t0 = times.iter().copied().fold(f64::INFINITY, f64::min);
-    let t1 = times.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let (t0, t1) = if t0.is_finite() && t1 > t0 {
+        .filter(|v| v.is_finite());
+    let (t0, t1) = times.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, z), v| {
+        (a.min(v), z.max(v))
+    });
+    if t0.is_finite() && t1 > t0 {
         (t0, t1)
     } else if t0.is_finite() {
         (t0, t0 + 1.0)
     } else {
         (0.0, 1.0)
-    };
-    let px = (1200.0 / (t1 - t0)).clamp(20.0, 400.0);
-    let x = |v: f64| LEFT + (v - t0) * px;
-    let lanes: usize = t.blocks.iter().map(|b| b.lanes.len()).sum();
-    let height_plot = TOP + 20.0 + t.blocks.len() as f64 * BLOCK_ROW + lanes as f64 * LANE;
-    let height = height_plot + 20.0 + 16.0 * t.warnings.len() as f64 + 10.0;
-    let width = x(t1) + RIGHT;
-
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0}" height="{height:.0}" viewBox="0 0 {width:.0} {height:.0}" font-family="sans-serif">"#
-    );
-    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    // time axis
-    let step = tick_step(px, 60.0);
-    let mut tick = (t0 / step).ceil() * step;
-    while tick <= t1 + 1e-9 {
-        let xt = x(tick);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{xt:.1}" y1="{:.1}" x2="{xt:.1}" y2="{height_plot:.1}" stroke="#e4e4e4"/><text x="{xt:.1}" y="{:.1}" font-size="11" text-anchor="middle" fill="#555">{tick:.2} s</text>"##,
-            TOP,
-            TOP - 8.0
-        );
-        tick += step;
     }
-    // rows
-    let mut y = TOP + 20.0;
-    let mut positions: Vec<(SyncId, (f64, f64))> = Vec::new();
-    let mut character: Option<&String> = None;
-    for b in &t.blocks {
-        let who = if b.character != character.cloned() && b.character.is_some() {
-            character = b.character.as_ref();
-            format!(" [{}]", b.character.as_deref().unwrap_or(""))
-        } else {
-            String::new()
-        };
-        let status = b.status.map_or(String::new(), |st| format!(" {st}"));
-        if let (Some(a), Some(e)) = (b.start, b.end.or(Some(t1))) {
+}
+
+/// The SVG being drawn: the time scale, and where each sync's mark is (for the links).
+struct Canvas {
+    s: String,
+    t0: f64,
+    t1: f64,
+    /// Pixels per second.
+    px: f64,
+    positions: Vec<(SyncId, (f64, f64))>,
+}
+
+impl Canvas {
+    fn x(&self, v: f64) -> f64 {
+        LEFT + (v - self.t0) * self.px
+    }
+
+    /// Vertical lines with their times, every `tick_step`.
+    fn axis(&mut self, height_plot: f64) {
+        let step = tick_step(self.px, 60.0);
+        let mut tick = (self.t0 / step).ceil() * step;
+        while tick <= self.t1 + 1e-9 {
+            let xt = self.x(tick);
             let _ = writeln!(
-                s,
+                self.s,
+                r##"<line x1="{xt:.1}" y1="{:.1}" x2="{xt:.1}" y2="{height_plot:.1}" stroke="#e4e4e4"/><text x="{xt:.1}" y="{:.1}" font-size="11" text-anchor="middle" fill="#555">{tick:.2} s</text>"##,
+                TOP,
+                TOP - 8.0
+            );
+            tick += step;
+        }
+    }
+
+    /// A block's row at height `y`: its span and its name, character and times.
+    fn block_row(&mut self, b: &BlockRow, who: &str, y: f64) {
+        let status = b.status.map_or(String::new(), |st| format!(" {st}"));
+        if let (Some(a), Some(e)) = (b.start, b.end.or(Some(self.t1))) {
+            let _ = writeln!(
+                self.s,
                 r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="#dbe8f6" stroke="#6f94c0"/>"##,
-                x(a),
+                self.x(a),
                 y + 4.0,
-                (x(e.max(a)) - x(a)).max(1.0),
+                (self.x(e.max(a)) - self.x(a)).max(1.0),
                 BLOCK_ROW - 8.0
             );
         }
         let _ = writeln!(
-            s,
+            self.s,
             r##"<text x="6" y="{:.1}" font-size="13" font-weight="bold">{}{}</text><text x="{:.1}" y="{:.1}" font-size="10" fill="#355">{}</text>"##,
             y + 17.0,
             esc(&b.id),
-            esc(&who),
-            x(b.start.unwrap_or(t0)) + 4.0,
+            esc(who),
+            self.x(b.start.unwrap_or(self.t0)) + 4.0,
             y + 17.0,
             esc(&format!(
                 "{}{}{}",
@@ -351,95 +347,139 @@ fn svg(t: &Timeline) -> String {
                 status
             ))
         );
-        y += BLOCK_ROW;
-        for l in &b.lanes {
-            let mid = y + LANE * 0.6;
-            let colour = if l.warned { "#c0392b" } else { "#222" };
+    }
+
+    /// A behaviour's lane at height `y`: its name, its span and a mark per sync.
+    fn lane(&mut self, block: &str, l: &Lane, y: f64) {
+        let mid = y + LANE * 0.6;
+        let colour = if l.warned { "#c0392b" } else { "#222" };
+        let _ = writeln!(
+            self.s,
+            r#"<text x="14" y="{:.1}" font-size="12" fill="{colour}">{}{}{}</text>"#,
+            mid + 4.0,
+            if l.warned { "⚠ " } else { "" },
+            esc(&l.behaviour),
+            esc(&l.kind.as_ref().map_or(String::new(), |k| format!(" ({k})")))
+        );
+        let finite: Vec<&(String, f64)> = l.syncs.iter().filter(|p| p.1.is_finite()).collect();
+        if let (Some(first), Some(last)) = (
+            finite.iter().map(|p| p.1).reduce(f64::min),
+            finite.iter().map(|p| p.1).reduce(f64::max),
+        ) {
             let _ = writeln!(
-                s,
-                r#"<text x="14" y="{:.1}" font-size="12" fill="{colour}">{}{}{}</text>"#,
-                mid + 4.0,
-                if l.warned { "⚠ " } else { "" },
-                esc(&l.behaviour),
-                esc(&l.kind.as_ref().map_or(String::new(), |k| format!(" ({k})")))
+                self.s,
+                r##"<line x1="{:.1}" y1="{mid:.1}" x2="{:.1}" y2="{mid:.1}" stroke="#888" stroke-width="3"/>"##,
+                self.x(first),
+                self.x(last)
             );
-            let finite: Vec<&(String, f64)> = l.syncs.iter().filter(|p| p.1.is_finite()).collect();
-            if let (Some(first), Some(last)) = (
-                finite.iter().map(|p| p.1).reduce(f64::min),
-                finite.iter().map(|p| p.1).reduce(f64::max),
-            ) {
+        }
+        // labels above or below the lane, wherever they do not overlap the previous one;
+        // a label that fits nowhere is left out (the mark's tooltip still names it)
+        let mut free = [f64::NEG_INFINITY; 2];
+        for (name, tv) in &finite {
+            let xs = self.x(*tv);
+            let half = 2.6 * name.chars().count() as f64 + 2.0;
+            let _ = writeln!(
+                self.s,
+                r##"<circle cx="{xs:.1}" cy="{mid:.1}" r="3.5" fill="{colour}"><title>{}:{}:{} {tv:.3} s</title></circle>"##,
+                esc(block),
+                esc(&l.behaviour),
+                esc(name)
+            );
+            if let Some(level) = (0..2).find(|&k| xs - half >= free[k]) {
+                free[level] = xs + half;
+                let ly = if level == 0 { mid - 7.0 } else { mid + 14.0 };
                 let _ = writeln!(
-                    s,
-                    r##"<line x1="{:.1}" y1="{mid:.1}" x2="{:.1}" y2="{mid:.1}" stroke="#888" stroke-width="3"/>"##,
-                    x(first),
-                    x(last)
-                );
-            }
-            // labels above or below the lane, wherever they do not overlap the previous one;
-            // a label that fits nowhere is left out (the mark's tooltip still names it)
-            let mut free = [f64::NEG_INFINITY; 2];
-            for (name, tv) in &finite {
-                let xs = x(*tv);
-                let half = 2.6 * name.chars().count() as f64 + 2.0;
-                let _ = writeln!(
-                    s,
-                    r##"<circle cx="{xs:.1}" cy="{mid:.1}" r="3.5" fill="{colour}"><title>{}:{}:{} {tv:.3} s</title></circle>"##,
-                    esc(&b.id),
-                    esc(&l.behaviour),
+                    self.s,
+                    r##"<text x="{xs:.1}" y="{ly:.1}" font-size="9" text-anchor="middle" fill="#444">{}</text>"##,
                     esc(name)
                 );
-                if let Some(level) = (0..2).find(|&k| xs - half >= free[k]) {
-                    free[level] = xs + half;
-                    let ly = if level == 0 { mid - 7.0 } else { mid + 14.0 };
-                    let _ = writeln!(
-                        s,
-                        r##"<text x="{xs:.1}" y="{ly:.1}" font-size="9" text-anchor="middle" fill="#444">{}</text>"##,
-                        esc(name)
-                    );
-                }
-                positions.push(((b.id.clone(), l.behaviour.clone(), name.clone()), (xs, mid)));
             }
+            let id = (block.to_string(), l.behaviour.clone(), name.clone());
+            self.positions.push((id, (xs, mid)));
+        }
+    }
+
+    /// A dashed curve from one sync's mark to another's.
+    fn link(&mut self, link: &Link) {
+        let at = |p: &SyncId| self.positions.iter().find(|q| &q.0 == p).map(|q| q.1);
+        let (Some((x1, y1)), Some((x2, y2))) = (at(&link.from), at(&link.to)) else {
+            return;
+        };
+        let colour = if link.label == "≈" {
+            "#9aa"
+        } else {
+            "#2c7a4b"
+        };
+        let bend = 18.0 + (y2 - y1).abs() * 0.1;
+        let _ = writeln!(
+            self.s,
+            r#"<path d="M {x1:.1} {y1:.1} C {:.1} {y1:.1} {:.1} {y2:.1} {x2:.1} {y2:.1}" fill="none" stroke="{colour}" stroke-dasharray="4 3"><title>{}:{}:{} {} {}:{}:{}</title></path>"#,
+            x1 + bend,
+            x2 + bend,
+            esc(&link.from.0),
+            esc(&link.from.1),
+            esc(&link.from.2),
+            esc(&link.label),
+            esc(&link.to.0),
+            esc(&link.to.1),
+            esc(&link.to.2)
+        );
+    }
+}
+
+fn svg(t: &Timeline) -> String {
+    let (t0, t1) = time_range(t);
+    let px = (1200.0 / (t1 - t0)).clamp(20.0, 400.0);
+    let mut c = Canvas {
+        s: String::new(),
+        t0,
+        t1,
+        px,
+        positions: Vec::new(),
+    };
+    let lanes: usize = t.blocks.iter().map(|b| b.lanes.len()).sum();
+    let height_plot = TOP + 20.0 + t.blocks.len() as f64 * BLOCK_ROW + lanes as f64 * LANE;
+    let height = height_plot + 20.0 + 16.0 * t.warnings.len() as f64 + 10.0;
+    let width = c.x(t1) + RIGHT;
+    let _ = writeln!(
+        c.s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0}" height="{height:.0}" viewBox="0 0 {width:.0} {height:.0}" font-family="sans-serif">"#
+    );
+    let _ = writeln!(c.s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    c.axis(height_plot);
+    let mut y = TOP + 20.0;
+    let mut character: Option<&String> = None;
+    for b in &t.blocks {
+        // the character is named where it changes
+        let who = if b.character != character.cloned() && b.character.is_some() {
+            character = b.character.as_ref();
+            format!(" [{}]", b.character.as_deref().unwrap_or(""))
+        } else {
+            String::new()
+        };
+        c.block_row(b, &who, y);
+        y += BLOCK_ROW;
+        for l in &b.lanes {
+            c.lane(&b.id, l, y);
             y += LANE;
         }
     }
-    // links
     for link in &t.links {
-        let at = |p: &SyncId| positions.iter().find(|q| &q.0 == p).map(|q| q.1);
-        if let (Some((x1, y1)), Some((x2, y2))) = (at(&link.from), at(&link.to)) {
-            let colour = if link.label == "≈" {
-                "#9aa"
-            } else {
-                "#2c7a4b"
-            };
-            let bend = 18.0 + (y2 - y1).abs() * 0.1;
-            let _ = writeln!(
-                s,
-                r#"<path d="M {x1:.1} {y1:.1} C {:.1} {y1:.1} {:.1} {y2:.1} {x2:.1} {y2:.1}" fill="none" stroke="{colour}" stroke-dasharray="4 3"><title>{}:{}:{} {} {}:{}:{}</title></path>"#,
-                x1 + bend,
-                x2 + bend,
-                esc(&link.from.0),
-                esc(&link.from.1),
-                esc(&link.from.2),
-                esc(&link.label),
-                esc(&link.to.0),
-                esc(&link.to.1),
-                esc(&link.to.2)
-            );
-        }
+        c.link(link);
     }
-    // warnings
     let mut wy = height_plot + 24.0;
     for (id, text) in &t.warnings {
         let _ = writeln!(
-            s,
+            c.s,
             r##"<text x="6" y="{wy:.1}" font-size="11" fill="#c0392b">⚠ {}: {}</text>"##,
             esc(id),
             esc(text)
         );
         wy += 16.0;
     }
-    s.push_str("</svg>\n");
-    s
+    c.s.push_str("</svg>\n");
+    c.s
 }
 
 #[cfg(test)]
