@@ -248,65 +248,94 @@ impl crate::engine::Motion for GazeEngine {
         if let Some(u) = finished_shift(&self.units, now, |u| u.shift) {
             self.rest = Some((u.target.clone(), u.influence));
         }
+        let Some(aim) = self.aim(now, skeleton, world) else {
+            return;
+        };
+        aim.turn_body(skeleton, pose);
+        aim.turn_eyes(skeleton, pose);
+    }
+}
+
+/// Where the gaze points in one frame: the rest aim (a gaze shift's target, if one ended) and the
+/// target of the gaze that wins now, with its weights.
+struct Aim {
+    /// Where the eyes are with the body at rest.
+    eyes: Vec3,
+    /// The rest target and influence.
+    rest: Option<(Vec3, Influence)>,
+    /// The winning gaze's target.
+    target: Option<Target>,
+}
+
+/// The target of the gaze that wins in a frame.
+#[derive(Clone, Copy)]
+struct Target {
+    point: Vec3,
+    influence: Influence,
+    /// How far the body and the eyes have turned from the rest aim to the target (0–1).
+    body_weight: f32,
+    eye_weight: f32,
+    /// (yaw, pitch) offset from the target, radians.
+    offset: (f32, f32),
+}
+
+impl GazeEngine {
+    /// The aim at `now`, or `None` when there is neither a target nor a rest aim.
+    fn aim(&mut self, now: f64, skeleton: &Skeleton, world: &World) -> Option<Aim> {
         let eyes = self.eyes_at_rest(skeleton);
-        let rest_aim = self
-            .rest
-            .as_ref()
-            .and_then(|(t, i)| Some((world.get(t)?, *i)));
+        let rest = (self.rest.as_ref()).and_then(|(t, i)| Some((world.get(t)?, *i)));
         // the saccade's amplitude: from the rest aim (straight ahead without one) to the target
-        let from = rest_aim.map_or(Vec3::Z, |(p, _)| p - eyes);
+        let from = rest.map_or(Vec3::Z, |(p, _)| p - eyes);
         let amplitude = |target: &str| {
-            world
-                .get(target)
-                .map_or(0.0, |p| f64::from(from.angle_between(p - eyes)))
+            (world.get(target)).map_or(0.0, |p| f64::from(from.angle_between(p - eyes)))
         };
         // the gaze that started last wins; ties go to the one that ends first
-        let active = self
-            .units
-            .all()
+        let active = (self.units.all())
             .filter_map(|(syncs, u)| {
                 let w = weights(u, syncs, now, amplitude(&u.target))?;
                 Some((at(syncs, "start")?, at(syncs, "end")?, u, w))
             })
             .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
-        let target =
-            active.and_then(|(_, _, u, w)| Some((world.get(&u.target)?, u.influence, w, u.offset)));
-        if target.is_none() && rest_aim.is_none() {
-            return;
-        }
-        let aim_of = |p: Vec3| yaw_pitch(p - eyes);
-        let (rest_yaw, rest_pitch, rest_influence) = match rest_aim {
+        let target = active.and_then(|(_, _, u, (wb, we))| {
+            Some(Target {
+                point: world.get(&u.target)?,
+                influence: u.influence,
+                body_weight: wb as f32,
+                eye_weight: we as f32,
+                offset: u.offset,
+            })
+        });
+        (target.is_some() || rest.is_some()).then_some(Aim { eyes, rest, target })
+    }
+}
+
+impl Aim {
+    /// The spine, neck and head: the rest aim's shares blended with the target's.
+    fn turn_body(&self, skeleton: &Skeleton, pose: &mut Pose) {
+        let aim_of = |p: Vec3| yaw_pitch(p - self.eyes);
+        let (rest_yaw, rest_pitch, rest_influence) = match self.rest {
             Some((p, i)) => {
                 let (y, pi) = aim_of(p);
                 (y, pi, i)
             }
             None => (0.0, 0.0, Influence::Eyes),
         };
-        // the body: blend of the rest aim's shares and the target's shares
-        let (wb, we) = target.map_or((0.0, 0.0), |t| (t.2 .0 as f32, t.2 .1 as f32));
-        let off = target.map_or((0.0, 0.0), |t| t.3);
-        let (t_yaw, t_pitch, t_influence) = match target {
-            Some((p, i, _, _)) => {
-                let (y, pi) = aim_of(p);
-                (y + off.0, pi + off.1, i)
+        let wb = self.target.map_or(0.0, |t| t.body_weight);
+        let (t_yaw, t_pitch, t_influence) = match self.target {
+            Some(t) => {
+                let (y, pi) = aim_of(t.point);
+                (y + t.offset.0, pi + t.offset.1, t.influence)
             }
             None => (rest_yaw, rest_pitch, rest_influence),
         };
-        let joints: Vec<&str> = shares(rest_influence)
-            .iter()
-            .chain(shares(t_influence))
-            .map(|s| s.0)
-            .fold(Vec::new(), |mut v, j| {
-                if !v.contains(&j) {
-                    v.push(j);
-                }
-                v
-            });
+        let mut joints: Vec<&str> = Vec::new();
+        for s in shares(rest_influence).iter().chain(shares(t_influence)) {
+            if !joints.contains(&s.0) {
+                joints.push(s.0);
+            }
+        }
         let share = |inf: Influence, j: &str| {
-            shares(inf)
-                .iter()
-                .find(|s| s.0 == j)
-                .map_or((0.0, 0.0), |s| (s.1, s.2))
+            (shares(inf).iter().find(|s| s.0 == j)).map_or((0.0, 0.0), |s| (s.1, s.2))
         };
         for j in joints {
             let Some(i) = skeleton.joint(j) else { continue };
@@ -316,9 +345,18 @@ impl crate::engine::Motion for GazeEngine {
             let pitch = (1.0 - wb) * rp * rest_pitch + wb * tp * t_pitch;
             pose.rotate(i, donders(yaw, pitch));
         }
-        // the eyes: aimed exactly from where they are now, blended from the rest aim
-        let rest_point = rest_aim.map(|r| r.0);
-        let target_point = target.map(|t| t.0);
+    }
+
+    /// The eyes: aimed exactly from where they are now (after the body turned), blended from the
+    /// rest aim, within their limits.
+    fn turn_eyes(&self, skeleton: &Skeleton, pose: &mut Pose) {
+        let (yaw_max, pitch_max) = (EYE_YAW_LIMIT.to_radians(), EYE_PITCH_LIMIT.to_radians());
+        let limit =
+            |(y, p): (f32, f32)| (y.clamp(-yaw_max, yaw_max), p.clamp(-pitch_max, pitch_max));
+        let rest_point = self.rest.map(|r| r.0);
+        let (we, off) = self
+            .target
+            .map_or((0.0, (0.0, 0.0)), |t| (t.eye_weight, t.offset));
         for eye in ["l_eyeball_joint", "r_eyeball_joint"] {
             let Some(e) = skeleton.joint(eye) else {
                 continue;
@@ -327,24 +365,15 @@ impl crate::engine::Motion for GazeEngine {
             // along the eye's ancestors only
             let (at_eye, eye_orientation) = pose.joint_world(skeleton, e);
             let inv = (eye_orientation * pose.rotations[e].inverse()).inverse();
-            let eye_aim = |p: Option<Vec3>| {
-                p.map_or((0.0, 0.0), |p| {
-                    let (y, pi) = yaw_pitch(inv * (p - at_eye));
-                    (
-                        y.clamp(-EYE_YAW_LIMIT.to_radians(), EYE_YAW_LIMIT.to_radians()),
-                        pi.clamp(-EYE_PITCH_LIMIT.to_radians(), EYE_PITCH_LIMIT.to_radians()),
-                    )
-                })
-            };
+            let eye_aim =
+                |p: Option<Vec3>| p.map_or((0.0, 0.0), |p| limit(yaw_pitch(inv * (p - at_eye))));
             let (ry, rp) = eye_aim(rest_point);
-            let (ty, tp) = if target_point.is_some() {
-                let (y, p) = eye_aim(target_point);
-                (
-                    (y + off.0).clamp(-EYE_YAW_LIMIT.to_radians(), EYE_YAW_LIMIT.to_radians()),
-                    (p + off.1).clamp(-EYE_PITCH_LIMIT.to_radians(), EYE_PITCH_LIMIT.to_radians()),
-                )
-            } else {
-                (ry, rp)
+            let (ty, tp) = match self.target {
+                Some(t) => {
+                    let (y, pi) = eye_aim(Some(t.point));
+                    limit((y + off.0, pi + off.1))
+                }
+                None => (ry, rp),
             };
             let yaw = ry + we * (ty - ry);
             let pitch = rp + we * (tp - rp);
