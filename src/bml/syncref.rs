@@ -194,104 +194,106 @@ impl SyncRef {
                 "empty sync reference: expected a time in seconds or behaviour:sync".into(),
             ));
         }
-        // the colons, found in one pass over the bytes (ids are short: no searcher set-up)
-        let (mut colons, mut count) = ([0usize; 2], 0usize);
-        for (i, &c) in t.as_bytes().iter().enumerate() {
-            if c == b':' {
-                if count < 2 {
-                    colons[count] = i;
-                }
-                count += 1;
-            }
-        }
-        if count == 0 {
-            return parse_seconds(t).map(SyncRef::Time).ok_or_else(|| {
-                err(
-                    Code::MalformedSyncRef,
-                    format!(
-                        "sync reference '{t}' is neither a number of seconds nor of the form behaviour:sync"
-                    ),
-                )
-            });
-        }
-        if count > 2 {
+        let mut parts = t.split(':').map(str::trim_ascii);
+        let first = parts.next().unwrap_or_default();
+        let (second, third) = (parts.next(), parts.next());
+        if parts.next().is_some() {
             return Err(err(
                 Code::MalformedSyncRef,
                 format!(
                     "sync reference '{t}' has {} parts; expected behaviour:sync, block:behaviour:sync or anticipators:id:sync",
-                    count + 1
+                    t.split(':').count()
                 ),
             ));
         }
-        let parts: [Option<&str>; 3] = if count == 1 {
-            [Some(&t[..colons[0]]), Some(&t[colons[0] + 1..]), None]
-        } else {
-            [
-                Some(&t[..colons[0]]),
-                Some(&t[colons[0] + 1..colons[1]]),
-                Some(&t[colons[1] + 1..]),
-            ]
-        }
-        .map(|p| p.map(str::trim_ascii));
-        let n = parts.iter().flatten().count();
-        let part = |i: usize| parts[i].unwrap_or_default();
-        let last = part(n - 1);
-        let (sync, offset) = match last.bytes().position(|b| b == b'+' || b == b'-') {
-            None => (last.trim_ascii(), 0.0),
-            Some(i) => {
-                let sign = if last.as_bytes()[i] == b'-' {
-                    -1.0
-                } else {
-                    1.0
-                };
-                let num = last[i + 1..].trim_ascii();
-                if num.starts_with(['+', '-']) {
-                    return Err(err(
-                        Code::MalformedOffset,
-                        format!("sync reference '{t}' has a doubled sign in its offset"),
-                    ));
-                }
-                let v = parse_seconds(num).ok_or_else(|| {
+        let point = match (second, third) {
+            (None, _) => {
+                return parse_seconds(t).map(SyncRef::Time).ok_or_else(|| {
                     err(
-                        Code::MalformedOffset,
-                        if num.is_empty() {
-                            format!("sync reference '{t}' has a sign but no offset after it")
-                        } else {
-                            format!(
-                                "sync reference '{t}' has offset '{num}', which is not a number of seconds"
-                            )
-                        },
-                    )
-                })?;
-                (last[..i].trim_ascii(), sign * v)
-            }
-        };
-        let sync = check_id(sync, "sync id", t)?;
-        let point = match n {
-            2 => {
-                if part(0) == ANTICIPATORS {
-                    return Err(err(
                         Code::MalformedSyncRef,
-                        format!("anticipator reference '{t}' needs the form anticipators:ID:SYNC"),
-                    ));
-                }
-                SyncPoint::Local {
-                    behaviour: check_id(part(0), "behaviour id", t)?,
-                    sync,
-                }
+                        format!("sync reference '{t}' is neither a number of seconds nor of the form behaviour:sync"),
+                    )
+                })
             }
-            _ if part(0) == ANTICIPATORS => SyncPoint::Anticipator {
-                anticipator: check_id(part(1), "anticipator id", t)?,
-                sync,
-            },
-            _ => SyncPoint::External {
-                block: check_id(part(0), "block id", t)?,
-                behaviour: check_id(part(1), "behaviour id", t)?,
-                sync,
-            },
+            (Some(last), None) => {
+                let (sync, offset) = sync_and_offset(last, t)?;
+                (local_point(first, sync, t)?, offset)
+            }
+            (Some(middle), Some(last)) => {
+                let (sync, offset) = sync_and_offset(last, t)?;
+                (three_part_point(first, middle, sync, t)?, offset)
+            }
         };
-        Ok(SyncRef::Point { point, offset })
+        Ok(SyncRef::Point {
+            point: point.0,
+            offset: point.1,
+        })
     }
+}
+
+/// The last part of reference `t`: a sync id optionally followed by `+o` or `-o` seconds.
+fn sync_and_offset(last: &str, t: &str) -> Result<(Id, f64), SyncRefError> {
+    let Some(i) = last.find(['+', '-']) else {
+        return Ok((check_id(last, "sync id", t)?, 0.0));
+    };
+    let sign = if last.as_bytes()[i] == b'-' {
+        -1.0
+    } else {
+        1.0
+    };
+    let num = last[i + 1..].trim_ascii();
+    if num.starts_with(['+', '-']) {
+        return Err(err(
+            Code::MalformedOffset,
+            format!("sync reference '{t}' has a doubled sign in its offset"),
+        ));
+    }
+    let v = parse_seconds(num).ok_or_else(|| {
+        err(
+            Code::MalformedOffset,
+            if num.is_empty() {
+                format!("sync reference '{t}' has a sign but no offset after it")
+            } else {
+                format!("sync reference '{t}' has offset '{num}', which is not a number of seconds")
+            },
+        )
+    })?;
+    Ok((check_id(last[..i].trim_ascii(), "sync id", t)?, sign * v))
+}
+
+/// `behaviour:sync` in the block itself.
+fn local_point(behaviour: &str, sync: Id, t: &str) -> Result<SyncPoint, SyncRefError> {
+    if behaviour == ANTICIPATORS {
+        return Err(err(
+            Code::MalformedSyncRef,
+            format!("anticipator reference '{t}' needs the form anticipators:ID:SYNC"),
+        ));
+    }
+    Ok(SyncPoint::Local {
+        behaviour: check_id(behaviour, "behaviour id", t)?,
+        sync,
+    })
+}
+
+/// `anticipators:id:sync` or `block:behaviour:sync`.
+fn three_part_point(
+    first: &str,
+    middle: &str,
+    sync: Id,
+    t: &str,
+) -> Result<SyncPoint, SyncRefError> {
+    Ok(if first == ANTICIPATORS {
+        SyncPoint::Anticipator {
+            anticipator: check_id(middle, "anticipator id", t)?,
+            sync,
+        }
+    } else {
+        SyncPoint::External {
+            block: check_id(first, "block id", t)?,
+            behaviour: check_id(middle, "behaviour id", t)?,
+            sync,
+        }
+    })
 }
 
 #[cfg(test)]
