@@ -712,102 +712,152 @@ fn tame(items: &[Item], links: &[Link]) -> bool {
             .all(|it| it.model.keys.iter().all(|k| small(k.at)))
 }
 
-/// The two-stage linear program for blocks where some behaviour must stretch.
+/// The two-stage linear program for blocks where some behaviour must stretch: first the least
+/// deviation from the preferred timing, then, within it, the earliest times.
 fn optimise(items: &[Item], links: &[Link]) -> Vec<f64> {
     if !tame(items, links) {
         return earliest(items, links);
     }
-    let build = |deviation_bound: Option<f64>| {
+    // the hard system is feasible, so both stages have solutions; fall back to the earliest
+    // feasible times if the LP solver gives up numerically
+    let Some((least_deviation, _)) = Program::new(items, links).solve(None) else {
+        return earliest(items, links);
+    };
+    let bound = least_deviation + 1e-7 * (1.0 + least_deviation);
+    match Program::new(items, links).solve(Some(bound)) {
+        Some((_, times)) => times,
+        None => earliest(items, links),
+    }
+}
+
+/// The linear program of one block: a variable per key of every item, the hard constraints
+/// (timing models, links) and the deviation from the preferred timing.
+struct Program {
+    vars: ProblemVariables,
+    /// `t[i][k]`: the time of key `k` of item `i`.
+    t: Vec<Vec<Variable>>,
+    constraints: Vec<good_lp::Constraint>,
+    deviation: Expression,
+}
+
+impl Program {
+    fn new(items: &[Item], links: &[Link]) -> Program {
         let mut vars = ProblemVariables::new();
-        let t: Vec<Vec<Variable>> = items
-            .iter()
+        let t = (items.iter())
             .map(|it| (0..it.len).map(|_| vars.add(variable().min(0.0))).collect())
             .collect();
-        let mut constraints = Vec::new();
-        let mut deviation = Expression::from(0.0);
+        let mut p = Program {
+            vars,
+            t,
+            constraints: Vec::new(),
+            deviation: Expression::from(0.0),
+        };
         for (i, it) in items.iter().enumerate() {
-            let keys = &it.model.keys;
             match it.model.flexibility {
-                Flexibility::Rigid => {
-                    for k in 1..it.len {
-                        constraints.push(constraint!(t[i][k] - t[i][0] == keys[k].at));
-                    }
-                }
+                Flexibility::Rigid => p.rigid(i, it),
                 Flexibility::Stretchable {
                     min_duration,
                     max_duration,
-                } => {
-                    for k in 1..it.len {
-                        constraints.push(constraint!(t[i][k] - t[i][k - 1] >= 0.0));
-                        if keys[k].max_phase.is_finite() {
-                            let max = keys[k].max_phase;
-                            constraints.push(constraint!(t[i][k] - t[i][k - 1] <= max));
-                        }
-                    }
-                    if it.len == keys.len() {
-                        let end = it.len - 1;
-                        constraints.push(constraint!(t[i][end] - t[i][0] >= min_duration));
-                        if max_duration.is_finite() {
-                            constraints.push(constraint!(t[i][end] - t[i][0] <= max_duration));
-                        }
-                    }
-                    let sigma = vars.add(variable().min(0.0));
-                    let stretch = vars.add(variable().min(0.0));
-                    let duration = it.model.preferred_duration().max(EPSILON);
-                    constraints.push(constraint!(stretch >= (sigma - 1.0) * duration));
-                    constraints.push(constraint!(stretch >= (1.0 - sigma) * duration));
-                    deviation += stretch;
-                    for k in 1..it.len {
-                        let p = keys[k].at - keys[k - 1].at;
-                        let d = vars.add(variable().min(0.0));
-                        constraints.push(constraint!(d >= t[i][k] - t[i][k - 1] - sigma * p));
-                        constraints.push(constraint!(d >= sigma * p - (t[i][k] - t[i][k - 1])));
-                        deviation += NON_UNIFORM_WEIGHT * d;
-                    }
-                }
+                } => p.stretchable(i, it, min_duration, max_duration),
             }
         }
-        let term = |x: Term| -> Expression {
-            match x {
-                Term::Key(i, k) => t[i][k].into(),
-                Term::Fixed(v) => Expression::from(v),
+        p.links(links);
+        p
+    }
+
+    /// A rigid item keeps its keys' distances.
+    fn rigid(&mut self, i: usize, it: &Item) {
+        let (t, keys) = (&self.t[i], &it.model.keys);
+        for k in 1..it.len {
+            self.constraints
+                .push(constraint!(t[k] - t[0] == keys[k].at));
+        }
+    }
+
+    /// A stretchable item: keys in order, phases and duration within bounds; its deviation is
+    /// how far its duration is from the preferred one (a uniform stretch `sigma`) plus, weighted,
+    /// how unevenly its phases stretch.
+    fn stretchable(&mut self, i: usize, it: &Item, min_duration: f64, max_duration: f64) {
+        let (t, keys) = (self.t[i].clone(), &it.model.keys);
+        for k in 1..it.len {
+            self.constraints.push(constraint!(t[k] - t[k - 1] >= 0.0));
+            if keys[k].max_phase.is_finite() {
+                let max = keys[k].max_phase;
+                self.constraints.push(constraint!(t[k] - t[k - 1] <= max));
             }
-        };
+        }
+        if it.len == keys.len() {
+            let end = it.len - 1;
+            self.constraints
+                .push(constraint!(t[end] - t[0] >= min_duration));
+            if max_duration.is_finite() {
+                self.constraints
+                    .push(constraint!(t[end] - t[0] <= max_duration));
+            }
+        }
+        let sigma = self.vars.add(variable().min(0.0));
+        let stretch = self.vars.add(variable().min(0.0));
+        let duration = it.model.preferred_duration().max(EPSILON);
+        self.constraints
+            .push(constraint!(stretch >= (sigma - 1.0) * duration));
+        self.constraints
+            .push(constraint!(stretch >= (1.0 - sigma) * duration));
+        self.deviation += stretch;
+        for k in 1..it.len {
+            let p = keys[k].at - keys[k - 1].at;
+            let d = self.vars.add(variable().min(0.0));
+            self.constraints
+                .push(constraint!(d >= t[k] - t[k - 1] - sigma * p));
+            self.constraints
+                .push(constraint!(d >= sigma * p - (t[k] - t[k - 1])));
+            self.deviation += NON_UNIFORM_WEIGHT * d;
+        }
+    }
+
+    /// The links between keys and fixed times.
+    fn links(&mut self, links: &[Link]) {
         for l in links {
+            let term = |x: Term| -> Expression {
+                match x {
+                    Term::Key(i, k) => self.t[i][k].into(),
+                    Term::Fixed(v) => Expression::from(v),
+                }
+            };
             let (a, b) = (term(l.left), term(l.right) + l.offset);
-            constraints.push(match l.relation {
+            self.constraints.push(match l.relation {
                 Relation::At => constraint!(a == b),
                 Relation::Before => constraint!(a <= b),
                 Relation::After => constraint!(a >= b),
             });
         }
+    }
+
+    /// Without a bound: the least deviation. With one: the earliest times whose deviation stays
+    /// within it. Returns the objective's value and every key's time (items in order).
+    fn solve(mut self, deviation_bound: Option<f64>) -> Option<(f64, Vec<f64>)> {
         let objective: Expression = match deviation_bound {
-            None => deviation.clone(),
+            None => self.deviation.clone(),
             Some(bound) => {
-                constraints.push(constraint!(deviation.clone() <= bound));
-                t.iter().flatten().map(|&v| Expression::from(v)).sum()
+                self.constraints
+                    .push(constraint!(self.deviation.clone() <= bound));
+                self.t.iter().flatten().map(|&v| Expression::from(v)).sum()
             }
         };
-        let mut problem = vars
-            .minimise(objective.clone())
+        let mut problem = (self.vars.minimise(objective.clone()))
             .using(microlp)
             .with_time_limit(LP_TIME_LIMIT_SECS);
-        for c in constraints {
+        for c in self.constraints {
             problem = problem.with(c);
         }
         let solution = problem.solve().ok()?;
         let value = solution.eval(&objective);
-        let times = t.iter().flatten().map(|&v| solution.value(v)).collect();
+        let times = self
+            .t
+            .iter()
+            .flatten()
+            .map(|&v| solution.value(v))
+            .collect();
         Some((value, times))
-    };
-    // the hard system is feasible, so both stages have solutions; fall back to the earliest
-    // feasible times if the LP solver gives up numerically
-    let Some((least_deviation, _)) = build(None) else {
-        return earliest(items, links);
-    };
-    match build(Some(least_deviation + 1e-7 * (1.0 + least_deviation))) {
-        Some((_, times)) => times,
-        None => earliest(items, links),
     }
 }
 
