@@ -89,82 +89,9 @@ impl Timeline {
         let mut started = std::collections::HashSet::new();
         for fb in feedback {
             match fb {
-                Feedback::Prediction(p) => {
-                    for b in &p.blocks {
-                        let row = t.block(&b.id, p.character_id.as_ref());
-                        if row.start.is_none() || b.status == Some(BlockStatus::Pending) {
-                            row.start = b.global_start.or(row.start);
-                            row.end = b.global_end.or(row.end);
-                        }
-                        row.status = b.status.or(row.status);
-                        let start = row.start.unwrap_or(0.0);
-                        for x in p.behaviours.iter().filter(|x| x.block == b.id) {
-                            if row.lanes.iter().any(|l| l.behaviour == x.behaviour) {
-                                continue;
-                            }
-                            row.lanes.push(Lane {
-                                behaviour: x.behaviour.to_string(),
-                                kind: Some(x.kind.to_string()),
-                                syncs: x
-                                    .syncs
-                                    .iter()
-                                    .map(|(s, v)| (s.to_string(), start + v))
-                                    .collect(),
-                                warned: false,
-                            });
-                        }
-                    }
-                }
-                Feedback::BlockProgress(p) => {
-                    let row = t.block(&p.block, p.character_id.as_ref());
-                    match p.sync.as_str() {
-                        "start" => {
-                            // predicted sync times move with the block's actual start
-                            if let Some(old) = row.start {
-                                let shift = p.global_time - old;
-                                for l in &mut row.lanes {
-                                    for s in &mut l.syncs {
-                                        s.1 += shift;
-                                    }
-                                }
-                            }
-                            row.start = Some(p.global_time);
-                            started.insert(p.block.to_string());
-                        }
-                        // revoked before it started: it never ran, so nothing of it is drawn
-                        // but the moment it was removed
-                        "end"
-                            if p.status == Some(BlockStatus::Revoked)
-                                && !started.contains(p.block.as_str()) =>
-                        {
-                            row.start = Some(p.global_time);
-                            row.end = Some(p.global_time);
-                            row.lanes.clear();
-                        }
-                        "end" => row.end = Some(p.global_time),
-                        _ => {}
-                    }
-                    row.status = p.status.or(row.status);
-                }
-                Feedback::SyncPointProgress(p) => {
-                    let row = t.block(&p.block, p.character_id.as_ref());
-                    let lane = match row.lanes.iter().position(|l| l.behaviour == p.behaviour) {
-                        Some(i) => &mut row.lanes[i],
-                        None => {
-                            row.lanes.push(Lane {
-                                behaviour: p.behaviour.to_string(),
-                                kind: None,
-                                syncs: Vec::new(),
-                                warned: false,
-                            });
-                            row.lanes.last_mut().expect("just pushed")
-                        }
-                    };
-                    match lane.syncs.iter_mut().find(|s| s.0 == p.sync) {
-                        Some(s) => s.1 = p.global_time,
-                        None => lane.syncs.push((p.sync.to_string(), p.global_time)),
-                    }
-                }
+                Feedback::Prediction(p) => t.prediction(p),
+                Feedback::BlockProgress(p) => t.block_progress(p, &mut started),
+                Feedback::SyncPointProgress(p) => t.sync_progress(p),
                 Feedback::Warning(w) => t.warnings.push((w.id.clone(), w.text.clone())),
             }
         }
@@ -179,6 +106,93 @@ impl Timeline {
         }
         t.link_coincident();
         t
+    }
+
+    /// A prediction gives blocks their predicted span and behaviours their predicted syncs (the
+    /// first prediction of a behaviour; a PENDING one also moves the block).
+    fn prediction(&mut self, p: &crate::feedback::PredictionFeedback) {
+        for b in &p.blocks {
+            let row = self.block(&b.id, p.character_id.as_ref());
+            if row.start.is_none() || b.status == Some(BlockStatus::Pending) {
+                row.start = b.global_start.or(row.start);
+                row.end = b.global_end.or(row.end);
+            }
+            row.status = b.status.or(row.status);
+            let start = row.start.unwrap_or(0.0);
+            for x in p.behaviours.iter().filter(|x| x.block == b.id) {
+                if row.lanes.iter().any(|l| l.behaviour == x.behaviour) {
+                    continue;
+                }
+                row.lanes.push(Lane {
+                    behaviour: x.behaviour.to_string(),
+                    kind: Some(x.kind.to_string()),
+                    syncs: x
+                        .syncs
+                        .iter()
+                        .map(|(s, v)| (s.to_string(), start + v))
+                        .collect(),
+                    warned: false,
+                });
+            }
+        }
+    }
+
+    /// A block started (its predicted syncs move with it) or ended.
+    fn block_progress(
+        &mut self,
+        p: &crate::feedback::BlockProgress,
+        started: &mut std::collections::HashSet<String>,
+    ) {
+        let row = self.block(&p.block, p.character_id.as_ref());
+        match p.sync.as_str() {
+            "start" => {
+                // predicted sync times move with the block's actual start
+                if let Some(old) = row.start {
+                    let shift = p.global_time - old;
+                    for l in &mut row.lanes {
+                        for s in &mut l.syncs {
+                            s.1 += shift;
+                        }
+                    }
+                }
+                row.start = Some(p.global_time);
+                started.insert(p.block.to_string());
+            }
+            // revoked before it started: it never ran, so nothing of it is drawn
+            // but the moment it was removed
+            "end"
+                if p.status == Some(BlockStatus::Revoked)
+                    && !started.contains(p.block.as_str()) =>
+            {
+                row.start = Some(p.global_time);
+                row.end = Some(p.global_time);
+                row.lanes.clear();
+            }
+            "end" => row.end = Some(p.global_time),
+            _ => {}
+        }
+        row.status = p.status.or(row.status);
+    }
+
+    /// A sync point passed: its lane gets the actual time.
+    fn sync_progress(&mut self, p: &crate::feedback::SyncPointProgress) {
+        let row = self.block(&p.block, p.character_id.as_ref());
+        let lane = match row.lanes.iter().position(|l| l.behaviour == p.behaviour) {
+            Some(i) => &mut row.lanes[i],
+            None => {
+                row.lanes.push(Lane {
+                    behaviour: p.behaviour.to_string(),
+                    kind: None,
+                    syncs: Vec::new(),
+                    warned: false,
+                });
+                row.lanes.last_mut().expect("just pushed")
+            }
+        };
+        match lane.syncs.iter_mut().find(|s| s.0 == p.sync) {
+            Some(s) => s.1 = p.global_time,
+            None => lane.syncs.push((p.sync.to_string(), p.global_time)),
+        }
     }
 
     /// Links sync points of different behaviours of one block that happen at the same time.
