@@ -760,6 +760,8 @@ impl<'i> Parser<'i> {
         }
     }
 
+    /// A `<constraint>` element: its `<synchronize>`, `<before>` and `<after>` items. `None` if
+    /// anything in it is wrong (every problem is reported).
     fn constraint(
         &mut self,
         mut el: El<'i>,
@@ -771,77 +773,7 @@ impl<'i> Parser<'i> {
         let mut items = Vec::new();
         let mut ok = true;
         self.children(&el, |p, mut item| {
-            let kind = match (item.ns.is_core(), item.name) {
-                (true, k @ ("synchronize" | "before" | "after")) => k.to_string(),
-                _ => {
-                    p.error(
-                        Code::UnknownElement,
-                        item.offset,
-                        format!("<{}> is not allowed in <constraint>; expected <synchronize>, <before> or <after>", item.qname),
-                    );
-                    p.skip(&item)?;
-                    ok = false;
-                    return Ok(());
-                }
-            };
-            let on = format!("<{kind}>");
-            let mut attrs = Attrs::new(std::mem::take(&mut item.attrs));
-            let reference = match attrs.take("ref") {
-                Some(a) => {
-                    let r = p.sync_ref(&a, &on);
-                    ok &= r.is_some();
-                    r
-                }
-                None if kind == "synchronize" => None,
-                None => {
-                    p.error(Code::MissingAttribute, item.offset, format!("{on} needs a ref attribute"));
-                    ok = false;
-                    None
-                }
-            };
-            let _ = p.leftover_attrs(attrs, &on);
-            let mut syncs = Vec::new();
-            p.children(&item, |p, mut s| {
-                if !(s.ns.is_core() && s.name == "sync") {
-                    p.error(Code::UnknownElement, s.offset, format!("<{}> is not allowed in {on}; expected <sync ref>", s.qname));
-                    ok = false;
-                    p.skip(&s)?;
-                    return Ok(());
-                }
-                let mut attrs = Attrs::new(std::mem::take(&mut s.attrs));
-                match attrs.take("ref") {
-                    Some(a) => match p.sync_ref(&a, &"<sync>") {
-                        Some(r) => syncs.push(ConstraintSync {
-                            reference: r,
-                            pos: p.pos(s.offset),
-                        }),
-                        None => ok = false,
-                    },
-                    None => {
-                        p.error(Code::MissingAttribute, s.offset, "<sync> needs a ref attribute");
-                        ok = false;
-                    }
-                }
-                let _ = p.leftover_attrs(attrs, &"<sync>");
-                p.skip(&s)?;
-                Ok(())
-            })?;
-            let pos = p.pos(item.offset);
-            let needed = if reference.is_some() { 1 } else { 2 };
-            if ok && syncs.len() < needed {
-                p.error(
-                    Code::InvalidConstraint,
-                    item.offset,
-                    format!("{on} relates nothing: it needs {} <sync ref> child{}", needed, if needed == 1 { "" } else { "ren" }),
-                );
-                ok = false;
-            }
-            match (kind.as_str(), reference) {
-                ("before", Some(reference)) => items.push(ConstraintItem::Before { reference, syncs, pos }),
-                ("after", Some(reference)) => items.push(ConstraintItem::After { reference, syncs, pos }),
-                ("synchronize", reference) => items.push(ConstraintItem::Synchronize { reference, syncs, pos }),
-                _ => {} // missing ref: already reported
-            }
+            items.extend(p.constraint_item(&mut item, &mut ok)?);
             Ok(())
         })?;
         if ok && items.is_empty() {
@@ -858,6 +790,192 @@ impl<'i> Parser<'i> {
             required,
             pos: self.pos(el.offset),
         }))
+    }
+
+    /// One item of a constraint: `<synchronize ref?>`, `<before ref>` or `<after ref>` with its
+    /// `<sync ref>` children. Clears `ok` on any problem.
+    fn constraint_item(
+        &mut self,
+        item: &mut El<'i>,
+        ok: &mut bool,
+    ) -> Result<Option<ConstraintItem>, Fatal> {
+        let kind = match (item.ns.is_core(), item.name) {
+            (true, k @ ("synchronize" | "before" | "after")) => k,
+            _ => {
+                self.error(
+                    Code::UnknownElement,
+                    item.offset,
+                    format!("<{}> is not allowed in <constraint>; expected <synchronize>, <before> or <after>", item.qname),
+                );
+                self.skip(item)?;
+                *ok = false;
+                return Ok(None);
+            }
+        };
+        let on = format!("<{kind}>");
+        let mut attrs = Attrs::new(std::mem::take(&mut item.attrs));
+        let reference = match attrs.take("ref") {
+            Some(a) => {
+                let r = self.sync_ref(&a, &on);
+                *ok &= r.is_some();
+                r
+            }
+            None if kind == "synchronize" => None,
+            None => {
+                self.error(
+                    Code::MissingAttribute,
+                    item.offset,
+                    format!("{on} needs a ref attribute"),
+                );
+                *ok = false;
+                None
+            }
+        };
+        let _ = self.leftover_attrs(attrs, &on);
+        let mut syncs = Vec::new();
+        self.children(item, |p, mut s| {
+            syncs.extend(p.constraint_sync(&mut s, &on, ok)?);
+            Ok(())
+        })?;
+        let pos = self.pos(item.offset);
+        let needed = if reference.is_some() { 1 } else { 2 };
+        if *ok && syncs.len() < needed {
+            self.error(
+                Code::InvalidConstraint,
+                item.offset,
+                format!(
+                    "{on} relates nothing: it needs {} <sync ref> child{}",
+                    needed,
+                    if needed == 1 { "" } else { "ren" }
+                ),
+            );
+            *ok = false;
+        }
+        Ok(match (kind, reference) {
+            ("before", Some(reference)) => Some(ConstraintItem::Before {
+                reference,
+                syncs,
+                pos,
+            }),
+            ("after", Some(reference)) => Some(ConstraintItem::After {
+                reference,
+                syncs,
+                pos,
+            }),
+            ("synchronize", reference) => Some(ConstraintItem::Synchronize {
+                reference,
+                syncs,
+                pos,
+            }),
+            _ => None, // missing ref: already reported
+        })
+    }
+
+    /// A `<sync ref>` child of a constraint item (`on`). Clears `ok` on any problem.
+    fn constraint_sync(
+        &mut self,
+        s: &mut El<'i>,
+        on: &str,
+        ok: &mut bool,
+    ) -> Result<Option<ConstraintSync>, Fatal> {
+        if !(s.ns.is_core() && s.name == "sync") {
+            self.error(
+                Code::UnknownElement,
+                s.offset,
+                format!("<{}> is not allowed in {on}; expected <sync ref>", s.qname),
+            );
+            *ok = false;
+            self.skip(s)?;
+            return Ok(None);
+        }
+        let mut attrs = Attrs::new(std::mem::take(&mut s.attrs));
+        let mut sync = None;
+        match attrs.take("ref") {
+            Some(a) => match self.sync_ref(&a, &"<sync>") {
+                Some(r) => {
+                    sync = Some(ConstraintSync {
+                        reference: r,
+                        pos: self.pos(s.offset),
+                    })
+                }
+                None => *ok = false,
+            },
+            None => {
+                self.error(
+                    Code::MissingAttribute,
+                    s.offset,
+                    "<sync> needs a ref attribute",
+                );
+                *ok = false;
+            }
+        }
+        let _ = self.leftover_attrs(attrs, &"<sync>");
+        self.skip(s)?;
+        Ok(sync)
+    }
+
+    /// A behaviour's `id`: present, not empty, without ':'.
+    fn behaviour_id(&mut self, attrs: &mut Attrs<'i>, el: &El<'i>) -> Option<Id> {
+        match attrs.take("id") {
+            Some(a) if !a.value.trim_ascii().is_empty() => {
+                let id = Id::new(a.value.trim_ascii());
+                if id.contains(':') {
+                    self.error(
+                        Code::InvalidId,
+                        a.offset,
+                        format!("behaviour id '{id}' contains ':', so it cannot be referred to"),
+                    );
+                }
+                Some(id)
+            }
+            _ => {
+                self.error(
+                    Code::MissingId,
+                    el.offset,
+                    format!(
+                        "<{}> has no id attribute; every behaviour needs one",
+                        el.qname
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    /// A behaviour of a namespace this parser does not know: kept as written (its attributes and
+    /// content), with a warning that nothing realizes it.
+    fn extension_behaviour(
+        &mut self,
+        el: &El<'i>,
+        mut attrs: Attrs<'i>,
+        on: &On<'_>,
+    ) -> Result<(BehaviourKind, Vec<SyncAttr>), Fatal> {
+        self.warn(
+            Code::UnsupportedExtension,
+            el.offset,
+            format!("unsupported extension behaviour {on} (namespace {}); it is kept but will not be realized", el.ns.uri()),
+        );
+        let syncs = self.sync_attrs(&mut attrs, super::kinds::ALL_STANDARD_SYNCS, on);
+        let scope = self.scope();
+        let Skipped {
+            content, prefixes, ..
+        } = self.skip(el)?;
+        let namespaces = used_prefixes(scope, &prefixes, &[]);
+        let kind = BehaviourKind::Unknown(UnknownBehaviour {
+            ns: el.ns.uri().to_string(),
+            name: el.name.to_string(),
+            attrs: attrs
+                .rest()
+                .map(|a| ForeignAttr {
+                    ns: a.ns.uri().to_string(),
+                    name: a.name.to_owned(),
+                    value: a.value.into_owned(),
+                })
+                .collect(),
+            content,
+            namespaces,
+        });
+        Ok((kind, syncs))
     }
 
     /// Reads a behaviour element into `out` (nothing is added for one that cannot be kept; the
@@ -884,61 +1002,14 @@ impl<'i> Parser<'i> {
             return Ok(());
         }
         let mut attrs = Attrs::new(std::mem::take(&mut el.attrs));
-        let id = match attrs.take("id") {
-            Some(a) if !a.value.trim_ascii().is_empty() => {
-                let id = Id::new(a.value.trim_ascii());
-                if id.contains(':') {
-                    self.error(
-                        Code::InvalidId,
-                        a.offset,
-                        format!("behaviour id '{id}' contains ':', so it cannot be referred to"),
-                    );
-                }
-                Some(id)
-            }
-            _ => {
-                self.error(
-                    Code::MissingId,
-                    el.offset,
-                    format!(
-                        "<{}> has no id attribute; every behaviour needs one",
-                        el.qname
-                    ),
-                );
-                None
-            }
-        };
+        let id = self.behaviour_id(&mut attrs, &el);
         let qname = el.qname;
         let on = On {
             qname,
             id: id.as_deref(),
         };
         let (kind, syncs, descriptions, foreign_attrs) = if !known {
-            self.warn(
-                Code::UnsupportedExtension,
-                el.offset,
-                format!("unsupported extension behaviour {on} (namespace {}); it is kept but will not be realized", el.ns.uri()),
-            );
-            let syncs = self.sync_attrs(&mut attrs, super::kinds::ALL_STANDARD_SYNCS, &on);
-            let scope = self.scope();
-            let Skipped {
-                content, prefixes, ..
-            } = self.skip(&el)?;
-            let namespaces = used_prefixes(scope, &prefixes, &[]);
-            let kind = BehaviourKind::Unknown(UnknownBehaviour {
-                ns: el.ns.uri().to_string(),
-                name: el.name.to_string(),
-                attrs: attrs
-                    .rest()
-                    .map(|a| ForeignAttr {
-                        ns: a.ns.uri().to_string(),
-                        name: a.name.to_owned(),
-                        value: a.value.into_owned(),
-                    })
-                    .collect(),
-                content,
-                namespaces,
-            });
+            let (kind, syncs) = self.extension_behaviour(&el, attrs, &on)?;
             (kind, syncs, Vec::new(), Vec::new())
         } else {
             let mut kb = KindBuilder::new(self, &mut attrs, &on, &el);
