@@ -328,7 +328,7 @@ fn run_bvh_records_frames_without_changing_the_feedback() {
     let (_, without, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
     assert_eq!(with, without, "frames do not change the feedback");
     // 0 .. 2.9 s at 50 fps: 146 frames
-    assert!(err.contains("(146 frames at 50 fps, 32 joints)"), "{err}");
+    assert!(err.contains("(146 frames at 50 fps, 57 joints)"), "{err}");
     let text = std::fs::read_to_string(&bvh).unwrap();
     assert!(text.starts_with("HIERARCHY\nROOT HumanoidRoot\n"));
     assert!(text.contains("MOTION\nFrames: 146\nFrame Time: 0.020000\n"));

@@ -303,7 +303,6 @@ fn the_beat_between_two_speeches_prepares_at_a_natural_pace() {
 /// T-pose rest and puts the hand beside and behind the head (about 1.7 m up, 0.35 m behind):
 /// this fails until the lexicon and the rest pose are re-authored in gesture space.
 #[test]
-#[ignore = "the BEAT of the gesture lexicon puts the hand behind the head"]
 fn at_the_stroke_of_a_beat_the_hand_is_in_front_of_the_torso() {
     let stroke = beat_wrist_at(&[2.3])[0];
     assert!(

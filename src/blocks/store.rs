@@ -1,6 +1,7 @@
 //! The live blocks of one character: stable handles ([`BlockKey`]) that stay valid while other
 //! blocks come and go, arrival order, and lookup by id.
 
+use std::collections::BTreeMap;
 use std::ops::{Index, IndexMut};
 
 // block ids come from the host: a fast hash (rustc's) instead of SipHash for the id index
@@ -20,17 +21,18 @@ new_key_type! {
 #[derive(Default)]
 pub(super) struct Blocks {
     slots: SlotMap<BlockKey, LiveBlock>,
-    /// Handles in arrival order.
-    order: Vec<BlockKey>,
+    /// Handles by arrival (the block's `seq`): blocks leave from anywhere, most often the front,
+    /// so a map rather than a list that would shift.
+    order: BTreeMap<u64, BlockKey>,
     by_id: HashMap<bml::Id, BlockKey>,
 }
 
 impl Blocks {
     /// Adds a block (its id is not in use); returns its handle.
     pub(super) fn insert(&mut self, block: LiveBlock) -> BlockKey {
-        let id = block.id.clone();
+        let (id, seq) = (block.id.clone(), block.seq);
         let key = self.slots.insert(block);
-        self.order.push(key);
+        self.order.insert(seq, key);
         self.by_id.insert(id, key);
         key
     }
@@ -38,7 +40,7 @@ impl Blocks {
     /// Takes block `key` out.
     pub(super) fn remove(&mut self, key: BlockKey) -> Option<LiveBlock> {
         let block = self.slots.remove(key)?;
-        self.order.retain(|&k| k != key);
+        self.order.remove(&block.seq);
         self.by_id.remove(&block.id);
         Some(block)
     }
@@ -65,17 +67,17 @@ impl Blocks {
 
     /// Handles in arrival order.
     pub(super) fn keys(&self) -> impl Iterator<Item = BlockKey> + '_ {
-        self.order.iter().copied()
+        self.order.values().copied()
     }
 
     /// Blocks in arrival order.
     pub(super) fn iter(&self) -> impl Iterator<Item = &LiveBlock> + '_ {
-        self.order.iter().map(|&k| &self.slots[k])
+        self.order.values().map(|&k| &self.slots[k])
     }
 
     /// (handle, block) in arrival order.
     pub(super) fn with_keys(&self) -> impl Iterator<Item = (BlockKey, &LiveBlock)> + '_ {
-        self.order.iter().map(|&k| (k, &self.slots[k]))
+        self.order.values().map(|&k| (k, &self.slots[k]))
     }
 }
 

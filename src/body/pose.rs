@@ -132,12 +132,12 @@ mod tests {
             s.joint("l_elbow").unwrap(),
             s.joint("l_wrist").unwrap(),
         );
-        // rest: the left arm points along +x
-        assert!((w.positions[el] - w.positions[sh] - Vec3::new(0.29, 0.0, 0.0)).length() < 1e-6);
-        // the elbow bent 90° about +y turns the forearm from +x to -z
-        pose.rotate(el, Quat::from_rotation_y(FRAC_PI_2));
+        // rest: the left arm hangs down (-y)
+        assert!((w.positions[el] - w.positions[sh] - Vec3::new(0.0, -0.29, 0.0)).length() < 1e-6);
+        // the elbow bent 90° about -x turns the forearm from -y to +z (forward)
+        pose.rotate(el, Quat::from_rotation_x(-FRAC_PI_2));
         let w2 = pose.world(&s);
-        assert!((w2.positions[wr] - w2.positions[el] - Vec3::new(0.0, 0.0, -0.25)).length() < 1e-6);
+        assert!((w2.positions[wr] - w2.positions[el] - Vec3::new(0.0, 0.0, 0.25)).length() < 1e-6);
         assert_eq!(
             w2.positions[el], w.positions[el],
             "the elbow itself does not move"

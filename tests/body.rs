@@ -1,0 +1,315 @@
+//! Does the body look like a person? Each test realizes BML on the virtual clock at 60 Hz and
+//! looks at the frames through forward kinematics, the way a person looks at the character: where
+//! the hands are, whether an arm passes through the torso, how fast a joint turns. (A test that
+//! only checks that joints reach their bound rotations passes on a hand behind the head.)
+
+use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::realizer::Realizer;
+use glam::{Quat, Vec3};
+
+const FPS: f64 = 60.0;
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// The poses of the default character while `bml` plays, at 60 Hz for `seconds`.
+fn frames(bml: &[&str], seconds: f64) -> Vec<(f64, Pose)> {
+    let mut r = Realizer::new();
+    for b in bml {
+        r.perform_bml(b).unwrap();
+    }
+    (0..=(seconds * FPS).ceil() as u32)
+        .map(|i| {
+            let t = f64::from(i) / FPS;
+            (t, r.tick(t).poses[0].pose.clone())
+        })
+        .collect()
+}
+
+/// World positions of the named joints.
+struct Body {
+    skeleton: Skeleton,
+}
+
+impl Body {
+    fn new() -> Body {
+        Body {
+            skeleton: Skeleton::adult(),
+        }
+    }
+
+    fn at(&self, pose: &Pose, joint: &str) -> Vec3 {
+        let j = self
+            .skeleton
+            .joint(joint)
+            .unwrap_or_else(|| panic!("no {joint}"));
+        pose.world(&self.skeleton).positions[j]
+    }
+
+    /// The direction the palm of `side`'s hand faces in the world (at rest toward the thigh).
+    fn palm(&self, pose: &Pose, side: char) -> Vec3 {
+        let j = self.skeleton.joint(&format!("{side}_wrist")).unwrap();
+        let rest_normal = if side == 'l' { -Vec3::X } else { Vec3::X };
+        pose.world(&self.skeleton).orientations[j] * rest_normal
+    }
+
+    /// Distance from `p` to the torso's axis, a segment from the pelvis to the neck.
+    fn distance_to_torso_axis(&self, pose: &Pose, p: Vec3) -> f32 {
+        let (a, b) = (self.at(pose, "sacroiliac"), self.at(pose, "vc7"));
+        let s = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+        p.distance(a + s * (b - a))
+    }
+}
+
+#[test]
+fn at_rest_the_arms_hang_at_the_sides() {
+    let body = Body::new();
+    let rest = Pose::rest(&body.skeleton);
+    let hips = body.at(&rest, "l_hip").y.max(body.at(&rest, "r_hip").y);
+    for side in ['l', 'r'] {
+        let (elbow, wrist) = (
+            body.at(&rest, &format!("{side}_elbow")),
+            body.at(&rest, &format!("{side}_wrist")),
+        );
+        assert!(
+            wrist.y < elbow.y,
+            "{side}: wrist {wrist} not below the elbow {elbow}"
+        );
+        assert!(
+            wrist.y < hips + 0.25,
+            "{side}: wrist {wrist} not below the hips + 0.25 m"
+        );
+        let from_axis = Vec3::new(wrist.x, 0.0, wrist.z).length();
+        assert!(
+            from_axis < 0.4,
+            "{side}: wrist {from_axis} m from the body axis"
+        );
+        // palms toward the thighs
+        let palm = body.palm(&rest, side);
+        assert!(
+            palm.x * wrist.x < 0.0 && palm.x.abs() > 0.9,
+            "{side}: palm {palm}"
+        );
+        // the fingers hang below the wrist
+        let tip = body.at(&rest, &format!("{side}_middle3"));
+        assert!(tip.y < wrist.y - 0.1, "{side}: fingertip {tip}");
+    }
+    // and a character with nothing to do stands that way
+    let (_, idle) = frames(&[&format!(r#"<bml {NS} id="nothing"/>"#)], 1.0)
+        .pop()
+        .unwrap();
+    for side in ['l', 'r'] {
+        let wrist = body.at(&idle, &format!("{side}_wrist"));
+        assert!(wrist.y < hips + 0.25, "{side}: idle wrist {wrist}");
+    }
+}
+
+#[test]
+fn the_hands_have_five_fingers_and_the_head_a_jaw() {
+    let s = Skeleton::adult();
+    for side in ["l", "r"] {
+        for finger in ["thumb", "index", "middle", "ring", "pinky"] {
+            for k in 1..=3 {
+                let name = format!("{side}_{finger}{k}");
+                assert!(s.joint(&name).is_some(), "no {name}");
+            }
+        }
+    }
+    assert!(s.joint("temporomandibular").is_some());
+}
+
+/// Where a gesture's hand must be at its stroke, in the character's frame (+z forward, +x to
+/// its left), for the right hand; the left hand mirrors it.
+struct Stroke {
+    lexeme: &'static str,
+    check: fn(&Body, &Pose, char) -> Result<(), String>,
+}
+
+fn front_of_torso(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let ok = w.z > 0.15 && (1.0..1.35).contains(&w.y) && w.x.abs() < 0.35;
+    ok.then_some(()).ok_or(format!(
+        "wrist {w} not in front of the torso between waist and chest"
+    ))
+}
+
+fn beside_the_head_palm_forward(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let (w, shoulder) = (
+        body.at(pose, &format!("{side}_wrist")),
+        body.at(pose, &format!("{side}_shoulder")),
+    );
+    let palm = body.palm(pose, side);
+    let outward = if side == 'l' { w.x > 0.15 } else { w.x < -0.15 };
+    if w.y <= shoulder.y || !outward {
+        return Err(format!(
+            "wrist {w} not raised beside the head (shoulder {shoulder})"
+        ));
+    }
+    (palm.z > 0.7)
+        .then_some(())
+        .ok_or(format!("palm {palm} not forward"))
+}
+
+fn open_palm_up_in_front(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let palm = body.palm(pose, side);
+    (w.z > 0.25 && palm.y > 0.8).then_some(()).ok_or(format!(
+        "wrist {w}, palm {palm}: not an open palm up in front"
+    ))
+}
+
+fn pointing_forward(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let (w, shoulder) = (
+        body.at(pose, &format!("{side}_wrist")),
+        body.at(pose, &format!("{side}_shoulder")),
+    );
+    let (index, middle) = (
+        body.at(pose, &format!("{side}_index3")),
+        body.at(pose, &format!("{side}_middle3")),
+    );
+    let ok = w.z > 0.4 && (w.y - shoulder.y).abs() < 0.15 && index.z > w.z + 0.08;
+    // the other fingers are curled: their tips stay near the palm
+    (ok && middle.z < index.z - 0.05)
+        .then_some(())
+        .ok_or(format!(
+            "wrist {w}, index tip {index}, middle tip {middle}: not pointing forward"
+        ))
+}
+
+fn palm_out_in_front(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let palm = body.palm(pose, side);
+    (w.z > 0.3 && palm.z > 0.7)
+        .then_some(())
+        .ok_or(format!("wrist {w}, palm {palm}: not a palm out in front"))
+}
+
+const STROKES: &[Stroke] = &[
+    Stroke {
+        lexeme: "BEAT",
+        check: front_of_torso,
+    },
+    Stroke {
+        lexeme: "WAVE",
+        check: beside_the_head_palm_forward,
+    },
+    Stroke {
+        lexeme: "HELLO",
+        check: beside_the_head_palm_forward,
+    },
+    Stroke {
+        lexeme: "CONDUIT",
+        check: open_palm_up_in_front,
+    },
+    Stroke {
+        lexeme: "OFFER",
+        check: open_palm_up_in_front,
+    },
+    Stroke {
+        lexeme: "CUP",
+        check: open_palm_up_in_front,
+    },
+    Stroke {
+        lexeme: "POINT",
+        check: pointing_forward,
+    },
+    Stroke {
+        lexeme: "STOP",
+        check: palm_out_in_front,
+    },
+];
+
+fn gesture(lexeme: &str, mode: &str) -> String {
+    format!(
+        r#"<bml {NS} id="b"><gesture id="g" lexeme="{lexeme}" mode="{mode}" start="0" stroke="1" end="2"/></bml>"#
+    )
+}
+
+#[test]
+fn at_its_stroke_each_lexeme_puts_the_hand_where_it_should_be() {
+    let body = Body::new();
+    let mut wrong = Vec::new();
+    for s in STROKES {
+        for (mode, side) in [("RIGHT_HAND", 'r'), ("LEFT_HAND", 'l')] {
+            let f = frames(&[&gesture(s.lexeme, mode)], 1.0);
+            let (_, pose) = f.last().unwrap();
+            if let Err(e) = (s.check)(&body, pose, side) {
+                wrong.push(format!("{} {mode}: {e}", s.lexeme));
+            }
+            // the other hand stays at rest
+            let other = if side == 'l' { 'r' } else { 'l' };
+            let w = body.at(pose, &format!("{other}_wrist"));
+            if w.y > 1.0 {
+                wrong.push(format!("{} {mode}: the other wrist moved to {w}", s.lexeme));
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// Every example, and every lexeme with each hand.
+fn everything() -> Vec<(String, Vec<(f64, Pose)>)> {
+    let mut runs = Vec::new();
+    for entry in std::fs::read_dir("fixtures/examples").unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "xml") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            runs.push((path.display().to_string(), frames(&[&text], 8.0)));
+        }
+    }
+    for s in STROKES {
+        for mode in ["RIGHT_HAND", "LEFT_HAND", "BOTH_HANDS"] {
+            let name = format!("{} {mode}", s.lexeme);
+            runs.push((name, frames(&[&gesture(s.lexeme, mode)], 2.5)));
+        }
+    }
+    runs
+}
+
+#[test]
+fn no_wrist_or_elbow_ever_enters_the_torso() {
+    let body = Body::new();
+    let mut wrong = Vec::new();
+    for (name, frames) in everything() {
+        for (t, pose) in &frames {
+            for joint in ["l_wrist", "r_wrist", "l_elbow", "r_elbow"] {
+                let d = body.distance_to_torso_axis(pose, body.at(pose, joint));
+                if d < 0.12 {
+                    wrong.push(format!(
+                        "{name}: {joint} {d:.3} m from the torso axis at {t:.2} s"
+                    ));
+                    break;
+                }
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// The angle a joint turns through between two local rotations.
+fn turned(a: Quat, b: Quat) -> f32 {
+    (a.inverse() * b).normalize().angle_between(Quat::IDENTITY)
+}
+
+#[test]
+fn no_joint_but_the_eyes_turns_faster_than_15_rad_per_s() {
+    let skeleton = Skeleton::adult();
+    let mut wrong = Vec::new();
+    for (name, frames) in everything() {
+        'run: for w in frames.windows(2) {
+            let ((_, a), (t, b)) = (&w[0], &w[1]);
+            for (j, joint) in skeleton.joints().iter().enumerate() {
+                if joint.name.contains("eyeball") {
+                    continue;
+                }
+                let speed = f64::from(turned(a.rotations[j], b.rotations[j])) * FPS;
+                if speed > 15.0 {
+                    wrong.push(format!(
+                        "{name}: {} at {speed:.1} rad/s at {t:.2} s",
+                        joint.name
+                    ));
+                    break 'run;
+                }
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
