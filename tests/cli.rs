@@ -388,3 +388,60 @@ fn run_assets_extend_the_motion_data_and_report_bad_files() {
     assert!(err.contains("not a directory"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn run_frames_writes_the_skeleton_and_every_frame_without_changing_the_feedback() {
+    let path = std::env::temp_dir().join(format!("bmlr-{}-welcome.jsonl", std::process::id()));
+    let args = [
+        "run",
+        "--frames",
+        path.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ];
+    let (code, with, err) = bmlr(&args);
+    assert_eq!(code, 0, "{err}");
+    let (_, without, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
+    assert_eq!(with, without, "frames do not change the feedback");
+    // 0 .. 2.9 s at 60 fps: 175 frames
+    assert!(
+        err.contains("(175 frames at 60 fps, 1 character(s))"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let skeleton = bml_realizer::body::Skeleton::adult();
+    let joints = lines[0]["skeleton"]["joints"].as_array().unwrap();
+    assert_eq!(joints.len(), skeleton.len());
+    assert_eq!(lines[0]["characters"], serde_json::json!([""]));
+    assert_eq!(lines.len(), 1 + 175);
+    // rebuild a pose from the file: at the beat's stroke (0.6 s) the right hand is in front
+    let stroke = lines.iter().find(|l| l["time"] == 0.6).unwrap();
+    let mut pose = bml_realizer::body::Pose::rest(&skeleton);
+    for (i, j) in skeleton.joints().iter().enumerate() {
+        let q = stroke["characters"][""]["joints"][&j.name]
+            .as_array()
+            .unwrap();
+        let q: Vec<f32> = q.iter().map(|v| v.as_f64().unwrap() as f32).collect();
+        pose.rotations[i] = glam::Quat::from_xyzw(q[0], q[1], q[2], q[3]);
+    }
+    let wrist = pose.world(&skeleton).positions[skeleton.joint("r_wrist").unwrap()];
+    assert!(wrist.z > 0.15 && (1.0..1.35).contains(&wrist.y), "{wrist}");
+    // the same input gives the same file
+    bmlr(&args);
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), text);
+    let (code, _, err) = bmlr(&[
+        "run",
+        "--realtime",
+        "--frames",
+        "x.jsonl",
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("--frames records on the virtual clock"),
+        "{err}"
+    );
+}

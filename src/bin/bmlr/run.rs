@@ -14,6 +14,8 @@ use bml_realizer::realizer::Realizer;
 use bml_realizer::timeline::Timeline;
 use clap::{Args, ValueEnum};
 
+use crate::record::Recording;
+
 /// Feedback line format.
 #[derive(Clone, Copy, ValueEnum)]
 pub enum FormatArg {
@@ -64,6 +66,10 @@ pub struct RunArgs {
     /// one frame every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.bvh")]
     bvh: Option<std::path::PathBuf>,
+    /// Write the realized frames of every character as JSON lines (docs/cli.md, "Frames"):
+    /// a header with the skeleton, then one line every 1/--fps seconds (virtual clock only).
+    #[arg(long, value_name = "OUT.jsonl")]
+    frames: Option<std::path::PathBuf>,
     #[command(flatten)]
     pub limits: LimitArgs,
     /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
@@ -220,82 +226,15 @@ struct VirtualRun {
     until: f64,
     out: std::io::StdoutLock<'static>,
     open: bool,
-    /// BVH recording: the character, the frame period, the next frame's time and the poses.
-    motion: Option<Motion>,
+    /// The frames recorded for --bvh and --frames.
+    motion: Option<Recording>,
     /// Blocks that could not be parsed (the run goes on; it exits 1).
     invalid: usize,
 }
 
-/// BVH recording: the frame period, the next frame's time, and every character's pose in each
-/// frame so far (which character the file shows is decided at the end).
-struct Motion {
-    period: f64,
-    next: f64,
-    frames: Vec<Vec<bml_realizer::engine::CharacterPose>>,
-}
-
-impl Motion {
-    /// The poses of `character` ("" the default one), frame by frame (the rest pose where a
-    /// frame has none for it).
-    fn poses_of(&self, character: &str) -> Vec<bml_realizer::body::Pose> {
-        let rest = bml_realizer::body::Pose::rest(&bml_realizer::body::Skeleton::adult());
-        self.frames
-            .iter()
-            .map(|f| {
-                f.iter()
-                    .find(|p| p.character.as_deref().unwrap_or("") == character)
-                    .map_or_else(|| rest.clone(), |p| p.pose.clone())
-            })
-            .collect()
-    }
-}
-
-/// The character a BVH shows: `asked` (--character) if it received blocks, else the only one
-/// that did (or, of several, the default one, else the first by id, with a note on stderr).
-/// An error names the characters that received blocks.
-fn recorded_character(realizer: &Realizer, asked: Option<&str>) -> Result<String, String> {
-    let mut received: Vec<&str> = realizer
-        .characters()
-        .filter(|(_, m)| m.received_blocks())
-        .map(|(c, _)| c)
-        .collect();
-    received.sort_unstable();
-    let named = |list: &[&str]| -> String {
-        let names: Vec<String> = list
-            .iter()
-            .map(|c| {
-                if c.is_empty() {
-                    "the default character".into()
-                } else {
-                    format!("'{c}'")
-                }
-            })
-            .collect();
-        names.join(", ")
-    };
-    match (asked, received.as_slice()) {
-        (Some(c), list) if list.contains(&c) => Ok(c.to_string()),
-        (_, []) => Err("no character received a block: the BVH would show nothing move".into()),
-        (Some(c), list) => Err(format!(
-            "character '{c}' received no blocks (these did: {}); choose one with --character",
-            named(list)
-        )),
-        (None, [one]) => Ok(one.to_string()),
-        (None, list) => {
-            let c = if list.contains(&"") { "" } else { list[0] };
-            eprintln!(
-                "bmlr run: several characters received blocks ({}); the BVH shows {} (choose with --character)",
-                named(list),
-                named(&[c])
-            );
-            Ok(c.to_string())
-        }
-    }
-}
-
 impl VirtualRun {
     /// Moves the clock to `t` (capped at `--until`), event by event; frames on the way are
-    /// recorded when a BVH is asked for (feedback does not depend on them).
+    /// recorded when a BVH or a frames file is asked for (feedback does not depend on them).
     fn advance_to(&mut self, t: f64) {
         let t = t.min(self.until);
         while let Some(m) = self.motion.as_mut().filter(|m| m.next <= t) {
@@ -303,15 +242,15 @@ impl VirtualRun {
             m.next = (m.frames.len() + 1) as f64 * m.period;
             let frame = self.realizer.tick(at);
             self.open &= print(&mut self.out, self.format, &frame.feedback);
-            self.record(frame.poses);
+            self.record(at, frame.poses);
         }
         let frame = self.realizer.tick(t);
         self.open &= print(&mut self.out, self.format, &frame.feedback);
     }
 
-    fn record(&mut self, poses: Vec<bml_realizer::engine::CharacterPose>) {
+    fn record(&mut self, time: f64, poses: Vec<bml_realizer::engine::CharacterPose>) {
         if let Some(m) = self.motion.as_mut() {
-            m.frames.push(poses);
+            m.frames.push((time, poses));
         }
     }
 
@@ -370,9 +309,14 @@ pub fn run(args: RunArgs) -> ExitCode {
     .with_default_character(args.character.clone())
     .with_posix_time(args.realtime)
     .with_limits(args.limits.limits());
-    if args.realtime && args.bvh.is_some() {
-        eprintln!("bmlr run: --bvh records on the virtual clock; leave out --realtime");
-        return ExitCode::from(2);
+    for (asked, flag) in [
+        (args.bvh.is_some(), "--bvh"),
+        (args.frames.is_some(), "--frames"),
+    ] {
+        if args.realtime && asked {
+            eprintln!("bmlr run: {flag} records on the virtual clock; leave out --realtime");
+            return ExitCode::from(2);
+        }
     }
     if args.realtime {
         return run_realtime(realizer, items, &args);
@@ -384,11 +328,7 @@ pub fn run(args: RunArgs) -> ExitCode {
         out: std::io::stdout().lock(),
         open: true,
         invalid: 0,
-        motion: args.bvh.as_ref().map(|_| Motion {
-            period: 1.0 / args.fps,
-            next: 0.0,
-            frames: Vec::new(),
-        }),
+        motion: (args.bvh.is_some() || args.frames.is_some()).then(|| Recording::new(args.fps)),
     };
     for item in items {
         match item {
@@ -430,35 +370,27 @@ pub fn run(args: RunArgs) -> ExitCode {
         run.advance_to(run.until);
     }
     report_unfinished(&run.realizer);
-    if let (Some(path), Some(m)) = (&args.bvh, run.motion.take()) {
+    if let Some(mut m) = run.motion.take() {
         // one last frame at the final time
         let now = run.realizer.now();
-        let mut m = m;
         if m.frames.is_empty() || m.next <= now + 1e-9 {
             let frame = run.realizer.tick(now);
-            m.frames.push(frame.poses);
+            m.frames.push((now, frame.poses));
         }
-        let character = match recorded_character(&run.realizer, args.character.as_deref()) {
-            Ok(c) => c,
-            Err(e) => {
-                eprintln!("bmlr run: --bvh: {e}");
-                return ExitCode::from(1);
+        let written = [
+            args.bvh
+                .as_ref()
+                .map(|p| m.write_bvh(&run.realizer, p, args.character.as_deref())),
+            args.frames
+                .as_ref()
+                .map(|p| m.write_frames(&run.realizer, p)),
+        ];
+        for result in written.into_iter().flatten() {
+            if let Err((code, e)) = result {
+                eprintln!("bmlr run: {e}");
+                return ExitCode::from(code);
             }
-        };
-        let poses = m.poses_of(&character);
-        let skeleton = bml_realizer::body::Skeleton::adult();
-        let text = bml_realizer::body::bvh::write(&skeleton, &poses, args.fps);
-        if let Err(e) = std::fs::write(path, text) {
-            eprintln!("bmlr run: {}: cannot write: {e}", path.display());
-            return ExitCode::from(2);
         }
-        eprintln!(
-            "wrote {} ({} frames at {} fps, {} joints)",
-            path.display(),
-            poses.len(),
-            args.fps,
-            skeleton.len()
-        );
     }
     exit_for(run.invalid, "run")
 }

@@ -1,0 +1,143 @@
+//! Recording the realized motion of `bmlr run` on the virtual clock: every character's pose once
+//! per frame, written at the end as BVH (one character) or as a frames file (all of them).
+
+use std::path::Path;
+
+use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::engine::CharacterPose;
+use bml_realizer::realizer::Realizer;
+
+/// The frame period, the next frame's time, and every character's pose in each frame so far
+/// (which characters a file shows is decided at the end).
+pub struct Recording {
+    pub period: f64,
+    pub next: f64,
+    /// (time, the poses of the characters that had one).
+    pub frames: Vec<(f64, Vec<CharacterPose>)>,
+    fps: f64,
+}
+
+impl Recording {
+    /// Nothing recorded yet; frames every 1/`fps` seconds from 0.
+    pub fn new(fps: f64) -> Recording {
+        Recording {
+            period: 1.0 / fps,
+            next: 0.0,
+            frames: Vec::new(),
+            fps,
+        }
+    }
+
+    /// Writes the BVH of the character `asked` (or the one chosen by [`recorded_character`]).
+    /// An error has the exit code.
+    pub fn write_bvh(
+        &self,
+        realizer: &Realizer,
+        path: &Path,
+        asked: Option<&str>,
+    ) -> Result<(), (u8, String)> {
+        let character =
+            recorded_character(realizer, asked).map_err(|e| (1, format!("--bvh: {e}")))?;
+        let poses = self.poses_of(&character);
+        let skeleton = Skeleton::adult();
+        let text = bml_realizer::body::bvh::write(&skeleton, &poses, self.fps);
+        std::fs::write(path, text)
+            .map_err(|e| (2, format!("{}: cannot write: {e}", path.display())))?;
+        eprintln!(
+            "wrote {} ({} frames at {} fps, {} joints)",
+            path.display(),
+            poses.len(),
+            self.fps,
+            skeleton.len()
+        );
+        Ok(())
+    }
+
+    /// Writes the frames of every character that received blocks (sorted by id; the default
+    /// character is `""`). An error has the exit code.
+    pub fn write_frames(&self, realizer: &Realizer, path: &Path) -> Result<(), (u8, String)> {
+        let mut ids: Vec<&str> = (realizer.characters())
+            .filter(|(_, m)| m.received_blocks())
+            .map(|(c, _)| c)
+            .collect();
+        ids.sort_unstable();
+        let skeleton = Skeleton::adult();
+        let mut text = bml_realizer::body::frames::header(&skeleton, self.fps, &ids);
+        text.push('\n');
+        let per_character: Vec<Vec<Pose>> = ids.iter().map(|c| self.poses_of(c)).collect();
+        for (k, (time, _)) in self.frames.iter().enumerate() {
+            let poses: Vec<(&str, &Pose)> = (ids.iter().zip(&per_character))
+                .map(|(&id, p)| (id, &p[k]))
+                .collect();
+            text.push_str(&bml_realizer::body::frames::line(&skeleton, *time, &poses));
+            text.push('\n');
+        }
+        std::fs::write(path, text)
+            .map_err(|e| (2, format!("{}: cannot write: {e}", path.display())))?;
+        eprintln!(
+            "wrote {} ({} frames at {} fps, {} character(s))",
+            path.display(),
+            self.frames.len(),
+            self.fps,
+            ids.len()
+        );
+        Ok(())
+    }
+
+    /// The poses of `character` ("" the default one), frame by frame (the rest pose where a
+    /// frame has none for it).
+    fn poses_of(&self, character: &str) -> Vec<bml_realizer::body::Pose> {
+        let rest = Pose::rest(&Skeleton::adult());
+        self.frames
+            .iter()
+            .map(|(_, f)| {
+                f.iter()
+                    .find(|p| p.character.as_deref().unwrap_or("") == character)
+                    .map_or_else(|| rest.clone(), |p| p.pose.clone())
+            })
+            .collect()
+    }
+}
+
+/// The character a BVH shows: `asked` (--character) if it received blocks, else the only one
+/// that did (or, of several, the default one, else the first by id, with a note on stderr).
+/// An error names the characters that received blocks.
+fn recorded_character(realizer: &Realizer, asked: Option<&str>) -> Result<String, String> {
+    let mut received: Vec<&str> = realizer
+        .characters()
+        .filter(|(_, m)| m.received_blocks())
+        .map(|(c, _)| c)
+        .collect();
+    received.sort_unstable();
+    let named = |list: &[&str]| -> String {
+        let names: Vec<String> = list
+            .iter()
+            .map(|c| {
+                if c.is_empty() {
+                    "the default character".into()
+                } else {
+                    format!("'{c}'")
+                }
+            })
+            .collect();
+        names.join(", ")
+    };
+    match (asked, received.as_slice()) {
+        (Some(c), list) if list.contains(&c) => Ok(c.to_string()),
+        (_, []) => Err("no character received a block: the BVH would show nothing move".into()),
+        (Some(c), list) => Err(format!(
+            "character '{c}' received no blocks (these did: {}); choose one with --character",
+            named(list)
+        )),
+        (None, [one]) => Ok(one.to_string()),
+        (None, list) => {
+            let c = if list.contains(&"") { "" } else { list[0] };
+            eprintln!(
+                "bmlr run: several characters received blocks ({}); the BVH shows {} (choose with --character)",
+                named(list),
+                named(&[c])
+            );
+            Ok(c.to_string())
+        }
+    }
+}

@@ -1,0 +1,130 @@
+//! The frames file (`bmlr run --frames OUT.jsonl`): the realized motion for tools and tests, as
+//! JSON lines. Line 1 is a header with the frame rate, the skeleton (each joint's name, parent and
+//! rest translation from the parent, metres) and the characters; then one line per frame with
+//! each character's root (HumanoidRoot's world position and rotation) and every joint's local
+//! rotation relative to the rest pose (quaternion `[x, y, z, w]`; the rest pose is identity).
+//! Numbers are rounded to 6 decimals so that files diff well and stay deterministic.
+
+use indexmap::IndexMap;
+use serde::Serialize;
+
+use super::pose::Pose;
+use super::skeleton::Skeleton;
+
+/// Line 1.
+#[derive(Serialize)]
+struct Header<'a> {
+    fps: f64,
+    skeleton: SkeletonLine<'a>,
+    /// Character ids in the order of the frames' `characters` (the default character is `""`).
+    characters: &'a [&'a str],
+}
+
+#[derive(Serialize)]
+struct SkeletonLine<'a> {
+    joints: Vec<JointLine<'a>>,
+}
+
+#[derive(Serialize)]
+struct JointLine<'a> {
+    name: &'a str,
+    parent: Option<&'a str>,
+    offset: [f64; 3],
+}
+
+/// One frame.
+#[derive(Serialize)]
+struct FrameLine<'a> {
+    time: f64,
+    characters: IndexMap<&'a str, CharacterLine<'a>>,
+}
+
+#[derive(Serialize)]
+struct CharacterLine<'a> {
+    root: [f64; 3],
+    rotation: [f64; 4],
+    joints: IndexMap<&'a str, [f64; 4]>,
+}
+
+fn round(v: f32) -> f64 {
+    (f64::from(v) * 1e6).round() / 1e6 + 0.0 // + 0.0: no negative zero in the file
+}
+
+fn quat(q: glam::Quat) -> [f64; 4] {
+    let q = q.normalize();
+    [round(q.x), round(q.y), round(q.z), round(q.w)]
+}
+
+/// The header line (without a newline) for frames at `fps` of `characters` on `skeleton`.
+pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
+    let joints = skeleton.joints();
+    let header = Header {
+        fps,
+        skeleton: SkeletonLine {
+            joints: (joints.iter())
+                .map(|j| JointLine {
+                    name: &j.name,
+                    parent: j.parent.map(|p| joints[p].name.as_str()),
+                    offset: [round(j.offset.x), round(j.offset.y), round(j.offset.z)],
+                })
+                .collect(),
+        },
+        characters,
+    };
+    serde_json::to_string(&header).expect("a header always encodes")
+}
+
+/// One frame's line (without a newline): the time and each character's pose, in order.
+pub fn line(skeleton: &Skeleton, time: f64, poses: &[(&str, &Pose)]) -> String {
+    let characters = (poses.iter())
+        .map(|&(id, pose)| {
+            let world = pose.world(skeleton);
+            let joints = (skeleton.joints().iter().zip(&pose.rotations))
+                .map(|(j, &q)| (j.name.as_str(), quat(q)))
+                .collect();
+            let (root, rotation) = (world.positions[0], world.orientations[0]);
+            let character = CharacterLine {
+                root: [round(root.x), round(root.y), round(root.z)],
+                rotation: quat(rotation),
+                joints,
+            };
+            (id, character)
+        })
+        .collect();
+    let time = (time * 1e6).round() / 1e6;
+    serde_json::to_string(&FrameLine { time, characters }).expect("a frame always encodes")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_header_names_every_joint_and_a_frame_every_rotation() {
+        let s = Skeleton::adult();
+        let h: serde_json::Value = serde_json::from_str(&header(&s, 60.0, &["", "anna"])).unwrap();
+        assert_eq!(h["fps"], 60.0);
+        assert_eq!(h["characters"], serde_json::json!(["", "anna"]));
+        let joints = h["skeleton"]["joints"].as_array().unwrap();
+        assert_eq!(joints.len(), s.len());
+        assert_eq!(joints[0]["parent"], serde_json::Value::Null);
+        assert_eq!(joints[0]["offset"], serde_json::json!([0.0, 0.95, 0.0]));
+        let mut pose = Pose::rest(&s);
+        let elbow = s.joint("l_elbow").unwrap();
+        pose.rotate(
+            elbow,
+            glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+        );
+        let f: serde_json::Value = serde_json::from_str(&line(&s, 0.5, &[("", &pose)])).unwrap();
+        assert_eq!(f["time"], 0.5);
+        let c = &f["characters"][""];
+        assert_eq!(c["root"], serde_json::json!([0.0, 0.95, 0.0]));
+        assert_eq!(c["rotation"], serde_json::json!([0.0, 0.0, 0.0, 1.0]));
+        assert_eq!(c["joints"].as_object().unwrap().len(), s.len());
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let q = c["joints"]["l_elbow"].as_array().unwrap();
+        assert!(
+            (q[0].as_f64().unwrap() + h).abs() < 1e-6 && (q[3].as_f64().unwrap() - h).abs() < 1e-6
+        );
+    }
+}
