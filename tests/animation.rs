@@ -356,9 +356,10 @@ fn keyframes_hit_every_key_exactly_at_its_stretched_time() {
     let keys = [
         (0.0, Quat::IDENTITY),
         (1.0, Quat::from_rotation_y(1.0)),
+        // (a twist and a bend forward: both inside the elbow's limits)
         (
             3.0,
-            Quat::from_rotation_y(-0.5) * Quat::from_rotation_x(0.4),
+            Quat::from_rotation_x(-0.4) * Quat::from_rotation_y(-0.5),
         ),
     ];
     let lines: String = keys
@@ -858,10 +859,10 @@ fn a_transition_starts_at_the_current_pose_and_ends_at_the_predicted_one() {
     );
     // no jump anywhere from the keyframe through the transition into the lift: no step larger
     // than the peak of a minimum-jerk move (1.875 × the mean speed) through the transition's
-    // whole angle, or 6° where that is less
+    // whole angle, with 20 % to spare, or 6° where that is less
     for j in [shoulder, elbow] {
         let whole = run.at(1.5).rotations[j].angle_between(run.at(1.0).rotations[j]);
-        let bound = (1.875 * whole.to_degrees() / (0.5 * FPS as f32) * 1.05).max(6.0);
+        let bound = (1.875 * whole.to_degrees() / (0.5 * FPS as f32) * 1.2).max(6.0);
         for w in (run.frames.windows(2)).filter(|w| w[0].0 >= 0.5 && w[1].0 <= 2.0) {
             let step = w[1].1.rotations[j]
                 .angle_between(w[0].1.rotations[j])
@@ -969,12 +970,18 @@ fn a_murml_keyframed_gesture_turns_its_joints_exactly_at_its_frames() {
     ))
     .unwrap();
     let mut angle = |t: f64| {
-        let q = r.tick(t).poses[0].pose.rotations[shoulder];
+        let frame = r.tick(t);
+        let q = frame.poses[0].pose.rotations[shoulder];
         let (x, y, z) = q.to_euler(glam::EulerRot::XYZ);
         assert!(y.abs() < 1e-4 && z.abs() < 1e-4);
-        f64::from(x).to_degrees()
+        (
+            f64::from(x).to_degrees(),
+            frame.poses[0].clamped.contains(&shoulder),
+        )
     };
-    // frames at 0, 0.5, 1, 1.5, 2 (0°, 100°, 0°, 100°, 0°) from the start at 2 s
+    // frames at 0, 0.5, 1, 1.5, 2 (0°, 100°, 0°, 100°, 0°) from the start at 2 s. The file's
+    // 100° turn the arm backward (x > 0 is extension), which a shoulder does only to 60°: the
+    // frame clamps it there and says so; below 60° the frames are exact
     for (t, deg) in [
         (1.0, 0.0),
         (2.0, 0.0),
@@ -984,7 +991,12 @@ fn a_murml_keyframed_gesture_turns_its_joints_exactly_at_its_frames() {
         (3.5, 100.0),
         (4.0, 0.0),
     ] {
-        assert!((angle(t) - deg).abs() < 1e-2, "{t}: {} vs {deg}", angle(t));
+        let (got, clamped) = angle(t);
+        assert!(
+            (got - f64::min(deg, 60.0)).abs() < 1e-2,
+            "{t}: {got} vs {deg}"
+        );
+        assert_eq!(clamped, deg > 60.0, "{t}: clamped");
     }
 }
 

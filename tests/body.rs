@@ -4,6 +4,7 @@
 //! only checks that joints reach their bound rotations passes on a hand behind the head.)
 
 use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::engine::CharacterPose;
 use bml_realizer::realizer::Realizer;
 use glam::{Quat, Vec3};
 
@@ -12,6 +13,14 @@ const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 
 /// The poses of the default character while `bml` plays, at 60 Hz for `seconds`.
 fn frames(bml: &[&str], seconds: f64) -> Vec<(f64, Pose)> {
+    poses(bml, seconds)
+        .into_iter()
+        .map(|(t, p)| (t, p.pose))
+        .collect()
+}
+
+/// The default character's frames while `bml` plays, at 60 Hz for `seconds`.
+fn poses(bml: &[&str], seconds: f64) -> Vec<(f64, CharacterPose)> {
     let mut r = Realizer::new();
     for b in bml {
         r.perform_bml(b).unwrap();
@@ -19,7 +28,7 @@ fn frames(bml: &[&str], seconds: f64) -> Vec<(f64, Pose)> {
     (0..=(seconds * FPS).ceil() as u32)
         .map(|i| {
             let t = f64::from(i) / FPS;
-            (t, r.tick(t).poses[0].pose.clone())
+            (t, r.tick(t).poses[0].clone())
         })
         .collect()
 }
@@ -247,18 +256,24 @@ fn at_its_stroke_each_lexeme_puts_the_hand_where_it_should_be() {
 
 /// Every example, and every lexeme with each hand.
 fn everything() -> Vec<(String, Vec<(f64, Pose)>)> {
+    (everything_framed().into_iter())
+        .map(|(name, f)| (name, f.into_iter().map(|(t, p)| (t, p.pose)).collect()))
+        .collect()
+}
+
+fn everything_framed() -> Vec<(String, Vec<(f64, CharacterPose)>)> {
     let mut runs = Vec::new();
     for entry in std::fs::read_dir("fixtures/examples").unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "xml") {
             let text = std::fs::read_to_string(&path).unwrap();
-            runs.push((path.display().to_string(), frames(&[&text], 8.0)));
+            runs.push((path.display().to_string(), poses(&[&text], 8.0)));
         }
     }
     for s in STROKES {
         for mode in ["RIGHT_HAND", "LEFT_HAND", "BOTH_HANDS"] {
             let name = format!("{} {mode}", s.lexeme);
-            runs.push((name, frames(&[&gesture(s.lexeme, mode)], 2.5)));
+            runs.push((name, poses(&[&gesture(s.lexeme, mode)], 2.5)));
         }
     }
     runs
@@ -307,6 +322,31 @@ fn no_joint_but_the_eyes_turns_faster_than_15_rad_per_s() {
                         joint.name
                     ));
                     break 'run;
+                }
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn no_joint_ever_leaves_its_limits() {
+    let skeleton = Skeleton::adult();
+    let mut wrong = Vec::new();
+    for (name, frames) in everything_framed() {
+        for (t, p) in &frames {
+            // the engines' motion stays inside the anatomical limits: nothing needs clamping
+            if let Some(&j) = p.clamped.first() {
+                let joint = &skeleton.joints()[j].name;
+                wrong.push(format!(
+                    "{name}: {joint} clamped into its limits at {t:.2} s"
+                ));
+                break;
+            }
+            // and what the frame shows is inside them
+            for (j, q) in p.pose.rotations.iter().enumerate() {
+                if let Some(limit) = skeleton.limits().of(j) {
+                    assert!(limit.admits(*q), "{name}: joint {j} outside at {t:.2} s");
                 }
             }
         }

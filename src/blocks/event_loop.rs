@@ -149,9 +149,11 @@ impl BlockManager {
                 m.animate(to, &self.skeleton, &self.world, &mut pose);
             }
         }
+        let clamped = self.skeleton.limits().clamp(&mut pose);
         frame.poses.push(CharacterPose {
             character: self.character.clone(),
             pose,
+            clamped,
         });
         for (engine, key) in std::mem::take(&mut self.retiring) {
             self.registry.engine_mut(engine).remove(&key);

@@ -44,6 +44,9 @@ struct CharacterLine<'a> {
     root: [f64; 3],
     rotation: [f64; 4],
     joints: IndexMap<&'a str, [f64; 4]>,
+    /// The joints the engines turned beyond their limits in this frame (clamped back).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    clamped: Vec<&'a str>,
 }
 
 fn round(v: f32) -> f64 {
@@ -74,10 +77,11 @@ pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
     serde_json::to_string(&header).expect("a header always encodes")
 }
 
-/// One frame's line (without a newline): the time and each character's pose, in order.
-pub fn line(skeleton: &Skeleton, time: f64, poses: &[(&str, &Pose)]) -> String {
+/// One frame's line (without a newline): the time and each character's pose, in order, with the
+/// joints that were clamped into their limits.
+pub fn line(skeleton: &Skeleton, time: f64, poses: &[(&str, &Pose, &[usize])]) -> String {
     let characters = (poses.iter())
-        .map(|&(id, pose)| {
+        .map(|&(id, pose, clamped)| {
             let world = pose.world(skeleton);
             let joints = (skeleton.joints().iter().zip(&pose.rotations))
                 .map(|(j, &q)| (j.name.as_str(), quat(q)))
@@ -87,6 +91,9 @@ pub fn line(skeleton: &Skeleton, time: f64, poses: &[(&str, &Pose)]) -> String {
                 root: [round(root.x), round(root.y), round(root.z)],
                 rotation: quat(rotation),
                 joints,
+                clamped: (clamped.iter())
+                    .map(|&j| skeleton.joints()[j].name.as_str())
+                    .collect(),
             };
             (id, character)
         })
@@ -115,7 +122,8 @@ mod tests {
             elbow,
             glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         );
-        let f: serde_json::Value = serde_json::from_str(&line(&s, 0.5, &[("", &pose)])).unwrap();
+        let f: serde_json::Value =
+            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[])])).unwrap();
         assert_eq!(f["time"], 0.5);
         let c = &f["characters"][""];
         assert_eq!(c["root"], serde_json::json!([0.0, 0.95, 0.0]));
@@ -125,6 +133,13 @@ mod tests {
         let q = c["joints"]["l_elbow"].as_array().unwrap();
         assert!(
             (q[0].as_f64().unwrap() + h).abs() < 1e-6 && (q[3].as_f64().unwrap() - h).abs() < 1e-6
+        );
+        assert!(c.get("clamped").is_none(), "only when a joint was clamped");
+        let f: serde_json::Value =
+            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[elbow])])).unwrap();
+        assert_eq!(
+            f["characters"][""]["clamped"],
+            serde_json::json!(["l_elbow"])
         );
     }
 }

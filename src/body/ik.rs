@@ -11,6 +11,10 @@ use super::skeleton::Skeleton;
 pub const ARM_POLE: Vec3 = Vec3::new(0.0, -1.0, -0.4);
 /// Where knees bend: forward.
 pub const LEG_POLE: Vec3 = Vec3::new(0.0, 0.0, 1.0);
+/// The elbow's hinge, in its local frame: a positive turn about it bends the forearm forward.
+pub const ARM_HINGE: Vec3 = Vec3::NEG_X;
+/// The knee's hinge, in its local frame: a positive turn about it bends the shin backward.
+pub const LEG_HINGE: Vec3 = Vec3::X;
 
 /// The rotation taking direction `from` to direction `to` (shortest arc).
 pub fn arc(from: Vec3, to: Vec3) -> Quat {
@@ -44,28 +48,42 @@ impl LimbRoot {
 
 /// The local rotations of a limb's `root` and `mid` joints (shoulder and elbow, hip and knee) that
 /// put its `end` joint (wrist, ankle) at `goal` (the space of `frame`), the middle joint bending
-/// toward `pole`; `frame` is the root joint's world frame in `pose`.
+/// toward `pole`; `frame` is the root joint's world frame in `pose`. The middle joint is a hinge:
+/// it turns only about `hinge` (its local axis, [`ARM_HINGE`] or [`LEG_HINGE`]), as far as the
+/// distance to the goal needs; the root turns the limb so that its bend lies in the plane toward
+/// the pole (which also sets the upper link's twist).
 pub fn place_limb(
     skeleton: &Skeleton,
-    pose: &Pose,
     frame: LimbRoot,
     [_root, mid, end]: [usize; 3],
     goal: Vec3,
     pole: Vec3,
+    hinge: Vec3,
 ) -> Option<(Quat, Quat)> {
     let joints = skeleton.joints();
     let (upper, lower) = (joints[mid].offset, joints[end].offset);
     let s = frame.position;
     let e = two_link(s, upper.length(), lower.length(), goal, pole);
-    // root: the upper link toward the middle joint
-    let parent = frame.parent;
-    let current_s = frame.orientation;
-    let local_s = parent.inverse() * arc(current_s * upper, e - s) * current_s;
-    // middle: the lower link toward the goal
-    let o_s = parent * local_s;
-    let current_e = o_s * pose.rotations[mid];
-    let local_e = o_s.inverse() * arc(current_e * lower, goal - e) * current_e;
+    // the middle joint: bent by the angle between the links' directions
+    let bend = (e - s).angle_between(goal - e);
+    let local_e = Quat::from_axis_angle(hinge.normalize_or(Vec3::X), bend);
+    // the root: the limb as bent, in the root's frame, onto the elbow and the goal
+    let reach = upper + local_e * lower;
+    let onto = align(reach, upper, goal - s, e - s)?;
+    let local_s = frame.parent.inverse() * onto;
     Some((local_s, local_e))
+}
+
+/// The rotation taking direction `a1` onto `a2` and the plane of `a1` and `b1` onto that of `a2`
+/// and `b2` (`b1` to the side of `b2`).
+fn align(a1: Vec3, b1: Vec3, a2: Vec3, b2: Vec3) -> Option<Quat> {
+    let frame = |a: Vec3, b: Vec3| {
+        let x = a.normalize_or_zero();
+        let y = (b - x * b.dot(x)).normalize_or_zero();
+        (x != Vec3::ZERO && y != Vec3::ZERO).then(|| glam::Mat3::from_cols(x, y, x.cross(y)))
+    };
+    let (m1, m2) = (frame(a1, b1)?, frame(a2, b2)?);
+    Some(Quat::from_mat3(&(m2 * m1.transpose())).normalize())
 }
 
 /// The middle joint's position for links of lengths `upper` and `lower` from `root` to reach

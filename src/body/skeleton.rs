@@ -7,6 +7,8 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
+use super::limits::Limits;
+
 /// The embedded default adult.
 const ADULT: &str = include_str!("../../fixtures/skeletons/adult.json");
 
@@ -28,6 +30,7 @@ pub struct Skeleton {
     pub name: String,
     joints: Vec<Joint>,
     index: HashMap<String, usize>,
+    limits: Limits,
 }
 
 /// Why a skeleton file was refused.
@@ -65,7 +68,10 @@ impl Skeleton {
     /// The default adult (read from its embedded JSON once per process, then copied).
     pub fn adult() -> Skeleton {
         static ADULT_SKELETON: std::sync::LazyLock<Skeleton> = std::sync::LazyLock::new(|| {
-            Skeleton::from_json(ADULT).expect("the embedded adult skeleton is valid")
+            let s = Skeleton::from_json(ADULT).expect("the embedded adult skeleton is valid");
+            let limits = Limits::from_json(super::limits::ADULT_LIMITS, &s)
+                .expect("the embedded adult limits are valid");
+            s.with_limits(limits)
         });
         ADULT_SKELETON.clone()
     }
@@ -78,6 +84,7 @@ impl Skeleton {
             name: file.name,
             joints: Vec::new(),
             index: HashMap::new(),
+            limits: Limits::default(),
         };
         for (i, j) in file.joints.into_iter().enumerate() {
             if j.name.is_empty() {
@@ -113,7 +120,20 @@ impl Skeleton {
         if s.joints.is_empty() {
             return Err(e("no joints".into()));
         }
+        s.limits = Limits::none(&s);
         Ok(s)
+    }
+
+    /// This skeleton with joint limits (read for it with [`Limits::from_json`]).
+    pub fn with_limits(mut self, limits: Limits) -> Skeleton {
+        self.limits = limits;
+        self
+    }
+
+    /// Its joint limits (the default adult's are embedded; a skeleton read from a file has none
+    /// until [`with_limits`](Self::with_limits)).
+    pub fn limits(&self) -> &Limits {
+        &self.limits
     }
 
     /// The joints, parents before children.

@@ -25,8 +25,11 @@ pub struct Output {
 pub struct CharacterPose {
     /// The character (`None`: the default character).
     pub character: Option<String>,
-    /// Its pose (joint order of the character's skeleton).
+    /// Its pose (joint order of the character's skeleton), inside the joint limits.
     pub pose: Pose,
+    /// The joints (indices) the engines turned beyond their limits in this frame, which were
+    /// clamped back into them.
+    pub clamped: Vec<usize>,
 }
 
 /// Everything the realizer produced for one moment: engine output, each character's pose, and the

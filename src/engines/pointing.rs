@@ -9,7 +9,7 @@
 use glam::Vec3;
 
 use crate::bml::{Behaviour, BehaviourKind, Mode};
-use crate::body::ik::{arc, place_limb, LimbRoot, ARM_POLE};
+use crate::body::ik::{arc, place_limb, LimbRoot, ARM_HINGE, ARM_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{envelope, hands};
@@ -17,7 +17,7 @@ use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// How far along its reach the wrist goes.
-pub const REACH: f32 = 0.85;
+pub const REACH: f32 = 0.97;
 
 #[derive(Debug, Clone)]
 struct PointingUnit {
@@ -53,11 +53,11 @@ fn point(skeleton: &Skeleton, pose: &mut Pose, side: &str, target: Vec3, w: f32)
     // shoulder and elbow put the wrist at the goal, the elbow bending down and back
     let (local_s, local_e) = place_limb(
         skeleton,
-        pose,
         limb,
         [shoulder, elbow, wrist],
         goal,
         ARM_POLE,
+        ARM_HINGE,
     )?;
     let o_s = limb.parent * local_s;
     // wrist: the index finger (from its base, along its bones) toward the target; the base

@@ -48,7 +48,7 @@ use indexmap::IndexMap;
 use serde::Deserialize;
 
 use crate::bml::{Behaviour, BehaviourKind, Id, Param};
-use crate::body::ik::{place_limb, LimbRoot, ARM_POLE, LEG_POLE};
+use crate::body::ik::{place_limb, LimbRoot, ARM_HINGE, ARM_POLE, LEG_HINGE, LEG_POLE};
 use crate::body::{Pose, Skeleton};
 use crate::engine::{
     named_param, named_params, set_named_param, Engine, EngineError, Steering, SyncTimes, Unit,
@@ -497,12 +497,12 @@ fn reach(
         Frame::Body => goal,
         Frame::Limb => limb.position + goal,
     };
-    let pole = if name.contains("talocrural") || name.contains("ankle") {
-        LEG_POLE
+    let (pole, hinge) = if name.contains("talocrural") || name.contains("ankle") {
+        (LEG_POLE, LEG_HINGE)
     } else {
-        ARM_POLE
+        (ARM_POLE, ARM_HINGE)
     };
-    let rotations = place_limb(skeleton, pose, limb, [root, mid, end], goal, pole)?;
+    let rotations = place_limb(skeleton, limb, [root, mid, end], goal, pole, hinge)?;
     Some(([root, mid], rotations))
 }
 

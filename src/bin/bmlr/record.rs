@@ -38,7 +38,11 @@ impl Recording {
     ) -> Result<(), (u8, String)> {
         let character =
             recorded_character(realizer, asked).map_err(|e| (1, format!("--bvh: {e}")))?;
-        let poses = self.poses_of(&character);
+        let poses: Vec<Pose> = self
+            .poses_of(&character)
+            .into_iter()
+            .map(|p| p.pose)
+            .collect();
         let skeleton = Skeleton::adult();
         let text = bml_realizer::body::bvh::write(&skeleton, &poses, self.fps);
         std::fs::write(path, text)
@@ -64,10 +68,10 @@ impl Recording {
         let skeleton = Skeleton::adult();
         let mut text = bml_realizer::body::frames::header(&skeleton, self.fps, &ids);
         text.push('\n');
-        let per_character: Vec<Vec<Pose>> = ids.iter().map(|c| self.poses_of(c)).collect();
+        let per_character: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
         for (k, (time, _)) in self.frames.iter().enumerate() {
-            let poses: Vec<(&str, &Pose)> = (ids.iter().zip(&per_character))
-                .map(|(&id, p)| (id, &p[k]))
+            let poses: Vec<(&str, &Pose, &[usize])> = (ids.iter().zip(&per_character))
+                .map(|(&id, p)| (id, &p[k].pose, p[k].clamped.as_slice()))
                 .collect();
             text.push_str(&bml_realizer::body::frames::line(&skeleton, *time, &poses));
             text.push('\n');
@@ -86,14 +90,18 @@ impl Recording {
 
     /// The poses of `character` ("" the default one), frame by frame (the rest pose where a
     /// frame has none for it).
-    fn poses_of(&self, character: &str) -> Vec<bml_realizer::body::Pose> {
-        let rest = Pose::rest(&Skeleton::adult());
+    fn poses_of(&self, character: &str) -> Vec<CharacterPose> {
+        let rest = CharacterPose {
+            character: Some(character.to_string()),
+            pose: Pose::rest(&Skeleton::adult()),
+            clamped: Vec::new(),
+        };
         self.frames
             .iter()
             .map(|(_, f)| {
                 f.iter()
                     .find(|p| p.character.as_deref().unwrap_or("") == character)
-                    .map_or_else(|| rest.clone(), |p| p.pose.clone())
+                    .map_or_else(|| rest.clone(), |p| p.clone())
             })
             .collect()
     }
