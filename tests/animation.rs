@@ -5,6 +5,12 @@ use bml_realizer::body::Skeleton;
 use bml_realizer::engines::head::{DEFAULT_AMOUNT, NOD_DEGREES};
 use bml_realizer::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
+
+/// A realizer without the idle layer: these tests measure each engine's motion exactly, from the
+/// rest pose (tests/body.rs looks at the body with the idle layer on, as a person sees it).
+fn still() -> Realizer {
+    Realizer::new().with_idle(false)
+}
 use glam::Vec3;
 
 const FPS: f64 = 60.0;
@@ -16,7 +22,7 @@ type Series = Vec<(f64, f64)>;
 fn run(bml: &str, until: f64) -> (Series, Vec<(String, f64)>) {
     let skeleton = Skeleton::adult();
     let skull = skeleton.joint("skullbase").unwrap();
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(bml).unwrap();
     let (mut pitches, mut syncs) = (Vec::new(), Vec::new());
     let frames = (until * FPS).ceil() as u32;
@@ -147,7 +153,7 @@ fn gaze_block(id: &str, target: &str, extra: &str) -> String {
 fn a_gaze_puts_the_eyes_on_a_static_target_within_their_limits() {
     let skeleton = Skeleton::adult();
     let target = Vec3::new(0.5, 1.3, 1.0);
-    let mut r = Realizer::new();
+    let mut r = still();
     r.world_mut().set("cup", target);
     r.perform_bml(&gaze_block(
         "b",
@@ -196,7 +202,7 @@ fn donders_the_final_head_orientation_does_not_depend_on_where_the_head_was() {
     let skeleton = Skeleton::adult();
     let skull = skeleton.joint("skullbase").unwrap();
     let head_at = |before: Option<&str>| -> Quat {
-        let mut r = Realizer::new();
+        let mut r = still();
         r.world_mut().set("left", Vec3::new(1.0, 1.0, 0.8));
         r.world_mut().set("cup", Vec3::new(-0.4, 1.2, 1.0));
         if let Some(t) = before {
@@ -222,7 +228,7 @@ fn donders_the_final_head_orientation_does_not_depend_on_where_the_head_was() {
 #[test]
 fn a_moving_target_is_tracked_after_ready() {
     let skeleton = Skeleton::adult();
-    let mut r = Realizer::new();
+    let mut r = still();
     let place = |t: f64| {
         // 30°/s around the character, 1.2 m away, at eye height
         let a = (30.0 * t).to_radians();
@@ -249,7 +255,7 @@ fn a_moving_target_is_tracked_after_ready() {
 
 #[test]
 fn a_gaze_at_a_target_the_world_lacks_is_refused_with_a_warning() {
-    let mut r = Realizer::new();
+    let mut r = still();
     let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
     let sink = log.clone();
     r.add_listener(Box::new(move |f: &Feedback| {
@@ -272,7 +278,7 @@ fn a_gaze_at_a_target_the_world_lacks_is_refused_with_a_warning() {
 fn a_gaze_shift_keeps_looking_at_its_target_after_it_ends() {
     let skeleton = Skeleton::adult();
     let target = Vec3::new(1.0, 1.0, 0.8);
-    let mut r = Realizer::new();
+    let mut r = still();
     r.world_mut().set("left", target);
     r.perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><gazeShift id="s" target="left" start="0" end="1"/></bml>"#)
         .unwrap();
@@ -298,7 +304,7 @@ fn pointing_aims_the_index_finger_at_the_target_at_the_stroke_and_returns() {
         ("LEFT_HAND", "l", Vec3::new(0.8, 0.9, 0.7)),
         ("RIGHT_HAND", "r", Vec3::new(0.1, 1.8, 1.0)),
     ] {
-        let mut r = Realizer::new();
+        let mut r = still();
         r.world_mut().set("thing", target);
         let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
         let sink = log.clone();
@@ -366,7 +372,7 @@ fn keyframes_hit_every_key_exactly_at_its_stretched_time() {
         .iter()
         .map(|(t, q)| format!("{t} {} {} {} {}\n", q.w, q.x, q.y, q.z))
         .collect();
-    let mut r = Realizer::new();
+    let mut r = still();
     // 3 s of keys stretched over 1..7: keys at 1, 3 and 7
     r.perform_bml(&format!(
         r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b">
@@ -386,7 +392,7 @@ fn keyframes_hit_every_key_exactly_at_its_stretched_time() {
 fn a_gaze_offset_looks_beside_the_target() {
     let skeleton = Skeleton::adult();
     let target = Vec3::new(0.0, 1.55, 2.0);
-    let mut r = Realizer::new();
+    let mut r = still();
     r.world_mut().set("door", target);
     r.perform_bml(&gaze_block(
         "b",
@@ -418,7 +424,7 @@ fn a_beat_hits_its_bound_keys_at_its_syncs_and_the_left_hand_mirrors_them() {
     let lexicon = Lexicon::default_lexicon();
     let beat = lexicon.keys("BEAT").unwrap();
     for mode in ["RIGHT_HAND", "LEFT_HAND"] {
-        let mut r = Realizer::new();
+        let mut r = still();
         let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
         let sink = log.clone();
         r.add_listener(Box::new(move |f: &Feedback| {
@@ -476,7 +482,7 @@ fn a_sitting_shift_folds_the_legs_and_stays_a_posture_returns() {
         skeleton.joint("l_knee").unwrap(),
         skeleton.joint("l_hip").unwrap(),
     );
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(
         r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a"><postureShift id="sit" start="0" end="2"><stance type="SITTING"/></postureShift></bml>"#,
     )
@@ -532,7 +538,7 @@ struct Recording {
 
 /// Runs `bml` at 60 Hz from 0 to `until` and records it.
 fn record(bml: &str, until: f64) -> Recording {
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(bml).unwrap();
     let (mut frames, mut syncs, mut warnings) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..=(until * FPS).round() as u32 {
@@ -689,7 +695,7 @@ fn a_limb_frame_effector_lifts_the_foot_relative_to_the_hip() {
     let skeleton = Skeleton::adult();
     let hip = skeleton.joint("l_hip").unwrap();
     let ankle = skeleton.joint("l_talocrural").unwrap();
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(&format!(
         r#"<bml {BMLT} id="b"><bmlt:procanimation id="f" name="foot_lift" start="0.5"/></bml>"#
     ))
@@ -708,7 +714,7 @@ fn a_limb_frame_effector_lifts_the_foot_relative_to_the_hip() {
 fn a_procedural_parameter_changes_while_the_unit_runs() {
     let skeleton = Skeleton::adult();
     let wrist = skeleton.joint("r_wrist").unwrap();
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(&format!(
         r#"<bml {BMLT} xmlns:bmla="http://www.asap-project.org/bmla" id="b"><bmlt:procanimation id="p" name="lift" start="0" end="2"><bmlt:parameter name="height" value="1.2"/></bmlt:procanimation><bmla:parametervaluechange id="c" target="b:p" paramId="height" start="0.5" end="0.6"><bmla:trajectory type="instant" targetValue="1.4"/></bmla:parametervaluechange></bml>"#
     ))
@@ -940,7 +946,7 @@ fn a_head_direction_shift_turns_the_face_to_its_target_and_keeps_it_there() {
             / 2.0
     };
     let target = Vec3::new(-0.4, 1.6, 1.5); // the default world's speaker
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><headDirectionShift id="h" target="speaker" start="0.5" end="1.5"/></bml>"#)
         .unwrap();
     let face = |r: &mut Realizer, t: f64| {
@@ -964,7 +970,7 @@ fn a_head_direction_shift_turns_the_face_to_its_target_and_keeps_it_there() {
 fn a_murml_keyframed_gesture_turns_its_joints_exactly_at_its_frames() {
     let skeleton = Skeleton::adult();
     let shoulder = skeleton.joint("l_shoulder").unwrap();
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(include_str!(
         "../fixtures/realizertester/bml-1/murml/murmlbodykeyframe.xml"
     ))
@@ -1084,7 +1090,7 @@ fn the_eyes_saccade_in_an_amplitude_dependent_time_then_the_head_catches_up() {
     let amplitude = f64::from(Vec3::Z.angle_between(target - eyes_rest));
     let d = saccade_duration(amplitude);
     assert!((d - (0.021 + 1.875 / 8.7 * amplitude)).abs() < 1e-12);
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(&gaze_block(
         "b",
         "bluebox",
@@ -1152,7 +1158,7 @@ fn saccades_are_affine_in_amplitude_and_never_too_fast() {
 fn fastest_wrist(bml: &str, wrist: &str, until: f64) -> (f64, f64) {
     let skeleton = Skeleton::adult();
     let w = skeleton.joint(wrist).unwrap();
-    let mut r = Realizer::new();
+    let mut r = still();
     r.perform_bml(bml).unwrap();
     let (mut last, mut fastest) = (None::<Vec3>, (0.0, 0.0));
     for i in 0..=(until * FPS).ceil() as u32 {

@@ -445,3 +445,39 @@ fn run_frames_writes_the_skeleton_and_every_frame_without_changing_the_feedback(
         "{err}"
     );
 }
+
+#[test]
+fn the_idle_layer_moves_the_body_and_never_the_feedback() {
+    let dir = std::env::temp_dir();
+    let (a, b) = (
+        dir.join(format!("bmlr-{}-idle.jsonl", std::process::id())),
+        dir.join(format!("bmlr-{}-still.jsonl", std::process::id())),
+    );
+    let run = |extra: &[&str], path: &std::path::Path| {
+        let mut args = vec!["run", "--frames", path.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        args.push("fixtures/examples/welcome.xml");
+        let (code, out, err) = bmlr(&args);
+        assert_eq!(code, 0, "{err}");
+        out
+    };
+    assert_eq!(run(&[], &a), run(&["--no-idle"], &b), "the same feedback");
+    let root_x = |path: &std::path::Path| -> Vec<f64> {
+        let text = std::fs::read_to_string(path).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+            .map(|f| f["characters"][""]["root"][0].as_f64().unwrap())
+            .collect()
+    };
+    let (idle, still) = (root_x(&a), root_x(&b));
+    assert!(
+        still.iter().all(|&x| x == 0.0),
+        "without it the pelvis stays put"
+    );
+    let sway = idle.iter().fold(0f64, |m, x| m.max(x.abs()));
+    assert!(
+        (0.001..0.02).contains(&sway),
+        "with it the pelvis sways {sway} m"
+    );
+}

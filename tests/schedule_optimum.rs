@@ -260,7 +260,8 @@ fn beat_wrist_at(times: &[f64]) -> Vec<glam::Vec3> {
       <speech id="s3" start="s2:end"><text>Goodbye <sync id="e"/>now.</text></speech>
       <gesture id="g2" lexeme="BEAT" strokeStart="s2:d" stroke="s3:e"/>
     </bml>"#;
-    let mut r = Realizer::new();
+    // without the idle layer: the wrist moves only with the beat
+    let mut r = Realizer::new().with_idle(false);
     r.perform_bml(src).unwrap();
     let skeleton = Skeleton::adult();
     let wrist = skeleton.joint("r_wrist").unwrap();

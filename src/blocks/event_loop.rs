@@ -142,7 +142,7 @@ impl BlockManager {
         self.update_anticipators(to);
         self.apply_changes(to);
         self.predict_poses(to);
-        let mut pose = Pose::rest(&self.skeleton);
+        let mut pose = self.base_pose(to);
         for e in self.registry.engines_mut() {
             e.play(to, frame);
             if let Some(m) = e.as_motion() {
@@ -175,7 +175,7 @@ impl BlockManager {
             let poses = times
                 .into_iter()
                 .map(|t| {
-                    let mut pose = Pose::rest(&self.skeleton);
+                    let mut pose = self.base_pose(t);
                     for e in self.registry.engines_mut() {
                         if let Some(p) = e.as_prediction() {
                             p.predict(t, &self.skeleton, &self.world, &mut pose);

@@ -91,6 +91,8 @@ pub struct BlockManager {
     /// the frame at their end still shows their last moment.
     retiring: Vec<(crate::engine::EngineId, UnitKey)>,
     skeleton: Skeleton,
+    /// The idle layer every frame's pose starts from (`None`: the rest pose).
+    idle: Option<crate::body::idle::Idle>,
     /// The world as of the last advance (shared with the realizer).
     world: std::sync::Arc<World>,
     now: f64,
@@ -105,6 +107,7 @@ impl BlockManager {
         strategy: Box<dyn SchedulingStrategy>,
         character: Option<String>,
     ) -> Self {
+        let idle = crate::body::idle::Idle::new(character.as_deref().unwrap_or(""));
         BlockManager {
             due: std::cell::RefCell::new(BinaryHeap::new()),
             due_stale: std::cell::Cell::new(true),
@@ -119,6 +122,7 @@ impl BlockManager {
             anticipators: Vec::new(),
             retiring: Vec::new(),
             skeleton: Skeleton::adult(),
+            idle: Some(idle),
             world: std::sync::Arc::new(World::default()),
             now: 0.0,
             seq: 0,
@@ -136,6 +140,21 @@ impl BlockManager {
     pub fn set_world(&mut self, world: &std::sync::Arc<World>) {
         if !std::sync::Arc::ptr_eq(&self.world, world) {
             self.world = world.clone();
+        }
+    }
+
+    /// Turns the idle layer (breathing, a slow weight shift) on or off; it is on by default. It
+    /// never changes the feedback.
+    pub fn set_idle(&mut self, on: bool) {
+        let id = self.character.as_deref().unwrap_or("");
+        self.idle = on.then(|| crate::body::idle::Idle::new(id));
+    }
+
+    /// The pose a frame at `t` starts from: the idle layer's, or the rest pose.
+    fn base_pose(&self, t: f64) -> Pose {
+        match &self.idle {
+            Some(idle) => idle.pose(&self.skeleton, t),
+            None => Pose::rest(&self.skeleton),
         }
     }
 

@@ -46,6 +46,8 @@ pub struct Realizer {
     /// What one block may hold (see [`bml::Limits`]).
     limits: bml::Limits,
     skeleton: Skeleton,
+    /// Whether characters breathe and shift their weight while standing (`body::idle`).
+    idle: bool,
     world: std::sync::Arc<World>,
     now: f64,
     unframed: Vec<Feedback>,
@@ -69,6 +71,7 @@ impl Realizer {
             posix_time: false,
             limits: bml::Limits::default(),
             skeleton: Skeleton::adult(),
+            idle: true,
             world: std::sync::Arc::new(World::default()),
             now: 0.0,
             unframed: Vec::new(),
@@ -94,6 +97,13 @@ impl Realizer {
     /// Every character gets `skeleton` (the default adult otherwise).
     pub fn with_skeleton(mut self, skeleton: Skeleton) -> Self {
         self.skeleton = skeleton;
+        self
+    }
+
+    /// Whether characters breathe and shift their weight from foot to foot while standing (the
+    /// idle layer, on by default). It changes the pose only, never the feedback.
+    pub fn with_idle(mut self, on: bool) -> Self {
+        self.idle = on;
         self
     }
 
@@ -162,11 +172,17 @@ impl Realizer {
             return self.characters.get_mut(&key).expect("just found");
         }
         let now = self.now;
-        let (engines, strategy, skeleton, world) =
-            (&self.engines, &self.strategy, &self.skeleton, &self.world);
+        let (engines, strategy, skeleton, world, idle) = (
+            &self.engines,
+            &self.strategy,
+            &self.skeleton,
+            &self.world,
+            self.idle,
+        );
         self.characters.entry(key).or_insert_with(|| {
             let mut m = BlockManager::new(engines(), strategy(), character);
             m.set_skeleton(skeleton.clone());
+            m.set_idle(idle);
             m.advance(now, world, &mut Frame::default());
             m
         })

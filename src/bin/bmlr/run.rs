@@ -66,6 +66,10 @@ pub struct RunArgs {
     /// one frame every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.bvh")]
     bvh: Option<std::path::PathBuf>,
+    /// Characters stand still between behaviours: no breathing, no weight shift (the idle layer
+    /// changes the motion only, never the feedback).
+    #[arg(long)]
+    no_idle: bool,
     /// Write the realized frames of every character as JSON lines (docs/cli.md, "Frames"):
     /// a header with the skeleton, then one line every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.jsonl")]
@@ -308,6 +312,7 @@ pub fn run(args: RunArgs) -> ExitCode {
     }
     .with_default_character(args.character.clone())
     .with_posix_time(args.realtime)
+    .with_idle(!args.no_idle)
     .with_limits(args.limits.limits());
     for (asked, flag) in [
         (args.bvh.is_some(), "--bvh"),

@@ -35,6 +35,9 @@ pub struct ServeArgs {
     /// Frames per second of the engine loop.
     #[arg(long, value_name = "HZ", default_value_t = 60.0)]
     fps: f64,
+    /// Characters stand still between behaviours: no breathing, no weight shift.
+    #[arg(long)]
+    no_idle: bool,
     /// Speech may change its rate to meet its constraints (an incremental TTS).
     #[arg(long)]
     retimable_speech: bool,
@@ -69,6 +72,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
     let realizer = Realizer::new()
         .with_engines(move || registry_with(DefaultTimingModels { speech }, &assets))
         .with_posix_time(true)
+        .with_idle(!args.no_idle)
         .with_limits(args.limits.limits());
     let realizer = match crate::run::with_world(realizer, args.world.as_deref()) {
         Ok(r) => r,

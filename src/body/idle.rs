@@ -1,0 +1,110 @@
+//! The idle layer: what a standing person does while nothing else moves them — breathing (the
+//! chest and the shoulders rise and fall) and a slow shift of weight from foot to foot (the pelvis
+//! sways sideways, the spine leans back against it). It is the pose every frame starts from, so
+//! behaviours play on top of it and inverse kinematics and gaze aim from where it put the body.
+//! It is not a behaviour: it has no timing and never shows in the feedback. Deterministic: the
+//! same character (by id) at the same time gets the same pose.
+
+use glam::{Quat, Vec3};
+
+use super::pose::Pose;
+use super::skeleton::Skeleton;
+
+/// Breaths per second (15 a minute, a person at rest).
+pub const BREATHING_HZ: f32 = 0.25;
+/// How far the upper chest turns back at the top of a breath, degrees.
+pub const BREATHING_CHEST_DEG: f32 = 0.6;
+/// How far the shoulders rise at the top of a breath, degrees at the collarbone.
+pub const BREATHING_SHOULDER_DEG: f32 = 0.8;
+/// One weight shift, left and back, takes this long, seconds.
+pub const WEIGHT_SHIFT_PERIOD: f32 = 7.0;
+/// How far the pelvis moves sideways, metres.
+pub const WEIGHT_SHIFT_M: f32 = 0.008;
+/// How far the pelvis rolls with it, degrees (the spine rolls back by as much).
+pub const WEIGHT_SHIFT_ROLL_DEG: f32 = 0.6;
+
+/// The idle motion of one character.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Idle {
+    /// Phase offset in seconds, from the character's id (characters do not breathe in step).
+    phase: f32,
+}
+
+impl Idle {
+    /// The idle motion of character `id` ("" the default one).
+    pub fn new(id: &str) -> Idle {
+        // FNV-1a: a fixed hash, so the phase is the same in every run and on every platform
+        let hash = id.bytes().fold(0x811c_9dc5u32, |h, b| {
+            (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
+        });
+        Idle {
+            phase: (hash % 10_000) as f32 / 10_000.0 * WEIGHT_SHIFT_PERIOD,
+        }
+    }
+
+    /// The pose at global time `t`: the rest pose with breathing and the weight shift.
+    pub fn pose(&self, skeleton: &Skeleton, t: f64) -> Pose {
+        let mut pose = Pose::rest(skeleton);
+        let t = t as f32 + self.phase;
+        let tau = std::f32::consts::TAU;
+        // breathing: in for the first part of the cycle, out after (a raised cosine, 0 at rest)
+        let breath = 0.5 - 0.5 * (tau * BREATHING_HZ * t).cos();
+        let turn = |joint: &str, q: Quat, pose: &mut Pose| {
+            if let Some(j) = skeleton.joint(joint) {
+                pose.rotate(j, q);
+            }
+        };
+        turn(
+            "vt6",
+            Quat::from_rotation_x(-(BREATHING_CHEST_DEG * breath).to_radians()),
+            &mut pose,
+        );
+        let shoulder = (BREATHING_SHOULDER_DEG * breath).to_radians();
+        turn(
+            "l_sternoclavicular",
+            Quat::from_rotation_z(shoulder),
+            &mut pose,
+        );
+        turn(
+            "r_sternoclavicular",
+            Quat::from_rotation_z(-shoulder),
+            &mut pose,
+        );
+        // weight shift: the pelvis sways sideways and rolls, the lower spine rolls it back
+        let shift = (tau * t / WEIGHT_SHIFT_PERIOD).sin();
+        pose.root += Vec3::X * (WEIGHT_SHIFT_M * shift);
+        let roll = (WEIGHT_SHIFT_ROLL_DEG * shift).to_radians();
+        turn("sacroiliac", Quat::from_rotation_z(roll), &mut pose);
+        turn("vl5", Quat::from_rotation_z(-roll), &mut pose);
+        pose
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_chest_rises_and_falls_every_four_seconds_and_the_pelvis_sways() {
+        let s = Skeleton::adult();
+        let idle = Idle::new("");
+        let chest = |t: f64| idle.pose(&s, t).world(&s).positions[s.joint("vc7").unwrap()];
+        let root = |t: f64| idle.pose(&s, t).root.x;
+        // the breathing repeats every 4 s, and moves the neck base by about a millimetre
+        let heights: Vec<f32> = (0..80).map(|i| chest(f64::from(i) * 0.05).z).collect();
+        let range = heights.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b))
+            - heights.iter().fold(f32::INFINITY, |a, &b| a.min(b));
+        assert!((0.0005..0.005).contains(&range), "{range}");
+        assert!(
+            (chest(1.3).z - chest(5.3).z).abs() < 1e-4,
+            "every 4 s the same breath"
+        );
+        // the weight shift: ±8 mm over 7 s
+        let xs: Vec<f32> = (0..140).map(|i| root(f64::from(i) * 0.05)).collect();
+        let max = xs.iter().fold(0f32, |a, &b| a.max(b.abs()));
+        assert!((max - WEIGHT_SHIFT_M).abs() < 1e-3, "{max}");
+        // deterministic, and another character is out of step
+        assert_eq!(idle.pose(&s, 2.0), Idle::new("").pose(&s, 2.0));
+        assert_ne!(idle.pose(&s, 2.0), Idle::new("anna").pose(&s, 2.0));
+    }
+}
