@@ -191,6 +191,88 @@ fn palm_out_in_front(body: &Body, pose: &Pose, side: char) -> Result<(), String>
         .ok_or(format!("wrist {w}, palm {palm}: not a palm out in front"))
 }
 
+/// +1 for the left side, -1 for the right: x toward the hand's own side.
+fn outward(side: char) -> f32 {
+    if side == 'l' {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+fn shoulders_up_palms_up(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let rest = Pose::rest(&body.skeleton);
+    let shoulder = format!("{side}_shoulder");
+    let lift = body.at(pose, &shoulder).y - body.at(&rest, &shoulder).y;
+    let palm = body.palm(pose, side);
+    (lift > 0.02 && palm.y > 0.7)
+        .then_some(())
+        .ok_or(format!("shoulder up {lift:.3} m, palm {palm}: not a shrug"))
+}
+
+fn palm_down_in_front(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let palm = body.palm(pose, side);
+    (w.z > 0.2 && palm.y < -0.8)
+        .then_some(())
+        .ok_or(format!("wrist {w}, palm {palm}: not a palm down in front"))
+}
+
+fn raised_palm_out(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let palm = body.palm(pose, side);
+    (w.z > 0.3 && w.y > 1.25 && palm.z > 0.6)
+        .then_some(())
+        .ok_or(format!("wrist {w}, palm {palm}: not a raised hand, palm out"))
+}
+
+fn index_up(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let index = body.at(pose, &format!("{side}_index3"));
+    let middle = body.at(pose, &format!("{side}_middle3"));
+    (w.z > 0.2 && index.y > w.y + 0.06 && middle.y < index.y - 0.05)
+        .then_some(())
+        .ok_or(format!("wrist {w}, index {index}, middle {middle}: not the index up"))
+}
+
+fn out_to_the_side_palm_down(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let palm = body.palm(pose, side);
+    (w.x * outward(side) > 0.35 && palm.y < -0.5)
+        .then_some(())
+        .ok_or(format!("wrist {w}, palm {palm}: not swept out to the side"))
+}
+
+fn framing(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let palm = body.palm(pose, side);
+    // the palm faces the middle of the body
+    (w.z > 0.3 && (1.25..1.55).contains(&w.y) && palm.x * outward(side) < -0.7)
+        .then_some(())
+        .ok_or(format!("wrist {w}, palm {palm}: not a framing hand"))
+}
+
+fn hand_to_chin(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    let chin = body.at(pose, "temporomandibular") + Vec3::new(0.0, -0.07, 0.05);
+    let tip = body.at(pose, &format!("{side}_middle3"));
+    (tip.distance(chin) < 0.12)
+        .then_some(())
+        .ok_or(format!("fingers {tip} {:.2} m from the chin {chin}", tip.distance(chin)))
+}
+
+/// Presenting the open hand to the character's left (`left`) or right: out beyond the shoulder
+/// with the hand of that side, across to the middle with the other.
+fn presented(body: &Body, pose: &Pose, side: char, left: bool) -> Result<(), String> {
+    let w = body.at(pose, &format!("{side}_wrist"));
+    let own = (side == 'l') == left;
+    let x = if left { w.x } else { -w.x };
+    let ok = w.z > 0.25 && if own { x > 0.35 } else { x > -0.05 };
+    ok.then_some(()).ok_or(format!(
+        "wrist {w}: not presented to the {}",
+        if left { "left" } else { "right" }
+    ))
+}
+
 const STROKES: &[Stroke] = &[
     Stroke {
         lexeme: "BEAT",
@@ -224,7 +306,51 @@ const STROKES: &[Stroke] = &[
         lexeme: "STOP",
         check: palm_out_in_front,
     },
+    Stroke {
+        lexeme: "SHRUG",
+        check: shoulders_up_palms_up,
+    },
+    Stroke {
+        lexeme: "CALM",
+        check: palm_down_in_front,
+    },
+    Stroke {
+        lexeme: "NEGATE",
+        check: raised_palm_out,
+    },
+    Stroke {
+        lexeme: "ENUMERATE",
+        check: index_up,
+    },
+    Stroke {
+        lexeme: "SWEEP",
+        check: out_to_the_side_palm_down,
+    },
+    Stroke {
+        lexeme: "FRAME",
+        check: framing,
+    },
+    Stroke {
+        lexeme: "THINK",
+        check: hand_to_chin,
+    },
+    Stroke {
+        lexeme: "INDICATE_LEFT",
+        check: to_the_left,
+    },
+    Stroke {
+        lexeme: "INDICATE_RIGHT",
+        check: to_the_right,
+    },
 ];
+
+fn to_the_left(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    presented(body, pose, side, true)
+}
+
+fn to_the_right(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
+    presented(body, pose, side, false)
+}
 
 fn gesture(lexeme: &str, mode: &str) -> String {
     format!(

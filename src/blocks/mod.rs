@@ -107,7 +107,8 @@ impl BlockManager {
         strategy: Box<dyn SchedulingStrategy>,
         character: Option<String>,
     ) -> Self {
-        let idle = crate::body::idle::Idle::new(character.as_deref().unwrap_or(""));
+        let skeleton = Skeleton::adult();
+        let idle = crate::body::idle::Idle::new(character.as_deref().unwrap_or(""), &skeleton);
         BlockManager {
             due: std::cell::RefCell::new(BinaryHeap::new()),
             due_stale: std::cell::Cell::new(true),
@@ -121,7 +122,7 @@ impl BlockManager {
             changes: Vec::new(),
             anticipators: Vec::new(),
             retiring: Vec::new(),
-            skeleton: Skeleton::adult(),
+            skeleton,
             idle: Some(idle),
             world: std::sync::Arc::new(World::default()),
             now: 0.0,
@@ -134,6 +135,8 @@ impl BlockManager {
     /// character acts: engines may keep measurements of the skeleton.
     pub fn set_skeleton(&mut self, skeleton: Skeleton) {
         self.skeleton = skeleton;
+        let on = self.idle.is_some();
+        self.set_idle(on);
     }
 
     /// Uses `world` for targets from now on (the realizer shares its world this way).
@@ -147,7 +150,7 @@ impl BlockManager {
     /// never changes the feedback.
     pub fn set_idle(&mut self, on: bool) {
         let id = self.character.as_deref().unwrap_or("");
-        self.idle = on.then(|| crate::body::idle::Idle::new(id));
+        self.idle = on.then(|| crate::body::idle::Idle::new(id, &self.skeleton));
     }
 
     /// The pose a frame at `t` starts from: the idle layer's, or the rest pose.

@@ -28,17 +28,22 @@ pub const WEIGHT_SHIFT_ROLL_DEG: f32 = 0.6;
 pub struct Idle {
     /// Phase offset in seconds, from the character's id (characters do not breathe in step).
     phase: f32,
+    /// The joints it turns, found once: chest (vt6), collarbones (left, right), pelvis
+    /// (sacroiliac) and lower spine (vl5).
+    joints: [Option<usize>; 5],
 }
 
 impl Idle {
-    /// The idle motion of character `id` ("" the default one).
-    pub fn new(id: &str) -> Idle {
+    /// The idle motion of character `id` ("" the default one) on `skeleton`.
+    pub fn new(id: &str, skeleton: &Skeleton) -> Idle {
         // FNV-1a: a fixed hash, so the phase is the same in every run and on every platform
         let hash = id.bytes().fold(0x811c_9dc5u32, |h, b| {
             (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
         });
         Idle {
             phase: (hash % 10_000) as f32 / 10_000.0 * WEIGHT_SHIFT_PERIOD,
+            joints: ["vt6", "l_sternoclavicular", "r_sternoclavicular", "sacroiliac", "vl5"]
+                .map(|j| skeleton.joint(j)),
         }
     }
 
@@ -49,33 +54,23 @@ impl Idle {
         let tau = std::f32::consts::TAU;
         // breathing: in for the first part of the cycle, out after (a raised cosine, 0 at rest)
         let breath = 0.5 - 0.5 * (tau * BREATHING_HZ * t).cos();
-        let turn = |joint: &str, q: Quat, pose: &mut Pose| {
-            if let Some(j) = skeleton.joint(joint) {
+        let [chest, l_clavicle, r_clavicle, pelvis, spine] = self.joints;
+        let turn = |joint: Option<usize>, q: Quat, pose: &mut Pose| {
+            if let Some(j) = joint {
                 pose.rotate(j, q);
             }
         };
-        turn(
-            "vt6",
-            Quat::from_rotation_x(-(BREATHING_CHEST_DEG * breath).to_radians()),
-            &mut pose,
-        );
+        let chest_turn = -(BREATHING_CHEST_DEG * breath).to_radians();
+        turn(chest, Quat::from_rotation_x(chest_turn), &mut pose);
         let shoulder = (BREATHING_SHOULDER_DEG * breath).to_radians();
-        turn(
-            "l_sternoclavicular",
-            Quat::from_rotation_z(shoulder),
-            &mut pose,
-        );
-        turn(
-            "r_sternoclavicular",
-            Quat::from_rotation_z(-shoulder),
-            &mut pose,
-        );
+        turn(l_clavicle, Quat::from_rotation_z(shoulder), &mut pose);
+        turn(r_clavicle, Quat::from_rotation_z(-shoulder), &mut pose);
         // weight shift: the pelvis sways sideways and rolls, the lower spine rolls it back
         let shift = (tau * t / WEIGHT_SHIFT_PERIOD).sin();
         pose.root += Vec3::X * (WEIGHT_SHIFT_M * shift);
         let roll = (WEIGHT_SHIFT_ROLL_DEG * shift).to_radians();
-        turn("sacroiliac", Quat::from_rotation_z(roll), &mut pose);
-        turn("vl5", Quat::from_rotation_z(-roll), &mut pose);
+        turn(pelvis, Quat::from_rotation_z(roll), &mut pose);
+        turn(spine, Quat::from_rotation_z(-roll), &mut pose);
         pose
     }
 }
@@ -87,7 +82,7 @@ mod tests {
     #[test]
     fn the_chest_rises_and_falls_every_four_seconds_and_the_pelvis_sways() {
         let s = Skeleton::adult();
-        let idle = Idle::new("");
+        let idle = Idle::new("", &s);
         let chest = |t: f64| idle.pose(&s, t).world(&s).positions[s.joint("vc7").unwrap()];
         let root = |t: f64| idle.pose(&s, t).root.x;
         // the breathing repeats every 4 s, and moves the neck base by about a millimetre
@@ -104,7 +99,7 @@ mod tests {
         let max = xs.iter().fold(0f32, |a, &b| a.max(b.abs()));
         assert!((max - WEIGHT_SHIFT_M).abs() < 1e-3, "{max}");
         // deterministic, and another character is out of step
-        assert_eq!(idle.pose(&s, 2.0), Idle::new("").pose(&s, 2.0));
-        assert_ne!(idle.pose(&s, 2.0), Idle::new("anna").pose(&s, 2.0));
+        assert_eq!(idle.pose(&s, 2.0), Idle::new("", &s).pose(&s, 2.0));
+        assert_ne!(idle.pose(&s, 2.0), Idle::new("anna", &s).pose(&s, 2.0));
     }
 }
