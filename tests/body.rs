@@ -223,7 +223,9 @@ fn raised_palm_out(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
     let palm = body.palm(pose, side);
     (w.z > 0.3 && w.y > 1.25 && palm.z > 0.6)
         .then_some(())
-        .ok_or(format!("wrist {w}, palm {palm}: not a raised hand, palm out"))
+        .ok_or(format!(
+            "wrist {w}, palm {palm}: not a raised hand, palm out"
+        ))
 }
 
 fn index_up(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
@@ -232,7 +234,9 @@ fn index_up(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
     let middle = body.at(pose, &format!("{side}_middle3"));
     (w.z > 0.2 && index.y > w.y + 0.06 && middle.y < index.y - 0.05)
         .then_some(())
-        .ok_or(format!("wrist {w}, index {index}, middle {middle}: not the index up"))
+        .ok_or(format!(
+            "wrist {w}, index {index}, middle {middle}: not the index up"
+        ))
 }
 
 fn out_to_the_side_palm_down(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
@@ -255,9 +259,10 @@ fn framing(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
 fn hand_to_chin(body: &Body, pose: &Pose, side: char) -> Result<(), String> {
     let chin = body.at(pose, "temporomandibular") + Vec3::new(0.0, -0.07, 0.05);
     let tip = body.at(pose, &format!("{side}_middle3"));
-    (tip.distance(chin) < 0.12)
-        .then_some(())
-        .ok_or(format!("fingers {tip} {:.2} m from the chin {chin}", tip.distance(chin)))
+    (tip.distance(chin) < 0.12).then_some(()).ok_or(format!(
+        "fingers {tip} {:.2} m from the chin {chin}",
+        tip.distance(chin)
+    ))
 }
 
 /// Presenting the open hand to the character's left (`left`) or right: out beyond the shoulder
@@ -478,4 +483,35 @@ fn no_joint_ever_leaves_its_limits() {
         }
     }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// The pictures of the lexicon's stroke poses in `docs/lexemes/` (shown in docs/bml-support.md)
+/// are what the realizer does now: drawn by `body::sketch` from the frame at the stroke, without
+/// the idle layer. `BMLR_BLESS=1 cargo test --test body` redraws them.
+#[test]
+fn the_lexicon_pictures_in_the_docs_are_current() {
+    let skeleton = Skeleton::adult();
+    let bless = std::env::var_os("BMLR_BLESS").is_some();
+    let mut stale = Vec::new();
+    for s in STROKES {
+        let mode = if matches!(s.lexeme, "SHRUG" | "FRAME") {
+            "BOTH_HANDS"
+        } else {
+            "RIGHT_HAND"
+        };
+        let mut r = Realizer::new().with_idle(false);
+        r.perform_bml(&gesture(s.lexeme, mode)).unwrap();
+        r.tick(0.0);
+        let pose = r.tick(1.0).poses[0].pose.clone();
+        let title = format!("{} ({mode}) at its stroke", s.lexeme);
+        let svg = bml_realizer::body::sketch::svg(&skeleton, &pose, &title);
+        let path = format!("docs/lexemes/{}.svg", s.lexeme.to_lowercase());
+        if bless {
+            std::fs::create_dir_all("docs/lexemes").unwrap();
+            std::fs::write(&path, &svg).unwrap();
+        } else if std::fs::read_to_string(&path).ok().as_deref() != Some(svg.as_str()) {
+            stale.push(path);
+        }
+    }
+    assert!(stale.is_empty(), "redraw with BMLR_BLESS=1: {stale:?}");
 }

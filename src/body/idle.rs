@@ -42,8 +42,14 @@ impl Idle {
         });
         Idle {
             phase: (hash % 10_000) as f32 / 10_000.0 * WEIGHT_SHIFT_PERIOD,
-            joints: ["vt6", "l_sternoclavicular", "r_sternoclavicular", "sacroiliac", "vl5"]
-                .map(|j| skeleton.joint(j)),
+            joints: [
+                "vt6",
+                "l_sternoclavicular",
+                "r_sternoclavicular",
+                "sacroiliac",
+                "vl5",
+            ]
+            .map(|j| skeleton.joint(j)),
         }
     }
 

@@ -1,6 +1,6 @@
 //! The body: an H-Anim skeleton ([`skeleton`]), poses with forward kinematics ([`pose`]), BVH
 //! export ([`bvh`]), the frames file ([`frames`]), joint limits ([`limits`]), the idle layer
-//! ([`idle`]) and two-link inverse kinematics ([`ik`]).
+//! ([`idle`]), stick-figure pictures ([`sketch`]) and two-link inverse kinematics ([`ik`]).
 //! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians.
 
 pub mod bvh;
@@ -10,6 +10,7 @@ pub mod ik;
 pub mod limits;
 pub mod pose;
 pub mod skeleton;
+pub mod sketch;
 
 pub use pose::{Pose, WorldPose};
 pub use skeleton::{Joint, Skeleton, SkeletonError};
