@@ -156,27 +156,14 @@ impl Skeleton {
         self.index.get(name).copied()
     }
 
-    /// The index of joint `name`, or of its mirror image (`l_…` ↔ `r_…`) when `mirrored`,
-    /// without allocating.
+    /// The index of joint `name`, or of its mirror image (`l_…` ↔ `r_…`) when `mirrored`.
     pub fn joint_mirrored(&self, name: &str, mirrored: bool) -> Option<usize> {
         let other = match name.as_bytes() {
-            [b'l', b'_', ..] => b'r',
-            [b'r', b'_', ..] => b'l',
+            [b'l', b'_', ..] if mirrored => 'r',
+            [b'r', b'_', ..] if mirrored => 'l',
             _ => return self.joint(name),
         };
-        if !mirrored {
-            return self.joint(name);
-        }
-        let mut buf = [0u8; 64];
-        let n = name.len();
-        if n > buf.len() {
-            return self.joint(&format!("{}{}", other as char, &name[1..]));
-        }
-        buf[..n].copy_from_slice(name.as_bytes());
-        buf[0] = other;
-        std::str::from_utf8(&buf[..n])
-            .ok()
-            .and_then(|s| self.joint(s))
+        self.joint(&format!("{other}{}", &name[1..]))
     }
 
     /// The children of joint `i`.

@@ -269,6 +269,63 @@ impl VirtualRun {
         self.open &= print(&mut self.out, self.format, &frame.feedback);
     }
 
+    /// Blocks from standard input, line by line: a line that is not UTF-8 (or too long) costs
+    /// only itself.
+    fn stdin(&mut self) {
+        let mut stream = BlockStream::new();
+        let max_line = self.realizer.limits().block_bytes;
+        for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
+            match line {
+                Ok(text) => {
+                    stream.push(&text);
+                    stream.push("\n");
+                    while let Some(item) = stream.next_item(false) {
+                        self.stream(item);
+                    }
+                }
+                Err(bad) => {
+                    self.invalid += 1;
+                    self.realizer.refuse_line(STDIN, &bad);
+                }
+            }
+        }
+        while let Some(item) = stream.next_item(true) {
+            self.stream(item);
+        }
+    }
+
+    /// Runs until nothing more will happen (or `--until`, or stdout closed).
+    fn run_out(&mut self) {
+        while let Some(t) = self.realizer.next_event() {
+            if t > self.until || !self.open {
+                break;
+            }
+            self.advance_to(t);
+        }
+        if self.until.is_finite() {
+            self.advance_to(self.until);
+        }
+    }
+
+    /// Writes the --bvh and --frames files asked for, with one last frame at the final time.
+    fn write_recordings(&mut self, args: &RunArgs) -> Result<(), (u8, String)> {
+        let Some(mut m) = self.motion.take() else {
+            return Ok(());
+        };
+        let now = self.realizer.now();
+        if m.frames.is_empty() || m.next <= now + 1e-9 {
+            let frame = self.realizer.tick(now);
+            m.frames.push((now, frame.poses));
+        }
+        if let Some(path) = &args.bvh {
+            m.write_bvh(&self.realizer, path, args.character.as_deref())?;
+        }
+        if let Some(path) = &args.frames {
+            m.write_frames(&self.realizer, path)?;
+        }
+        Ok(())
+    }
+
     fn stream(&mut self, item: StreamItem) {
         match item {
             StreamItem::Block(text) | StreamItem::Garbage(text) => self.perform(&text, STDIN),
@@ -279,50 +336,13 @@ impl VirtualRun {
 
 /// `bmlr run`.
 pub fn run(args: RunArgs) -> ExitCode {
-    let items = match read_items(&args.items) {
-        Ok(i) => i,
+    let (items, realizer) = match checked(&args) {
+        Ok(ok) => ok,
         Err(e) => {
             eprintln!("bmlr run: {e}");
             return ExitCode::from(2);
         }
     };
-    if let Some(u) = args.until {
-        if !(u.is_finite() && u >= 0.0) {
-            eprintln!("bmlr run: --until must be a number of seconds >= 0");
-            return ExitCode::from(2);
-        }
-    }
-    if !(args.fps.is_finite() && args.fps > 0.0) {
-        eprintln!("bmlr run: --fps must be a positive number");
-        return ExitCode::from(2);
-    }
-    let realizer = match with_assets(Realizer::new(), args.assets.as_deref()) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("bmlr run: --assets {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let realizer = match with_world(realizer, args.world.as_deref()) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("bmlr run: --world {e}");
-            return ExitCode::from(2);
-        }
-    }
-    .with_default_character(args.character.clone())
-    .with_posix_time(args.realtime)
-    .with_idle(!args.no_idle)
-    .with_limits(args.limits.limits());
-    for (asked, flag) in [
-        (args.bvh.is_some(), "--bvh"),
-        (args.frames.is_some(), "--frames"),
-    ] {
-        if args.realtime && asked {
-            eprintln!("bmlr run: {flag} records on the virtual clock; leave out --realtime");
-            return ExitCode::from(2);
-        }
-    }
     if args.realtime {
         return run_realtime(realizer, items, &args);
     }
@@ -339,65 +359,46 @@ pub fn run(args: RunArgs) -> ExitCode {
         match item {
             Item::Text(path, text) => run.perform(&text, &path),
             Item::Advance(s) => run.advance_to(run.realizer.now() + s),
-            Item::Stdin => {
-                // line by line: a line that is not UTF-8 (or too long) costs only itself
-                let mut stream = BlockStream::new();
-                let max_line = run.realizer.limits().block_bytes;
-                for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
-                    match line {
-                        Ok(text) => {
-                            stream.push(&text);
-                            stream.push("\n");
-                            while let Some(item) = stream.next_item(false) {
-                                run.stream(item);
-                            }
-                        }
-                        Err(bad) => {
-                            run.invalid += 1;
-                            run.realizer.refuse_line(STDIN, &bad);
-                        }
-                    }
-                }
-                while let Some(item) = stream.next_item(true) {
-                    run.stream(item);
-                }
-            }
+            Item::Stdin => run.stdin(),
         }
     }
-    // run until nothing more will happen
-    while let Some(t) = run.realizer.next_event() {
-        if t > run.until || !run.open {
-            break;
-        }
-        run.advance_to(t);
-    }
-    if run.until.is_finite() {
-        run.advance_to(run.until);
-    }
+    run.run_out();
     report_unfinished(&run.realizer);
-    if let Some(mut m) = run.motion.take() {
-        // one last frame at the final time
-        let now = run.realizer.now();
-        if m.frames.is_empty() || m.next <= now + 1e-9 {
-            let frame = run.realizer.tick(now);
-            m.frames.push((now, frame.poses));
-        }
-        let written = [
-            args.bvh
-                .as_ref()
-                .map(|p| m.write_bvh(&run.realizer, p, args.character.as_deref())),
-            args.frames
-                .as_ref()
-                .map(|p| m.write_frames(&run.realizer, p)),
-        ];
-        for result in written.into_iter().flatten() {
-            if let Err((code, e)) = result {
-                eprintln!("bmlr run: {e}");
-                return ExitCode::from(code);
-            }
-        }
+    if let Err((code, e)) = run.write_recordings(&args) {
+        eprintln!("bmlr run: {e}");
+        return ExitCode::from(code);
     }
     exit_for(run.invalid, "run")
+}
+
+/// The items and the realizer of `bmlr run`, or what is wrong with the command line (exit 2).
+fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer), String> {
+    let items = read_items(&args.items)?;
+    if args.until.is_some_and(|u| !(u.is_finite() && u >= 0.0)) {
+        return Err("--until must be a number of seconds >= 0".into());
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        return Err("--fps must be a positive number".into());
+    }
+    for (asked, flag) in [
+        (args.bvh.is_some(), "--bvh"),
+        (args.frames.is_some(), "--frames"),
+    ] {
+        if args.realtime && asked {
+            return Err(format!(
+                "{flag} records on the virtual clock; leave out --realtime"
+            ));
+        }
+    }
+    let realizer = with_assets(Realizer::new(), args.assets.as_deref())
+        .map_err(|e| format!("--assets {e}"))?;
+    let realizer = with_world(realizer, args.world.as_deref())
+        .map_err(|e| format!("--world {e}"))?
+        .with_default_character(args.character.clone())
+        .with_posix_time(args.realtime)
+        .with_idle(!args.no_idle)
+        .with_limits(args.limits.limits());
+    Ok((items, realizer))
 }
 
 /// Tells stderr which blocks did not finish (waiting for activation, persistent behaviour, or
@@ -424,104 +425,124 @@ fn report_unfinished(realizer: &Realizer) {
 }
 
 /// `bmlr run --realtime`: the wall clock drives the realizer at `--fps`; `+SECS` waits.
-fn run_realtime(mut realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> ExitCode {
-    let clock = WallClock::new();
-    let format: Format = args.format.into();
-    let until = args.until.unwrap_or(f64::INFINITY);
-    let period = 1.0 / args.fps;
-    let mut out = std::io::stdout().lock();
-    let mut invalid = 0;
-    let wait_until = |realizer: &mut Realizer, t: f64, out: &mut std::io::StdoutLock| loop {
-        let now = clock.now().min(until);
-        let frame = realizer.tick(now);
-        if !print(out, format, &frame.feedback) {
-            return false;
-        }
-        if now >= t || now >= until {
-            return true;
-        }
-        std::thread::sleep(Duration::from_secs_f64(period.min((t - now).max(0.0))));
+fn run_realtime(realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> ExitCode {
+    let mut run = RealtimeRun {
+        realizer,
+        clock: WallClock::new(),
+        format: args.format.into(),
+        until: args.until.unwrap_or(f64::INFINITY),
+        period: 1.0 / args.fps,
+        out: std::io::stdout().lock(),
+        invalid: 0,
     };
     for item in items {
-        match item {
-            Item::Text(path, text) => {
-                let frame = realizer.tick(clock.now().min(until));
-                if !print(&mut out, format, &frame.feedback) {
-                    return ExitCode::SUCCESS;
-                }
-                invalid += usize::from(realizer.perform_bml_from(&text, Some(&path)).is_err());
-            }
-            Item::Advance(s) => {
-                let t = clock.now() + s;
-                if !wait_until(&mut realizer, t, &mut out) {
-                    return ExitCode::SUCCESS;
-                }
-            }
-            Item::Stdin => {
-                // a reader thread hands over lines; blocks run as soon as they are complete
-                // (a line that is not UTF-8, or too long, costs only itself)
-                let (tx, rx) = mpsc::sync_channel(256);
-                let max_line = realizer.limits().block_bytes;
-                std::thread::spawn(move || {
-                    for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
-                        if tx.send(Some(line)).is_err() {
-                            return;
-                        }
-                    }
-                    let _ = tx.send(None);
-                });
-                let mut stream = BlockStream::new();
-                let mut finished = false;
-                while !finished {
-                    match rx.recv_timeout(Duration::from_secs_f64(period)) {
-                        Ok(Some(Ok(text))) => {
-                            stream.push(&text);
-                            stream.push("\n");
-                        }
-                        Ok(Some(Err(bad))) => {
-                            invalid += 1;
-                            realizer.refuse_line(STDIN, &bad);
-                        }
-                        Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => finished = true,
-                        Err(mpsc::RecvTimeoutError::Timeout) => {}
-                    }
-                    while let Some(item) = stream.next_item(finished) {
-                        match item {
-                            StreamItem::Block(t) | StreamItem::Garbage(t) => {
-                                let frame = realizer.tick(clock.now().min(until));
-                                if !print(&mut out, format, &frame.feedback) {
-                                    return ExitCode::SUCCESS;
-                                }
-                                let result = realizer.perform_bml_from(&t, Some(STDIN));
-                                invalid += usize::from(result.is_err());
-                            }
-                            StreamItem::Advance(s) => {
-                                let t = clock.now() + s;
-                                if !wait_until(&mut realizer, t, &mut out) {
-                                    return ExitCode::SUCCESS;
-                                }
-                            }
-                        }
-                    }
-                    let frame = realizer.tick(clock.now().min(until));
-                    if !print(&mut out, format, &frame.feedback) {
-                        return ExitCode::SUCCESS;
-                    }
-                }
-            }
+        let open = match item {
+            Item::Text(path, text) => run.perform(&text, &path),
+            Item::Advance(s) => run.wait_until(run.clock.now() + s),
+            Item::Stdin => run.stdin(),
+        };
+        if !open {
+            return ExitCode::SUCCESS; // stdout is gone
         }
     }
     // until nothing more will happen
-    while let Some(t) = realizer.next_event() {
-        if t > until || !wait_until(&mut realizer, t, &mut out) {
+    while let Some(t) = run.realizer.next_event() {
+        if t > run.until || !run.wait_until(t) {
             break;
         }
     }
-    if until.is_finite() {
-        wait_until(&mut realizer, until, &mut out);
+    if run.until.is_finite() {
+        run.wait_until(run.until);
     }
-    report_unfinished(&realizer);
-    exit_for(invalid, "run")
+    report_unfinished(&run.realizer);
+    exit_for(run.invalid, "run")
+}
+
+/// A realizer on the wall clock that prints its feedback as it goes. Its methods return false
+/// when stdout is gone.
+struct RealtimeRun {
+    realizer: Realizer,
+    clock: WallClock,
+    format: Format,
+    until: f64,
+    period: f64,
+    out: std::io::StdoutLock<'static>,
+    /// Blocks that could not be parsed.
+    invalid: usize,
+}
+
+impl RealtimeRun {
+    /// A frame now (capped at `--until`), its feedback printed.
+    fn tick(&mut self) -> bool {
+        let frame = self.realizer.tick(self.clock.now().min(self.until));
+        print(&mut self.out, self.format, &frame.feedback)
+    }
+
+    /// Frames every period until global time `t` (or `--until`).
+    fn wait_until(&mut self, t: f64) -> bool {
+        loop {
+            let now = self.clock.now().min(self.until);
+            if !self.tick() {
+                return false;
+            }
+            if now >= t || now >= self.until {
+                return true;
+            }
+            std::thread::sleep(Duration::from_secs_f64(self.period.min((t - now).max(0.0))));
+        }
+    }
+
+    /// Performs a block now.
+    fn perform(&mut self, text: &str, source: &str) -> bool {
+        let open = self.tick();
+        let result = self.realizer.perform_bml_from(text, Some(source));
+        self.invalid += usize::from(result.is_err());
+        open
+    }
+
+    /// Blocks from standard input: a reader thread hands over lines, and blocks run as soon as
+    /// they are complete (a line that is not UTF-8, or too long, costs only itself).
+    fn stdin(&mut self) -> bool {
+        let (tx, rx) = mpsc::sync_channel(256);
+        let max_line = self.realizer.limits().block_bytes;
+        std::thread::spawn(move || {
+            for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
+                if tx.send(Some(line)).is_err() {
+                    return;
+                }
+            }
+            let _ = tx.send(None);
+        });
+        let mut stream = BlockStream::new();
+        let mut finished = false;
+        while !finished {
+            match rx.recv_timeout(Duration::from_secs_f64(self.period)) {
+                Ok(Some(Ok(text))) => {
+                    stream.push(&text);
+                    stream.push("\n");
+                }
+                Ok(Some(Err(bad))) => {
+                    self.invalid += 1;
+                    self.realizer.refuse_line(STDIN, &bad);
+                }
+                Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => finished = true,
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+            }
+            while let Some(item) = stream.next_item(finished) {
+                let open = match item {
+                    StreamItem::Block(t) | StreamItem::Garbage(t) => self.perform(&t, STDIN),
+                    StreamItem::Advance(s) => self.wait_until(self.clock.now() + s),
+                };
+                if !open {
+                    return false;
+                }
+            }
+            if !self.tick() {
+                return false;
+            }
+        }
+        true
+    }
 }
 
 /// Success, or exit 1 (after a line on stderr) when `invalid` blocks could not be parsed.
