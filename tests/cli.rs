@@ -481,3 +481,49 @@ fn the_idle_layer_moves_the_body_and_never_the_feedback() {
         "with it the pelvis sways {sway} m"
     );
 }
+
+#[test]
+fn run_gltf_writes_a_skinned_mannequin_with_the_motion() {
+    let path = std::env::temp_dir().join(format!("bmlr-{}-welcome.glb", std::process::id()));
+    let (code, with, err) = bmlr(&[
+        "run",
+        "--gltf",
+        path.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (_, without, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
+    assert_eq!(with, without, "the glTF does not change the feedback");
+    assert!(err.contains("(175 frames at 60 fps, 57 joints,"), "{err}");
+    let glb = std::fs::read(&path).unwrap();
+    assert_eq!(&glb[0..4], b"glTF");
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let gltf: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let skeleton = bml_realizer::body::Skeleton::adult();
+    assert_eq!(
+        gltf["skins"][0]["joints"].as_array().unwrap().len(),
+        skeleton.len()
+    );
+    let animation = &gltf["animations"][0];
+    let input = animation["samplers"][0]["input"].as_u64().unwrap() as usize;
+    assert_eq!(gltf["accessors"][input]["count"], 175);
+    assert_eq!(gltf["accessors"][input]["max"], serde_json::json!([2.9f32]));
+    // the skinned mesh: positions with bounds, one joint per vertex, two materials
+    let primitive = &gltf["meshes"][0]["primitives"][0];
+    let position = primitive["attributes"]["POSITION"].as_u64().unwrap() as usize;
+    let max_y = gltf["accessors"][position]["max"][1].as_f64().unwrap();
+    assert!(
+        (1.7..1.9).contains(&max_y),
+        "the mannequin is {max_y} m tall"
+    );
+    assert_eq!(gltf["materials"].as_array().unwrap().len(), 2);
+    let (code, _, err) = bmlr(&[
+        "run",
+        "--realtime",
+        "--gltf",
+        "x.glb",
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--gltf records on the virtual clock"), "{err}");
+}

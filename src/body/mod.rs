@@ -1,10 +1,11 @@
 //! The body: an H-Anim skeleton ([`skeleton`]), poses with forward kinematics ([`pose`]), BVH
-//! export ([`bvh`]), the frames file ([`frames`]), joint limits ([`limits`]), the idle layer
+//! export ([`bvh`]), glTF export ([`gltf`]), the frames file ([`frames`]), joint limits ([`limits`]), the idle layer
 //! ([`idle`]), stick-figure pictures ([`sketch`]) and two-link inverse kinematics ([`ik`]).
 //! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians.
 
 pub mod bvh;
 pub mod frames;
+pub mod gltf;
 pub mod idle;
 pub mod ik;
 pub mod limits;

@@ -57,6 +57,35 @@ impl Recording {
         Ok(())
     }
 
+    /// Writes the glTF mannequin of the character `asked` (or the one chosen as for BVH) with its
+    /// motion. An error has the exit code.
+    pub fn write_gltf(
+        &self,
+        realizer: &Realizer,
+        path: &Path,
+        asked: Option<&str>,
+    ) -> Result<(), (u8, String)> {
+        let character =
+            recorded_character(realizer, asked).map_err(|e| (1, format!("--gltf: {e}")))?;
+        let poses = self.poses_of(&character);
+        let frames: Vec<(f64, &Pose)> = (self.frames.iter().zip(&poses))
+            .map(|((t, _), p)| (*t, &p.pose))
+            .collect();
+        let skeleton = Skeleton::adult();
+        let glb = bml_realizer::body::gltf::write(&skeleton, &frames);
+        std::fs::write(path, &glb)
+            .map_err(|e| (2, format!("{}: cannot write: {e}", path.display())))?;
+        eprintln!(
+            "wrote {} ({} frames at {} fps, {} joints, {} kB)",
+            path.display(),
+            frames.len(),
+            self.fps,
+            skeleton.len(),
+            glb.len() / 1024
+        );
+        Ok(())
+    }
+
     /// Writes the frames of every character that received blocks (sorted by id; the default
     /// character is `""`). An error has the exit code.
     pub fn write_frames(&self, realizer: &Realizer, path: &Path) -> Result<(), (u8, String)> {

@@ -66,6 +66,10 @@ pub struct RunArgs {
     /// one frame every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.bvh")]
     bvh: Option<std::path::PathBuf>,
+    /// Write a skinned mannequin with the realized motion of the character (--character, else
+    /// the default one) as binary glTF, one key every 1/--fps seconds (virtual clock only).
+    #[arg(long, value_name = "OUT.glb")]
+    gltf: Option<std::path::PathBuf>,
     /// Characters stand still between behaviours: no breathing, no weight shift (the idle layer
     /// changes the motion only, never the feedback).
     #[arg(long)]
@@ -323,6 +327,9 @@ impl VirtualRun {
         if let Some(path) = &args.frames {
             m.write_frames(&self.realizer, path)?;
         }
+        if let Some(path) = &args.gltf {
+            m.write_gltf(&self.realizer, path, args.character.as_deref())?;
+        }
         Ok(())
     }
 
@@ -353,7 +360,8 @@ pub fn run(args: RunArgs) -> ExitCode {
         out: std::io::stdout().lock(),
         open: true,
         invalid: 0,
-        motion: (args.bvh.is_some() || args.frames.is_some()).then(|| Recording::new(args.fps)),
+        motion: (args.bvh.is_some() || args.frames.is_some() || args.gltf.is_some())
+            .then(|| Recording::new(args.fps)),
     };
     for item in items {
         match item {
@@ -383,6 +391,7 @@ fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer), String> {
     for (asked, flag) in [
         (args.bvh.is_some(), "--bvh"),
         (args.frames.is_some(), "--frames"),
+        (args.gltf.is_some(), "--gltf"),
     ] {
         if args.realtime && asked {
             return Err(format!(
