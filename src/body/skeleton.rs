@@ -120,7 +120,6 @@ impl Skeleton {
         if s.joints.is_empty() {
             return Err(e("no joints".into()));
         }
-        s.limits = Limits::none(&s);
         Ok(s)
     }
 
@@ -130,8 +129,8 @@ impl Skeleton {
         self
     }
 
-    /// Its joint limits (the default adult's are embedded; a skeleton read from a file has none
-    /// until [`with_limits`](Self::with_limits)).
+    /// Its joint limits (the default adult's are embedded; a skeleton read from a file has none,
+    /// every joint free, until [`with_limits`](Self::with_limits)).
     pub fn limits(&self) -> &Limits {
         &self.limits
     }

@@ -232,12 +232,7 @@ impl Line {
                 posix_time,
                 ..
             }) => {
-                let (block, sync) = id
-                    .rsplit_once(':')
-                    .filter(|(b, s)| !b.is_empty() && !s.is_empty())
-                    .ok_or_else(|| {
-                        FeedbackError(format!("blockProgress id '{id}' should be block:sync"))
-                    })?;
+                let (block, sync) = block_and_sync(&id)?;
                 Feedback::BlockProgress(BlockProgress {
                     block: block.into(),
                     sync: sync.into(),

@@ -301,6 +301,13 @@ pub(crate) fn check_name(name: &str) -> Result<(), FeedbackError> {
     }
 }
 
+/// A blockProgress id `block:sync` (the block id may hold ':'; the sync is after the last).
+pub(crate) fn block_and_sync(id: &str) -> Result<(&str, &str), FeedbackError> {
+    id.rsplit_once(':')
+        .filter(|(b, s)| !b.is_empty() && !s.is_empty())
+        .ok_or_else(|| FeedbackError(format!("blockProgress id '{id}' should be block:sync")))
+}
+
 /// Splits `a:b` ids; `n` is the number of parts expected.
 pub(crate) fn split_id(id: &str, n: usize, what: &str) -> Result<Vec<String>, FeedbackError> {
     let parts: Vec<String> = id.split(':').map(str::to_string).collect();

@@ -226,12 +226,7 @@ pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
         return match name.as_str() {
             "blockProgress" => {
                 let id = req(&a, "id", &name)?;
-                let (block, sync) = id
-                    .rsplit_once(':')
-                    .filter(|(b, s)| !b.is_empty() && !s.is_empty())
-                    .ok_or_else(|| {
-                        FeedbackError(format!("blockProgress id '{id}' should be block:sync"))
-                    })?;
+                let (block, sync) = block_and_sync(id)?;
                 Ok(Feedback::BlockProgress(BlockProgress {
                     block: block.into(),
                     sync: sync.into(),

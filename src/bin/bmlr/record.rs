@@ -1,5 +1,5 @@
 //! Recording the realized motion of `bmlr run` on the virtual clock: every character's pose once
-//! per frame, written at the end as BVH (one character) or as a frames file (all of them).
+//! per frame, written at the end as BVH or glTF (one character) or as a frames file (all of them).
 
 use std::path::Path;
 
@@ -36,17 +36,14 @@ impl Recording {
         path: &Path,
         asked: Option<&str>,
     ) -> Result<(), (u8, String)> {
-        let character =
-            recorded_character(realizer, asked).map_err(|e| (1, format!("--bvh: {e}")))?;
-        let poses: Vec<Pose> = self
-            .poses_of(&character)
-            .into_iter()
+        let poses: Vec<Pose> = (self.one_character(realizer, asked, "--bvh")?.into_iter())
             .map(|p| p.pose)
             .collect();
         let skeleton = Skeleton::adult();
-        let text = bml_realizer::body::bvh::write(&skeleton, &poses, self.fps);
-        std::fs::write(path, text)
-            .map_err(|e| (2, format!("{}: cannot write: {e}", path.display())))?;
+        write_file(
+            path,
+            bml_realizer::body::bvh::write(&skeleton, &poses, self.fps).as_bytes(),
+        )?;
         eprintln!(
             "wrote {} ({} frames at {} fps, {} joints)",
             path.display(),
@@ -65,16 +62,13 @@ impl Recording {
         path: &Path,
         asked: Option<&str>,
     ) -> Result<(), (u8, String)> {
-        let character =
-            recorded_character(realizer, asked).map_err(|e| (1, format!("--gltf: {e}")))?;
-        let poses = self.poses_of(&character);
+        let poses = self.one_character(realizer, asked, "--gltf")?;
         let frames: Vec<(f64, &Pose)> = (self.frames.iter().zip(&poses))
             .map(|((t, _), p)| (*t, &p.pose))
             .collect();
         let skeleton = Skeleton::adult();
         let glb = bml_realizer::body::gltf::write(&skeleton, &frames);
-        std::fs::write(path, &glb)
-            .map_err(|e| (2, format!("{}: cannot write: {e}", path.display())))?;
+        write_file(path, &glb)?;
         eprintln!(
             "wrote {} ({} frames at {} fps, {} joints, {} kB)",
             path.display(),
@@ -84,6 +78,18 @@ impl Recording {
             glb.len() / 1024
         );
         Ok(())
+    }
+
+    /// The frames of the one character a BVH or glTF file (`flag`) shows.
+    fn one_character(
+        &self,
+        realizer: &Realizer,
+        asked: Option<&str>,
+        flag: &str,
+    ) -> Result<Vec<CharacterPose>, (u8, String)> {
+        let character =
+            recorded_character(realizer, asked, flag).map_err(|e| (1, format!("{flag}: {e}")))?;
+        Ok(self.poses_of(&character))
     }
 
     /// Writes the frames of every character that received blocks (sorted by id; the default
@@ -105,8 +111,7 @@ impl Recording {
             text.push_str(&bml_realizer::body::frames::line(&skeleton, *time, &poses));
             text.push('\n');
         }
-        std::fs::write(path, text)
-            .map_err(|e| (2, format!("{}: cannot write: {e}", path.display())))?;
+        write_file(path, text.as_bytes())?;
         eprintln!(
             "wrote {} ({} frames at {} fps, {} character(s))",
             path.display(),
@@ -136,10 +141,19 @@ impl Recording {
     }
 }
 
-/// The character a BVH shows: `asked` (--character) if it received blocks, else the only one
+/// Writes `bytes` to `path`; an error has exit code 2.
+fn write_file(path: &Path, bytes: &[u8]) -> Result<(), (u8, String)> {
+    std::fs::write(path, bytes).map_err(|e| (2, format!("{}: cannot write: {e}", path.display())))
+}
+
+/// The character a BVH or glTF file (`flag`) shows: `asked` (--character) if it received blocks, else the only one
 /// that did (or, of several, the default one, else the first by id, with a note on stderr).
 /// An error names the characters that received blocks.
-fn recorded_character(realizer: &Realizer, asked: Option<&str>) -> Result<String, String> {
+fn recorded_character(
+    realizer: &Realizer,
+    asked: Option<&str>,
+    flag: &str,
+) -> Result<String, String> {
     let mut received: Vec<&str> = realizer
         .characters()
         .filter(|(_, m)| m.received_blocks())
@@ -161,7 +175,7 @@ fn recorded_character(realizer: &Realizer, asked: Option<&str>) -> Result<String
     };
     match (asked, received.as_slice()) {
         (Some(c), list) if list.contains(&c) => Ok(c.to_string()),
-        (_, []) => Err("no character received a block: the BVH would show nothing move".into()),
+        (_, []) => Err("no character received a block: the file would show nothing move".into()),
         (Some(c), list) => Err(format!(
             "character '{c}' received no blocks (these did: {}); choose one with --character",
             named(list)
@@ -170,7 +184,7 @@ fn recorded_character(realizer: &Realizer, asked: Option<&str>) -> Result<String
         (None, list) => {
             let c = if list.contains(&"") { "" } else { list[0] };
             eprintln!(
-                "bmlr run: several characters received blocks ({}); the BVH shows {} (choose with --character)",
+                "bmlr run: several characters received blocks ({}); {flag} shows {} (choose with --character)",
                 named(list),
                 named(&[c])
             );
