@@ -515,3 +515,30 @@ fn the_lexicon_pictures_in_the_docs_are_current() {
     }
     assert!(stale.is_empty(), "redraw with BMLR_BLESS=1: {stale:?}");
 }
+
+/// Seen in a plot of lift-and-wave: when the procedural lift eased in from rest, the transition
+/// that leads the raised arm into it aimed at the rest pose, so the arm dropped to the thigh
+/// between the raise and the lift (the wrist at 0.91 m, its rest height) and rose again. Led by a transition, the
+/// arm stays up; and the lift still lets go by its end.
+#[test]
+fn a_transition_leads_the_raised_arm_into_the_lift_without_dropping_it() {
+    let text = std::fs::read_to_string("fixtures/examples/lift-and-wave.xml").unwrap();
+    let body = Body::new();
+    let f = frames(&[&text], 3.5);
+    let wrist = |t: f64| {
+        let (_, p) = f.iter().find(|(u, _)| (*u - t).abs() < 1e-9).unwrap();
+        body.at(p, "r_wrist").y
+    };
+    let lowest = (60..=135)
+        .map(|i| wrist(f64::from(i) / FPS))
+        .fold(f32::INFINITY, f32::min);
+    assert!(
+        lowest > 1.05,
+        "the wrist drops to {lowest} m between the raise and the lift"
+    );
+    assert!(
+        wrist(3.5) < 0.95,
+        "the arm is down again after the lift: {}",
+        wrist(3.5)
+    );
+}

@@ -26,9 +26,10 @@
 //! A unit may also declare a replacement `group` (of the running units of a group only the
 //! one with the latest start plays, ties going to the earliest end; units of one block with the
 //! same start and end leave one and a warning), that it is `additive` (its rotations add to
-//! what the joints have: a layer, e.g. a sway over a posture) and a `blend` time (it eases in
+//! what the joints have: a layer, e.g. a sway over a posture), a `blend` time (it eases in
 //! from what the joints have after its start and back out before its end; otherwise it replaces
-//! the joints it sets).
+//! the joints it sets) and a `release` time (it eases out only, over that time before its end:
+//! it starts where a transition led the joints and still lets go of them by its end).
 //!
 //! Time is warped linearly between keys: at each key's scheduled time α is exactly the key's
 //! α. Effector `frame` is `body` (the character's space, as [`Pose::world`] gives it) or `limb`
@@ -114,6 +115,9 @@ pub struct ProcUnit {
     pub additive: bool,
     /// Seconds over which it blends in after its start and out before its end (0: none).
     pub blend: f64,
+    /// Seconds over which it lets go before its end, where that is longer than `blend`: a unit
+    /// that starts where the motion before it leads (a transition) but must end at rest.
+    pub release: f64,
     /// Its replacement group: of the running units of a group, only the one with the
     /// latest start plays (ties: the earliest end).
     pub group: Option<String>,
@@ -147,6 +151,8 @@ struct UnitFile {
     additive: bool,
     #[serde(default)]
     blend: f64,
+    #[serde(default)]
+    release: f64,
     group: Option<String>,
 }
 
@@ -262,6 +268,7 @@ impl ProcUnit {
         }
         let additive = u.additive;
         let blend = finite(u.blend, "blend")?.max(0.0);
+        let release = finite(u.release, "release")?.max(0.0);
         let group = u.group;
         let unit = ProcUnit {
             name: name.to_string(),
@@ -270,6 +277,7 @@ impl ProcUnit {
             duration: (preferred, min.max(MIN_DURATION), max),
             additive,
             blend,
+            release,
             group,
             rotations,
             effectors,
@@ -359,12 +367,12 @@ impl ProcUnit {
     }
 
     /// Its weight at global time `t` for a run from `start` to `end`: blending in after `start`
-    /// and out before `end` over [`blend`](Self::blend) seconds (minimum jerk), else 1.
+    /// over [`blend`](Self::blend) seconds and out before `end` over the longer of `blend` and
+    /// [`release`](Self::release) (minimum jerk), else 1.
     pub fn weight(&self, start: f64, end: f64, t: f64) -> f32 {
-        if self.blend <= 0.0 {
-            return 1.0;
-        }
-        min_jerk((t - start) / self.blend).min(min_jerk((end - t) / self.blend)) as f32
+        let ease = |span: f64, d: f64| if span > 0.0 { min_jerk(d / span) } else { 1.0 };
+        let out = self.blend.max(self.release);
+        ease(self.blend, t - start).min(ease(out, end - t)) as f32
     }
 
     /// Plays a run timed by `syncs` (its keys' global times) at `t` on `sides` (`false` as
