@@ -254,6 +254,35 @@ impl Timeline {
     pub fn to_svg(&self) -> String {
         svg(self)
     }
+
+    /// Where times are in the picture of [`Timeline::to_svg`] (for a cursor drawn over it).
+    pub fn axis(&self) -> Axis {
+        let (t0, t1) = time_range(self);
+        Axis {
+            t0,
+            t1,
+            left: LEFT,
+            px_per_s: px_per_s(t0, t1),
+        }
+    }
+}
+
+/// The time axis of a timeline picture: time `t` is at x = `left + (t - t0) * px_per_s`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Axis {
+    /// The first time shown (seconds).
+    pub t0: f64,
+    /// The last time shown.
+    pub t1: f64,
+    /// Where `t0` is (pixels from the left edge).
+    pub left: f64,
+    /// Pixels per second.
+    pub px_per_s: f64,
+}
+
+/// The scale of a picture of the times `t0`–`t1`: about 1200 pixels wide, within bounds.
+fn px_per_s(t0: f64, t1: f64) -> f64 {
+    (1200.0 / (t1 - t0)).clamp(20.0, 400.0)
 }
 
 fn esc(s: &str) -> String {
@@ -444,7 +473,7 @@ impl Canvas {
 
 fn svg(t: &Timeline) -> String {
     let (t0, t1) = time_range(t);
-    let px = (1200.0 / (t1 - t0)).clamp(20.0, 400.0);
+    let px = px_per_s(t0, t1);
     let mut c = Canvas {
         s: String::new(),
         t0,

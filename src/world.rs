@@ -144,6 +144,11 @@ impl World {
         self.points.iter().map(|(k, v)| (k.as_str(), *v))
     }
 
+    /// Every point that moves along a path, with its keys (time, position) in time order.
+    pub fn paths(&self) -> impl Iterator<Item = (&str, &[(f64, Vec3)])> {
+        self.paths.iter().map(|(k, v)| (k.as_str(), v.as_slice()))
+    }
+
     /// The sentence for a target the world does not have, listing the points it has.
     pub fn unknown_target(&self, target: &str) -> String {
         let known: Vec<&str> = self.points.keys().map(String::as_str).collect();

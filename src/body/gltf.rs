@@ -1,5 +1,5 @@
-//! glTF 2.0 export (`bmlr run --gltf OUT.glb`): a skinned mannequin generated from the skeleton —
-//! a box along every bone, a box head, two materials (skin for the head and hands, cloth for the
+//! glTF 2.0 export (`bmlr run --gltf OUT.glb`): the skinned mannequin of [`mannequin`] — a box
+//! along every bone, a box head, two materials (skin for the head and hands, cloth for the
 //! rest) — and the realized motion as animation channels (every joint's rotation, the root's
 //! translation), in one binary `.glb` file for Blender, three.js or a game engine. Each vertex
 //! follows one joint (the one whose bone it belongs to), so the mannequin moves rigidly per bone.
@@ -7,6 +7,7 @@
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{json, Value};
 
+use super::mannequin;
 use super::pose::Pose;
 use super::skeleton::Skeleton;
 
@@ -16,24 +17,6 @@ const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
-
-/// A body part's thickness (metres) and whether it shows skin.
-fn part(name: &str) -> (f32, bool) {
-    let finger = ["thumb", "index", "middle", "ring", "pinky"];
-    if finger.iter().any(|f| name.contains(f)) {
-        (0.016, true)
-    } else if name.contains("wrist") {
-        (0.045, true)
-    } else if name.starts_with("vl") || name.starts_with("vt") || name == "sacroiliac" {
-        (0.2, false)
-    } else if name.starts_with("vc") || name == "skullbase" {
-        (0.09, true)
-    } else if name.contains("sternoclavicular") || name.contains("hip") {
-        (0.09, false)
-    } else {
-        (0.075, false)
-    }
-}
 
 /// The mesh being built: positions, normals, the joint of each vertex, and the triangles of the
 /// two materials.
@@ -138,14 +121,9 @@ pub fn write(skeleton: &Skeleton, frames: &[(f64, &Pose)]) -> Vec<u8> {
     let joints = skeleton.joints();
     let rest = Pose::rest(skeleton).world(skeleton).positions;
     let mut mesh = Mesh::default();
-    for (i, j) in joints.iter().enumerate() {
-        let Some(p) = j.parent else { continue };
-        let (width, skin) = part(&joints[p].name);
-        mesh.bone(rest[p], rest[i], width, p as u16, skin);
-    }
-    if let Some(head) = skeleton.joint("skullbase") {
-        let at = rest[head];
-        mesh.bone(at, at + Vec3::new(0.0, 0.22, 0.0), 0.17, head as u16, true);
+    for part in mannequin::segments(skeleton) {
+        let (a, b) = (Vec3::from(part.from), Vec3::from(part.to));
+        mesh.bone(a, b, part.width, part.joint as u16, part.skin);
     }
     let mut buf = Buffer::default();
     let position = buf.vec3s(&mesh.positions, Some(ARRAY_BUFFER), true);

@@ -5,6 +5,8 @@ mod record;
 mod run;
 mod serve;
 mod tcp;
+mod view;
+mod web;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -33,6 +35,9 @@ enum Command {
     Run(run::RunArgs),
     /// Schedule BML files without executing them; print every sync point's time.
     Plan(run::PlanArgs),
+    /// Realize BML on the virtual clock and show it on a web page: the character in 3D, the
+    /// timeline and the feedback (--out DIR writes the page, --serve ADDR serves it).
+    View(view::ViewArgs),
     /// Draw a feedback log as a timeline picture (SVG).
     Timeline(run::TimelineArgs),
     /// Compare two feedback logs (XML or JSON lines) modulo clock origin, posix times and jitter.
@@ -65,6 +70,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run::run(args),
         Command::Plan(args) => run::plan(args),
         Command::Diff(args) => diff::run(args),
+        Command::View(args) => view::view(args),
         Command::Timeline(args) => run::timeline(args),
         Command::Serve(args) => serve::serve(args),
         Command::Conformance(args) => serve::conformance(args),

@@ -92,23 +92,15 @@ impl Recording {
         Ok(self.poses_of(&character))
     }
 
-    /// Writes the frames of every character that received blocks (sorted by id; the default
-    /// character is `""`). An error has the exit code.
+    /// Writes the frames of every character that received blocks (see [`Recording::lines`]).
+    /// An error has the exit code.
     pub fn write_frames(&self, realizer: &Realizer, path: &Path) -> Result<(), (u8, String)> {
-        let mut ids: Vec<&str> = (realizer.characters())
-            .filter(|(_, m)| m.received_blocks())
-            .map(|(c, _)| c)
-            .collect();
-        ids.sort_unstable();
-        let skeleton = Skeleton::adult();
-        let mut text = bml_realizer::body::frames::header(&skeleton, self.fps, &ids);
+        let ids = received(realizer);
+        let (header, lines) = self.lines(&ids);
+        let mut text = header;
         text.push('\n');
-        let per_character: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
-        for (k, (time, _)) in self.frames.iter().enumerate() {
-            let poses: Vec<(&str, &Pose, &[usize])> = (ids.iter().zip(&per_character))
-                .map(|(&id, p)| (id, &p[k].pose, p[k].clamped.as_slice()))
-                .collect();
-            text.push_str(&bml_realizer::body::frames::line(&skeleton, *time, &poses));
+        for line in lines {
+            text.push_str(&line);
             text.push('\n');
         }
         write_file(path, text.as_bytes())?;
@@ -120,6 +112,23 @@ impl Recording {
             ids.len()
         );
         Ok(())
+    }
+
+    /// The frames file's header line and its frame lines, showing the characters `ids` (the
+    /// default character is `""`).
+    pub fn lines(&self, ids: &[&str]) -> (String, Vec<String>) {
+        let skeleton = Skeleton::adult();
+        let header = bml_realizer::body::frames::header(&skeleton, self.fps, ids);
+        let per_character: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
+        let lines = (self.frames.iter().enumerate())
+            .map(|(k, (time, _))| {
+                let poses: Vec<(&str, &Pose, &[usize])> = (ids.iter().zip(&per_character))
+                    .map(|(&id, p)| (id, &p[k].pose, p[k].clamped.as_slice()))
+                    .collect();
+                bml_realizer::body::frames::line(&skeleton, *time, &poses)
+            })
+            .collect();
+        (header, lines)
     }
 
     /// The poses of `character` ("" the default one), frame by frame (the rest pose where a
@@ -141,6 +150,16 @@ impl Recording {
     }
 }
 
+/// Every character that received blocks, sorted by id (the default character is `""`).
+pub fn received(realizer: &Realizer) -> Vec<&str> {
+    let mut ids: Vec<&str> = (realizer.characters())
+        .filter(|(_, m)| m.received_blocks())
+        .map(|(c, _)| c)
+        .collect();
+    ids.sort_unstable();
+    ids
+}
+
 /// Writes `bytes` to `path`; an error has exit code 2.
 fn write_file(path: &Path, bytes: &[u8]) -> Result<(), (u8, String)> {
     std::fs::write(path, bytes).map_err(|e| (2, format!("{}: cannot write: {e}", path.display())))
@@ -154,12 +173,7 @@ fn recorded_character(
     asked: Option<&str>,
     flag: &str,
 ) -> Result<String, String> {
-    let mut received: Vec<&str> = realizer
-        .characters()
-        .filter(|(_, m)| m.received_blocks())
-        .map(|(c, _)| c)
-        .collect();
-    received.sort_unstable();
+    let received = received(realizer);
     let named = |list: &[&str]| -> String {
         let names: Vec<String> = list
             .iter()

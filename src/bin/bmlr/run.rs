@@ -50,9 +50,33 @@ pub struct RunArgs {
     /// computed at this rate when a frame consumer needs them).
     #[arg(long, value_name = "HZ", default_value_t = 60.0)]
     fps: f64,
+    #[command(flatten)]
+    pub setup: SetupArgs,
+    /// Write the realized motion of the character (--character, else the default one) as BVH,
+    /// one frame every 1/--fps seconds (virtual clock only).
+    #[arg(long, value_name = "OUT.bvh")]
+    bvh: Option<std::path::PathBuf>,
+    /// Write a skinned mannequin with the realized motion of the character (--character, else
+    /// the default one) as binary glTF, one key every 1/--fps seconds (virtual clock only).
+    #[arg(long, value_name = "OUT.glb")]
+    gltf: Option<std::path::PathBuf>,
+    /// Write the realized frames of every character as JSON lines (docs/cli.md, "Frames"):
+    /// a header with the skeleton, then one line every 1/--fps seconds (virtual clock only).
+    #[arg(long, value_name = "OUT.jsonl")]
+    frames: Option<std::path::PathBuf>,
+    /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
+    /// clock before the next item.
+    #[arg(required = true, value_name = "ITEM")]
+    items: Vec<String>,
+}
+
+/// The character, motion data, world, idle layer and limits of a realizer on the virtual clock
+/// (`bmlr run` and `bmlr view`).
+#[derive(Args)]
+pub struct SetupArgs {
     /// Character for blocks without a characterId.
     #[arg(long, value_name = "ID")]
-    character: Option<String>,
+    pub character: Option<String>,
     /// A directory of motion data adding to the embedded defaults: any of units.json (procedural
     /// units), gestures.json, poses.json and heads.json (bindings, which win over the embedded
     /// ones for what they bind).
@@ -62,28 +86,27 @@ pub struct RunArgs {
     /// gaze, pointing and headDirectionShift, added to the built-in scene.
     #[arg(long, value_name = "WORLD.json")]
     pub world: Option<std::path::PathBuf>,
-    /// Write the realized motion of the character (--character, else the default one) as BVH,
-    /// one frame every 1/--fps seconds (virtual clock only).
-    #[arg(long, value_name = "OUT.bvh")]
-    bvh: Option<std::path::PathBuf>,
-    /// Write a skinned mannequin with the realized motion of the character (--character, else
-    /// the default one) as binary glTF, one key every 1/--fps seconds (virtual clock only).
-    #[arg(long, value_name = "OUT.glb")]
-    gltf: Option<std::path::PathBuf>,
     /// Characters stand still between behaviours: no breathing, no weight shift (the idle layer
     /// changes the motion only, never the feedback).
     #[arg(long)]
-    no_idle: bool,
-    /// Write the realized frames of every character as JSON lines (docs/cli.md, "Frames"):
-    /// a header with the skeleton, then one line every 1/--fps seconds (virtual clock only).
-    #[arg(long, value_name = "OUT.jsonl")]
-    frames: Option<std::path::PathBuf>,
+    pub no_idle: bool,
     #[command(flatten)]
     pub limits: LimitArgs,
-    /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
-    /// clock before the next item.
-    #[arg(required = true, value_name = "ITEM")]
-    items: Vec<String>,
+}
+
+impl SetupArgs {
+    /// The realizer asked for (`posix_time`: feedback carries wall-clock times); the error
+    /// names the option that is wrong.
+    pub fn realizer(&self, posix_time: bool) -> Result<Realizer, String> {
+        let realizer = with_assets(Realizer::new(), self.assets.as_deref())
+            .map_err(|e| format!("--assets {e}"))?;
+        Ok(with_world(realizer, self.world.as_deref())
+            .map_err(|e| format!("--world {e}"))?
+            .with_default_character(self.character.clone())
+            .with_posix_time(posix_time)
+            .with_idle(!self.no_idle)
+            .with_limits(self.limits.limits()))
+    }
 }
 
 /// The limits on one block (`docs/cli.md`, "Limits"), shared by the commands that read BML.
@@ -184,14 +207,15 @@ pub struct PlanArgs {
 }
 
 /// An item of the command line, read before anything runs.
-enum Item {
+pub enum Item {
     /// A file's name and text.
     Text(String, String),
     Advance(f64),
     Stdin,
 }
 
-fn read_items(items: &[String]) -> Result<Vec<Item>, String> {
+/// The items of a command line: files read, clock advances checked.
+pub fn read_items(items: &[String]) -> Result<Vec<Item>, String> {
     items
         .iter()
         .map(|a| {
@@ -227,20 +251,60 @@ fn print(out: &mut impl Write, format: Format, feedback: &[Feedback]) -> bool {
 /// How warnings name blocks read from standard input.
 const STDIN: &str = "<stdin>";
 
-/// A realizer on the virtual clock that prints its feedback as it goes.
-struct VirtualRun {
-    realizer: Realizer,
+/// A realizer on the virtual clock that prints its feedback as it goes (or keeps it, with the
+/// time it was sent, for `bmlr view`).
+pub struct VirtualRun {
+    pub realizer: Realizer,
     format: Format,
     until: f64,
-    out: std::io::StdoutLock<'static>,
+    /// Where feedback is printed (`None`: kept in `log` only).
+    out: Option<std::io::StdoutLock<'static>>,
     open: bool,
-    /// The frames recorded for --bvh and --frames.
-    motion: Option<Recording>,
+    /// The frames recorded for --bvh, --frames, --gltf and the viewer.
+    pub motion: Option<Recording>,
+    /// Every message with the time of the frame that sent it, when it is kept.
+    pub log: Option<Vec<(f64, Feedback)>>,
     /// Blocks that could not be parsed (the run goes on; it exits 1).
-    invalid: usize,
+    pub invalid: usize,
 }
 
 impl VirtualRun {
+    /// A run that keeps its feedback and records frames at `fps` instead of printing.
+    pub fn recording(realizer: Realizer, fps: f64, until: f64) -> VirtualRun {
+        VirtualRun {
+            realizer,
+            format: Format::Xml,
+            until,
+            out: None,
+            open: true,
+            motion: Some(Recording::new(fps)),
+            log: Some(Vec::new()),
+            invalid: 0,
+        }
+    }
+
+    /// Sends `items` in order and runs until nothing more will happen.
+    pub fn items(&mut self, items: Vec<Item>) {
+        for item in items {
+            match item {
+                Item::Text(path, text) => self.perform(&text, &path),
+                Item::Advance(s) => self.advance_to(self.realizer.now() + s),
+                Item::Stdin => self.stdin(),
+            }
+        }
+        self.run_out();
+    }
+
+    /// Prints (or keeps) the feedback of a frame at time `at`.
+    fn emit(&mut self, at: f64, feedback: Vec<Feedback>) {
+        if let Some(out) = self.out.as_mut() {
+            self.open &= print(out, self.format, &feedback);
+        }
+        if let Some(log) = self.log.as_mut() {
+            log.extend(feedback.into_iter().map(|f| (at, f)));
+        }
+    }
+
     /// Moves the clock to `t` (capped at `--until`), event by event; frames on the way are
     /// recorded when a BVH or a frames file is asked for (feedback does not depend on them).
     fn advance_to(&mut self, t: f64) {
@@ -249,11 +313,11 @@ impl VirtualRun {
             let at = m.next;
             m.next = (m.frames.len() + 1) as f64 * m.period;
             let frame = self.realizer.tick(at);
-            self.open &= print(&mut self.out, self.format, &frame.feedback);
+            self.emit(at, frame.feedback);
             self.record(at, frame.poses);
         }
         let frame = self.realizer.tick(t);
-        self.open &= print(&mut self.out, self.format, &frame.feedback);
+        self.emit(t, frame.feedback);
     }
 
     fn record(&mut self, time: f64, poses: Vec<bml_realizer::engine::CharacterPose>) {
@@ -269,8 +333,9 @@ impl VirtualRun {
         if self.realizer.perform_bml_from(text, Some(source)).is_err() {
             self.invalid += 1;
         }
-        let frame = self.realizer.tick(self.realizer.now());
-        self.open &= print(&mut self.out, self.format, &frame.feedback);
+        let now = self.realizer.now();
+        let frame = self.realizer.tick(now);
+        self.emit(now, frame.feedback);
     }
 
     /// Blocks from standard input, line by line: a line that is not UTF-8 (or too long) costs
@@ -311,24 +376,30 @@ impl VirtualRun {
         }
     }
 
-    /// Writes the --bvh and --frames files asked for, with one last frame at the final time.
-    fn write_recordings(&mut self, args: &RunArgs) -> Result<(), (u8, String)> {
-        let Some(mut m) = self.motion.take() else {
-            return Ok(());
-        };
+    /// The recorded frames, with one last frame at the final time.
+    pub fn take_motion(&mut self) -> Option<Recording> {
+        let mut m = self.motion.take()?;
         let now = self.realizer.now();
         if m.frames.is_empty() || m.next <= now + 1e-9 {
             let frame = self.realizer.tick(now);
             m.frames.push((now, frame.poses));
         }
+        Some(m)
+    }
+
+    /// Writes the --bvh, --frames and --gltf files asked for.
+    fn write_recordings(&mut self, args: &RunArgs) -> Result<(), (u8, String)> {
+        let Some(m) = self.take_motion() else {
+            return Ok(());
+        };
         if let Some(path) = &args.bvh {
-            m.write_bvh(&self.realizer, path, args.character.as_deref())?;
+            m.write_bvh(&self.realizer, path, args.setup.character.as_deref())?;
         }
         if let Some(path) = &args.frames {
             m.write_frames(&self.realizer, path)?;
         }
         if let Some(path) = &args.gltf {
-            m.write_gltf(&self.realizer, path, args.character.as_deref())?;
+            m.write_gltf(&self.realizer, path, args.setup.character.as_deref())?;
         }
         Ok(())
     }
@@ -357,20 +428,14 @@ pub fn run(args: RunArgs) -> ExitCode {
         realizer,
         format: args.format.into(),
         until: args.until.unwrap_or(f64::INFINITY),
-        out: std::io::stdout().lock(),
+        out: Some(std::io::stdout().lock()),
         open: true,
         invalid: 0,
         motion: (args.bvh.is_some() || args.frames.is_some() || args.gltf.is_some())
             .then(|| Recording::new(args.fps)),
+        log: None,
     };
-    for item in items {
-        match item {
-            Item::Text(path, text) => run.perform(&text, &path),
-            Item::Advance(s) => run.advance_to(run.realizer.now() + s),
-            Item::Stdin => run.stdin(),
-        }
-    }
-    run.run_out();
+    run.items(items);
     report_unfinished(&run.realizer);
     if let Err((code, e)) = run.write_recordings(&args) {
         eprintln!("bmlr run: {e}");
@@ -399,20 +464,12 @@ fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer), String> {
             ));
         }
     }
-    let realizer = with_assets(Realizer::new(), args.assets.as_deref())
-        .map_err(|e| format!("--assets {e}"))?;
-    let realizer = with_world(realizer, args.world.as_deref())
-        .map_err(|e| format!("--world {e}"))?
-        .with_default_character(args.character.clone())
-        .with_posix_time(args.realtime)
-        .with_idle(!args.no_idle)
-        .with_limits(args.limits.limits());
-    Ok((items, realizer))
+    Ok((items, args.setup.realizer(args.realtime)?))
 }
 
 /// Tells stderr which blocks did not finish (waiting for activation, persistent behaviour, or
 /// the clock stopped).
-fn report_unfinished(realizer: &Realizer) {
+pub fn report_unfinished(realizer: &Realizer) {
     for (character, m) in realizer.characters() {
         for (id, status) in m.live_blocks() {
             let why = match status {
@@ -555,7 +612,7 @@ impl RealtimeRun {
 }
 
 /// Success, or exit 1 (after a line on stderr) when `invalid` blocks could not be parsed.
-fn exit_for(invalid: usize, command: &str) -> ExitCode {
+pub fn exit_for(invalid: usize, command: &str) -> ExitCode {
     if invalid == 0 {
         return ExitCode::SUCCESS;
     }

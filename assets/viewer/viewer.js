@@ -1,0 +1,468 @@
+// bmlr view: the page that shows a realized BML run. It reads the run from the page itself
+// (the JSON in #bmlr-data: the frames file's header and frames, the mannequin's boxes, the
+// feedback with the time each message was sent, the timeline picture and the world's points)
+// or, live, from a WebSocket that sends the same frames and feedback as they happen. It draws
+// the mannequin with three.js (loaded from the page's own text, so that the page works opened
+// from disk), the world's points, a cursor over the timeline and the feedback up to the cursor,
+// with play / pause / scrub / speed. It opens paused at #t=SECONDS and sets the title to
+// "bmlr view: ready" once the first frame is drawn.
+'use strict';
+
+(function () {
+  const data = JSON.parse(document.getElementById('bmlr-data').textContent);
+  const source = document.getElementById('three-source').textContent;
+  const url = URL.createObjectURL(new Blob([source], { type: 'text/javascript' }));
+  import(url).then(
+    (THREE) => new Viewer(THREE, data).start(),
+    (e) => fail('three.js did not load: ' + e),
+  );
+
+  function fail(message) {
+    const box = document.getElementById('error');
+    box.textContent = message;
+    box.style.display = 'block';
+    console.error(message);
+  }
+
+  /** The frames of a run: times, and per frame each character's root and joint rotations. */
+  class Clip {
+    constructor(header) {
+      this.joints = header.skeleton.joints;
+      this.characters = header.characters;
+      this.times = [];
+      // per frame, per character: root x y z, rotation x y z w, then x y z w per joint
+      this.poses = [];
+      this.clamped = [];
+    }
+
+    get duration() {
+      return this.times.length ? this.times[this.times.length - 1] : 0;
+    }
+
+    /** Adds a frame line of the frames file (frames arrive in time order). */
+    push(frame) {
+      const poses = this.characters.map((id) => {
+        const c = frame.characters[id];
+        const pose = new Float32Array(7 + 4 * this.joints.length);
+        if (!c) {
+          for (let j = 0; j <= this.joints.length; j++) pose[6 + 4 * j] = 1;
+          return pose;
+        }
+        pose.set(c.root, 0);
+        pose.set(c.rotation, 3);
+        this.joints.forEach((j, k) => pose.set(c.joints[j.name] || [0, 0, 0, 1], 7 + 4 * k));
+        return pose;
+      });
+      this.times.push(frame.time);
+      this.poses.push(poses);
+      this.clamped.push(this.characters.map((id) => (frame.characters[id] || {}).clamped || []));
+    }
+
+    /** The index of the last frame at or before `t` (0 before the first). */
+    index(t) {
+      let lo = 0;
+      let hi = this.times.length - 1;
+      while (lo < hi) {
+        const mid = (lo + hi + 1) >> 1;
+        if (this.times[mid] <= t) lo = mid;
+        else hi = mid - 1;
+      }
+      return lo;
+    }
+
+    /** Character `k`'s pose at time `t`, interpolated between frames, into `out`. */
+    sample(THREE, t, k, out) {
+      const i = this.index(t);
+      const a = this.poses[i][k];
+      const j = Math.min(i + 1, this.times.length - 1);
+      const span = this.times[j] - this.times[i];
+      const f = span > 0 ? Math.min(Math.max((t - this.times[i]) / span, 0), 1) : 0;
+      const b = this.poses[j][k];
+      for (let c = 0; c < 3; c++) out[c] = a[c] + (b[c] - a[c]) * f;
+      for (let q = 3; q < out.length; q += 4) THREE.Quaternion.slerpFlat(out, q, a, q, b, q, f);
+      return out;
+    }
+  }
+
+  /** Where world point keys put a point at time `t` (linear, resting before and after). */
+  function along(keys, t) {
+    if (t <= keys[0][0]) return keys[0][1];
+    for (let i = 1; i < keys.length; i++) {
+      if (t <= keys[i][0]) {
+        const [t0, a] = keys[i - 1];
+        const [t1, b] = keys[i];
+        const f = t1 > t0 ? (t - t0) / (t1 - t0) : 1;
+        return a.map((v, c) => v + (b[c] - v) * f);
+      }
+    }
+    return keys[keys.length - 1][1];
+  }
+
+  function fmt(t) {
+    return t.toFixed(3) + ' s';
+  }
+
+  class Viewer {
+    constructor(THREE, data) {
+      this.THREE = THREE;
+      this.data = data;
+      this.clip = new Clip(data.header);
+      data.frames.forEach((f) => this.clip.push(f));
+      this.feedback = [];
+      this.shown = 0;
+      this.t = 0;
+      this.playing = false;
+      this.following = !!data.live;
+      this.speed = 1;
+      this.drawn = false;
+      this.last = null;
+    }
+
+    start() {
+      this.scene3d();
+      this.figures = this.clip.characters.map((id, k) => this.figure(k));
+      this.worldPoints();
+      this.controls();
+      this.orbit();
+      this.setTimeline(this.data.timeline);
+      this.data.feedback.forEach((m) => this.addFeedback(m));
+      this.refreshFeedbackEmpty();
+      const caption = this.data.title + (this.data.live ? ' (live)' : '');
+      document.getElementById('what').textContent = caption;
+      this.seek(this.hashTime());
+      window.addEventListener('hashchange', () => {
+        this.pause();
+        this.seek(this.hashTime());
+      });
+      if (this.data.live) this.connect();
+      requestAnimationFrame((now) => this.frame(now));
+    }
+
+    /** The time of the page address (#t=SECONDS), else 0. */
+    hashTime() {
+      const m = /(?:^#|&)t=([0-9]*\.?[0-9]+)/.exec(location.hash);
+      return m ? parseFloat(m[1]) : 0;
+    }
+
+    scene3d() {
+      const THREE = this.THREE;
+      this.canvas = document.getElementById('scene');
+      this.renderer = new THREE.WebGLRenderer({ canvas: this.canvas, antialias: true });
+      this.renderer.setPixelRatio(window.devicePixelRatio || 1);
+      this.scene = new THREE.Scene();
+      this.scene.background = new THREE.Color(0xdde3ea);
+      this.camera = new THREE.PerspectiveCamera(32, 1, 0.05, 100);
+      this.scene.add(new THREE.HemisphereLight(0xffffff, 0x8a8f99, 2.2));
+      const sun = new THREE.DirectionalLight(0xffffff, 2.0);
+      sun.position.set(2, 4, 3);
+      this.scene.add(sun);
+      const floor = new THREE.Mesh(
+        new THREE.CircleGeometry(4, 48),
+        new THREE.MeshLambertMaterial({ color: 0xc9ced6 }),
+      );
+      floor.rotation.x = -Math.PI / 2;
+      this.scene.add(floor);
+      const grid = new THREE.GridHelper(8, 16, 0xaab1bc, 0xb8bec8);
+      grid.position.y = 0.001;
+      this.scene.add(grid);
+      this.materials = [
+        new THREE.MeshStandardMaterial({ color: 0x3f5473, roughness: 0.8 }),
+        new THREE.MeshStandardMaterial({ color: 0xdcab8c, roughness: 0.6 }),
+      ];
+      this.resize();
+      window.addEventListener('resize', () => this.resize());
+    }
+
+    resize() {
+      const w = this.canvas.clientWidth || 1;
+      const h = this.canvas.clientHeight || 1;
+      this.renderer.setSize(w, h, false);
+      this.camera.aspect = w / h;
+      this.camera.updateProjectionMatrix();
+    }
+
+    /** Character `k`'s mannequin: a group per joint, the boxes on the joints they follow. */
+    figure(k) {
+      const THREE = this.THREE;
+      const joints = this.clip.joints;
+      const index = new Map(joints.map((j, i) => [j.name, i]));
+      const nodes = joints.map((j) => {
+        const g = new THREE.Group();
+        g.position.fromArray(j.offset);
+        return g;
+      });
+      const rest = [];
+      joints.forEach((j, i) => {
+        const p = new THREE.Vector3().fromArray(j.offset);
+        if (j.parent !== null) {
+          const parent = index.get(j.parent);
+          nodes[parent].add(nodes[i]);
+          p.add(rest[parent]);
+        } else {
+          this.scene.add(nodes[i]);
+        }
+        rest.push(p);
+      });
+      const up = new THREE.Vector3(0, 1, 0);
+      for (const s of this.data.segments) {
+        const a = new THREE.Vector3().fromArray(s.from);
+        const b = new THREE.Vector3().fromArray(s.to);
+        const length = Math.max(a.distanceTo(b), 0.01);
+        const box = new THREE.Mesh(
+          new THREE.BoxGeometry(s.width, length, s.width),
+          this.materials[s.skin ? 1 : 0],
+        );
+        box.position.copy(a).add(b).multiplyScalar(0.5).sub(rest[s.joint]);
+        if (length > 0.01) box.quaternion.setFromUnitVectors(up, b.clone().sub(a).normalize());
+        nodes[s.joint].add(box);
+      }
+      return { nodes, pose: new Float32Array(7 + 4 * joints.length), k };
+    }
+
+    /** Every world point as a small sphere with its name; paths as lines. */
+    worldPoints() {
+      const THREE = this.THREE;
+      const world = this.data.world || { points: {}, paths: {} };
+      this.points = [];
+      const material = new THREE.MeshStandardMaterial({ color: 0xd9822b });
+      for (const [name, at] of Object.entries(world.points)) {
+        const ball = new THREE.Mesh(new THREE.SphereGeometry(0.035, 16, 12), material);
+        ball.position.fromArray(at);
+        const label = this.label(name);
+        label.position.set(0, 0.08, 0);
+        ball.add(label);
+        this.scene.add(ball);
+        this.points.push({ ball, keys: (world.paths || {})[name] });
+      }
+      for (const keys of Object.values(world.paths || {})) {
+        const line = new THREE.Line(
+          new THREE.BufferGeometry().setFromPoints(keys.map((k) => new THREE.Vector3().fromArray(k[1]))),
+          new THREE.LineDashedMaterial({ color: 0xd9822b, dashSize: 0.05, gapSize: 0.04 }),
+        );
+        line.computeLineDistances();
+        this.scene.add(line);
+      }
+    }
+
+    label(text) {
+      const THREE = this.THREE;
+      const canvas = document.createElement('canvas');
+      canvas.width = 256;
+      canvas.height = 64;
+      const g = canvas.getContext('2d');
+      g.font = '28px sans-serif';
+      g.fillStyle = '#7a4510';
+      g.textAlign = 'center';
+      g.fillText(text, 128, 40);
+      const sprite = new THREE.Sprite(
+        new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(canvas), depthWrite: false }),
+      );
+      sprite.scale.set(0.32, 0.08, 1);
+      return sprite;
+    }
+
+    controls() {
+      this.playButton = document.getElementById('play');
+      this.scrub = document.getElementById('scrub');
+      this.clock = document.getElementById('clock');
+      this.playButton.addEventListener('click', () => (this.playing ? this.pause(true) : this.play()));
+      this.scrub.addEventListener('input', () => {
+        this.pause();
+        this.seek(parseFloat(this.scrub.value));
+      });
+      this.scrub.addEventListener('change', () => this.remember());
+      document.getElementById('speed').addEventListener('change', (e) => {
+        this.speed = parseFloat(e.target.value);
+      });
+      window.addEventListener('keydown', (e) => {
+        if (e.code === 'Space' && e.target.tagName !== 'SELECT') {
+          e.preventDefault();
+          this.playButton.click();
+        }
+      });
+    }
+
+    /** Drag to turn around the character, wheel to come closer. */
+    orbit() {
+      this.view = { azimuth: 0.35, elevation: 0.08, distance: 3.5 };
+      let drag = null;
+      this.canvas.addEventListener('pointerdown', (e) => {
+        drag = { x: e.clientX, y: e.clientY, ...this.view };
+        this.canvas.setPointerCapture(e.pointerId);
+      });
+      this.canvas.addEventListener('pointermove', (e) => {
+        if (!drag) return;
+        this.view.azimuth = drag.azimuth - (e.clientX - drag.x) * 0.01;
+        const elevation = drag.elevation + (e.clientY - drag.y) * 0.01;
+        this.view.elevation = Math.min(Math.max(elevation, -0.4), 1.4);
+      });
+      this.canvas.addEventListener('pointerup', () => (drag = null));
+      this.canvas.addEventListener('wheel', (e) => {
+        e.preventDefault();
+        this.view.distance = Math.min(Math.max(this.view.distance * Math.exp(e.deltaY * 0.001), 1), 12);
+      }, { passive: false });
+    }
+
+    play() {
+      if (!this.data.live && this.t >= this.clip.duration) this.seek(0);
+      this.playing = true;
+      this.following = !!this.data.live;
+      this.last = null;
+      this.playButton.textContent = '❚❚ pause';
+    }
+
+    /** Stops at the current time; `remember` puts the time into the address. */
+    pause(remember) {
+      this.playing = false;
+      this.following = false;
+      this.playButton.textContent = '▶ play';
+      if (remember) this.remember();
+    }
+
+    /** The time into the page address, so that a reload or a shared link opens here. */
+    remember() {
+      try {
+        history.replaceState(null, '', '#t=' + this.t.toFixed(3));
+      } catch (e) {
+        // some file:// settings forbid it; the page works without it
+      }
+    }
+
+    seek(t) {
+      this.t = Math.min(Math.max(t, 0), Math.max(this.clip.duration, 0));
+    }
+
+    frame(now) {
+      if (this.playing) {
+        if (this.following) {
+          this.t = this.clip.duration;
+        } else if (this.last !== null) {
+          this.seek(this.t + ((now - this.last) / 1000) * this.speed);
+          if (this.t >= this.clip.duration && !this.data.live) this.pause(true);
+        }
+      }
+      this.last = now;
+      this.draw();
+      requestAnimationFrame((n) => this.frame(n));
+    }
+
+    draw() {
+      const THREE = this.THREE;
+      if (this.clip.times.length) {
+        for (const f of this.figures) {
+          const pose = this.clip.sample(THREE, this.t, f.k, f.pose);
+          f.nodes[0].position.set(pose[0], pose[1], pose[2]);
+          f.nodes[0].quaternion.fromArray(pose, 3);
+          for (let j = 1; j < f.nodes.length; j++) f.nodes[j].quaternion.fromArray(pose, 7 + 4 * j);
+        }
+      }
+      for (const p of this.points) if (p.keys) p.ball.position.fromArray(along(p.keys, this.t));
+      const v = this.view;
+      const target = new THREE.Vector3(0, 0.92, 0);
+      this.camera.position.set(
+        target.x + v.distance * Math.sin(v.azimuth) * Math.cos(v.elevation),
+        target.y + v.distance * Math.sin(v.elevation),
+        target.z + v.distance * Math.cos(v.azimuth) * Math.cos(v.elevation),
+      );
+      this.camera.lookAt(target);
+      this.renderer.render(this.scene, this.camera);
+      this.scrub.max = String(Math.max(this.clip.duration, 0.001));
+      this.scrub.value = String(this.t);
+      this.clock.textContent = fmt(this.t) + ' / ' + fmt(this.clip.duration);
+      this.moveCursor();
+      this.showFeedbackUpTo(this.t);
+      if (!this.drawn) {
+        this.drawn = true;
+        document.title = 'bmlr view: ready';
+      }
+    }
+
+    /** Puts the timeline picture in place, with a cursor line over it; a click seeks. */
+    setTimeline(timeline) {
+      if (!timeline) return;
+      const box = document.getElementById('timeline');
+      box.innerHTML = timeline.svg;
+      this.axis = timeline.axis;
+      const svg = box.querySelector('svg');
+      if (!svg) return;
+      const ns = 'http://www.w3.org/2000/svg';
+      this.cursor = document.createElementNS(ns, 'line');
+      this.cursor.setAttribute('y1', '0');
+      this.cursor.setAttribute('y2', svg.getAttribute('height'));
+      this.cursor.setAttribute('stroke', '#d03030');
+      this.cursor.setAttribute('stroke-width', '2');
+      svg.appendChild(this.cursor);
+      svg.addEventListener('click', (e) => {
+        const x = e.clientX - svg.getBoundingClientRect().left;
+        this.pause();
+        this.seek(this.axis.t0 + (x - this.axis.left) / this.axis.px_per_s);
+        this.remember();
+      });
+      this.cursorAt = null;
+    }
+
+    moveCursor() {
+      if (!this.cursor || this.cursorAt === this.t) return;
+      this.cursorAt = this.t;
+      const x = this.axis.left + (this.t - this.axis.t0) * this.axis.px_per_s;
+      this.cursor.setAttribute('x1', x.toFixed(1));
+      this.cursor.setAttribute('x2', x.toFixed(1));
+      const box = document.getElementById('timeline');
+      if (x < box.scrollLeft + 40 || x > box.scrollLeft + box.clientWidth - 40) {
+        box.scrollLeft = Math.max(x - box.clientWidth / 3, 0);
+      }
+    }
+
+    /** One feedback message ({time, kind, text}); messages arrive in time order. */
+    addFeedback(m) {
+      const li = document.createElement('li');
+      li.className = m.kind;
+      li.hidden = true;
+      const at = document.createElement('span');
+      at.className = 'at';
+      at.textContent = m.time.toFixed(3);
+      // the namespace declarations repeat on every line: the list leaves them out
+      li.append(at, m.text.replace(/ xmlns(:\w+)?="[^"]*"/g, ''));
+      document.getElementById('feedback').appendChild(li);
+      this.feedback.push({ time: m.time, li });
+      if (this.feedback.length === 1) this.refreshFeedbackEmpty();
+    }
+
+    refreshFeedbackEmpty() {
+      const list = document.getElementById('feedback');
+      const empty = list.querySelector('.empty');
+      if (this.feedback.length && empty) empty.remove();
+      if (!this.feedback.length && !empty) {
+        const li = document.createElement('li');
+        li.className = 'empty';
+        li.textContent = 'no feedback yet';
+        list.appendChild(li);
+      }
+    }
+
+    showFeedbackUpTo(t) {
+      let n = 0;
+      while (n < this.feedback.length && this.feedback[n].time <= t + 1e-9) n++;
+      if (n === this.shown) return;
+      const [lo, hi] = n > this.shown ? [this.shown, n] : [n, this.shown];
+      for (let i = lo; i < hi; i++) this.feedback[i].li.hidden = i >= n;
+      this.shown = n;
+      if (n > 0) this.feedback[n - 1].li.scrollIntoView({ block: 'nearest' });
+    }
+
+    /** Live: frames, feedback and the timeline arrive over a WebSocket as they happen. */
+    connect() {
+      const socket = new WebSocket('ws://' + location.host + '/live');
+      socket.onmessage = (e) => {
+        const m = JSON.parse(e.data);
+        if (m.frame) this.clip.push(m.frame);
+        if (m.feedback) this.addFeedback(m.feedback);
+        if (m.timeline) this.setTimeline(m.timeline);
+      };
+      socket.onclose = () => {
+        document.getElementById('what').textContent = this.data.title + ' (disconnected)';
+      };
+      this.play();
+    }
+  }
+})();

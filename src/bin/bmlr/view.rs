@@ -1,0 +1,188 @@
+//! `bmlr view ITEM... --out DIR | --serve ADDR`: realizes the items on the virtual clock (as
+//! `bmlr run` does), then writes or serves a page that shows the run: the mannequin in 3D with
+//! the world's points, the timeline with a cursor, and the feedback up to the cursor. The page's
+//! data is the frames file's header and lines, the mannequin's boxes, every feedback message with
+//! the time it was sent, the timeline picture and its time axis, and the world.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+
+use bml_realizer::body::{mannequin, Skeleton};
+use bml_realizer::feedback::{Feedback, Format};
+use bml_realizer::realizer::Realizer;
+use bml_realizer::timeline::Timeline;
+use clap::Args;
+use serde_json::{json, Value};
+
+use crate::run::{SetupArgs, VirtualRun};
+use crate::web;
+
+/// Arguments of `bmlr view`.
+#[derive(Args)]
+#[command(group(clap::ArgGroup::new("to").required(true).args(["out", "serve"])))]
+pub struct ViewArgs {
+    #[command(flatten)]
+    setup: SetupArgs,
+    /// Frames per second of the motion on the page.
+    #[arg(long, value_name = "HZ", default_value_t = 30.0)]
+    fps: f64,
+    /// Stop the clock at this global time (seconds).
+    #[arg(long, value_name = "SECS")]
+    until: Option<f64>,
+    /// Write the page into this directory: index.html (self-contained; it works opened from
+    /// disk) and three-LICENSE.txt.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Serve the page on this loopback address (e.g. 127.0.0.1:8080; port 0 picks one, printed
+    /// on stderr) until interrupted.
+    #[arg(long, value_name = "ADDR", conflicts_with = "out")]
+    serve: Option<String>,
+    /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
+    /// clock before the next item.
+    #[arg(required = true, value_name = "ITEM")]
+    items: Vec<String>,
+}
+
+/// `bmlr view`.
+pub fn view(args: ViewArgs) -> ExitCode {
+    let (page, invalid) = match realize(&args) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("bmlr view: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let written = match (&args.out, &args.serve) {
+        (Some(dir), _) => write(dir, &page),
+        (None, Some(addr)) => serve(addr, page),
+        (None, None) => unreachable!("clap requires --out or --serve"),
+    };
+    match written {
+        Ok(()) => crate::run::exit_for(invalid, "view"),
+        Err(e) => {
+            eprintln!("bmlr view: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Runs the items and returns the page, and how many blocks could not be parsed.
+fn realize(args: &ViewArgs) -> Result<(String, usize), String> {
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        return Err("--fps must be a positive number".into());
+    }
+    if args.until.is_some_and(|u| !(u.is_finite() && u >= 0.0)) {
+        return Err("--until must be a number of seconds >= 0".into());
+    }
+    let items = crate::run::read_items(&args.items)?;
+    let until = args.until.unwrap_or(f64::INFINITY);
+    let mut run = VirtualRun::recording(args.setup.realizer(false)?, args.fps, until);
+    run.items(items);
+    crate::run::report_unfinished(&run.realizer);
+    let motion = run.take_motion().expect("a recording run records");
+    let log = run.log.take().unwrap_or_default();
+    let mut characters = crate::record::received(&run.realizer);
+    if characters.is_empty() {
+        characters.push(""); // the default character, standing
+    }
+    let (header, lines) = motion.lines(&characters);
+    let data = data(&title(&args.items), &header, &lines, &log, &run.realizer);
+    Ok((web::page(&data), run.invalid))
+}
+
+/// The page's heading: the items, shortened to their file names.
+fn title(items: &[String]) -> String {
+    let names: Vec<&str> = (items.iter())
+        .map(|i| i.rsplit(['/', '\\']).next().unwrap_or(i))
+        .collect();
+    names.join(" ")
+}
+
+/// The page's data (see the module comment) as JSON; `header` and `lines` are JSON already.
+pub fn data(
+    title: &str,
+    header: &str,
+    lines: &[String],
+    log: &[(f64, Feedback)],
+    realizer: &Realizer,
+) -> String {
+    let feedback: Vec<Value> = log.iter().map(|(t, f)| message(*t, f)).collect();
+    let messages: Vec<Feedback> = log.iter().map(|(_, f)| f.clone()).collect();
+    let head = json!({
+        "title": title,
+        "live": false,
+        "segments": mannequin::segments(&Skeleton::adult()),
+        "feedback": feedback,
+        "timeline": timeline(&messages),
+        "world": world(realizer.world()),
+    });
+    let head = serde_json::to_string(&head).expect("the page data encodes");
+    // the frames file's lines go in as they are
+    let mut out = String::with_capacity(head.len() + lines.iter().map(|l| l.len() + 1).sum::<usize>());
+    out.push_str(&head[..head.len() - 1]);
+    out.push_str(",\"header\":");
+    out.push_str(header);
+    out.push_str(",\"frames\":[");
+    for (k, line) in lines.iter().enumerate() {
+        if k > 0 {
+            out.push(',');
+        }
+        out.push_str(line);
+    }
+    out.push_str("]}");
+    out
+}
+
+/// A feedback message for the page: when it was sent, its element name and its XML.
+pub fn message(time: f64, f: &Feedback) -> Value {
+    let kind = match f {
+        Feedback::BlockProgress(_) => "blockProgress",
+        Feedback::SyncPointProgress(_) => "syncPointProgress",
+        Feedback::Prediction(_) => "predictionFeedback",
+        Feedback::Warning(_) => "warningFeedback",
+    };
+    json!({"time": (time * 1e6).round() / 1e6, "kind": kind, "text": Format::Xml.encode(f)})
+}
+
+/// The timeline picture of `feedback` and its time axis.
+pub fn timeline(feedback: &[Feedback]) -> Value {
+    let t = Timeline::from_feedback(feedback);
+    json!({"svg": t.to_svg(), "axis": t.axis()})
+}
+
+/// The world's points and paths.
+fn world(w: &bml_realizer::world::World) -> Value {
+    let points: serde_json::Map<String, Value> = (w.points())
+        .map(|(name, at)| (name.to_string(), json!(at.to_array())))
+        .collect();
+    let paths: serde_json::Map<String, Value> = (w.paths())
+        .map(|(name, keys)| {
+            let keys: Vec<Value> = keys.iter().map(|(t, p)| json!([t, p.to_array()])).collect();
+            (name.to_string(), Value::Array(keys))
+        })
+        .collect();
+    json!({"points": points, "paths": paths})
+}
+
+/// Writes DIR/index.html and DIR/three-LICENSE.txt.
+fn write(dir: &std::path::Path, page: &str) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    let index = dir.join("index.html");
+    for (path, text) in [
+        (&index, page),
+        (&dir.join("three-LICENSE.txt"), web::THREE_LICENSE),
+    ] {
+        std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    }
+    eprintln!("wrote {} ({} kB)", index.display(), page.len() / 1024);
+    Ok(())
+}
+
+/// Serves the page on `addr` until the process is stopped.
+fn serve(addr: &str, page: String) -> Result<(), String> {
+    let (listener, at) = web::bind(addr)?;
+    eprintln!("bmlr view: serving http://{at}/ (Ctrl-C stops)");
+    web::serve(listener, Arc::new(page), None);
+    Ok(())
+}
