@@ -24,30 +24,46 @@
     console.error(message);
   }
 
+  /** Frames a live page keeps (ten minutes at 30 a second); older ones are let go. */
+  const LIVE_FRAMES = 18000;
+
   /** The frames of a run: times, and per frame each character's root and joint rotations. */
   class Clip {
     constructor(header) {
       this.joints = header.skeleton.joints;
-      this.characters = header.characters;
+      this.characters = header.characters.slice();
       this.times = [];
       // per frame, per character: root x y z, rotation x y z w, then x y z w per joint
       this.poses = [];
       this.clamped = [];
+      // the rest pose, for a character in the frames before it first appears
+      this.rest = new Float32Array(7 + 4 * this.joints.length);
+      this.rest.set(this.joints[0].offset, 0);
+      for (let q = 6; q < this.rest.length; q += 4) this.rest[q] = 1;
+      this.added = () => {};
     }
 
     get duration() {
       return this.times.length ? this.times[this.times.length - 1] : 0;
     }
 
+    /** The first frame's time (a live page starts when the watcher connects). */
+    get start() {
+      return this.times.length ? this.times[0] : 0;
+    }
+
     /** Adds a frame line of the frames file (frames arrive in time order). */
     push(frame) {
+      for (const id of Object.keys(frame.characters)) {
+        if (!this.characters.includes(id)) {
+          this.characters.push(id);
+          this.added(this.characters.length - 1);
+        }
+      }
       const poses = this.characters.map((id) => {
         const c = frame.characters[id];
+        if (!c) return this.rest;
         const pose = new Float32Array(7 + 4 * this.joints.length);
-        if (!c) {
-          for (let j = 0; j <= this.joints.length; j++) pose[6 + 4 * j] = 1;
-          return pose;
-        }
         pose.set(c.root, 0);
         pose.set(c.rotation, 3);
         this.joints.forEach((j, k) => pose.set(c.joints[j.name] || [0, 0, 0, 1], 7 + 4 * k));
@@ -56,6 +72,12 @@
       this.times.push(frame.time);
       this.poses.push(poses);
       this.clamped.push(this.characters.map((id) => (frame.characters[id] || {}).clamped || []));
+      if (this.times.length > LIVE_FRAMES) {
+        const drop = LIVE_FRAMES / 10;
+        this.times.splice(0, drop);
+        this.poses.splice(0, drop);
+        this.clamped.splice(0, drop);
+      }
     }
 
     /** The index of the last frame at or before `t` (0 before the first). */
@@ -73,11 +95,11 @@
     /** Character `k`'s pose at time `t`, interpolated between frames, into `out`. */
     sample(THREE, t, k, out) {
       const i = this.index(t);
-      const a = this.poses[i][k];
+      const a = this.poses[i][k] || this.rest;
       const j = Math.min(i + 1, this.times.length - 1);
       const span = this.times[j] - this.times[i];
       const f = span > 0 ? Math.min(Math.max((t - this.times[i]) / span, 0), 1) : 0;
-      const b = this.poses[j][k];
+      const b = this.poses[j][k] || this.rest;
       for (let c = 0; c < 3; c++) out[c] = a[c] + (b[c] - a[c]) * f;
       for (let q = 3; q < out.length; q += 4) THREE.Quaternion.slerpFlat(out, q, a, q, b, q, f);
       return out;
@@ -121,6 +143,7 @@
     start() {
       this.scene3d();
       this.figures = this.clip.characters.map((id, k) => this.figure(k));
+      this.clip.added = (k) => this.figures.push(this.figure(k));
       this.worldPoints();
       this.controls();
       this.orbit();
@@ -304,7 +327,7 @@
     }
 
     play() {
-      if (!this.data.live && this.t >= this.clip.duration) this.seek(0);
+      if (!this.data.live && this.t >= this.clip.duration) this.seek(this.clip.start);
       this.playing = true;
       this.following = !!this.data.live;
       this.last = null;
@@ -329,7 +352,7 @@
     }
 
     seek(t) {
-      this.t = Math.min(Math.max(t, 0), Math.max(this.clip.duration, 0));
+      this.t = Math.min(Math.max(t, this.clip.start), this.clip.duration);
     }
 
     frame(now) {
@@ -366,7 +389,8 @@
       );
       this.camera.lookAt(target);
       this.renderer.render(this.scene, this.camera);
-      this.scrub.max = String(Math.max(this.clip.duration, 0.001));
+      this.scrub.min = String(this.clip.start);
+      this.scrub.max = String(Math.max(this.clip.duration, this.clip.start + 0.001));
       this.scrub.value = String(this.t);
       this.clock.textContent = fmt(this.t) + ' / ' + fmt(this.clip.duration);
       this.moveCursor();

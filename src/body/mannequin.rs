@@ -95,10 +95,18 @@ mod tests {
     fn every_bone_and_the_head_is_a_box() {
         let s = Skeleton::adult();
         let parts = segments(&s);
-        assert_eq!(parts.len(), s.len() - 1 + 1, "one per bone (all but the root) + head");
+        assert_eq!(
+            parts.len(),
+            s.len() - 1 + 1,
+            "one per bone (all but the root) + head"
+        );
         let head = parts.last().unwrap();
         assert_eq!(head.joint, s.joint("skullbase").unwrap());
-        assert!(head.to[1] > 1.7 && head.to[1] < 1.9, "the head's top at {:?}", head.to);
+        assert!(
+            head.to[1] > 1.7 && head.to[1] < 1.9,
+            "the head's top at {:?}",
+            head.to
+        );
         let wrist = s.joint("r_wrist").unwrap();
         assert!(parts.iter().any(|p| p.joint == wrist && p.skin));
     }

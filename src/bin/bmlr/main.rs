@@ -1,6 +1,7 @@
 //! `bmlr`: the command-line front end of the BML realizer.
 
 mod diff;
+mod live;
 mod record;
 mod run;
 mod serve;

@@ -29,6 +29,10 @@ pub struct ServeArgs {
     /// on stderr).
     #[arg(long, value_name = "ADDR")]
     tcp: Option<String>,
+    /// With --tcp: also serve the viewer's page on this loopback address (e.g. 127.0.0.1:8080;
+    /// port 0 picks one, printed on stderr); it shows the character move as blocks arrive.
+    #[arg(long, value_name = "ADDR", requires = "tcp")]
+    view: Option<String>,
     /// With --tcp: send each client only the feedback about its own blocks.
     #[arg(long, requires = "tcp")]
     per_client: bool,
@@ -82,7 +86,18 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         }
     };
     if let Some(addr) = &args.tcp {
-        return crate::tcp::serve(addr, args.per_client, args.fps, realizer);
+        let view = match args
+            .view
+            .as_deref()
+            .map(|v| crate::live::LiveView::start(v, realizer.world()))
+        {
+            Some(Err(e)) => {
+                eprintln!("bmlr serve: --view {e}");
+                return ExitCode::from(2);
+            }
+            view => view.and_then(Result::ok),
+        };
+        return crate::tcp::serve(addr, args.per_client, args.fps, realizer, view);
     }
     serve_stdio(realizer, Duration::from_secs_f64(1.0 / args.fps))
 }

@@ -25,6 +25,8 @@ use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
 use bml_realizer::realizer::{Realizer, NO_ID};
 
+use crate::live::LiveView;
+
 type Client = u64;
 
 /// Lines of feedback a client may leave unread before it is disconnected.
@@ -112,7 +114,13 @@ fn block_of(fb: &Feedback) -> Option<&str> {
 }
 
 /// `bmlr serve --tcp ADDR`.
-pub fn serve(addr: &str, per_client: bool, fps: f64, realizer: Realizer) -> ExitCode {
+pub fn serve(
+    addr: &str,
+    per_client: bool,
+    fps: f64,
+    realizer: Realizer,
+    view: Option<LiveView>,
+) -> ExitCode {
     let listener = match TcpListener::bind(addr) {
         Ok(l) => l,
         Err(e) => {
@@ -130,7 +138,9 @@ pub fn serve(addr: &str, per_client: bool, fps: f64, realizer: Realizer) -> Exit
     let (tx, events) = mpsc::sync_channel(PENDING_LINES);
     let limits = *realizer.limits();
     std::thread::spawn(move || accept(listener, tx, limits));
-    Server::new(realizer, per_client, fps).run(events);
+    let mut server = Server::new(realizer, per_client, fps);
+    server.view = view;
+    server.run(events);
     ExitCode::SUCCESS
 }
 
@@ -146,6 +156,8 @@ struct Server {
     clients: HashMap<Client, Conn>,
     /// Per-client routing: block id → the client that sent it (until the block ends).
     owner: HashMap<String, Client>,
+    /// The live view (`--view`), told every frame and every message.
+    view: Option<LiveView>,
 }
 
 impl Server {
@@ -157,6 +169,7 @@ impl Server {
             per_client,
             clients: HashMap::new(),
             owner: HashMap::new(),
+            view: None,
         }
     }
 
@@ -191,7 +204,11 @@ impl Server {
 
     /// Brings the realizer up to the wall clock; its feedback goes by the routing rule.
     fn tick(&mut self, routed: &mut Routed) {
-        let frame = self.realizer.tick(self.clock.now());
+        let now = self.clock.now();
+        let frame = self.realizer.tick(now);
+        if let Some(view) = self.view.as_mut() {
+            view.frame(now, &frame.poses);
+        }
         routed.extend(frame.feedback.into_iter().map(|f| (None, f)));
     }
 
@@ -250,6 +267,9 @@ impl Server {
     /// Sends each message to its client(s).
     fn send_all(&mut self, routed: Routed) {
         for (to, fb) in routed {
+            if let Some(view) = self.view.as_mut() {
+                view.feedback(self.realizer.now(), &fb);
+            }
             let block = block_of(&fb).map(str::to_string);
             let to = match (self.per_client, to) {
                 (_, Some(c)) => Some(c),

@@ -10,8 +10,8 @@ use std::sync::Arc;
 
 use bml_realizer::body::{mannequin, Skeleton};
 use bml_realizer::feedback::{Feedback, Format};
-use bml_realizer::realizer::Realizer;
 use bml_realizer::timeline::Timeline;
+use bml_realizer::world::World;
 use clap::Args;
 use serde_json::{json, Value};
 
@@ -46,7 +46,7 @@ pub struct ViewArgs {
 
 /// `bmlr view`.
 pub fn view(args: ViewArgs) -> ExitCode {
-    let (page, invalid) = match realize(&args) {
+    let (page, summary, invalid) = match realize(&args) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("bmlr view: {e}");
@@ -54,7 +54,7 @@ pub fn view(args: ViewArgs) -> ExitCode {
         }
     };
     let written = match (&args.out, &args.serve) {
-        (Some(dir), _) => write(dir, &page),
+        (Some(dir), _) => write(dir, &page, &summary),
         (None, Some(addr)) => serve(addr, page),
         (None, None) => unreachable!("clap requires --out or --serve"),
     };
@@ -67,8 +67,8 @@ pub fn view(args: ViewArgs) -> ExitCode {
     }
 }
 
-/// Runs the items and returns the page, and how many blocks could not be parsed.
-fn realize(args: &ViewArgs) -> Result<(String, usize), String> {
+/// Runs the items and returns the page, a summary of it, and how many blocks could not be parsed.
+fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         return Err("--fps must be a positive number".into());
     }
@@ -87,8 +87,23 @@ fn realize(args: &ViewArgs) -> Result<(String, usize), String> {
         characters.push(""); // the default character, standing
     }
     let (header, lines) = motion.lines(&characters);
-    let data = data(&title(&args.items), &header, &lines, &log, &run.realizer);
-    Ok((web::page(&data), run.invalid))
+    let data = data(
+        &title(&args.items),
+        &header,
+        &lines,
+        &log,
+        run.realizer.world(),
+    );
+    let page = web::page(&data);
+    let s = if characters.len() == 1 { "" } else { "s" };
+    let summary = format!(
+        "{} frames at {} fps, {} character{s}, {} kB",
+        lines.len(),
+        args.fps,
+        characters.len(),
+        page.len() / 1024
+    );
+    Ok((page, summary, run.invalid))
 }
 
 /// The page's heading: the items, shortened to their file names.
@@ -105,7 +120,7 @@ pub fn data(
     header: &str,
     lines: &[String],
     log: &[(f64, Feedback)],
-    realizer: &Realizer,
+    world: &World,
 ) -> String {
     let feedback: Vec<Value> = log.iter().map(|(t, f)| message(*t, f)).collect();
     let messages: Vec<Feedback> = log.iter().map(|(_, f)| f.clone()).collect();
@@ -115,11 +130,12 @@ pub fn data(
         "segments": mannequin::segments(&Skeleton::adult()),
         "feedback": feedback,
         "timeline": timeline(&messages),
-        "world": world(realizer.world()),
+        "world": world_data(world),
     });
     let head = serde_json::to_string(&head).expect("the page data encodes");
     // the frames file's lines go in as they are
-    let mut out = String::with_capacity(head.len() + lines.iter().map(|l| l.len() + 1).sum::<usize>());
+    let mut out =
+        String::with_capacity(head.len() + lines.iter().map(|l| l.len() + 1).sum::<usize>());
     out.push_str(&head[..head.len() - 1]);
     out.push_str(",\"header\":");
     out.push_str(header);
@@ -151,14 +167,19 @@ pub fn timeline(feedback: &[Feedback]) -> Value {
     json!({"svg": t.to_svg(), "axis": t.axis()})
 }
 
+/// A position in metres, to the micrometre (as in the frames file).
+fn metres(p: glam::Vec3) -> [f64; 3] {
+    p.to_array().map(|v| (f64::from(v) * 1e6).round() / 1e6)
+}
+
 /// The world's points and paths.
-fn world(w: &bml_realizer::world::World) -> Value {
+fn world_data(w: &World) -> Value {
     let points: serde_json::Map<String, Value> = (w.points())
-        .map(|(name, at)| (name.to_string(), json!(at.to_array())))
+        .map(|(name, at)| (name.to_string(), json!(metres(at))))
         .collect();
     let paths: serde_json::Map<String, Value> = (w.paths())
         .map(|(name, keys)| {
-            let keys: Vec<Value> = keys.iter().map(|(t, p)| json!([t, p.to_array()])).collect();
+            let keys: Vec<Value> = keys.iter().map(|(t, p)| json!([t, metres(*p)])).collect();
             (name.to_string(), Value::Array(keys))
         })
         .collect();
@@ -166,7 +187,7 @@ fn world(w: &bml_realizer::world::World) -> Value {
 }
 
 /// Writes DIR/index.html and DIR/three-LICENSE.txt.
-fn write(dir: &std::path::Path, page: &str) -> Result<(), String> {
+fn write(dir: &std::path::Path, page: &str, summary: &str) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
     let index = dir.join("index.html");
     for (path, text) in [
@@ -175,7 +196,7 @@ fn write(dir: &std::path::Path, page: &str) -> Result<(), String> {
     ] {
         std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
     }
-    eprintln!("wrote {} ({} kB)", index.display(), page.len() / 1024);
+    eprintln!("wrote {}: {summary}", index.display());
     Ok(())
 }
 

@@ -45,7 +45,8 @@ pub fn page(data: &str) -> String {
 /// `template` with every `{{KEY}}` replaced by its value, in one pass (a value is never searched
 /// for keys, so the run's text cannot smuggle one in).
 fn fill(template: &str, values: &[(&str, &str)]) -> String {
-    let mut out = String::with_capacity(template.len() + values.iter().map(|v| v.1.len()).sum::<usize>());
+    let mut out =
+        String::with_capacity(template.len() + values.iter().map(|v| v.1.len()).sum::<usize>());
     let mut rest = template;
     while let Some(at) = rest.find("{{") {
         out.push_str(&rest[..at]);
@@ -76,7 +77,7 @@ pub struct Live {
 struct Watchers {
     queues: Vec<SyncSender<Arc<str>>>,
     /// Sent to a watcher when it connects (the feedback so far and the latest timeline).
-    backlog: Vec<Arc<str>>,
+    backlog: std::collections::VecDeque<Arc<str>>,
 }
 
 impl Live {
@@ -93,13 +94,23 @@ impl Live {
         w.queues.retain(|q| match q.try_send(message.clone()) {
             Ok(()) => true,
             Err(TrySendError::Full(_)) => {
-                eprintln!("bmlr serve: a viewer fell {WATCHER_QUEUE} messages behind; disconnected");
+                eprintln!(
+                    "bmlr serve: a viewer fell {WATCHER_QUEUE} messages behind; disconnected"
+                );
                 false
             }
             Err(TrySendError::Disconnected(_)) => false,
         });
         if keep {
-            w.backlog.push(message);
+            w.backlog.push_back(message);
+        }
+    }
+
+    /// Keeps only the last `n` messages for those who connect later.
+    pub fn trim(&self, n: usize) {
+        let mut w = self.lock();
+        while w.backlog.len() > n {
+            w.backlog.pop_front();
         }
     }
 
@@ -136,7 +147,8 @@ pub fn bind(addr: &str) -> Result<(TcpListener, SocketAddr), String> {
             "'{addr}' is not a loopback address; the page is served on 127.0.0.1 or ::1 only"
         ));
     }
-    let listener = TcpListener::bind(&addrs[..]).map_err(|e| format!("cannot listen on {addr}: {e}"))?;
+    let listener =
+        TcpListener::bind(&addrs[..]).map_err(|e| format!("cannot listen on {addr}: {e}"))?;
     let at = listener.local_addr().map_err(|e| e.to_string())?;
     Ok((listener, at))
 }
@@ -162,20 +174,37 @@ fn answer(mut stream: TcpStream, page: &str, live: Option<&Live>) -> std::io::Re
     let header = |name: &str| {
         head.lines().skip(1).find_map(|l| {
             let (k, v) = l.split_once(':')?;
-            k.trim().eq_ignore_ascii_case(name).then(|| v.trim().to_string())
+            k.trim()
+                .eq_ignore_ascii_case(name)
+                .then(|| v.trim().to_string())
         })
     };
     let (method, path) = match request.as_slice() {
         [m, p, ..] => (*m, p.split(['?', '#']).next().unwrap_or("")),
-        _ => return respond(&mut stream, "400 Bad Request", "text/plain", b"bad request\n"),
+        _ => {
+            return respond(
+                &mut stream,
+                "400 Bad Request",
+                "text/plain",
+                b"bad request\n",
+            )
+        }
     };
     if method != "GET" {
-        return respond(&mut stream, "405 Method Not Allowed", "text/plain", b"GET only\n");
+        return respond(
+            &mut stream,
+            "405 Method Not Allowed",
+            "text/plain",
+            b"GET only\n",
+        );
     }
     match (path, live, header("sec-websocket-key")) {
-        ("/" | "/index.html", _, _) => {
-            respond(&mut stream, "200 OK", "text/html; charset=utf-8", page.as_bytes())
-        }
+        ("/" | "/index.html", _, _) => respond(
+            &mut stream,
+            "200 OK",
+            "text/html; charset=utf-8",
+            page.as_bytes(),
+        ),
         ("/three-LICENSE.txt", _, _) => respond(
             &mut stream,
             "200 OK",
@@ -219,13 +248,13 @@ fn watch(mut stream: TcpStream, key: &str, live: &Live) -> std::io::Result<()> {
         "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
     )?;
     stream.set_read_timeout(None)?;
-    let mut socket = tungstenite::WebSocket::from_raw_socket(
-        stream,
-        tungstenite::protocol::Role::Server,
-        None,
-    );
+    let mut socket =
+        tungstenite::WebSocket::from_raw_socket(stream, tungstenite::protocol::Role::Server, None);
     for message in live.watch() {
-        if socket.send(tungstenite::Message::text(message.as_ref())).is_err() {
+        if socket
+            .send(tungstenite::Message::text(message.as_ref()))
+            .is_err()
+        {
             break; // the watcher left; its queue is dropped with this thread
         }
     }
@@ -245,7 +274,11 @@ mod tests {
     #[test]
     fn the_data_cannot_close_its_script() {
         let p = page(r#"{"text": "</script><script>alert(1)</script>"}"#);
-        assert_eq!(p.matches("</script>").count(), 3, "the three script elements only");
+        assert_eq!(
+            p.matches("</script>").count(),
+            3,
+            "the three script elements only"
+        );
         assert!(p.contains(r#""\u003c/script>\u003cscript>alert(1)\u003c/script>""#));
     }
 

@@ -1,0 +1,103 @@
+//! The live view of `bmlr serve --tcp ADDR --view ADDR2`: the viewer's page served on ADDR2, and
+//! over its WebSocket the realizer's frames (the frames file's lines, [`FPS`] a second), every
+//! feedback message with the time it was sent, and the timeline of the last [`WINDOW`] seconds,
+//! redrawn at most twice a second while feedback arrives. A watcher who connects late first gets
+//! the last [`BACKLOG`] feedback messages and the latest timeline, then the frames from then on.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::engine::CharacterPose;
+use bml_realizer::feedback::Feedback;
+use bml_realizer::world::World;
+use serde_json::json;
+
+use crate::web::{self, Live};
+
+/// Frames a second sent to watchers.
+pub const FPS: f64 = 30.0;
+/// Seconds of feedback the live timeline shows.
+pub const WINDOW: f64 = 30.0;
+/// Feedback messages a watcher who connects late is sent first.
+pub const BACKLOG: usize = 2_000;
+/// Least time between two timeline pictures (seconds).
+const REDRAW: f64 = 0.5;
+
+/// What the server tells the live page.
+pub struct LiveView {
+    live: Live,
+    skeleton: Skeleton,
+    next_frame: f64,
+    /// Feedback of the last [`WINDOW`] seconds, with the time each was sent.
+    recent: VecDeque<(f64, Feedback)>,
+    /// Feedback arrived since the last timeline, and when that was drawn.
+    stale: bool,
+    drawn_at: f64,
+}
+
+impl LiveView {
+    /// Serves the live page on `addr` (loopback only; the address it got is printed on stderr)
+    /// for a realizer in `world`.
+    pub fn start(addr: &str, world: &World) -> Result<LiveView, String> {
+        let (listener, at) = web::bind(addr)?;
+        let skeleton = Skeleton::adult();
+        let header = bml_realizer::body::frames::header(&skeleton, FPS, &[""]);
+        let data = crate::view::data("bmlr serve", &header, &[], &[], world);
+        let data = data.replacen("\"live\":false", "\"live\":true", 1);
+        let live = Live::default();
+        let page = Arc::new(web::page(&data));
+        let hub = live.clone();
+        std::thread::spawn(move || web::serve(listener, page, Some(hub)));
+        eprintln!("bmlr serve: live view on http://{at}/");
+        Ok(LiveView {
+            live,
+            skeleton,
+            next_frame: 0.0,
+            recent: VecDeque::new(),
+            stale: false,
+            drawn_at: f64::NEG_INFINITY,
+        })
+    }
+
+    /// The realizer's poses at time `t` (sent when a frame is due and someone watches), and the
+    /// timeline when it is due.
+    pub fn frame(&mut self, t: f64, poses: &[CharacterPose]) {
+        if self.stale && t - self.drawn_at >= REDRAW {
+            self.timeline(t);
+        }
+        if t < self.next_frame || !self.live.watched() {
+            return;
+        }
+        self.next_frame = t + 1.0 / FPS;
+        let poses: Vec<(&str, &Pose, &[usize])> = (poses.iter())
+            .map(|p| {
+                let id = p.character.as_deref().unwrap_or("");
+                (id, &p.pose, p.clamped.as_slice())
+            })
+            .collect();
+        let line = bml_realizer::body::frames::line(&self.skeleton, t, &poses);
+        self.live.send(format!("{{\"frame\":{line}}}"), false);
+    }
+
+    /// A feedback message sent at time `t`.
+    pub fn feedback(&mut self, t: f64, fb: &Feedback) {
+        let message = json!({ "feedback": crate::view::message(t, fb) });
+        self.live.send(message.to_string(), true);
+        self.live.trim(BACKLOG + 1); // + the timeline
+        self.recent.push_back((t, fb.clone()));
+        while self.recent.front().is_some_and(|(at, _)| *at < t - WINDOW) {
+            self.recent.pop_front();
+        }
+        self.stale = true;
+    }
+
+    fn timeline(&mut self, t: f64) {
+        let feedback: Vec<Feedback> = self.recent.iter().map(|(_, f)| f.clone()).collect();
+        let message = json!({ "timeline": crate::view::timeline(&feedback) });
+        self.live.forget(|m| m.starts_with("{\"timeline\""));
+        self.live.send(message.to_string(), true);
+        self.stale = false;
+        self.drawn_at = t;
+    }
+}

@@ -1,0 +1,462 @@
+//! `bmlr view` and the live view of `bmlr serve --view`: the page holds the run (frames that put
+//! the hand where the gesture says, the feedback with its times, the timeline, the world), it is
+//! served on loopback only, and the live WebSocket streams frames and feedback as blocks arrive.
+//! The browser test (headless Chromium draws the page) needs Debian's `chromium`: it is
+//! `#[ignore]`d here and `.ci/run` installs the browser and runs it with `--ignored`.
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use glam::{Quat, Vec3};
+use serde_json::Value;
+
+const WELCOME: &str = "fixtures/examples/welcome.xml";
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// A fresh directory under the target directory.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The page of `bmlr view ARGS --out DIR` and its directory.
+fn page(name: &str, args: &[&str]) -> (String, PathBuf) {
+    let dir = scratch(name);
+    let mut all = vec!["view", "--out", dir.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let (code, _, err) = common::bmlr(&all, "");
+    assert_eq!(code, 0, "{err}");
+    (
+        std::fs::read_to_string(dir.join("index.html")).unwrap(),
+        dir,
+    )
+}
+
+/// The run data in a page.
+fn data(page: &str) -> Value {
+    let start = page.find(r#"id="bmlr-data">"#).expect("the data element") + 15;
+    let end = start + page[start..].find("</script>").unwrap();
+    serde_json::from_str(&page[start..end]).expect("the data is JSON")
+}
+
+fn vec3(v: &Value) -> Vec3 {
+    let f = |i: usize| v[i].as_f64().unwrap() as f32;
+    Vec3::new(f(0), f(1), f(2))
+}
+
+fn quat(v: &Value) -> Quat {
+    let f = |i: usize| v[i].as_f64().unwrap() as f32;
+    Quat::from_xyzw(f(0), f(1), f(2), f(3))
+}
+
+/// World positions of every joint of character `id` in a frame line, by forward kinematics
+/// over the header's skeleton (written here, independently of the page's script).
+fn world(header: &Value, frame: &Value, id: &str) -> Vec<(String, Vec3)> {
+    let c = &frame["characters"][id];
+    let mut out: Vec<(String, Vec3, Quat)> = Vec::new();
+    for j in header["skeleton"]["joints"].as_array().unwrap() {
+        let name = j["name"].as_str().unwrap().to_string();
+        let (p, q) = match j["parent"].as_str() {
+            None => (vec3(&c["root"]), quat(&c["rotation"])),
+            Some(parent) => {
+                let (_, pp, pq) = out.iter().find(|(n, _, _)| n == parent).unwrap();
+                (
+                    *pp + *pq * vec3(&j["offset"]),
+                    *pq * quat(&c["joints"][&name]),
+                )
+            }
+        };
+        out.push((name, p, q));
+    }
+    out.into_iter().map(|(n, p, _)| (n, p)).collect()
+}
+
+fn at(joints: &[(String, Vec3)], name: &str) -> Vec3 {
+    joints.iter().find(|(n, _)| n == name).unwrap().1
+}
+
+#[test]
+fn the_page_holds_the_run_frames_feedback_timeline_and_world() {
+    let (page, dir) = page("view-welcome", &[WELCOME]);
+    assert!(
+        dir.join("three-LICENSE.txt").exists(),
+        "three.js's licence beside the page"
+    );
+    let d = data(&page);
+    let header = &d["header"];
+    assert_eq!(header["skeleton"]["joints"].as_array().unwrap().len(), 57);
+    assert_eq!(header["characters"], serde_json::json!([""]));
+    // frames every 1/30 s from 0 to the block's end (2.9 s)
+    let frames = d["frames"].as_array().unwrap();
+    let times: Vec<f64> = frames.iter().map(|f| f["time"].as_f64().unwrap()).collect();
+    assert_eq!(times[0], 0.0);
+    assert!((times.last().unwrap() - 2.9).abs() < 1e-6, "{times:?}");
+    assert!(times
+        .windows(2)
+        .all(|w| w[1] > w[0] && w[1] - w[0] <= 1.0 / 30.0 + 1e-6));
+    // at rest the right wrist hangs at the side; at the beat's stroke (0.6 s) it is in front of
+    // the torso between waist and chest
+    let frame_at = |t: f64| {
+        let k = times.iter().position(|&x| (x - t).abs() < 1e-3).unwrap();
+        world(header, &frames[k], "")
+    };
+    let rest = frame_at(0.0);
+    assert!(at(&rest, "r_wrist").y < at(&rest, "r_hip").y + 0.25);
+    let stroke = frame_at(0.6);
+    let (wrist, pelvis, neck) = (
+        at(&stroke, "r_wrist"),
+        at(&stroke, "sacroiliac"),
+        at(&stroke, "vc7"),
+    );
+    assert!(wrist.z > pelvis.z + 0.15, "in front: {wrist} vs {pelvis}");
+    assert!(
+        wrist.y > pelvis.y && wrist.y < neck.y,
+        "waist to chest: {wrist}"
+    );
+    // every feedback message of `bmlr run`, in time order, with the time it was sent
+    let (_, run, _) = common::bmlr(&["run", WELCOME], "");
+    let feedback = d["feedback"].as_array().unwrap();
+    assert_eq!(feedback.len(), run.lines().count());
+    let sent: Vec<f64> = feedback
+        .iter()
+        .map(|m| m["time"].as_f64().unwrap())
+        .collect();
+    assert!(sent.windows(2).all(|w| w[1] >= w[0]));
+    let stroke_message = (feedback.iter())
+        .find(|m| {
+            m["text"]
+                .as_str()
+                .unwrap()
+                .contains(r#"id="greet:beat:stroke""#)
+        })
+        .unwrap();
+    assert_eq!(stroke_message["time"], 0.6);
+    assert_eq!(stroke_message["kind"], "syncPointProgress");
+    // the timeline picture and where its times are
+    assert!(d["timeline"]["svg"].as_str().unwrap().starts_with("<svg"));
+    assert_eq!(d["timeline"]["axis"]["t0"], 0.0);
+    assert!((d["timeline"]["axis"]["t1"].as_f64().unwrap() - 2.9).abs() < 1e-9);
+    // the world's points, and the mannequin's boxes (one per bone and the head)
+    assert_eq!(
+        d["world"]["points"]["bluebox"],
+        serde_json::json!([0.6, 1.2, 1.2])
+    );
+    assert_eq!(d["segments"].as_array().unwrap().len(), 57);
+    assert!(page.contains("bmlr view: ready"));
+}
+
+#[test]
+fn the_page_is_the_same_for_the_same_input_and_shows_moving_world_points() {
+    let args = ["--world", "fixtures/examples/world.json", WELCOME];
+    let (a, _) = page("view-world-a", &args);
+    let (b, _) = page("view-world-b", &args);
+    assert!(a == b, "byte-identical pages");
+    let d = data(&a);
+    let paths = d["world"]["paths"].as_object().unwrap();
+    assert!(!paths.is_empty(), "world.json has a moving point");
+    for keys in paths.values() {
+        assert!(keys[0][1].as_array().unwrap().len() == 3);
+    }
+}
+
+#[test]
+fn a_run_without_a_valid_block_shows_the_character_standing_and_exits_1() {
+    let dir = scratch("view-invalid");
+    let (code, _, err) = common::bmlr(
+        &["view", "--out", dir.to_str().unwrap(), "-"],
+        "<bml id=\"oops\"><gesture",
+    );
+    assert_eq!(code, 1, "{err}");
+    let d = data(&std::fs::read_to_string(dir.join("index.html")).unwrap());
+    assert_eq!(d["header"]["characters"], serde_json::json!([""]));
+    let warning = &d["feedback"][0];
+    assert_eq!(warning["kind"], "warningFeedback", "{d}");
+}
+
+#[test]
+fn the_page_is_served_on_loopback_only() {
+    let (code, _, err) = common::bmlr(&["view", "--serve", "0.0.0.0:0", WELCOME], "");
+    assert_eq!(code, 2);
+    assert!(err.contains("not a loopback address"), "{err}");
+    let (code, _, err) = common::bmlr(
+        &["serve", "--tcp", "127.0.0.1:0", "--view", "0.0.0.0:0"],
+        "",
+    );
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("--view") && err.contains("not a loopback address"),
+        "{err}"
+    );
+    let (code, _, err) = common::bmlr(&["view", WELCOME], "");
+    assert_eq!(code, 2, "--out or --serve is needed: {err}");
+}
+
+/// A `bmlr` child process, killed when dropped, and the address it printed on stderr.
+struct Server {
+    child: Child,
+    lines: Vec<String>,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Starts `bmlr ARGS` and reads stderr until `n` lines have come.
+fn spawn(args: &[&str], n: usize) -> Server {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let lines = (0..n)
+        .map(|_| {
+            let mut line = String::new();
+            err.read_line(&mut line).unwrap();
+            line.trim().to_string()
+        })
+        .collect();
+    Server { child, lines }
+}
+
+/// The address after `prefix` in one of the lines.
+fn address(lines: &[String], prefix: &str) -> String {
+    let line = lines
+        .iter()
+        .find(|l| l.starts_with(prefix))
+        .unwrap_or_else(|| panic!("{lines:?}"));
+    let rest = &line[prefix.len()..];
+    rest.trim_start_matches("http://")
+        .split(['/', ' '])
+        .next()
+        .unwrap()
+        .to_string()
+}
+
+/// GET `path` from `addr`: (status line, body).
+fn get(addr: &str, path: &str) -> (String, Vec<u8>) {
+    let mut s = TcpStream::connect(addr).unwrap();
+    write!(s, "GET {path} HTTP/1.1\r\nHost: {addr}\r\n\r\n").unwrap();
+    let mut all = Vec::new();
+    s.read_to_end(&mut all).unwrap();
+    let split = all.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
+    let head = String::from_utf8_lossy(&all[..split]).into_owned();
+    (
+        head.lines().next().unwrap().to_string(),
+        all[split + 4..].to_vec(),
+    )
+}
+
+#[test]
+fn view_serve_serves_the_same_page() {
+    let (written, _) = page("view-served", &[WELCOME]);
+    let server = spawn(&["view", "--serve", "127.0.0.1:0", WELCOME], 1);
+    let addr = address(&server.lines, "bmlr view: serving ");
+    let (status, body) = get(&addr, "/");
+    assert_eq!(status, "HTTP/1.1 200 OK");
+    assert!(
+        body == written.as_bytes(),
+        "the served page is the written one"
+    );
+    let (status, body) = get(&addr, "/three-LICENSE.txt");
+    assert_eq!(status, "HTTP/1.1 200 OK");
+    assert!(String::from_utf8_lossy(&body).contains("MIT License"));
+    assert_eq!(get(&addr, "/elsewhere").0, "HTTP/1.1 404 Not Found");
+}
+
+#[test]
+fn the_live_view_streams_frames_and_feedback_as_blocks_arrive() {
+    let server = spawn(
+        &["serve", "--tcp", "127.0.0.1:0", "--view", "127.0.0.1:0"],
+        2,
+    );
+    let port = address(&server.lines, "bmlr serve: listening on ");
+    let view = address(&server.lines, "bmlr serve: live view on ");
+    let (status, body) = get(&view, "/");
+    assert_eq!(status, "HTTP/1.1 200 OK");
+    let d = data(&String::from_utf8(body).unwrap());
+    assert_eq!(d["live"], true);
+    let header = d["header"].clone();
+    let (mut socket, _) = tungstenite::connect(format!("ws://{view}/live")).unwrap();
+    let mut client = TcpStream::connect(&port).unwrap();
+    let block = format!(
+        r#"<bml {NS} id="hi"><gesture id="g" lexeme="WAVE" mode="RIGHT_HAND" start="0" end="1.5"/></bml>"#
+    );
+    writeln!(client, "{block}").unwrap();
+    // until the block ends: every frame, the feedback, the highest the right wrist went
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let (mut frames, mut ended, mut timeline, mut highest) = (0, false, false, f32::MIN);
+    let mut feedback = Vec::new();
+    while !ended || !timeline {
+        assert!(Instant::now() < deadline, "{frames} frames, {feedback:?}");
+        let m: Value = serde_json::from_str(socket.read().unwrap().to_text().unwrap()).unwrap();
+        if let Some(frame) = m.get("frame").filter(|f| f["characters"].get("").is_some()) {
+            frames += 1;
+            let joints = world(&header, frame, "");
+            highest = highest.max(at(&joints, "r_wrist").y - at(&joints, "r_shoulder").y);
+        }
+        if let Some(f) = m.get("feedback") {
+            let text = f["text"].as_str().unwrap().to_string();
+            ended |= text.contains(r#"id="hi:end""#);
+            feedback.push(text);
+        }
+        timeline |= ended && m.get("timeline").is_some();
+    }
+    assert!(frames >= 30, "about 30 frames a second: {frames} in 1.5 s");
+    assert!(
+        highest > 0.0,
+        "the wave raised the wrist above the shoulder: {highest}"
+    );
+    assert!(feedback.iter().any(|t| t.contains(r#"id="hi:g:stroke""#)));
+}
+
+/// Where `chromium` is, if it is installed.
+fn chromium() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|d| d.join("chromium"))
+        .find(|p| p.exists())
+}
+
+/// Headless Chromium on `url` with `what` (e.g. `--dump-dom` or `--screenshot=OUT.png`):
+/// (stdout, the page's console lines).
+fn browse(url: &str, what: &str) -> (String, Vec<String>) {
+    let chromium =
+        chromium().expect("Debian's chromium (apt-get install chromium; .ci/run installs it)");
+    let profile = scratch(&format!("chromium-{}", what.len() + url.len()));
+    let out = Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--window-size=1280,720",
+            "--virtual-time-budget=5000",
+            "--enable-logging=stderr",
+            "--v=0",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(what)
+        .arg(url)
+        .output()
+        .unwrap();
+    // (SwiftShader's notes on reading pixels back for the screenshot are the browser's, not the
+    // page's)
+    let console = String::from_utf8_lossy(&out.stderr)
+        .lines()
+        .filter(|l| l.contains(":CONSOLE") && !l.contains("GL Driver Message"))
+        .map(str::to_string)
+        .collect();
+    (String::from_utf8_lossy(&out.stdout).into_owned(), console)
+}
+
+/// An RGB screenshot: width, height, pixels.
+struct Shot(usize, usize, Vec<u8>);
+
+impl Shot {
+    fn load(path: &Path) -> Shot {
+        let decoder = png::Decoder::new(BufReader::new(std::fs::File::open(path).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let channels = info.color_type.samples();
+        let rgb = buf[..info.buffer_size()]
+            .chunks(channels)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        Shot(info.width as usize, info.height as usize, rgb)
+    }
+
+    fn px(&self, x: usize, y: usize) -> [u8; 3] {
+        let i = 3 * (y * self.0 + x);
+        [self.2[i], self.2[i + 1], self.2[i + 2]]
+    }
+
+    /// The share of pixels in the box (x0..x1, y0..y1) for which `differs` holds.
+    fn share(
+        &self,
+        (x0, x1, y0, y1): (usize, usize, usize, usize),
+        differs: impl Fn(usize, usize) -> bool,
+    ) -> f64 {
+        let hits = (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .filter(|&(x, y)| differs(x, y))
+            .count();
+        hits as f64 / ((x1 - x0) * (y1 - y0)) as f64
+    }
+}
+
+fn far([a, b, c]: [u8; 3], [x, y, z]: [u8; 3]) -> bool {
+    a.abs_diff(x).max(b.abs_diff(y)).max(c.abs_diff(z)) > 24
+}
+
+#[test]
+#[ignore = "needs Debian's chromium; .ci/run installs it and runs this with --ignored"]
+fn headless_chromium_draws_the_character_and_the_beat_moves_the_arm() {
+    // without the idle layer, so that only the gesture moves between the two pictures
+    let (_, dir) = page("view-browser", &["--no-idle", WELCOME]);
+    let url = |t: &str| format!("file://{}#t={t}", dir.join("index.html").display());
+    let (dom, console) = browse(&url("0"), "--dump-dom");
+    assert!(
+        dom.contains("<title>bmlr view: ready</title>"),
+        "{}",
+        &dom[..dom.len().min(400)]
+    );
+    assert!(console.is_empty(), "the page logs nothing: {console:?}");
+    let shots: Vec<Shot> = ["0", "0.6"]
+        .iter()
+        .map(|t| {
+            let out = dir.join(format!("t{t}.png"));
+            let (_, console) = browse(&url(t), &format!("--screenshot={}", out.display()));
+            assert!(console.is_empty(), "at t={t}: {console:?}");
+            Shot::load(&out)
+        })
+        .collect();
+    let (rest, beat) = (&shots[0], &shots[1]);
+    assert_eq!((rest.0, rest.1), (1280, 720));
+    // the stage's background, taken at its top right corner
+    let background = rest.px(880, 60);
+    let body = (410, 490, 60, 400);
+    let empty = (620, 880, 60, 240);
+    let drawn = rest.share(body, |x, y| far(rest.px(x, y), background));
+    let blank = rest.share(empty, |x, y| far(rest.px(x, y), background));
+    assert!(
+        drawn > 0.5,
+        "the figure stands in the middle: {drawn:.2} of its box drawn"
+    );
+    assert!(blank < 0.05, "beside it, the background: {blank:.2} drawn");
+    // the right arm (on the left of the picture) comes up in front at the stroke; the legs stay
+    let arm = (330, 420, 130, 200);
+    let legs = (410, 490, 300, 400);
+    let moved = |b| rest.share(b, |x, y| far(rest.px(x, y), beat.px(x, y)));
+    let (arm_moved, legs_moved) = (moved(arm), moved(legs));
+    assert!(
+        arm_moved > 0.15,
+        "the arm moved: {arm_moved:.2} of its box changed"
+    );
+    assert!(
+        legs_moved < 0.01,
+        "the legs stayed: {legs_moved:.2} changed"
+    );
+    eprintln!(
+        "figure {drawn:.2} drawn, background {blank:.2}, arm {arm_moved:.2} changed, legs {legs_moved:.2}"
+    );
+}
