@@ -27,6 +27,7 @@ pub mod conformance;
 mod data;
 pub mod engine;
 pub mod engines;
+pub mod face;
 pub mod feedback;
 pub mod plan;
 pub mod realizer;

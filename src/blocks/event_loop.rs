@@ -143,17 +143,31 @@ impl BlockManager {
         self.apply_changes(to);
         self.predict_poses(to);
         let mut pose = self.base_pose(to);
+        let model = crate::face::FaceModel::default_model();
+        let mut face = crate::face::Face::neutral(model);
         for e in self.registry.engines_mut() {
             e.play(to, frame);
             if let Some(m) = e.as_motion() {
                 m.animate(to, &self.skeleton, &self.world, &mut pose);
             }
+            if let Some(x) = e.as_expression() {
+                x.express(to, &mut face);
+            }
+        }
+        if let Some(b) = self.blinks.as_mut() {
+            b.apply(to, &self.skeleton, &pose, &mut face);
+        }
+        model.finish(&mut face);
+        if let Some(jaw) = self.skeleton.joint("temporomandibular") {
+            let open = face.morphs.get("jawOpen") * crate::face::JAW_OPEN;
+            pose.rotate(jaw, glam::Quat::from_rotation_x(open));
         }
         let clamped = self.skeleton.limits().clamp(&mut pose);
         frame.poses.push(CharacterPose {
             character: self.character.clone(),
             pose,
             clamped,
+            face,
         });
         for (engine, key) in std::mem::take(&mut self.retiring) {
             self.registry.engine_mut(engine).remove(&key);

@@ -93,6 +93,8 @@ pub struct BlockManager {
     skeleton: Skeleton,
     /// The idle layer every frame's pose starts from (`None`: the rest pose).
     idle: Option<crate::body::idle::Idle>,
+    /// The lids' idle life (blinks, lids following the eyes), with the idle layer.
+    blinks: Option<crate::face::blink::Blinker>,
     /// The world as of the last advance (shared with the realizer).
     world: std::sync::Arc<World>,
     now: f64,
@@ -109,6 +111,7 @@ impl BlockManager {
     ) -> Self {
         let skeleton = Skeleton::adult();
         let idle = crate::body::idle::Idle::new(character.as_deref().unwrap_or(""), &skeleton);
+        let blinks = crate::face::blink::Blinker::new(character.as_deref().unwrap_or(""));
         BlockManager {
             due: std::cell::RefCell::new(BinaryHeap::new()),
             due_stale: std::cell::Cell::new(true),
@@ -124,6 +127,7 @@ impl BlockManager {
             retiring: Vec::new(),
             skeleton,
             idle: Some(idle),
+            blinks: Some(blinks),
             world: std::sync::Arc::new(World::default()),
             now: 0.0,
             seq: 0,
@@ -146,11 +150,12 @@ impl BlockManager {
         }
     }
 
-    /// Turns the idle layer (breathing, a slow weight shift) on or off; it is on by default. It
-    /// never changes the feedback.
+    /// Turns the idle layer (breathing, a slow weight shift, blinks) on or off; it is on by
+    /// default. It never changes the feedback.
     pub fn set_idle(&mut self, on: bool) {
         let id = self.character.as_deref().unwrap_or("");
         self.idle = on.then(|| crate::body::idle::Idle::new(id, &self.skeleton));
+        self.blinks = on.then(|| crate::face::blink::Blinker::new(id));
     }
 
     /// The pose a frame at `t` starts from: the idle layer's, or the rest pose.

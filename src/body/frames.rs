@@ -2,7 +2,9 @@
 //! JSON lines. Line 1 is a header with the frame rate, the skeleton (each joint's name, parent and
 //! rest translation from the parent, metres) and the characters; then one line per frame with
 //! each character's root (HumanoidRoot's world position and rotation) and every joint's local
-//! rotation relative to the rest pose (quaternion `[x, y, z, w]`; the rest pose is identity).
+//! rotation relative to the rest pose (quaternion `[x, y, z, w]`; the rest pose is identity),
+//! and its face: the action units that are not 0 (`AU1` when both sides are equal, else `AU1L`
+//! and `AU1R`), the ARKit blendshapes that are not 0, and the viseme while speaking.
 //! Numbers are rounded to 6 decimals so that files diff well and stay deterministic.
 
 use indexmap::IndexMap;
@@ -10,6 +12,11 @@ use serde::Serialize;
 
 use super::pose::Pose;
 use super::skeleton::Skeleton;
+use crate::face::{Face, FaceModel, ARKIT, VISEMES};
+
+/// One character in a frame: its id (`""` the default one), pose, the joints clamped into their
+/// limits, and its face (if it has one).
+pub type Character<'a> = (&'a str, &'a Pose, &'a [usize], Option<&'a Face>);
 
 /// Line 1.
 #[derive(Serialize)]
@@ -47,6 +54,40 @@ struct CharacterLine<'a> {
     /// The joints the engines turned beyond their limits in this frame (clamped back).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     clamped: Vec<&'a str>,
+    #[serde(skip_serializing_if = "IndexMap::is_empty")]
+    face: IndexMap<String, f64>,
+    #[serde(skip_serializing_if = "IndexMap::is_empty")]
+    morphs: IndexMap<&'static str, f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    viseme: Option<&'static str>,
+}
+
+/// The action units of `face` that are not 0, one entry for both sides where they are equal.
+fn action_units(face: &Face) -> IndexMap<String, f64> {
+    let model = FaceModel::default_model();
+    let mut out = IndexMap::new();
+    for (k, pair) in face.aus.0.chunks(2).enumerate() {
+        let (l, r) = (round(pair[0]), round(pair.get(1).copied().unwrap_or(0.0)));
+        let number = model.aus.get(k).map_or(0, |a| a.number);
+        if l == r && l != 0.0 {
+            out.insert(format!("AU{number}"), l);
+        } else {
+            for (v, side) in [(l, 'L'), (r, 'R')] {
+                if v != 0.0 {
+                    out.insert(format!("AU{number}{side}"), v);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The blendshapes of `face` that are not 0.
+fn morphs(face: &Face) -> IndexMap<&'static str, f64> {
+    (ARKIT.iter().zip(face.morphs.0))
+        .map(|(&name, w)| (name, round(w)))
+        .filter(|(_, w)| *w != 0.0)
+        .collect()
 }
 
 fn round(v: f32) -> f64 {
@@ -78,10 +119,10 @@ pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
 }
 
 /// One frame's line (without a newline): the time and each character's pose, in order, with the
-/// joints that were clamped into their limits.
-pub fn line(skeleton: &Skeleton, time: f64, poses: &[(&str, &Pose, &[usize])]) -> String {
+/// joints that were clamped into their limits and the face.
+pub fn line(skeleton: &Skeleton, time: f64, poses: &[Character<'_>]) -> String {
     let characters = (poses.iter())
-        .map(|&(id, pose, clamped)| {
+        .map(|&(id, pose, clamped, face)| {
             let world = pose.world(skeleton);
             let joints = (skeleton.joints().iter().zip(&pose.rotations))
                 .map(|(j, &q)| (j.name.as_str(), quat(q)))
@@ -94,6 +135,11 @@ pub fn line(skeleton: &Skeleton, time: f64, poses: &[(&str, &Pose, &[usize])]) -
                 clamped: (clamped.iter())
                     .map(|&j| skeleton.joints()[j].name.as_str())
                     .collect(),
+                face: face.map(action_units).unwrap_or_default(),
+                morphs: face.map(morphs).unwrap_or_default(),
+                viseme: face
+                    .and_then(|f| f.viseme)
+                    .and_then(|v| VISEMES.get(v).copied()),
             };
             (id, character)
         })
@@ -123,7 +169,7 @@ mod tests {
             glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         );
         let f: serde_json::Value =
-            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[])])).unwrap();
+            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[], None)])).unwrap();
         assert_eq!(f["time"], 0.5);
         let c = &f["characters"][""];
         assert_eq!(c["root"], serde_json::json!([0.0, 0.95, 0.0]));
@@ -136,7 +182,7 @@ mod tests {
         );
         assert!(c.get("clamped").is_none(), "only when a joint was clamped");
         let f: serde_json::Value =
-            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[elbow])])).unwrap();
+            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[elbow], None)])).unwrap();
         assert_eq!(
             f["characters"][""]["clamped"],
             serde_json::json!(["l_elbow"])

@@ -20,6 +20,13 @@ pub trait Motion {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering>;
 }
 
+/// An engine that moves the face: it raises action units and blendshapes of the frame's face
+/// (sources combine by maximum; see `face::mixer`).
+pub trait Expression {
+    /// Shows the units running at `now` on `face`.
+    fn express(&mut self, now: f64, face: &mut crate::face::Face);
+}
+
 /// An engine's part in animation prediction: predictable engines say what they will have set
 /// at a future time; others (a transition) ask for those predicted poses.
 pub trait Prediction {

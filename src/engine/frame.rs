@@ -30,6 +30,8 @@ pub struct CharacterPose {
     /// The joints (indices) the engines turned beyond their limits in this frame, which were
     /// clamped back into them.
     pub clamped: Vec<usize>,
+    /// Its face: action units, blendshape weights, the viseme.
+    pub face: crate::face::Face,
 }
 
 /// Everything the realizer produced for one moment: engine output, each character's pose, and the

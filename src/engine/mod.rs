@@ -16,7 +16,7 @@ mod units;
 use std::fmt;
 
 pub use capabilities::{
-    Action, Control, Motion, MotionKind, Parameters, Prediction, Resources, Steering,
+    Action, Control, Expression, Motion, MotionKind, Parameters, Prediction, Resources, Steering,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};
@@ -177,6 +177,11 @@ pub trait Engine {
 
     /// The engine's part in animation prediction, if it predicts or needs predicted poses.
     fn as_prediction(&mut self) -> Option<&mut dyn Prediction> {
+        None
+    }
+
+    /// Its face motion, if it moves the face.
+    fn as_expression(&mut self) -> Option<&mut dyn Expression> {
         None
     }
 

@@ -8,6 +8,8 @@
 //! - [`timing_only`]: every other kind, timing only until its animation engine lands: it plays the
 //!   scheduled pegs and reports every sync point, but moves no body;
 //! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well);
+//! - [`face`]: face, faceLexeme, faceFacs, faceShift and BMLT facemorph as FACS action units and
+//!   ARKit blendshapes, mixed through a fading buffer;
 //! - [`head`]: head nods, shakes and tilts as real motion of the neck and skull;
 //! - [`head_direction`]: `headDirectionShift` turns the head toward a world point, for good;
 //! - [`gaze`]: gaze and gaze shifts as real motion of eyes, neck and trunk toward world targets;
@@ -22,6 +24,7 @@
 pub mod assets;
 pub mod control;
 pub mod expr;
+pub mod face;
 pub mod gaze;
 pub mod gesture;
 pub mod head;
@@ -42,13 +45,14 @@ use crate::engine::{KindKey, Registry};
 use crate::timing::DefaultTimingModels;
 
 /// Kinds the timing-only motion engine realizes (namespace, element).
-pub const MOTION_KINDS: &[(&str, &str)] = &[
+pub const MOTION_KINDS: &[(&str, &str)] = &[(NS_BML, "locomotion"), (NS_BMLT, "controller")];
+
+/// Kinds the face engine realizes (namespace, element).
+pub const FACE_KINDS: &[(&str, &str)] = &[
     (NS_BML, "face"),
     (NS_BML, "faceLexeme"),
     (NS_BML, "faceShift"),
     (NS_CORE_EXT, "faceFacs"),
-    (NS_BML, "locomotion"),
-    (NS_BMLT, "controller"),
     (NS_BMLT, "facemorph"),
 ];
 
@@ -82,6 +86,7 @@ pub fn registry_with(models: DefaultTimingModels, assets: &assets::Assets) -> Re
         Box::new(timing_only::TimingOnlyEngine::motion(models)),
         &keys(MOTION_KINDS),
     );
+    r.register(Box::new(face::FaceEngine::default()), &keys(FACE_KINDS));
     r.register(
         Box::new(timing_only::TimingOnlyEngine::audio(models)),
         &keys(&[(NS_BMLT, "audiofile")]),

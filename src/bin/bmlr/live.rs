@@ -7,7 +7,7 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::body::Skeleton;
 use bml_realizer::engine::CharacterPose;
 use bml_realizer::feedback::Feedback;
 use bml_realizer::world::World;
@@ -70,10 +70,10 @@ impl LiveView {
             return;
         }
         self.next_frame = t + 1.0 / FPS;
-        let poses: Vec<(&str, &Pose, &[usize])> = (poses.iter())
+        let poses: Vec<bml_realizer::body::frames::Character> = (poses.iter())
             .map(|p| {
                 let id = p.character.as_deref().unwrap_or("");
-                (id, &p.pose, p.clamped.as_slice())
+                (id, &p.pose, p.clamped.as_slice(), Some(&p.face))
             })
             .collect();
         let line = bml_realizer::body::frames::line(&self.skeleton, t, &poses);

@@ -122,8 +122,9 @@ impl Recording {
         let per_character: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
         let lines = (self.frames.iter().enumerate())
             .map(|(k, (time, _))| {
-                let poses: Vec<(&str, &Pose, &[usize])> = (ids.iter().zip(&per_character))
-                    .map(|(&id, p)| (id, &p[k].pose, p[k].clamped.as_slice()))
+                let poses: Vec<bml_realizer::body::frames::Character> = (ids.iter())
+                    .zip(&per_character)
+                    .map(|(&id, p)| (id, &p[k].pose, p[k].clamped.as_slice(), Some(&p[k].face)))
                     .collect();
                 bml_realizer::body::frames::line(&skeleton, *time, &poses)
             })
@@ -138,6 +139,7 @@ impl Recording {
             character: Some(character.to_string()),
             pose: Pose::rest(&Skeleton::adult()),
             clamped: Vec::new(),
+            face: bml_realizer::face::Face::neutral(bml_realizer::face::FaceModel::default_model()),
         };
         self.frames
             .iter()
