@@ -36,6 +36,7 @@ pub mod schedule;
 mod testrand;
 pub mod timeline;
 pub mod timing;
+pub mod voice;
 pub mod world;
 mod xmlname;
 

@@ -2,9 +2,9 @@
 //! order with preferred offsets from the start, whether the timing is rigid (TTS speech, audio) or may
 //! stretch within duration bounds, and whether it persists. Also the default models for every BML
 //! kind, so that the scheduler works before the animation engines exist, and a deterministic
-//! headless speech timing model (syllables at a configurable rate, inline syncs at word boundaries).
+//! speech timing model of the built-in TTS (phone durations, inline syncs at word starts).
 
-use crate::bml::{Behaviour, BehaviourKind, Speech, TextPart};
+use crate::bml::{Behaviour, BehaviourKind, Speech};
 
 /// A sync point's name: static for the standard names, owned for a speech's inline syncs.
 pub type SyncName = crate::bml::Id;
@@ -237,16 +237,24 @@ pub trait TimingModels {
     fn model(&self, behaviour: &Behaviour) -> Option<TimingModel>;
 }
 
-/// Deterministic speech timing without a TTS: each word takes its syllable count times
-/// `syllable_seconds`; punctuation adds a pause after the word; inline syncs sit at word boundaries.
+/// Which voice times speech.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Voice {
+    /// The built-in TTS (`voice::builtin`): phones with durations.
+    #[default]
+    Builtin,
+    /// The metronome voice (`voice::syllables`): 0.2 s per syllable, pauses after punctuation.
+    Syllables,
+}
+
+/// Speech timing from a voice (the built-in TTS by default): rigid, each inline sync where the
+/// voice puts it, `end` where it stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpeechTiming {
-    /// Seconds per syllable (default 0.2, about 5 syllables per second).
-    pub syllable_seconds: f64,
-    /// Pause after `,`, `;` or `:` (default 0.15 s).
-    pub comma_pause: f64,
-    /// Pause after `.`, `!` or `?` (default 0.3 s).
-    pub sentence_pause: f64,
+    /// The voice.
+    pub voice: Voice,
+    /// Speaking rate (1 = the TTS's own; 2 = twice as fast).
+    pub rate: f64,
     /// An incremental TTS that can change its speaking rate (AsapRealizer's incremental speech):
     /// speech is stretchable between 1/[`RETIME_RANGE`] and [`RETIME_RANGE`] times its preferred
     /// length instead of rigid. Off by default: a TTS decides its timing.
@@ -259,86 +267,47 @@ pub const RETIME_RANGE: f64 = 3.0;
 impl Default for SpeechTiming {
     fn default() -> Self {
         SpeechTiming {
-            syllable_seconds: 0.2,
-            comma_pause: 0.15,
-            sentence_pause: 0.3,
+            voice: Voice::Builtin,
+            rate: 1.0,
             retimable: false,
         }
     }
 }
 
-/// Syllables of a word, estimated as groups of vowels (a silent final `e` after a consonant
-/// does not count in a word of three letters or more); at least one for any word with a letter or
-/// digit, none for punctuation.
-pub fn syllables(word: &str) -> usize {
-    let (mut groups, mut letters, mut any) = (0, 0, false);
-    let (mut prev_vowel, mut e_end) = (false, false);
-    for c in word.chars() {
-        if c.is_alphabetic() {
-            let c = c.to_ascii_lowercase();
-            let vowel = matches!(c, 'a' | 'e' | 'i' | 'o' | 'u' | 'y');
-            if vowel && !prev_vowel {
-                groups += 1;
-            }
-            e_end = c == 'e' && !prev_vowel;
-            prev_vowel = vowel;
-            letters += 1;
-            any = true;
-        } else if c.is_numeric() {
-            any = true;
-        }
-    }
-    let silent_e = letters > 2 && e_end && groups > 1;
-    if any {
-        (groups - usize::from(silent_e)).max(1)
-    } else {
-        0
-    }
-}
-
-/// The pause after a word ending in `last`: 1 for a sentence end (`.`, `!`, `?`), 2 for a comma
-/// (`,`, `;`, `:`), 0 for none.
-fn pause_after(last: char) -> usize {
-    match last {
-        '.' | '!' | '?' => 1,
-        ',' | ';' | ':' => 2,
-        _ => 0,
-    }
-}
-
 impl SpeechTiming {
-    /// Time of a word of `syllables` whose last character is `last`, including the pause its
-    /// trailing punctuation asks for.
-    fn word(&self, syllables: usize, last: char) -> f64 {
-        let pause = [0.0, self.sentence_pause, self.comma_pause][pause_after(last)];
-        syllables as f64 * self.syllable_seconds + pause
-    }
-
-    /// Time of a run of text: its words one after another.
-    fn text(&self, text: &str) -> f64 {
-        text.split_whitespace()
-            .map(|w| self.word(syllables(w), w.chars().last().unwrap_or(' ')))
-            .sum()
-    }
-
-    /// The rigid timing of a speech: `start`, each inline sync at the boundary where it is written,
-    /// `end` after the last word. An empty text lasts one syllable.
+    /// The rigid timing of a speech: `start`, each inline sync where the voice puts it, `end`
+    /// where it stops.
     pub fn model(&self, speech: &Speech) -> TimingModel {
-        let syncs = speech
-            .text
-            .iter()
-            .filter(|p| matches!(p, TextPart::Sync(_)))
-            .count();
-        let mut keys = Vec::with_capacity(syncs + 2);
-        keys.push(SyncKey::new(crate::bml::Id::new_static("start"), 0.0));
-        let mut t = 0.0;
-        for part in &speech.text {
-            match part {
-                TextPart::Text(text) => t += self.text(text),
-                TextPart::Sync(id) => keys.push(SyncKey::new(id.clone(), t)),
-            }
+        self.model_of(&self.speak(&speech.text))
+    }
+
+    /// The metronome voice's timing (hand-computable: 0.2 s per syllable).
+    pub fn syllables() -> SpeechTiming {
+        SpeechTiming {
+            voice: Voice::Syllables,
+            ..SpeechTiming::default()
         }
-        let end = if t > 0.0 { t } else { self.syllable_seconds };
+    }
+
+    /// The utterance of `text` in this timing's voice.
+    pub fn speak(&self, text: &[crate::bml::TextPart]) -> crate::voice::Utterance {
+        use crate::voice::Tts;
+        let spoken = match self.voice {
+            Voice::Builtin => crate::voice::builtin::Builtin.speak(text),
+            Voice::Syllables => crate::voice::syllables::Syllables.speak(text),
+        };
+        spoken.expect("the built-in voices speak any text")
+    }
+
+    /// The rigid timing of an utterance (at this rate).
+    pub fn model_of(&self, u: &crate::voice::Utterance) -> TimingModel {
+        let rate = if self.rate > 0.0 { self.rate } else { 1.0 };
+        let mut keys = Vec::with_capacity(u.syncs.len() + 2);
+        keys.push(SyncKey::new(crate::bml::Id::new_static("start"), 0.0));
+        for (id, t) in &u.syncs {
+            keys.push(SyncKey::new(id.clone(), t / rate));
+        }
+        let end = u.end / rate;
         keys.push(SyncKey::new(crate::bml::Id::new_static("end"), end));
         let flexibility = if self.retimable {
             Flexibility::Stretchable {
@@ -411,6 +380,16 @@ fn limited(keys: &[(&'static str, f64)], max: f64) -> TimingModel {
         ("attackPeak", max),
         ("end", max),
     ])
+}
+
+impl DefaultTimingModels {
+    /// The default models with the metronome voice for speech (see [`SpeechTiming::syllables`]):
+    /// schedules that can be worked out by hand.
+    pub fn syllable_timed() -> Self {
+        DefaultTimingModels {
+            speech: SpeechTiming::syllables(),
+        }
+    }
 }
 
 impl TimingModels for DefaultTimingModels {
@@ -490,24 +469,6 @@ mod tests {
     }
 
     #[test]
-    fn syllable_estimates() {
-        for (w, n) in [
-            ("Hey", 1),
-            ("punk", 1),
-            ("want?", 1),
-            ("Welcome", 2),
-            ("ladies", 2),
-            ("gentlemen!", 3),
-            ("realizer", 3),
-            ("make", 1),
-            (",", 0),
-            ("16", 1),
-        ] {
-            assert_eq!(syllables(w), n, "{w}");
-        }
-    }
-
-    #[test]
     fn timing_models_admit_only_ordered_times_within_their_bounds() {
         let syncs = |v: &[(&'static str, f64)]| -> Vec<(crate::bml::Id, f64)> {
             v.iter()
@@ -543,39 +504,25 @@ mod tests {
     }
 
     #[test]
-    fn the_ascii_fast_path_times_text_like_the_word_by_word_path() {
-        let speech = SpeechTiming::default();
-        for text in [
-            "Welcome! I am Griet, I am 16 year old; and: make\tit \r\n  quick?",
-            "  -- ,  ",
-            "",
-            "trailing",
-        ] {
-            let by_words: f64 = text
-                .split_whitespace()
-                .map(|w| speech.word(syllables(w), w.chars().last().unwrap()))
-                .sum();
-            assert_eq!(speech.text(text), by_words, "{text:?}");
-        }
-        // Welcome(2)! I(1) am(1) Griet(1), = 5 syllables, a sentence and a comma pause
-        assert!((speech.text("Welcome! I am Griet,") - (1.0 + 0.3 + 0.15)).abs() < 1e-12);
-        // non-ASCII letters count as consonants
-        assert_eq!(syllables("Grüße"), 1);
-        assert!((speech.text("Grüße, Jürgen") - (0.2 + 0.15 + 0.2)).abs() < 1e-12);
-    }
-
-    #[test]
-    fn speech_is_rigid_with_syncs_at_word_boundaries() {
+    fn speech_is_rigid_with_syncs_at_the_start_of_the_next_word() {
         // RealizerTester core/testspeech2.xml
         let b = behaviours(
             r#"<speech id="s"><text>Hey punk <sync id="syncstart1" />what do ya want?</text></speech>"#,
         );
         let m = DefaultTimingModels::default().model(&b[0]).unwrap();
-        // Hey(1) punk(1) | what(1) do(1) ya(1) want?(1) + sentence pause: 0.4 | 0.8 + 0.3
+        let BehaviourKind::Speech(speech) = &b[0].kind else {
+            unreachable!()
+        };
+        use crate::voice::Tts;
+        let u = crate::voice::builtin::Builtin.speak(&speech.text).unwrap();
+        assert_eq!(u.words[2].text, "what");
+        let k = keys(&m);
         assert_eq!(
-            keys(&m),
-            [("start", 0.0), ("syncstart1", 0.4), ("end", 1.5)]
+            (k[0], k[1].0, k[2].0),
+            (("start", 0.0), "syncstart1", "end")
         );
+        assert!((k[1].1 - u.words[2].start).abs() < 1e-9 && (k[2].1 - u.end).abs() < 1e-9);
+        assert!(u.words[1].end <= u.words[2].start);
         assert_eq!(m.flexibility, Flexibility::Rigid);
         m.check().unwrap();
     }
@@ -586,30 +533,31 @@ mod tests {
             r#"<speech id="s"><text><sync id="a"/>One two<sync id="z"/></text></speech>"#,
         );
         let m = DefaultTimingModels::default().model(&b[0]).unwrap();
-        assert_eq!(
-            keys(&m),
-            [("start", 0.0), ("a", 0.0), ("z", 0.4), ("end", 0.4)]
-        );
+        let k = keys(&m);
+        assert_eq!(k[0..2], [("start", 0.0), ("a", 0.0)]);
+        assert_eq!(k[2].1, k[3].1, "z at the end");
         let b = behaviours(r#"<speech id="s"><text/></speech>"#);
         assert_eq!(
             DefaultTimingModels::default()
                 .model(&b[0])
                 .unwrap()
                 .preferred_duration(),
-            0.2
+            crate::voice::builtin::EMPTY
         );
     }
 
     #[test]
     fn speech_rate_is_configurable() {
         let b = behaviours(r#"<speech id="s"><text>one two three</text></speech>"#);
+        let normal = DefaultTimingModels::default().model(&b[0]).unwrap();
         let slow = DefaultTimingModels {
             speech: SpeechTiming {
-                syllable_seconds: 0.5,
+                rate: 0.5,
                 ..Default::default()
             },
         };
-        assert_eq!(slow.model(&b[0]).unwrap().preferred_duration(), 1.5);
+        let slow = slow.model(&b[0]).unwrap();
+        assert!((slow.preferred_duration() - 2.0 * normal.preferred_duration()).abs() < 1e-12);
     }
 
     #[test]

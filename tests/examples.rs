@@ -67,12 +67,24 @@ fn no_warnings(fb: &[Feedback]) {
 fn welcome() {
     let fb = run("run fixtures/examples/welcome.xml");
     no_warnings(&fb);
-    assert_eq!(ms(sync(&fb, "greet:hello:stress")), 0.6);
-    assert_eq!(ms(sync(&fb, "greet:beat:stroke")), 0.6);
-    assert_eq!(ms(sync(&fb, "greet:beat:start")), 0.1);
-    assert_eq!(ms(sync(&fb, "greet:hello:end")), 2.3);
-    assert_eq!(ms(sync(&fb, "greet:nod:start")), 2.3);
-    assert_eq!(block(&fb, "greet", "end"), (2.9, Some(BlockStatus::Done)));
+    // the speech as the built-in TTS says it: "welcome" starts at the stress sync
+    use bml_realizer::voice::Tts;
+    let text = [
+        bml_realizer::bml::TextPart::Text("Hello and ".into()),
+        bml_realizer::bml::TextPart::Sync(bml_realizer::bml::Id::new_static("stress")),
+        bml_realizer::bml::TextPart::Text("welcome to the realizer!".into()),
+    ];
+    let u = bml_realizer::voice::builtin::Builtin.speak(&text).unwrap();
+    assert_eq!(u.words[2].text, "welcome");
+    let stress = sync(&fb, "greet:hello:stress");
+    assert_eq!(ms(stress), ms(u.words[2].start));
+    assert_eq!(ms(sync(&fb, "greet:hello:end")), ms(u.end));
+    // the beat's stroke on the stress, its preparation 0.5 s before; the nod after the speech
+    assert_eq!(ms(sync(&fb, "greet:beat:stroke")), ms(stress));
+    assert_eq!(ms(sync(&fb, "greet:beat:start")), ms(stress - 0.5));
+    assert_eq!(ms(sync(&fb, "greet:nod:start")), ms(u.end));
+    let end = ms(sync(&fb, "greet:nod:end"));
+    assert_eq!(block(&fb, "greet", "end"), (end, Some(BlockStatus::Done)));
 }
 
 #[test]

@@ -34,14 +34,21 @@ fn speech(id: &str, words: usize, sync: Option<(&str, usize)>, attrs: &str) -> S
     format!(r#"<speech id="{id}" {attrs}><text>{text}</text></speech>"#)
 }
 
+/// A realizer with the metronome voice.
+fn metronome() -> Realizer {
+    Realizer::new().with_speech_timing(bml_realizer::timing::SpeechTiming::syllables())
+}
+
 struct Session {
     r: Realizer,
     log: Rc<RefCell<Vec<Feedback>>>,
 }
 
 impl Session {
+    /// A session whose speech is timed by the metronome voice (0.2 s per syllable), so that the
+    /// expected times below can be worked out by hand.
     fn new() -> Self {
-        Self::with(Realizer::new())
+        Self::with(metronome())
     }
 
     fn with(mut r: Realizer) -> Self {
@@ -749,7 +756,7 @@ fn memory_stays_bounded_while_streaming_100000_blocks() {
 
 #[test]
 fn blocks_are_routed_to_characters_and_their_feedback_names_them() {
-    let mut s = Session::with(Realizer::new().with_default_character(Some("anna".into())));
+    let mut s = Session::with(metronome().with_default_character(Some("anna".into())));
     s.send(
         0.0,
         &block("b1", r#"characterId="bob""#, &speech("s", 2, None, "")),

@@ -13,7 +13,7 @@ fn fixture(path: &str) -> String {
 fn schedule(src: &str) -> BlockSchedule {
     let block = bml::load(src).unwrap_or_else(|e| panic!("{e}")).block;
     Optimal
-        .schedule(&block, &DefaultTimingModels::default(), &NoExternal)
+        .schedule(&block, &DefaultTimingModels::syllable_timed(), &NoExternal)
         .unwrap()
 }
 
@@ -245,7 +245,7 @@ fn contradiction_inside_required_fails_the_block() {
     );
     let b = bml::load(&src).unwrap().block;
     let e = Optimal
-        .schedule(&b, &DefaultTimingModels::default(), &NoExternal)
+        .schedule(&b, &DefaultTimingModels::syllable_timed(), &NoExternal)
         .unwrap_err();
     assert!(e.reason.contains("g1:start = s1:end"), "{}", e.reason);
 }
@@ -297,7 +297,7 @@ mod order_invariance {
                 r ^= r << 13; r ^= r >> 7; r ^= r << 17;
                 shuffled.behaviours.swap(i, (r % (i as u64 + 1)) as usize);
             }
-            let models = DefaultTimingModels::default();
+            let models = DefaultTimingModels::syllable_timed();
             let a = Optimal.schedule(&original, &models, &NoExternal).unwrap();
             let b = Optimal.schedule(&shuffled, &models, &NoExternal).unwrap();
             for beh in &a.behaviours {
@@ -332,7 +332,7 @@ fn an_invalid_engine_timing_model_drops_the_behaviour_instead_of_panicking() {
     struct Broken;
     impl TimingModels for Broken {
         fn model(&self, b: &bml::Behaviour) -> Option<TimingModel> {
-            let mut m = DefaultTimingModels::default().model(b)?;
+            let mut m = DefaultTimingModels::syllable_timed().model(b)?;
             if b.id == "g1" {
                 m.keys.clear();
             }

@@ -150,7 +150,7 @@ fn least_deviation(d: f64, phases: &[(f64, f64)]) -> f64 {
 /// (deviation from preferred timing, sum of all sync times) of a schedule of `src`.
 fn objective(src: &str, schedule: &BlockSchedule) -> (f64, f64) {
     let block = bml::load(src).unwrap().block;
-    let models = DefaultTimingModels::default();
+    let models = DefaultTimingModels::syllable_timed();
     let (mut deviation, mut sum) = (0.0, 0.0);
     for b in &schedule.behaviours {
         let beh = block.behaviours.iter().find(|x| x.id == b.id).unwrap();
@@ -179,7 +179,7 @@ proptest! {
     ) {
         let src = block(&speeches, &moves);
         let parsed = bml::load(&src).unwrap().block;
-        let models = DefaultTimingModels::default();
+        let models = DefaultTimingModels::syllable_timed();
         let fast = Optimal.schedule(&parsed, &models, &NoExternal);
         let lp = LinearProgram.schedule(&parsed, &models, &NoExternal);
         let (fast, lp) = match (fast, lp) {
@@ -213,7 +213,7 @@ fn a_beat_between_two_speeches_keeps_its_preparation_and_the_speech_starts_at_on
     </bml>"#;
     let parsed = bml::load(src).unwrap().block;
     let s = Optimal
-        .schedule(&parsed, &DefaultTimingModels::default(), &NoExternal)
+        .schedule(&parsed, &DefaultTimingModels::syllable_timed(), &NoExternal)
         .unwrap();
     let time = |b: &str, k: &str| {
         s.behaviours
@@ -240,7 +240,7 @@ fn preparation_and_retraction_stay_within_their_limits_however_far_apart_the_key
     let parsed = bml::load(src).unwrap().block;
     for strategy in [&Optimal as &dyn SchedulingStrategy, &LinearProgram] {
         let s = strategy
-            .schedule(&parsed, &DefaultTimingModels::default(), &NoExternal)
+            .schedule(&parsed, &DefaultTimingModels::syllable_timed(), &NoExternal)
             .unwrap();
         let t = |k: &str| s.behaviours[0].time(k).unwrap();
         assert_eq!((t("start"), t("stroke"), t("end")), (0.0, 5.0, 12.0));
@@ -260,8 +260,11 @@ fn beat_wrist_at(times: &[f64]) -> Vec<glam::Vec3> {
       <speech id="s3" start="s2:end"><text>Goodbye <sync id="e"/>now.</text></speech>
       <gesture id="g2" lexeme="BEAT" strokeStart="s2:d" stroke="s3:e"/>
     </bml>"#;
-    // without the idle layer: the wrist moves only with the beat
-    let mut r = Realizer::new().with_idle(false);
+    // without the idle layer: the wrist moves only with the beat; the metronome voice gives the
+    // times below
+    let mut r = Realizer::new()
+        .with_speech_timing(bml_realizer::timing::SpeechTiming::syllables())
+        .with_idle(false);
     r.perform_bml(src).unwrap();
     let skeleton = Skeleton::adult();
     let wrist = skeleton.joint("r_wrist").unwrap();

@@ -30,7 +30,7 @@ fn planned(
             block_start: start,
         };
         Optimal
-            .schedule(&block, &DefaultTimingModels::default(), &times)
+            .schedule(&block, &DefaultTimingModels::syllable_timed(), &times)
             .unwrap()
     };
     assert!(schedule.dropped.is_empty(), "{:?}", schedule.dropped);

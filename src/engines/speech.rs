@@ -1,18 +1,22 @@
-//! The speech engine: `speech` (and BMLT `text`) with the headless timing model of
-//! [`SpeechTiming`] — rigid, words at a syllable rate, inline syncs at word boundaries. While a
-//! speech runs, `volume` (0–100) and `rate` (1 = the model's rate) can change; a rate change
-//! retimes the words still to come. Interrupting a speech stops it at once. No audio is produced
-//! (headless); the frame shows each running speech's progress, volume and rate.
+//! The speech engine: `speech` (and BMLT `text`) timed by the built-in TTS ([`SpeechTiming`],
+//! `voice::builtin`) — rigid, inline syncs at the start of the word after them — and spoken with
+//! the lips: each frame, the phones being said are turned into visemes with coarticulation
+//! (`voice::lipsync`) and the visemes into the face's blendshapes (jaw and lips), the frame's
+//! viseme the strongest of them. While a speech runs, `volume` (0–100) and `rate` (1 = the
+//! model's rate) can change; a rate change retimes the words still to come (and the lips with
+//! them). Interrupting a speech stops it at once. No audio is produced (headless); the frame
+//! shows each running speech's progress, volume and rate.
 //!
 //! Incremental speech (the `bmlis` extension of AsapRealizer's incremental TTS):
 //! `bmlis:generatefiller="true"` adds a hesitation filler after the text — the speech gets a
 //! `relax` sync where the text ends and its `end` after the filler; a chunked successor that
 //! speaks cuts the filler (co-articulation on the voice).
 
-use crate::bml::{Behaviour, BehaviourKind};
+use crate::bml::{Behaviour, BehaviourKind, TextPart};
 use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
-use crate::timing::SyncKey;
-use crate::timing::{SpeechTiming, TimingModel, TimingModels};
+use crate::face::{Face, FaceModel};
+use crate::timing::{SpeechTiming, SyncKey, SyncName, TimingModel, TimingModels};
+use crate::voice::{lipsync, Phone};
 
 /// Volume of a speech that no one changed.
 pub const DEFAULT_VOLUME: f64 = 100.0;
@@ -34,6 +38,34 @@ fn wants_filler(b: &Behaviour) -> bool {
 struct Speaking {
     volume: f64,
     rate: f64,
+    /// The phones, in the TTS's time (seconds from the speech's start at rate 1).
+    phones: Vec<Phone>,
+    /// The TTS's time of each sync key, in key order.
+    anchors: Vec<f64>,
+    /// Global time → TTS time: (global, TTS) knots, increasing; linear between them.
+    knots: Vec<(f64, f64)>,
+}
+
+impl Speaking {
+    /// The TTS's time at global time `t`.
+    fn tts_time(&self, t: f64) -> f64 {
+        let k = self.knots.partition_point(|&(g, _)| g <= t);
+        match (k.checked_sub(1).map(|i| self.knots[i]), self.knots.get(k)) {
+            (Some((g0, a0)), Some(&(g1, a1))) if g1 > g0 => a0 + (a1 - a0) * (t - g0) / (g1 - g0),
+            (Some((_, a0)), _) => a0,
+            (None, Some(&(_, a1))) => a1,
+            (None, None) => 0.0,
+        }
+    }
+
+    /// The knots for sync times `syncs`, keeping what was said up to `now`.
+    fn reknot(&mut self, now: f64, syncs: &[(SyncName, f64)]) {
+        let said = self.tts_time(now);
+        self.knots.retain(|&(g, _)| g <= now);
+        self.knots.push((now, said));
+        let later = (syncs.iter().zip(&self.anchors)).filter(|((_, g), &a)| *g > now && a >= said);
+        self.knots.extend(later.map(|((_, g), &a)| (*g, a)));
+    }
 }
 
 /// The speech engine (see the module documentation).
@@ -41,6 +73,8 @@ struct Speaking {
 pub struct SpeechEngine {
     timing: SpeechTiming,
     units: Units<Speaking>,
+    /// The last frame's time.
+    now: f64,
 }
 
 impl SpeechEngine {
@@ -49,17 +83,66 @@ impl SpeechEngine {
         SpeechEngine {
             timing,
             units: Units::new(),
+            now: 0.0,
         }
+    }
+
+    /// The phones of `behaviour` (with a filler's "uhm" after the text when it asks for one)
+    /// and the TTS's time of each of its sync keys.
+    fn spoken(&self, behaviour: &Behaviour) -> (Vec<Phone>, Vec<f64>) {
+        let text: &[TextPart] = match &behaviour.kind {
+            BehaviourKind::Speech(s) | BehaviourKind::Text(s) => &s.text,
+            _ => &[],
+        };
+        let u = self.timing.speak(text);
+        let mut phones = u.phones;
+        let mut anchors: Vec<f64> = std::iter::once(0.0)
+            .chain(u.syncs.iter().map(|s| s.1))
+            .chain([u.end])
+            .collect();
+        if wants_filler(behaviour) {
+            let (a, m) = (u.end + FILLER_SECONDS * 0.6, u.end + FILLER_SECONDS);
+            phones.push(Phone {
+                symbol: "AH",
+                start: u.end,
+                end: a,
+            });
+            phones.push(Phone {
+                symbol: "M",
+                start: a,
+                end: m,
+            });
+            anchors.push(m);
+        }
+        (phones, anchors)
     }
 }
 
 impl Engine for SpeechEngine {
     crate::units_remove!();
-    crate::units_retime_len!();
-    crate::units_interrupt!(crate::engine::stop_now);
 
     fn name(&self) -> &'static str {
         "speech"
+    }
+
+    fn retime(&mut self, key: &UnitKey, syncs: &[(SyncName, f64)]) {
+        let now = self.now;
+        if let Some((held, u)) = self.units.get_mut(key) {
+            u.reknot(now, syncs);
+            for (h, s) in held.iter_mut().zip(syncs) {
+                h.1 = s.1;
+            }
+        }
+    }
+
+    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+        let times = crate::engine::stop_now(now, syncs);
+        self.units.retime(key, &times);
+        times
+    }
+
+    fn len(&self) -> usize {
+        self.units.len()
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
@@ -90,11 +173,18 @@ impl Engine for SpeechEngine {
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         // keys are unique: the runtime never adds a unit twice
+        let (phones, anchors) = self.spoken(unit.behaviour);
+        let knots = (unit.syncs.iter().zip(&anchors))
+            .map(|(s, &a)| (s.1, a))
+            .collect();
         self.units.add(
             unit,
             Speaking {
                 volume: DEFAULT_VOLUME,
                 rate: 1.0,
+                phones,
+                anchors,
+                knots,
             },
         );
         Ok(())
@@ -117,6 +207,44 @@ impl Engine for SpeechEngine {
 
     fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
         Some(self)
+    }
+
+    fn as_expression(&mut self) -> Option<&mut dyn crate::engine::Expression> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Expression for SpeechEngine {
+    /// The lips of every speech being said at `now`: its visemes as blendshapes (several
+    /// speeches at once combine by maximum), and the strongest viseme.
+    fn express(&mut self, now: f64, face: &mut Face) {
+        self.now = now;
+        let model = FaceModel::default_model();
+        let mut strongest = (0.0f32, None);
+        for (syncs, u) in self.units.all() {
+            let (Some(start), Some(end)) = (syncs.first(), syncs.last()) else {
+                continue;
+            };
+            if now < start.1 || now > end.1 {
+                continue;
+            }
+            let w = lipsync::weights(&u.phones, u.tts_time(now));
+            let mut shapes = [0.0f32; 52];
+            for (v, &wv) in w.iter().enumerate() {
+                for &(m, weight) in model.viseme(v) {
+                    shapes[m] += wv * weight;
+                }
+                if wv > strongest.0 {
+                    strongest = (wv, Some(v));
+                }
+            }
+            for (m, &x) in shapes.iter().enumerate() {
+                face.raise_morph(m, x);
+            }
+        }
+        if strongest.1.is_some() {
+            face.viseme = strongest.1;
+        }
     }
 }
 
@@ -155,6 +283,7 @@ impl crate::engine::Parameters for SpeechEngine {
                         s.1 = now + (s.1 - now) * factor;
                     }
                 }
+                u.reknot(now, syncs);
                 Ok(Some(syncs.iter().map(|s| s.1).collect()))
             }
             "volume" | "rate" => Err(EngineError(format!(

@@ -85,6 +85,14 @@ impl Realizer {
         self
     }
 
+    /// Times speech with `speech` (the built-in TTS by default; `SpeechTiming::syllables()` for
+    /// the metronome voice), with the default engines.
+    pub fn with_speech_timing(self, speech: crate::timing::SpeechTiming) -> Self {
+        self.with_engines(move || {
+            crate::engines::default_registry(crate::timing::DefaultTimingModels { speech })
+        })
+    }
+
     /// Uses another scheduling strategy.
     pub fn with_strategy(
         mut self,
