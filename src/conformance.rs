@@ -10,7 +10,7 @@ use realizer_tests::{Fixture, TestPort};
 use crate::engines::default_registry;
 use crate::feedback::{Feedback, Format};
 use crate::realizer::Realizer;
-use crate::timing::{DefaultTimingModels, SpeechTiming};
+use crate::timing::{DefaultTimingModels, SpeechTiming, Voice};
 
 /// A fresh [`Realizer`] per test on a virtual clock; tests of the incremental-speech fixture get
 /// retimable speech.
@@ -18,6 +18,7 @@ pub struct InProcess {
     realizer: Realizer,
     lines: Rc<RefCell<Vec<String>>>,
     end_delay: f64,
+    voice: Voice,
 }
 
 impl Default for InProcess {
@@ -31,23 +32,37 @@ impl InProcess {
     pub fn new() -> Self {
         let lines = Rc::new(RefCell::new(Vec::new()));
         InProcess {
-            realizer: Self::realizer(&lines, 0.0, Fixture::Standard),
+            realizer: Self::realizer(&lines, 0.0, Fixture::Standard, Voice::Builtin),
             lines,
             end_delay: 0.0,
+            voice: Voice::Builtin,
         }
+    }
+
+    /// Speech said by `voice` (the built-in TTS by default; `Voice::Flite` runs flite).
+    pub fn with_voice(mut self, voice: Voice) -> Self {
+        self.voice = voice;
+        self.realizer = Self::realizer(&self.lines, self.end_delay, Fixture::Standard, voice);
+        self
     }
 
     /// A deliberately broken realizer that reports every block end `secs` seconds late (to show
     /// that the suite catches timing regressions).
     pub fn with_late_block_ends(mut self, secs: f64) -> Self {
         self.end_delay = secs;
-        self.realizer = Self::realizer(&self.lines, secs, Fixture::Standard);
+        self.realizer = Self::realizer(&self.lines, secs, Fixture::Standard, self.voice);
         self
     }
 
-    fn realizer(lines: &Rc<RefCell<Vec<String>>>, end_delay: f64, fixture: Fixture) -> Realizer {
+    fn realizer(
+        lines: &Rc<RefCell<Vec<String>>>,
+        end_delay: f64,
+        fixture: Fixture,
+        voice: Voice,
+    ) -> Realizer {
         let sink = lines.clone();
         let speech = SpeechTiming {
+            voice,
             retimable: fixture == Fixture::IncrementalSpeech,
             ..SpeechTiming::default()
         };
@@ -93,7 +108,7 @@ impl TestPort for InProcess {
     }
 
     fn reset(&mut self, fixture: Fixture) -> Result<(), String> {
-        self.realizer = Self::realizer(&self.lines, self.end_delay, fixture);
+        self.realizer = Self::realizer(&self.lines, self.end_delay, fixture, self.voice);
         self.lines.borrow_mut().clear();
         Ok(())
     }

@@ -32,6 +32,7 @@ pub mod feedback;
 pub mod plan;
 pub mod realizer;
 pub mod schedule;
+pub mod sound;
 #[cfg(test)]
 mod testrand;
 pub mod timeline;

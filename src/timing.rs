@@ -245,6 +245,9 @@ pub enum Voice {
     Builtin,
     /// The metronome voice (`voice::syllables`): 0.2 s per syllable, pauses after punctuation.
     Syllables,
+    /// CMU Flite run as a program (`voice::flite`; Debian package `flite`): its phone timings and
+    /// its sound.
+    Flite,
 }
 
 /// Speech timing from a voice (the built-in TTS by default): rigid, each inline sync where the
@@ -278,7 +281,15 @@ impl SpeechTiming {
     /// The rigid timing of a speech: `start`, each inline sync where the voice puts it, `end`
     /// where it stops.
     pub fn model(&self, speech: &Speech) -> TimingModel {
-        self.model_of(&self.speak(&speech.text))
+        let u = self.speak(&speech.text).unwrap_or_else(|_| {
+            SpeechTiming {
+                voice: Voice::Builtin,
+                ..*self
+            }
+            .speak(&speech.text)
+            .unwrap_or_default()
+        });
+        self.model_of(&u)
     }
 
     /// The metronome voice's timing (hand-computable: 0.2 s per syllable).
@@ -289,14 +300,15 @@ impl SpeechTiming {
         }
     }
 
-    /// The utterance of `text` in this timing's voice.
-    pub fn speak(&self, text: &[crate::bml::TextPart]) -> crate::voice::Utterance {
+    /// The utterance of `text` in this timing's voice (the built-in voices never fail; flite
+    /// can: the error says why).
+    pub fn speak(&self, text: &[crate::bml::TextPart]) -> Result<crate::voice::Utterance, String> {
         use crate::voice::Tts;
-        let spoken = match self.voice {
+        match self.voice {
             Voice::Builtin => crate::voice::builtin::Builtin.speak(text),
             Voice::Syllables => crate::voice::syllables::Syllables.speak(text),
-        };
-        spoken.expect("the built-in voices speak any text")
+            Voice::Flite => crate::voice::flite::Flite::default().speak(text),
+        }
     }
 
     /// The rigid timing of an utterance (at this rate).

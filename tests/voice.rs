@@ -21,7 +21,9 @@ fn speak() -> (Vec<Mouth>, bml_realizer::voice::Utterance) {
         r#"<bml {NS} id="v"><speech id="s"><text>{SENTENCE}</text></speech></bml>"#
     ))
     .unwrap();
-    let u = SpeechTiming::default().speak(&[TextPart::Text(SENTENCE.into())]);
+    let u = SpeechTiming::default()
+        .speak(&[TextPart::Text(SENTENCE.into())])
+        .unwrap();
     let frames = (0..=((u.end + 0.2) * FPS) as u32)
         .map(|i| {
             let t = f64::from(i) / FPS;

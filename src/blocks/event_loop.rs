@@ -163,15 +163,50 @@ impl BlockManager {
             pose.rotate(jaw, glam::Quat::from_rotation_x(open));
         }
         let clamped = self.skeleton.limits().clamp(&mut pose);
+        let (sounds, events) = self.sounds(to);
         frame.poses.push(CharacterPose {
             character: self.character.clone(),
             pose,
             clamped,
             face,
+            sounds,
+            events,
         });
         for (engine, key) in std::mem::take(&mut self.retiring) {
             self.registry.engine_mut(engine).remove(&key);
         }
+    }
+
+    /// What plays at `now`, and the sounds that started or stopped since the last frame.
+    fn sounds(&mut self, now: f64) -> (Vec<crate::sound::Playing>, Vec<crate::sound::SoundEvent>) {
+        let mut sounds = Vec::new();
+        for e in self.registry.engines_mut() {
+            if let Some(s) = e.as_sound() {
+                s.sounds(now, &mut sounds);
+            }
+        }
+        let mut events = Vec::new();
+        for p in &sounds {
+            if !self.playing.contains(&p.id) {
+                let offset = (now - p.start).max(0.0);
+                events.push(crate::sound::SoundEvent {
+                    start: true,
+                    id: p.id.clone(),
+                    offset,
+                });
+            }
+        }
+        for id in &self.playing {
+            if !sounds.iter().any(|p| p.id == *id) {
+                events.push(crate::sound::SoundEvent {
+                    start: false,
+                    id: id.clone(),
+                    offset: 0.0,
+                });
+            }
+        }
+        self.playing = sounds.iter().map(|p| p.id.clone()).collect();
+        (sounds, events)
     }
 
     /// Gives every engine that asks for them the poses the predictable units will have at the

@@ -95,6 +95,8 @@ pub struct BlockManager {
     idle: Option<crate::body::idle::Idle>,
     /// The lids' idle life (blinks, lids following the eyes), with the idle layer.
     blinks: Option<crate::face::blink::Blinker>,
+    /// The sounds that played in the last frame (ids).
+    playing: Vec<String>,
     /// The world as of the last advance (shared with the realizer).
     world: std::sync::Arc<World>,
     now: f64,
@@ -128,6 +130,7 @@ impl BlockManager {
             skeleton,
             idle: Some(idle),
             blinks: Some(blinks),
+            playing: Vec::new(),
             world: std::sync::Arc::new(World::default()),
             now: 0.0,
             seq: 0,

@@ -13,10 +13,24 @@ use serde::Serialize;
 use super::pose::Pose;
 use super::skeleton::Skeleton;
 use crate::face::{Face, FaceModel, ARKIT, VISEMES};
+use crate::sound::SoundEvent;
 
 /// One character in a frame: its id (`""` the default one), pose, the joints clamped into their
-/// limits, and its face (if it has one).
-pub type Character<'a> = (&'a str, &'a Pose, &'a [usize], Option<&'a Face>);
+/// limits, its face (if it has one) and the sounds that started or stopped since the last frame.
+pub type Character<'a> = (
+    &'a str,
+    &'a Pose,
+    &'a [usize],
+    Option<&'a Face>,
+    &'a [SoundEvent],
+);
+
+#[derive(Serialize)]
+struct EventLine<'a> {
+    kind: &'static str,
+    id: &'a str,
+    offset: f64,
+}
 
 /// Line 1.
 #[derive(Serialize)]
@@ -60,6 +74,8 @@ struct CharacterLine<'a> {
     morphs: IndexMap<&'static str, f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     viseme: Option<&'static str>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    events: Vec<EventLine<'a>>,
 }
 
 /// The action units of `face` that are not 0, one entry for both sides where they are equal.
@@ -122,7 +138,7 @@ pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
 /// joints that were clamped into their limits and the face.
 pub fn line(skeleton: &Skeleton, time: f64, poses: &[Character<'_>]) -> String {
     let characters = (poses.iter())
-        .map(|&(id, pose, clamped, face)| {
+        .map(|&(id, pose, clamped, face, events)| {
             let world = pose.world(skeleton);
             let joints = (skeleton.joints().iter().zip(&pose.rotations))
                 .map(|(j, &q)| (j.name.as_str(), quat(q)))
@@ -140,6 +156,13 @@ pub fn line(skeleton: &Skeleton, time: f64, poses: &[Character<'_>]) -> String {
                 viseme: face
                     .and_then(|f| f.viseme)
                     .and_then(|v| VISEMES.get(v).copied()),
+                events: (events.iter())
+                    .map(|e| EventLine {
+                        kind: if e.start { "audio-start" } else { "audio-stop" },
+                        id: &e.id,
+                        offset: (e.offset * 1e6).round() / 1e6,
+                    })
+                    .collect(),
             };
             (id, character)
         })
@@ -169,7 +192,7 @@ mod tests {
             glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         );
         let f: serde_json::Value =
-            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[], None)])).unwrap();
+            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[], None, &[])])).unwrap();
         assert_eq!(f["time"], 0.5);
         let c = &f["characters"][""];
         assert_eq!(c["root"], serde_json::json!([0.0, 0.95, 0.0]));
@@ -182,7 +205,7 @@ mod tests {
         );
         assert!(c.get("clamped").is_none(), "only when a joint was clamped");
         let f: serde_json::Value =
-            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[elbow], None)])).unwrap();
+            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[elbow], None, &[])])).unwrap();
         assert_eq!(
             f["characters"][""]["clamped"],
             serde_json::json!(["l_elbow"])

@@ -27,6 +27,12 @@ pub trait Expression {
     fn express(&mut self, now: f64, face: &mut crate::face::Face);
 }
 
+/// An engine that makes sound (synthesized speech, audio clips).
+pub trait Sound {
+    /// Appends what plays at `now` to `out`.
+    fn sounds(&self, now: f64, out: &mut Vec<crate::sound::Playing>);
+}
+
 /// An engine's part in animation prediction: predictable engines say what they will have set
 /// at a future time; others (a transition) ask for those predicted poses.
 pub trait Prediction {

@@ -32,6 +32,10 @@ pub struct CharacterPose {
     pub clamped: Vec<usize>,
     /// Its face: action units, blendshape weights, the viseme.
     pub face: crate::face::Face,
+    /// The sounds it makes in this frame.
+    pub sounds: Vec<crate::sound::Playing>,
+    /// Sounds that started or stopped since the previous frame.
+    pub events: Vec<crate::sound::SoundEvent>,
 }
 
 /// Everything the realizer produced for one moment: engine output, each character's pose, and the

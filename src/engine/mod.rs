@@ -16,7 +16,8 @@ mod units;
 use std::fmt;
 
 pub use capabilities::{
-    Action, Control, Expression, Motion, MotionKind, Parameters, Prediction, Resources, Steering,
+    Action, Control, Expression, Motion, MotionKind, Parameters, Prediction, Resources, Sound,
+    Steering,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};
@@ -177,6 +178,11 @@ pub trait Engine {
 
     /// The engine's part in animation prediction, if it predicts or needs predicted poses.
     fn as_prediction(&mut self) -> Option<&mut dyn Prediction> {
+        None
+    }
+
+    /// Its sound, if it makes any.
+    fn as_sound(&self) -> Option<&dyn Sound> {
         None
     }
 

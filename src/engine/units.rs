@@ -132,6 +132,14 @@ impl<T> Units<T> {
             .map(|u| &u.data)
     }
 
+    /// A unit's sync times and data, read only.
+    pub fn get_syncs(&self, key: &UnitKey) -> Option<(&SyncTimes, &T)> {
+        self.units
+            .values()
+            .find(|u| *u.key == *key)
+            .map(|u| (&u.syncs, &u.data))
+    }
+
     /// A unit's sync times and data.
     pub fn get_mut(&mut self, key: &UnitKey) -> Option<(&mut SyncTimes, &mut T)> {
         self.units

@@ -2,6 +2,7 @@
 //! kind to one of them:
 //!
 //! - [`assets`]: the motion data (units and bindings), embedded or read from a directory;
+//! - [`audio`]: BMLT `audiofile` as WAV clips, timed by their length;
 //! - [`control`]: `wait`, `interrupt`, `activate`, `parametervaluechange`;
 //! - [`speech`]: `speech` and `bmlt:text` with the headless speech timing model, `volume` settable
 //!   while speaking;
@@ -22,6 +23,7 @@
 //! - [`transition`]: BMLT transitions from the current pose to the predicted one.
 
 pub mod assets;
+pub mod audio;
 pub mod control;
 pub mod expr;
 pub mod face;
@@ -88,7 +90,7 @@ pub fn registry_with(models: DefaultTimingModels, assets: &assets::Assets) -> Re
     );
     r.register(Box::new(face::FaceEngine::default()), &keys(FACE_KINDS));
     r.register(
-        Box::new(timing_only::TimingOnlyEngine::audio(models)),
+        Box::new(audio::AudioEngine::default()),
         &keys(&[(NS_BMLT, "audiofile")]),
     );
     // keyframes set joint rotations; the engines after them add to or aim from them

@@ -4,8 +4,9 @@
 //! (`voice::lipsync`) and the visemes into the face's blendshapes (jaw and lips), the frame's
 //! viseme the strongest of them. While a speech runs, `volume` (0–100) and `rate` (1 = the
 //! model's rate) can change; a rate change retimes the words still to come (and the lips with
-//! them). Interrupting a speech stops it at once. No audio is produced (headless); the frame
-//! shows each running speech's progress, volume and rate.
+//! them). Interrupting a speech stops it at once. A voice that synthesizes sound (flite) plays
+//! it from the speech's start at its volume (`engine::Sound`); the built-in voice is silent. The
+//! frame shows each running speech's progress, volume and rate.
 //!
 //! Incremental speech (the `bmlis` extension of AsapRealizer's incremental TTS):
 //! `bmlis:generatefiller="true"` adds a hesitation filler after the text — the speech gets a
@@ -16,7 +17,8 @@ use crate::bml::{Behaviour, BehaviourKind, TextPart};
 use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
 use crate::face::{Face, FaceModel};
 use crate::timing::{SpeechTiming, SyncKey, SyncName, TimingModel, TimingModels};
-use crate::voice::{lipsync, Phone};
+use crate::voice::{lipsync, Phone, Utterance};
+use std::sync::Arc;
 
 /// Volume of a speech that no one changed.
 pub const DEFAULT_VOLUME: f64 = 100.0;
@@ -38,6 +40,8 @@ fn wants_filler(b: &Behaviour) -> bool {
 struct Speaking {
     volume: f64,
     rate: f64,
+    /// The synthesized sound, if the voice makes any.
+    audio: Option<Arc<crate::voice::Audio>>,
     /// The phones, in the TTS's time (seconds from the speech's start at rate 1).
     phones: Vec<Phone>,
     /// The TTS's time of each sync key, in key order.
@@ -75,6 +79,21 @@ pub struct SpeechEngine {
     units: Units<Speaking>,
     /// The last frame's time.
     now: f64,
+    /// The last [`CACHE`] texts said, with what the voice made of them: timing, warnings and the
+    /// unit ask for the same text, and a voice that runs a program is asked once.
+    said: std::sync::Mutex<std::collections::VecDeque<(Vec<TextPart>, Arc<Said>)>>,
+}
+
+/// How many texts the engine remembers.
+const CACHE: usize = 64;
+
+/// What the voice made of a text: the utterance, or (when it failed) the built-in TTS's and why.
+#[derive(Debug)]
+pub struct Said {
+    /// The utterance (phones, syncs, end, sound).
+    pub utterance: Utterance,
+    /// Why the chosen voice could not say it, if it could not.
+    pub failed: Option<String>,
 }
 
 impl SpeechEngine {
@@ -84,18 +103,50 @@ impl SpeechEngine {
             timing,
             units: Units::new(),
             now: 0.0,
+            said: std::sync::Mutex::new(std::collections::VecDeque::new()),
+        }
+    }
+
+    /// What the voice makes of `text` (remembered).
+    fn say(&self, text: &[TextPart]) -> Arc<Said> {
+        let mut cache = self.said.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, s)) = cache.iter().find(|(t, _)| t.as_slice() == text) {
+            return s.clone();
+        }
+        let said = Arc::new(match self.timing.speak(text) {
+            Ok(utterance) => Said {
+                utterance,
+                failed: None,
+            },
+            Err(e) => Said {
+                utterance: SpeechTiming::default().speak(text).unwrap_or_default(),
+                failed: Some(e),
+            },
+        });
+        cache.push_back((text.to_vec(), said.clone()));
+        if cache.len() > CACHE {
+            cache.pop_front();
+        }
+        said
+    }
+
+    /// The text of a speech behaviour.
+    fn text(behaviour: &Behaviour) -> &[TextPart] {
+        match &behaviour.kind {
+            BehaviourKind::Speech(s) | BehaviourKind::Text(s) => &s.text,
+            _ => &[],
         }
     }
 
     /// The phones of `behaviour` (with a filler's "uhm" after the text when it asks for one)
     /// and the TTS's time of each of its sync keys.
     fn spoken(&self, behaviour: &Behaviour) -> (Vec<Phone>, Vec<f64>) {
-        let text: &[TextPart] = match &behaviour.kind {
-            BehaviourKind::Speech(s) | BehaviourKind::Text(s) => &s.text,
-            _ => &[],
-        };
-        let u = self.timing.speak(text);
-        let mut phones = u.phones;
+        if !matches!(behaviour.kind, BehaviourKind::Speech(_)) {
+            return (Vec::new(), Vec::new()); // shown text: the lips stay still
+        }
+        let said = self.say(Self::text(behaviour));
+        let u = &said.utterance;
+        let mut phones = u.phones.clone();
         let mut anchors: Vec<f64> = std::iter::once(0.0)
             .chain(u.syncs.iter().map(|s| s.1))
             .chain([u.end])
@@ -146,13 +197,16 @@ impl Engine for SpeechEngine {
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        let mut model = match behaviour.kind {
-            BehaviourKind::Speech(_) | BehaviourKind::Text(_) => {
-                crate::timing::DefaultTimingModels {
-                    speech: self.timing,
-                }
-                .model(behaviour)?
+        let mut model = match &behaviour.kind {
+            BehaviourKind::Speech(s) => self.timing.model_of(&self.say(&s.text).utterance),
+            // shown text is timed as the built-in voice would say it, and may stretch
+            BehaviourKind::Text(_) => crate::timing::DefaultTimingModels {
+                speech: SpeechTiming {
+                    voice: crate::timing::Voice::Builtin,
+                    ..self.timing
+                },
             }
+            .model(behaviour)?,
             _ => return None,
         };
         if wants_filler(behaviour) {
@@ -167,6 +221,18 @@ impl Engine for SpeechEngine {
         Some(model)
     }
 
+    fn unanimated(&self, behaviour: &Behaviour) -> Option<String> {
+        if !matches!(behaviour.kind, BehaviourKind::Speech(_)) {
+            return None;
+        }
+        let said = self.say(Self::text(behaviour));
+        let why = said.failed.as_ref()?;
+        Some(format!(
+            "speech '{}': {why}; it is timed by the built-in TTS instead, without sound",
+            behaviour.id
+        ))
+    }
+
     fn interprets(&self, ns: &str, name: &str) -> bool {
         ns == NS_BMLIS && name == "generatefiller"
     }
@@ -174,6 +240,9 @@ impl Engine for SpeechEngine {
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         // keys are unique: the runtime never adds a unit twice
         let (phones, anchors) = self.spoken(unit.behaviour);
+        let audio = matches!(unit.behaviour.kind, BehaviourKind::Speech(_))
+            .then(|| self.say(Self::text(unit.behaviour)).utterance.audio.clone())
+            .flatten();
         let knots = (unit.syncs.iter().zip(&anchors))
             .map(|(s, &a)| (s.1, a))
             .collect();
@@ -182,6 +251,7 @@ impl Engine for SpeechEngine {
             Speaking {
                 volume: DEFAULT_VOLUME,
                 rate: 1.0,
+                audio,
                 phones,
                 anchors,
                 knots,
@@ -212,6 +282,32 @@ impl Engine for SpeechEngine {
     fn as_expression(&mut self) -> Option<&mut dyn crate::engine::Expression> {
         Some(self)
     }
+
+    fn as_sound(&self) -> Option<&dyn crate::engine::Sound> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Sound for SpeechEngine {
+    /// The synthesized sound of every speech being said, from its start peg at its volume (its
+    /// own rate: a rate change moves the lips, not the sound), until its end or interrupt.
+    fn sounds(&self, now: f64, out: &mut Vec<crate::sound::Playing>) {
+        for (key, _, u) in self.units.running(now) {
+            let (Some(audio), Some((syncs, _))) = (&u.audio, self.units.get_syncs(key)) else {
+                continue;
+            };
+            let (Some(start), Some(stop)) = (syncs.first(), syncs.last()) else {
+                continue;
+            };
+            out.push(crate::sound::Playing {
+                id: key.to_string(),
+                start: start.1,
+                stop: stop.1,
+                volume: (u.volume / 100.0) as f32,
+                audio: audio.clone(),
+            });
+        }
+    }
 }
 
 impl crate::engine::Expression for SpeechEngine {
@@ -225,7 +321,7 @@ impl crate::engine::Expression for SpeechEngine {
             let (Some(start), Some(end)) = (syncs.first(), syncs.last()) else {
                 continue;
             };
-            if now < start.1 || now > end.1 {
+            if now < start.1 || now > end.1 || u.phones.is_empty() {
                 continue;
             }
             let w = lipsync::weights(&u.phones, u.tts_time(now));

@@ -88,6 +88,11 @@ fn phone(symbol: &str) -> Option<(&'static str, f64)> {
     PHONES.iter().find(|(p, _)| *p == symbol).copied()
 }
 
+/// The `'static` name of ARPAbet phone `symbol` (upper case, no stress digit), if it is one.
+pub fn phone_name(symbol: &str) -> Option<&'static str> {
+    phone(symbol).map(|p| p.0)
+}
+
 /// Whether `symbol` is a vowel.
 pub fn is_vowel(symbol: &str) -> bool {
     PHONES[..VOWELS].iter().any(|(p, _)| *p == symbol)

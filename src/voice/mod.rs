@@ -1,10 +1,11 @@
 //! The voice: a text-to-speech interface ([`Tts`]) that turns a speech's text with inline syncs
 //! into phones with times, word times, sync times and optional audio; the built-in TTS
 //! ([`builtin`]: English letter-to-sound rules, a lexicon of common words, a duration model; no
-//! audio); a metronome voice whose timing can be worked out by hand ([`syllables`]); and lip sync ([`lipsync`]: phones to visemes with coarticulation). The scheduler keeps
+//! audio); flite run as a program ([`flite`]: its phone timings and its sound); a metronome voice whose timing can be worked out by hand ([`syllables`]); and lip sync ([`lipsync`]: phones to visemes with coarticulation). The scheduler keeps
 //! a speech rigid with the times its TTS gives.
 
 pub mod builtin;
+pub mod flite;
 pub mod lipsync;
 pub mod syllables;
 
@@ -67,7 +68,7 @@ pub struct Utterance {
     /// When the speech ends (seconds from its start).
     pub end: f64,
     /// The sound, if synthesized.
-    pub audio: Option<Audio>,
+    pub audio: Option<std::sync::Arc<Audio>>,
 }
 
 /// A text-to-speech engine.

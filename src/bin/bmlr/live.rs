@@ -73,7 +73,13 @@ impl LiveView {
         let poses: Vec<bml_realizer::body::frames::Character> = (poses.iter())
             .map(|p| {
                 let id = p.character.as_deref().unwrap_or("");
-                (id, &p.pose, p.clamped.as_slice(), Some(&p.face))
+                (
+                    id,
+                    &p.pose,
+                    p.clamped.as_slice(),
+                    Some(&p.face),
+                    p.events.as_slice(),
+                )
             })
             .collect();
         let line = bml_realizer::body::frames::line(&self.skeleton, t, &poses);

@@ -6,6 +6,7 @@ use std::path::Path;
 use bml_realizer::body::{Pose, Skeleton};
 use bml_realizer::engine::CharacterPose;
 use bml_realizer::realizer::Realizer;
+use bml_realizer::sound::{SoundEvent, Track};
 
 /// The frame period, the next frame's time, and every character's pose in each frame so far
 /// (which characters a file shows is decided at the end).
@@ -15,6 +16,9 @@ pub struct Recording {
     /// (time, the poses of the characters that had one).
     pub frames: Vec<(f64, Vec<CharacterPose>)>,
     fps: f64,
+    /// Every sound heard, from every tick (not only the recorded frames: an interrupt's cut
+    /// falls between them), and whether it still plays.
+    heard: Vec<(String, Track, bool)>,
 }
 
 impl Recording {
@@ -25,6 +29,45 @@ impl Recording {
             next: 0.0,
             frames: Vec::new(),
             fps,
+            heard: Vec::new(),
+        }
+    }
+
+    /// Notes the sounds playing at tick `t`: new ones, volume changes, and sounds gone before
+    /// their end (cut there).
+    pub fn observe(&mut self, t: f64, poses: &[CharacterPose]) {
+        let playing: Vec<&bml_realizer::sound::Playing> =
+            poses.iter().flat_map(|p| &p.sounds).collect();
+        for s in &playing {
+            let cut = (s.stop < s.start + s.length() - 1e-6).then_some(s.stop);
+            let known = (self.heard.iter_mut())
+                .find(|(id, tr, on)| *on && *id == s.id && tr.start == s.start);
+            match known {
+                Some((_, tr, _)) => {
+                    if tr.volume.last().is_none_or(|v| v.1 != s.volume) {
+                        tr.volume.push((t, s.volume));
+                    }
+                    tr.cut = cut;
+                }
+                None => self.heard.push((
+                    s.id.clone(),
+                    Track {
+                        start: s.start,
+                        audio: s.audio.clone(),
+                        volume: vec![(t, s.volume)],
+                        cut,
+                    },
+                    true,
+                )),
+            }
+        }
+        for (id, tr, on) in self.heard.iter_mut().filter(|h| h.2) {
+            if !playing.iter().any(|s| s.id == *id && s.start == tr.start) {
+                *on = false;
+                if tr.cut.is_none() && t < tr.start + tr.length() - 1e-6 {
+                    tr.cut = Some(t);
+                }
+            }
         }
     }
 
@@ -120,16 +163,54 @@ impl Recording {
         let skeleton = Skeleton::adult();
         let header = bml_realizer::body::frames::header(&skeleton, self.fps, ids);
         let per_character: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
+        let times: Vec<f64> = self.frames.iter().map(|f| f.0).collect();
+        let events: Vec<Vec<Vec<SoundEvent>>> = per_character
+            .iter()
+            .map(|p| sound_events(&times, p))
+            .collect();
         let lines = (self.frames.iter().enumerate())
             .map(|(k, (time, _))| {
                 let poses: Vec<bml_realizer::body::frames::Character> = (ids.iter())
                     .zip(&per_character)
-                    .map(|(&id, p)| (id, &p[k].pose, p[k].clamped.as_slice(), Some(&p[k].face)))
+                    .zip(&events)
+                    .map(|((&id, p), e)| {
+                        (
+                            id,
+                            &p[k].pose,
+                            p[k].clamped.as_slice(),
+                            Some(&p[k].face),
+                            e[k].as_slice(),
+                        )
+                    })
                     .collect();
                 bml_realizer::body::frames::line(&skeleton, *time, &poses)
             })
             .collect();
         (header, lines)
+    }
+
+    /// Writes the sound of the run (every character's speech and clips) as a WAV file, the
+    /// clips where they played, from time 0 to the end. An error has the exit code.
+    pub fn write_wav(&self, realizer: &Realizer, path: &Path) -> Result<(), (u8, String)> {
+        let tracks: Vec<Track> = self.heard.iter().map(|(_, t, _)| t.clone()).collect();
+        let rate = tracks.iter().map(|t| t.audio.rate).max().unwrap_or(16_000);
+        let end = (tracks.iter())
+            .map(|t| {
+                t.cut
+                    .map_or(t.start + t.length(), |c| c + bml_realizer::sound::CUT_FADE)
+            })
+            .fold(realizer.now(), f64::max);
+        let samples = bml_realizer::sound::mix(&tracks, rate, end);
+        let bytes = bml_realizer::sound::wav(&samples, rate)
+            .map_err(|e| (2, format!("{}: {e}", path.display())))?;
+        write_file(path, &bytes)?;
+        eprintln!(
+            "wrote {} ({} clip(s), {:.3} s at {rate} Hz)",
+            path.display(),
+            tracks.len(),
+            samples.len() as f64 / f64::from(rate)
+        );
+        Ok(())
     }
 
     /// The poses of `character` ("" the default one), frame by frame (the rest pose where a
@@ -140,6 +221,8 @@ impl Recording {
             pose: Pose::rest(&Skeleton::adult()),
             clamped: Vec::new(),
             face: bml_realizer::face::Face::neutral(bml_realizer::face::FaceModel::default_model()),
+            sounds: Vec::new(),
+            events: Vec::new(),
         };
         self.frames
             .iter()
@@ -150,6 +233,36 @@ impl Recording {
             })
             .collect()
     }
+}
+
+/// The sounds that started or stopped between recorded frames (the first frame starts what plays
+/// in it).
+fn sound_events(times: &[f64], frames: &[CharacterPose]) -> Vec<Vec<SoundEvent>> {
+    let mut before: Vec<&str> = Vec::new();
+    let mut out = Vec::with_capacity(frames.len());
+    for (k, f) in frames.iter().enumerate() {
+        let now: Vec<&str> = f.sounds.iter().map(|s| s.id.as_str()).collect();
+        let mut events: Vec<SoundEvent> = (f.sounds.iter())
+            .filter(|s| !before.contains(&s.id.as_str()))
+            .map(|s| SoundEvent {
+                start: true,
+                id: s.id.clone(),
+                offset: (times[k] - s.start).max(0.0),
+            })
+            .collect();
+        events.extend(
+            (before.iter())
+                .filter(|id| !now.contains(id))
+                .map(|id| SoundEvent {
+                    start: false,
+                    id: id.to_string(),
+                    offset: 0.0,
+                }),
+        );
+        out.push(events);
+        before = now;
+    }
+    out
 }
 
 /// Every character that received blocks, sorted by id (the default character is `""`).

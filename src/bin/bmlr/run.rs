@@ -12,6 +12,7 @@ use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{BlockStatus, Feedback, Format};
 use bml_realizer::realizer::Realizer;
 use bml_realizer::timeline::Timeline;
+use bml_realizer::timing::{SpeechTiming, Voice};
 use clap::{Args, ValueEnum};
 
 use crate::record::Recording;
@@ -60,6 +61,10 @@ pub struct RunArgs {
     /// the default one) as binary glTF, one key every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.glb")]
     gltf: Option<std::path::PathBuf>,
+    /// Write the run's sound as a WAV file: synthesized speech (--tts flite) and audiofile clips,
+    /// each at its peg and volume (virtual clock only).
+    #[arg(long, value_name = "OUT.wav")]
+    wav: Option<std::path::PathBuf>,
     /// Write the realized frames of every character as JSON lines (docs/cli.md, "Frames"):
     /// a header with the skeleton, then one line every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.jsonl")]
@@ -86,10 +91,13 @@ pub struct SetupArgs {
     /// gaze, pointing and headDirectionShift, added to the built-in scene.
     #[arg(long, value_name = "WORLD.json")]
     pub world: Option<std::path::PathBuf>,
-    /// Characters stand still between behaviours: no breathing, no weight shift (the idle layer
-    /// changes the motion only, never the feedback).
+    /// Characters stand still between behaviours: no breathing, no weight shift, no blinks (the
+    /// idle layer changes the motion only, never the feedback).
     #[arg(long)]
     pub no_idle: bool,
+    /// The voice that says speech: the built-in TTS, or flite (Debian package `flite`).
+    #[arg(long, value_enum, default_value = "builtin")]
+    pub tts: TtsArg,
     #[command(flatten)]
     pub limits: LimitArgs,
 }
@@ -98,7 +106,8 @@ impl SetupArgs {
     /// The realizer asked for (`posix_time`: feedback carries wall-clock times); the error
     /// names the option that is wrong.
     pub fn realizer(&self, posix_time: bool) -> Result<Realizer, String> {
-        let realizer = with_assets(Realizer::new(), self.assets.as_deref())
+        let speech = self.tts.timing().map_err(|e| format!("--tts flite: {e}"))?;
+        let realizer = with_assets(Realizer::new(), self.assets.as_deref(), speech)
             .map_err(|e| format!("--assets {e}"))?;
         Ok(with_world(realizer, self.world.as_deref())
             .map_err(|e| format!("--world {e}"))?
@@ -151,18 +160,53 @@ impl LimitArgs {
     }
 }
 
-/// `realizer` with the motion data of `dir` (units and bindings), if given.
-pub fn with_assets(realizer: Realizer, dir: Option<&Path>) -> Result<Realizer, String> {
+/// `realizer` with the motion data of `dir` (units and bindings), if given, and speech timed by
+/// `speech`.
+pub fn with_assets(
+    realizer: Realizer,
+    dir: Option<&Path>,
+    speech: SpeechTiming,
+) -> Result<Realizer, String> {
     let Some(dir) = dir else {
-        return Ok(realizer);
+        if speech == SpeechTiming::default() {
+            return Ok(realizer);
+        }
+        return Ok(realizer.with_speech_timing(speech));
     };
     let assets = bml_realizer::engines::assets::Assets::from_dir(dir)?;
     Ok(realizer.with_engines(move || {
         bml_realizer::engines::registry_with(
-            bml_realizer::timing::DefaultTimingModels::default(),
+            bml_realizer::timing::DefaultTimingModels { speech },
             &assets,
         )
     }))
+}
+
+/// The voice that says speech (`--tts`).
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Default)]
+pub enum TtsArg {
+    /// The built-in TTS: timing and lips, no sound.
+    #[default]
+    Builtin,
+    /// CMU Flite as a program (Debian package `flite`): its timing and its sound.
+    Flite,
+}
+
+impl TtsArg {
+    /// The speech timing of this voice; for flite, an error if it is not installed.
+    pub fn timing(self) -> Result<SpeechTiming, String> {
+        let voice = match self {
+            TtsArg::Builtin => Voice::Builtin,
+            TtsArg::Flite => {
+                bml_realizer::voice::flite::Flite::default().check()?;
+                Voice::Flite
+            }
+        };
+        Ok(SpeechTiming {
+            voice,
+            ..SpeechTiming::default()
+        })
+    }
 }
 
 /// `realizer` in the world of the file at `path`, if given. The error names the file.
@@ -314,15 +358,24 @@ impl VirtualRun {
             m.next = (m.frames.len() + 1) as f64 * m.period;
             let frame = self.realizer.tick(at);
             self.emit(at, frame.feedback);
+            self.hear(at, &frame.poses);
             self.record(at, frame.poses);
         }
         let frame = self.realizer.tick(t);
         self.emit(t, frame.feedback);
+        self.hear(t, &frame.poses);
     }
 
     fn record(&mut self, time: f64, poses: Vec<bml_realizer::engine::CharacterPose>) {
         if let Some(m) = self.motion.as_mut() {
             m.frames.push((time, poses));
+        }
+    }
+
+    /// Lets the recording hear the sounds of a tick that is not a recorded frame.
+    fn hear(&mut self, time: f64, poses: &[bml_realizer::engine::CharacterPose]) {
+        if let Some(m) = self.motion.as_mut() {
+            m.observe(time, poses);
         }
     }
 
@@ -336,6 +389,7 @@ impl VirtualRun {
         let now = self.realizer.now();
         let frame = self.realizer.tick(now);
         self.emit(now, frame.feedback);
+        self.hear(now, &frame.poses);
     }
 
     /// Blocks from standard input, line by line: a line that is not UTF-8 (or too long) costs
@@ -401,6 +455,9 @@ impl VirtualRun {
         if let Some(path) = &args.gltf {
             m.write_gltf(&self.realizer, path, args.setup.character.as_deref())?;
         }
+        if let Some(path) = &args.wav {
+            m.write_wav(&self.realizer, path)?;
+        }
         Ok(())
     }
 
@@ -431,8 +488,11 @@ pub fn run(args: RunArgs) -> ExitCode {
         out: Some(std::io::stdout().lock()),
         open: true,
         invalid: 0,
-        motion: (args.bvh.is_some() || args.frames.is_some() || args.gltf.is_some())
-            .then(|| Recording::new(args.fps)),
+        motion: (args.bvh.is_some()
+            || args.frames.is_some()
+            || args.gltf.is_some()
+            || args.wav.is_some())
+        .then(|| Recording::new(args.fps)),
         log: None,
     };
     run.items(items);
@@ -457,6 +517,7 @@ fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer), String> {
         (args.bvh.is_some(), "--bvh"),
         (args.frames.is_some(), "--frames"),
         (args.gltf.is_some(), "--gltf"),
+        (args.wav.is_some(), "--wav"),
     ] {
         if args.realtime && asked {
             return Err(format!(
@@ -631,7 +692,11 @@ pub fn plan(args: PlanArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let mut realizer = match with_assets(Realizer::new(), args.assets.as_deref()) {
+    let mut realizer = match with_assets(
+        Realizer::new(),
+        args.assets.as_deref(),
+        SpeechTiming::default(),
+    ) {
         Ok(r) => r
             .with_default_character(args.character)
             .with_limits(args.limits.limits()),

@@ -42,6 +42,9 @@ pub struct ServeArgs {
     /// Characters stand still between behaviours: no breathing, no weight shift.
     #[arg(long)]
     no_idle: bool,
+    /// The voice that says speech: the built-in TTS, or flite (Debian package `flite`).
+    #[arg(long, value_enum, default_value = "builtin")]
+    tts: crate::run::TtsArg,
     /// Speech may change its rate to meet its constraints (an incremental TTS).
     #[arg(long)]
     retimable_speech: bool,
@@ -62,9 +65,16 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         eprintln!("bmlr serve: --fps must be a positive number");
         return ExitCode::from(2);
     }
+    let voice = match args.tts.timing() {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("bmlr serve: --tts flite: {e}");
+            return ExitCode::from(2);
+        }
+    };
     let speech = SpeechTiming {
         retimable: args.retimable_speech,
-        ..SpeechTiming::default()
+        ..voice
     };
     let assets = match args.assets.as_deref().map(Assets::from_dir).transpose() {
         Ok(a) => a.unwrap_or_default(),
@@ -194,6 +204,14 @@ pub struct ConformanceArgs {
     /// Run only the tests whose name contains PAT.
     #[arg(long, value_name = "PAT", default_value = "")]
     filter: String,
+    /// In process: the voice that says speech (flite: Debian package `flite`).
+    #[arg(
+        long,
+        value_enum,
+        default_value = "builtin",
+        conflicts_with = "realizer"
+    )]
+    tts: crate::run::TtsArg,
 }
 
 /// The command for the incremental-speech tests: the one given, else `cmd` itself — with
@@ -252,7 +270,13 @@ fn started(port: std::io::Result<ProcessPort>) -> Result<ProcessPort, String> {
 /// `bmlr conformance`.
 pub fn conformance(args: ConformanceArgs) -> ExitCode {
     let mut port: Box<dyn TestPort> = match &args.realizer {
-        None => Box::new(InProcess::new()),
+        None => match args.tts.timing() {
+            Ok(t) => Box::new(InProcess::new().with_voice(t.voice)),
+            Err(e) => {
+                eprintln!("bmlr conformance: --tts flite: {e}");
+                return ExitCode::from(2);
+            }
+        },
         Some(cmd) => {
             let incremental = incremental_command(cmd, args.incremental_realizer.as_deref());
             if incremental != *cmd {
