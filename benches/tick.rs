@@ -2,7 +2,9 @@
 //! block of 20 units (gestures, nods, gaze, a speech) that last long enough to stay active; and
 //! one or 100 characters each running 10 units of every motion engine (keyed and procedural
 //! gestures, a procanimation with IK, a keyframe, a nod, a gaze, noise, a posture with a pose, a
-//! speech). Each iteration advances the clock by one 60 Hz frame.
+//! speech); and 100 characters each with 20 units of which half move the face (face lexemes,
+//! FACS units, a faceShift) and a speech moves the lips. Each iteration advances the clock by one
+//! 60 Hz frame.
 //!
 //! Run: `cargo bench --bench tick`
 
@@ -131,5 +133,71 @@ fn tick(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, tick, tick_mixed, tick_many_live_blocks);
+/// 20 units per character, half of them on the face, and a speech whose lips move.
+fn face_block(character: usize) -> String {
+    let mut body = String::new();
+    for i in 0..8 {
+        body.push_str(&format!(
+            r#"<gesture id="g{i}" lexeme="BEAT" start="{}" end="100000"/>"#,
+            i as f64 * 0.01
+        ));
+    }
+    body.push_str(r#"<head id="h" lexeme="NOD" start="0" end="100000"/>"#);
+    for (i, l) in [
+        "RAISE_BROWS",
+        "SMILE",
+        "WIDEN_EYES",
+        "LOWER_LEFT_BROW",
+        "OPEN_LIPS",
+        "RAISE_LEFT_MOUTH_CORNER",
+    ]
+    .iter()
+    .enumerate()
+    {
+        body.push_str(&format!(
+            r#"<faceLexeme id="f{i}" lexeme="{l}" amount="0.5" start="0" end="100000"/>"#
+        ));
+    }
+    for (i, au) in [9, 14].iter().enumerate() {
+        body.push_str(&format!(
+            r#"<faceFacs id="a{i}" au="{au}" side="LEFT" start="0" end="100000"/>"#
+        ));
+    }
+    body.push_str(
+        r#"<faceShift id="fs" lexeme="RAISE_MOUTH_CORNERS" amount="0.3" start="0" end="0.2"/>"#,
+    );
+    body.push_str(r#"<gaze id="look" target="user" start="0" end="100000"/>"#);
+    let words = "papa bought the map and made my bomb ".repeat(200);
+    body.push_str(&format!(r#"<speech id="s"><text>{words}</text></speech>"#));
+    format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b" characterId="c{character}">{body}</bml>"#
+    )
+}
+
+fn tick_face(c: &mut Criterion) {
+    let mut r = Realizer::new();
+    for ch in 0..100 {
+        r.perform_bml(&face_block(ch)).unwrap();
+    }
+    let mut t = 0.5;
+    r.tick(t);
+    let frame = r.tick(t);
+    assert_eq!(
+        frame.outputs.len(),
+        100 * 19,
+        "every unit is active (the faceShift has ended)"
+    );
+    assert!(
+        frame.poses.iter().all(|p| p.face.viseme.is_some()),
+        "the lips move"
+    );
+    c.bench_function("tick/100-characters-x-20-units-face-and-lips", |b| {
+        b.iter(|| {
+            t += 1.0 / 60.0;
+            black_box(r.tick(t))
+        })
+    });
+}
+
+criterion_group!(benches, tick, tick_mixed, tick_many_live_blocks, tick_face);
 criterion_main!(benches);

@@ -168,6 +168,15 @@ impl<T> Units<T> {
         self.units.values_mut().map(|u| (&u.syncs, &mut u.data))
     }
 
+    /// The units that have started by `now` (start ≤ now), in start order: what a frame at `now`
+    /// can show, without looking at the units still to come.
+    pub fn started(&self, now: f64) -> impl Iterator<Item = (&SyncTimes, &T)> + '_ {
+        self.units
+            .values()
+            .take_while(move |u| u.start() <= now)
+            .map(|u| (&u.syncs, &u.data))
+    }
+
     /// The units that have started by `now` (start ≤ now), in start order, the data mutable:
     /// what a frame at `now` can show.
     pub fn started_mut(&mut self, now: f64) -> impl Iterator<Item = (&SyncTimes, &mut T)> + '_ {

@@ -162,7 +162,7 @@ impl FaceEngine {
     fn begin_shifts(&mut self, now: f64) {
         let n = self.slots() + ARKIT.len();
         let mut current = vec![0.0; n];
-        for (syncs, u) in self.units.all_mut() {
+        for (syncs, u) in self.units.started_mut(now) {
             let (Some(start), Some(end)) = (sync(syncs, "start"), sync(syncs, "end")) else {
                 continue;
             };
@@ -268,7 +268,7 @@ impl crate::engine::Expression for FaceEngine {
         let mut mix = std::mem::take(&mut self.mix);
         mix.resize(slots + ARKIT.len(), 0.0);
         self.rest.at(now, &mut mix);
-        for (syncs, u) in self.units.all() {
+        for (syncs, u) in self.units.started(now) {
             let pegs = (
                 sync(syncs, "start"),
                 sync(syncs, "attackPeak"),

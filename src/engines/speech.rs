@@ -317,7 +317,7 @@ impl crate::engine::Expression for SpeechEngine {
         self.now = now;
         let model = FaceModel::default_model();
         let mut strongest = (0.0f32, None);
-        for (syncs, u) in self.units.all() {
+        for (syncs, u) in self.units.started(now) {
             let (Some(start), Some(end)) = (syncs.first(), syncs.last()) else {
                 continue;
             };
