@@ -88,6 +88,18 @@ fn welcome() {
 }
 
 #[test]
+fn faces() {
+    let fb = run("run fixtures/examples/faces.xml");
+    no_warnings(&fb);
+    for (id, start) in [("f:a", 0.0), ("f:b", 1.5), ("f:c", 3.0)] {
+        assert_eq!(ms(sync(&fb, &format!("{id}:start"))), start);
+        assert_eq!(ms(sync(&fb, &format!("{id}:attackPeak"))), ms(start + 0.3));
+        assert_eq!(ms(sync(&fb, &format!("{id}:end"))), start + 1.5);
+    }
+    assert_eq!(ms(sync(&fb, "f:s:start")), 4.5);
+}
+
+#[test]
 fn gaze_then_point() {
     let fb = run("run fixtures/examples/gaze-then-point.xml");
     no_warnings(&fb);

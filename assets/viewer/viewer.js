@@ -3,8 +3,9 @@
 // feedback with the time each message was sent, the timeline picture and the world's points)
 // or, live, from a WebSocket that sends the same frames and feedback as they happen. It draws
 // the mannequin with three.js (loaded from the page's own text, so that the page works opened
-// from disk), the world's points, a cursor over the timeline and the feedback up to the cursor,
-// with play / pause / scrub / speed. It opens paused at #t=SECONDS and sets the title to
+// from disk) with its face (brows, lids and mouth moved by the frames' blendshapes), the world's
+// points, a cursor over the timeline and the feedback up to the cursor, with play / pause /
+// scrub / speed, and the run's sound (if it has any) played in step with the cursor. It opens paused at #t=SECONDS and sets the title to
 // "bmlr view: ready" once the first frame is drawn.
 'use strict';
 
@@ -36,6 +37,8 @@
       // per frame, per character: root x y z, rotation x y z w, then x y z w per joint
       this.poses = [];
       this.clamped = [];
+      // per frame, per character: the blendshapes that are not 0
+      this.morphs = [];
       // the rest pose, for a character in the frames before it first appears
       this.rest = new Float32Array(7 + 4 * this.joints.length);
       this.rest.set(this.joints[0].offset, 0);
@@ -72,11 +75,13 @@
       this.times.push(frame.time);
       this.poses.push(poses);
       this.clamped.push(this.characters.map((id) => (frame.characters[id] || {}).clamped || []));
+      this.morphs.push(this.characters.map((id) => (frame.characters[id] || {}).morphs || {}));
       if (this.times.length > LIVE_FRAMES) {
         const drop = LIVE_FRAMES / 10;
         this.times.splice(0, drop);
         this.poses.splice(0, drop);
         this.clamped.splice(0, drop);
+        this.morphs.splice(0, drop);
       }
     }
 
@@ -90,6 +95,17 @@
         else hi = mid - 1;
       }
       return lo;
+    }
+
+    /** Character `k`'s blendshape `name` at time `t`, interpolated between frames. */
+    morph(t, k, name) {
+      const i = this.index(t);
+      const j = Math.min(i + 1, this.times.length - 1);
+      const span = this.times[j] - this.times[i];
+      const f = span > 0 ? Math.min(Math.max((t - this.times[i]) / span, 0), 1) : 0;
+      const a = (this.morphs[i][k] || {})[name] || 0;
+      const b = (this.morphs[j][k] || {})[name] || 0;
+      return a + (b - a) * f;
     }
 
     /** Character `k`'s pose at time `t`, interpolated between frames, into `out`. */
@@ -138,6 +154,7 @@
       this.speed = 1;
       this.drawn = false;
       this.last = null;
+      this.sound = data.audio ? new Audio(data.audio) : null;
     }
 
     start() {
@@ -150,7 +167,7 @@
       this.setTimeline(this.data.timeline);
       this.data.feedback.forEach((m) => this.addFeedback(m));
       this.refreshFeedbackEmpty();
-      const caption = this.data.title + (this.data.live ? ' (live)' : '');
+      const caption = this.data.title + (this.data.live ? ' (live)' : '') + (this.sound ? ' ♪' : '');
       document.getElementById('what').textContent = caption;
       this.seek(this.hashTime());
       window.addEventListener('hashchange', () => {
@@ -239,7 +256,63 @@
         if (length > 0.01) box.quaternion.setFromUnitVectors(up, b.clone().sub(a).normalize());
         nodes[s.joint].add(box);
       }
-      return { nodes, pose: new Float32Array(7 + 4 * joints.length), k };
+      const face = this.face(index, rest, nodes);
+      return { nodes, face, pose: new Float32Array(7 + 4 * joints.length), k };
+    }
+
+    /** Brows, lids and a mouth on the front of the head box, moved by the blendshapes. */
+    face(index, rest, nodes) {
+      const THREE = this.THREE;
+      const head = index.get('skullbase');
+      if (head === undefined) return null;
+      const at = (name) => rest[index.get(name)].clone().sub(rest[head]);
+      const front = 0.118;
+      const dark = new THREE.MeshStandardMaterial({ color: 0x3b2a22, roughness: 0.9 });
+      const lid = new THREE.MeshStandardMaterial({ color: 0xc9977a, roughness: 0.7 });
+      const lips = new THREE.MeshStandardMaterial({ color: 0x6e2a2a, roughness: 0.8 });
+      const part = (w, h, d, material, x, y, z) => {
+        const g = new THREE.Group();
+        g.position.set(x, y, z);
+        const m = new THREE.Mesh(new THREE.BoxGeometry(w, h, d), material);
+        g.add(m);
+        nodes[head].add(g);
+        return { g, m, y };
+      };
+      const sides = [['Left', 'l_eyeball_joint'], ['Right', 'r_eyeball_joint']].map(([side, joint]) => {
+        const eye = at(joint);
+        const brow = part(0.036, 0.007, 0.008, dark, eye.x, eye.y + 0.026, front);
+        // the lid hangs from the top of the eye: its box is moved down by half its height
+        const cover = part(0.03, 0.026, 0.006, lid, eye.x, eye.y + 0.013, front + 0.004);
+        cover.m.position.y = -0.013;
+        return { side, brow, cover };
+      });
+      const mouth = part(0.045, 0.006, 0.006, lips, 0, 0.016, front);
+      return { sides, mouth };
+    }
+
+    /** Moves figure `f`'s face to the blendshapes at time `t`. */
+    expression(f, t) {
+      if (!f.face || !this.clip.times.length) return;
+      const m = (name) => this.clip.morph(t, f.k, name);
+      for (const { side, brow, cover } of f.face.sides) {
+        const up = 0.5 * m('browInnerUp') + m('browOuterUp' + side);
+        brow.g.position.y = brow.y + 0.012 * up - 0.008 * m('browDown' + side);
+        // a lowered brow's inner end goes down, a raised inner brow's up (the left brow is on
+        // the +x side: turning it about +z lowers its inner end)
+        brow.g.rotation.z = (side === 'Left' ? 1 : -1) * (0.35 * m('browDown' + side) - 0.25 * m('browInnerUp'));
+        const closed = Math.min(Math.max(m('eyeBlink' + side) - 0.4 * m('eyeWide' + side), 0), 1);
+        cover.g.scale.y = Math.max(closed, 0.001);
+      }
+      const smile = (m('mouthSmileLeft') + m('mouthSmileRight')) / 2;
+      const frown = (m('mouthFrownLeft') + m('mouthFrownRight')) / 2;
+      const stretch = (m('mouthStretchLeft') + m('mouthStretchRight')) / 2;
+      const round = Math.max(m('mouthPucker'), m('mouthFunnel'));
+      const pressed = (m('mouthPressLeft') + m('mouthPressRight')) / 2;
+      const mouth = f.face.mouth;
+      mouth.g.scale.x = Math.max(1 + 0.45 * smile + 0.3 * stretch - 0.45 * round, 0.3);
+      const open = m('jawOpen') + 0.4 * (m('mouthLowerDownLeft') + m('mouthLowerDownRight')) / 2;
+      mouth.g.scale.y = Math.max(1 + 6 * open + 2 * round - 0.8 * pressed, 0.2);
+      mouth.g.position.y = mouth.y + 0.005 * smile - 0.005 * frown - 0.012 * open;
     }
 
     /** Every world point as a small sphere with its name; paths as lines. */
@@ -296,6 +369,7 @@
       this.scrub.addEventListener('change', () => this.remember());
       document.getElementById('speed').addEventListener('change', (e) => {
         this.speed = parseFloat(e.target.value);
+        if (this.sound) this.sound.playbackRate = this.speed;
       });
       window.addEventListener('keydown', (e) => {
         if (e.code === 'Space' && e.target.tagName !== 'SELECT') {
@@ -307,7 +381,16 @@
 
     /** Drag to turn around the character, wheel to come closer. */
     orbit() {
-      this.view = { azimuth: 0.35, elevation: 0.08, distance: 3.5 };
+      // the whole body, or (#face in the address, or the F key) a close look at the face
+      this.body = { azimuth: 0.35, elevation: 0.08, distance: 3.5, height: 0.92 };
+      this.close = { azimuth: 0.25, elevation: 0.05, distance: 0.75, height: 1.64 };
+      const face = /(?:^#|&)face(?:&|$)/.test(location.hash);
+      this.view = { ...(face ? this.close : this.body) };
+      window.addEventListener('keydown', (e) => {
+        if (e.key === 'f' || e.key === 'F') {
+          this.view = { ...(this.view.height === this.body.height ? this.close : this.body) };
+        }
+      });
       let drag = null;
       this.canvas.addEventListener('pointerdown', (e) => {
         drag = { x: e.clientX, y: e.clientY, ...this.view };
@@ -332,6 +415,11 @@
       this.following = !!this.data.live;
       this.last = null;
       this.playButton.textContent = '❚❚ pause';
+      if (this.sound) {
+        this.sound.currentTime = this.t;
+        this.sound.playbackRate = this.speed;
+        this.sound.play().catch(() => {});
+      }
     }
 
     /** Stops at the current time; `remember` puts the time into the address. */
@@ -339,6 +427,7 @@
       this.playing = false;
       this.following = false;
       this.playButton.textContent = '▶ play';
+      if (this.sound) this.sound.pause();
       if (remember) this.remember();
     }
 
@@ -362,6 +451,10 @@
         } else if (this.last !== null) {
           this.seek(this.t + ((now - this.last) / 1000) * this.speed);
           if (this.t >= this.clip.duration && !this.data.live) this.pause(true);
+          // the sound keeps to the cursor
+          if (this.sound && !this.sound.paused && Math.abs(this.sound.currentTime - this.t) > 0.08) {
+            this.sound.currentTime = this.t;
+          }
         }
       }
       this.last = now;
@@ -377,11 +470,12 @@
           f.nodes[0].position.set(pose[0], pose[1], pose[2]);
           f.nodes[0].quaternion.fromArray(pose, 3);
           for (let j = 1; j < f.nodes.length; j++) f.nodes[j].quaternion.fromArray(pose, 7 + 4 * j);
+          this.expression(f, this.t);
         }
       }
       for (const p of this.points) if (p.keys) p.ball.position.fromArray(along(p.keys, this.t));
       const v = this.view;
-      const target = new THREE.Vector3(0, 0.92, 0);
+      const target = new THREE.Vector3(0, v.height, 0);
       this.camera.position.set(
         target.x + v.distance * Math.sin(v.azimuth) * Math.cos(v.elevation),
         target.y + v.distance * Math.sin(v.elevation),

@@ -28,8 +28,9 @@ pub struct Segment {
 /// Height of the head box above the skull base, its width, and how far its centre is in front of
 /// the skull base.
 const HEAD: (f32, f32, f32) = (0.22, 0.17, 0.03);
-/// The jaw box: from the jaw joint to the chin, and its width.
-const JAW: ([f32; 3], f32) = ([0.0, -0.035, 0.03], 0.09);
+/// The jaw box: from the jaw joint down to the chin (behind the face's front, so the mouth
+/// shows), and its width.
+const JAW: ([f32; 3], f32) = ([0.0, -0.04, 0.0], 0.085);
 /// The eye boxes: how far each reaches forward from the eyeball joint, and their width.
 const EYE: (f32, f32) = (0.03, 0.025);
 

@@ -192,6 +192,19 @@ impl Recording {
     /// Writes the sound of the run (every character's speech and clips) as a WAV file, the
     /// clips where they played, from time 0 to the end. An error has the exit code.
     pub fn write_wav(&self, realizer: &Realizer, path: &Path) -> Result<(), (u8, String)> {
+        let (bytes, clips, seconds, rate) = self
+            .wav(realizer)
+            .map_err(|e| (2, format!("{}: {e}", path.display())))?;
+        write_file(path, &bytes)?;
+        eprintln!(
+            "wrote {} ({clips} clip(s), {seconds:.3} s at {rate} Hz)",
+            path.display()
+        );
+        Ok(())
+    }
+
+    /// The run's sound as WAV bytes, with the number of clips, the length and the rate.
+    pub fn wav(&self, realizer: &Realizer) -> Result<(Vec<u8>, usize, f64, u32), String> {
         let tracks: Vec<Track> = self.heard.iter().map(|(_, t, _)| t.clone()).collect();
         let rate = tracks.iter().map(|t| t.audio.rate).max().unwrap_or(16_000);
         let end = (tracks.iter())
@@ -201,16 +214,18 @@ impl Recording {
             })
             .fold(realizer.now(), f64::max);
         let samples = bml_realizer::sound::mix(&tracks, rate, end);
-        let bytes = bml_realizer::sound::wav(&samples, rate)
-            .map_err(|e| (2, format!("{}: {e}", path.display())))?;
-        write_file(path, &bytes)?;
-        eprintln!(
-            "wrote {} ({} clip(s), {:.3} s at {rate} Hz)",
-            path.display(),
+        let bytes = bml_realizer::sound::wav(&samples, rate)?;
+        Ok((
+            bytes,
             tracks.len(),
-            samples.len() as f64 / f64::from(rate)
-        );
-        Ok(())
+            samples.len() as f64 / f64::from(rate),
+            rate,
+        ))
+    }
+
+    /// Whether any sound was heard.
+    pub fn heard_any(&self) -> bool {
+        !self.heard.is_empty()
     }
 
     /// The poses of `character` ("" the default one), frame by frame (the rest pose where a

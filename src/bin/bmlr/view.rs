@@ -1,8 +1,9 @@
 //! `bmlr view ITEM... --out DIR | --serve ADDR`: realizes the items on the virtual clock (as
 //! `bmlr run` does), then writes or serves a page that shows the run: the mannequin in 3D with
 //! the world's points, the timeline with a cursor, and the feedback up to the cursor. The page's
-//! data is the frames file's header and lines, the mannequin's boxes, every feedback message with
-//! the time it was sent, the timeline picture and its time axis, and the world.
+//! data is the frames file's header and lines (with the face), the mannequin's boxes, every
+//! feedback message with the time it was sent, the timeline picture and its time axis, the world,
+//! and the run's sound (flite's speech, audiofile clips) as a WAV the page plays with the cursor.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -87,13 +88,21 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
         characters.push(""); // the default character, standing
     }
     let (header, lines) = motion.lines(&characters);
-    let data = data(
+    let mut data = data(
         &title(&args.items),
         &header,
         &lines,
         &log,
         run.realizer.world(),
     );
+    if motion.heard_any() {
+        // the sound goes in as a WAV data: URL, played in step with the cursor
+        use base64::Engine as _;
+        let (wav, _, _, _) = motion.wav(&run.realizer)?;
+        let url = base64::engine::general_purpose::STANDARD.encode(wav);
+        data.truncate(data.len() - 1);
+        data.push_str(&format!(",\"audio\":\"data:audio/wav;base64,{url}\"}}"));
+    }
     let page = web::page(&data);
     let s = if characters.len() == 1 { "" } else { "s" };
     let summary = format!(
