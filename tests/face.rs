@@ -279,3 +279,28 @@ fn idle_blinks_come_and_go_with_the_idle_layer_and_gaze_down_lowers_the_lids() {
     }
     assert!(lowered > 0.2, "lids lowered by {lowered}");
 }
+
+#[test]
+fn a_murmlface_moves_its_arkit_morph_targets_frame_by_frame() {
+    let bml = format!(
+        r#"<bml {NS} id="m"><murmlface xmlns="http://www.techfak.uni-bielefeld.de/ags/soa/murml" id="f" start="0"><murml-description><dynamic><keyframing><phase>
+        <frame ftime="0"><posture>Humanoid (jawOpen 1 0) (Rig_Own_Target 1 100)</posture></frame>
+        <frame ftime="0.5"><posture>Humanoid (jawOpen 1 80) (browInnerUp 1 50)</posture></frame>
+        <frame ftime="1"><posture>Humanoid (jawOpen 1 0)</posture></frame>
+        </phase></keyframing></dynamic></murml-description></murmlface></bml>"#
+    );
+    let (faces, syncs, warnings) = run(&[&bml], 1.5, false);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(
+        (at(&syncs, "f:end") - 1.0).abs() < 1e-9,
+        "the last frame's time is its length"
+    );
+    let f = |t: f64| &faces[(t * FPS).round() as usize].1;
+    assert!((f(0.5).morphs.get("jawOpen") - 0.8).abs() < 0.01);
+    assert!(
+        (f(0.25).morphs.get("jawOpen") - 0.4).abs() < 0.02,
+        "linear between frames"
+    );
+    assert!((f(0.5).morphs.get("browInnerUp") - 0.5).abs() < 0.01);
+    assert!(f(1.2).morphs.get("jawOpen") < 1e-6, "gone after its end");
+}

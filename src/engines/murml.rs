@@ -10,8 +10,11 @@
 //! `end` (the last frame's time is the preferred length) and slerped, each frame exact at its
 //! time; a joint a frame leaves out keeps its previous rotation, names the skeleton lacks are
 //! skipped. The keyframing's `easescale`/`easeturningpoint` are not applied (linear time), the
-//! procedural MURML parts (hand location, palm orientation, `<static>`) and `murmlface` morph
-//! targets are timing only.
+//! procedural MURML parts (hand location, palm orientation, `<static>`) are timing only. In a
+//! keyframed `murmlface`, each frame's `(NAME 1 PERCENT)` groups are morph-target weights: those
+//! named as ARKit blendshapes (`jawOpen`, `browInnerUp`, …) move the face, linear between frames
+//! laid from `start` to `end`; other names (a rig's own targets, as in RealizerTester's file) play
+//! their timing only, without a warning (the conformance suite runs that file expecting none).
 
 use quick_xml::events::Event;
 use quick_xml::Reader;
@@ -132,8 +135,8 @@ pub fn body_keys(content: &str) -> Result<Option<Keys>, String> {
     }))
 }
 
-/// Reads `Humanoid (JOINT N V…) …`: joints with 3 Euler angles (x, y, z degrees) or 1 (about x).
-fn posture(text: &str) -> Result<Vec<(String, Quat)>, String> {
+/// Reads `Humanoid (NAME N V…) …`: each group's name and values.
+fn groups(text: &str) -> Result<Vec<(String, Vec<f32>)>, String> {
     let mut out = Vec::new();
     let mut rest = text.trim();
     if let Some(r) = rest.strip_prefix("Humanoid") {
@@ -163,20 +166,86 @@ fn posture(text: &str) -> Result<Vec<(String, Quat)>, String> {
         if values.len() != n {
             return Err(bad());
         }
-        let q = match values.as_slice() {
-            [x, y, z] => Quat::from_euler(
-                EulerRot::XYZ,
-                x.to_radians(),
-                y.to_radians(),
-                z.to_radians(),
-            ),
-            [a] => Quat::from_rotation_x(a.to_radians()),
-            // morph targets and other channels do not turn a joint
-            _ => continue,
-        };
-        out.push((name.to_string(), q));
+        out.push((name.to_string(), values));
     }
     Ok(out)
+}
+
+/// Reads `Humanoid (JOINT N V…) …`: joints with 3 Euler angles (x, y, z degrees) or 1 (about x).
+fn posture(text: &str) -> Result<Vec<(String, Quat)>, String> {
+    Ok(groups(text)?
+        .into_iter()
+        .filter_map(|(name, values)| {
+            let q = match values.as_slice() {
+                [x, y, z] => Quat::from_euler(
+                    EulerRot::XYZ,
+                    x.to_radians(),
+                    y.to_radians(),
+                    z.to_radians(),
+                ),
+                [a] => Quat::from_rotation_x(a.to_radians()),
+                // other channels do not turn a joint
+                _ => return None,
+            };
+            Some((name, q))
+        })
+        .collect())
+}
+
+/// The morph keys of a keyframed `murmlface`: for each frame (time, in order), the weight (0–1;
+/// MURML gives percent) of each ARKit blendshape its `(NAME 1 PERCENT)` groups name. Groups with
+/// other names (a rig's own morph targets) are left out.
+pub fn morph_keys(content: &str) -> Result<Vec<(f64, Vec<(usize, f32)>)>, String> {
+    let mut reader = Reader::from_str(content);
+    let mut frames: Vec<(f64, Vec<(usize, f32)>)> = Vec::new();
+    let (mut time, mut in_posture, mut text) = (None, false, String::new());
+    loop {
+        match reader.read_event() {
+            Ok(Event::Start(e)) | Ok(Event::Empty(e)) if e.local_name().as_ref() == b"frame" => {
+                time = (e.attributes().flatten())
+                    .find(|a| a.key.local_name().as_ref() == b"ftime")
+                    .and_then(|a| a.unescape_value().ok()?.trim().parse::<f64>().ok())
+                    .filter(|t| t.is_finite() && *t >= 0.0);
+            }
+            Ok(Event::Start(e)) if e.local_name().as_ref() == b"posture" => {
+                in_posture = true;
+                text.clear();
+            }
+            Ok(Event::Text(t)) if in_posture => text.push_str(&String::from_utf8_lossy(&t)),
+            Ok(Event::End(e)) if e.local_name().as_ref() == b"posture" => {
+                in_posture = false;
+                let t = time.ok_or("a MURML <posture> outside a <frame>")?;
+                let morphs = (groups(&text)?.into_iter())
+                    .filter_map(|(name, v)| match v.as_slice() {
+                        [percent] => Some((
+                            crate::face::model::morph_index(&name)?,
+                            (percent / 100.0).clamp(0.0, 1.0),
+                        )),
+                        _ => None,
+                    })
+                    .collect();
+                frames.push((t, morphs));
+            }
+            Ok(Event::Eof) => break,
+            Err(e) => return Err(format!("the MURML description is not well-formed: {e}")),
+            Ok(_) => {}
+        }
+    }
+    frames.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(frames)
+}
+
+/// The weight of blendshape `m` at time `t` of morph keys `keys` (linear between frames; a frame
+/// that leaves `m` out has it at 0).
+fn morph_at(keys: &[(f64, Vec<(usize, f32)>)], m: usize, t: f64) -> f32 {
+    let w = |k: &(f64, Vec<(usize, f32)>)| k.1.iter().find(|x| x.0 == m).map_or(0.0, |x| x.1);
+    let i = keys.partition_point(|k| k.0 <= t);
+    match (i.checked_sub(1).map(|j| &keys[j]), keys.get(i)) {
+        (Some(a), Some(b)) if b.0 > a.0 => w(a) + (w(b) - w(a)) * ((t - a.0) / (b.0 - a.0)) as f32,
+        (Some(a), _) => w(a),
+        (None, Some(b)) => w(b),
+        (None, None) => 0.0,
+    }
 }
 
 /// The two MURML kinds.
@@ -202,6 +271,9 @@ fn kind(b: &Behaviour) -> Option<(Kind, &str)> {
 struct MurmlUnit {
     /// Body keys of a keyframed `murmlgesture`.
     keys: Option<Keys>,
+    /// Blendshape keys of a keyframed `murmlface`, and the length they were written for.
+    morphs: Vec<(f64, Vec<(usize, f32)>)>,
+    length: f64,
     /// The skeleton joint of each part, resolved on first use.
     joints: Option<Vec<Option<usize>>>,
 }
@@ -236,14 +308,19 @@ impl Engine for MurmlEngine {
         let (k, content) = kind(unit.behaviour).ok_or_else(|| {
             EngineError("the MURML engine realizes murmlgesture and murmlface".into())
         })?;
-        duration(content).map_err(EngineError)?;
-        let keys = match k {
-            Kind::Gesture => {
-                body_keys(content).map_err(|e| EngineError(format!("{}: {e}", unit.key)))?
-            }
-            Kind::Face => None,
+        let length = duration(content).map_err(EngineError)?;
+        let fail = |e: String| EngineError(format!("{}: {e}", unit.key));
+        let (keys, morphs) = match k {
+            Kind::Gesture => (body_keys(content).map_err(fail)?, Vec::new()),
+            Kind::Face => (None, morph_keys(content).map_err(fail)?),
         };
-        self.units.add(unit, MurmlUnit { keys, joints: None });
+        let data = MurmlUnit {
+            keys,
+            morphs,
+            length,
+            joints: None,
+        };
+        self.units.add(unit, data);
         Ok(())
     }
 
@@ -253,6 +330,36 @@ impl Engine for MurmlEngine {
 
     fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
         Some(self)
+    }
+
+    fn as_expression(&mut self) -> Option<&mut dyn crate::engine::Expression> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Expression for MurmlEngine {
+    /// The blendshapes of every `murmlface` playing: its frames laid linearly from `start` to
+    /// `end`.
+    fn express(&mut self, now: f64, face: &mut crate::face::Face) {
+        for (syncs, u) in self.units.started(now) {
+            let (Some(start), Some(end)) = (syncs.first(), syncs.last()) else {
+                continue;
+            };
+            if u.morphs.is_empty() || now > end.1 || end.1 <= start.1 {
+                continue;
+            }
+            let t = (now - start.1) / (end.1 - start.1) * u.length;
+            let mut names: Vec<usize> = u
+                .morphs
+                .iter()
+                .flat_map(|k| k.1.iter().map(|x| x.0))
+                .collect();
+            names.sort_unstable();
+            names.dedup();
+            for m in names {
+                face.raise_morph(m, morph_at(&u.morphs, m, t));
+            }
+        }
     }
 }
 
