@@ -192,12 +192,15 @@ fn posture(text: &str) -> Result<Vec<(String, Quat)>, String> {
         .collect())
 }
 
+/// Blendshape keys: (time, [(blendshape index, weight)]) per frame, in time order.
+pub type MorphKeys = Vec<(f64, Vec<(usize, f32)>)>;
+
 /// The morph keys of a keyframed `murmlface`: for each frame (time, in order), the weight (0–1;
 /// MURML gives percent) of each ARKit blendshape its `(NAME 1 PERCENT)` groups name. Groups with
 /// other names (a rig's own morph targets) are left out.
-pub fn morph_keys(content: &str) -> Result<Vec<(f64, Vec<(usize, f32)>)>, String> {
+pub fn morph_keys(content: &str) -> Result<MorphKeys, String> {
     let mut reader = Reader::from_str(content);
-    let mut frames: Vec<(f64, Vec<(usize, f32)>)> = Vec::new();
+    let mut frames: MorphKeys = Vec::new();
     let (mut time, mut in_posture, mut text) = (None, false, String::new());
     loop {
         match reader.read_event() {
@@ -272,7 +275,7 @@ struct MurmlUnit {
     /// Body keys of a keyframed `murmlgesture`.
     keys: Option<Keys>,
     /// Blendshape keys of a keyframed `murmlface`, and the length they were written for.
-    morphs: Vec<(f64, Vec<(usize, f32)>)>,
+    morphs: MorphKeys,
     length: f64,
     /// The skeleton joint of each part, resolved on first use.
     joints: Option<Vec<Option<usize>>>,
