@@ -304,3 +304,27 @@ fn a_murmlface_moves_its_arkit_morph_targets_frame_by_frame() {
     assert!((f(0.5).morphs.get("browInnerUp") - 0.5).abs() < 0.01);
     assert!(f(1.2).morphs.get("jawOpen") < 1e-6, "gone after its end");
 }
+
+#[test]
+fn a_large_fast_gaze_shift_comes_with_a_blink() {
+    // the first closed-lid moment after 1 s, with and without a gaze shift to the far left at 1 s
+    let first_blink = |bml: &str| {
+        let mut r = Realizer::new().with_idle(true);
+        r.world_mut()
+            .set("far-left", glam::Vec3::new(2.0, 1.6, 0.6));
+        r.perform_bml(bml).unwrap();
+        (60..240)
+            .map(|i| f64::from(i) / FPS)
+            .find(|&t| au(&r.tick(t).poses[0].face, "AU45L") >= 0.99)
+    };
+    let shift = format!(
+        r#"<bml {NS} id="g"><gazeShift id="z" target="far-left" influence="EYES" start="1" end="1.3"/></bml>"#
+    );
+    let with = first_blink(&shift).expect("a blink");
+    assert!((1.0..1.4).contains(&with), "blinked at {with}");
+    let without = first_blink(&format!(r#"<bml {NS} id="g"/>"#));
+    assert!(
+        without.is_none_or(|t| t > 1.4),
+        "an idle blink would have come at {without:?}"
+    );
+}

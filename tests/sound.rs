@@ -248,3 +248,16 @@ fn the_conformance_suite_passes_with_flite() {
     assert_eq!(code, 0, "{out}{err}");
     assert_eq!(out.lines().last(), Some("41 passed, 0 failed"), "{out}");
 }
+
+#[test]
+fn without_flite_the_tts_option_says_which_package_to_install() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(["run", "--tts", "flite", "fixtures/examples/welcome.xml"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("install the Debian package 'flite'"), "{err}");
+}
