@@ -25,6 +25,7 @@ pub mod clock;
 #[cfg(feature = "conformance")]
 pub mod conformance;
 mod data;
+pub mod dynamics;
 pub mod engine;
 pub mod engines;
 pub mod face;
