@@ -132,14 +132,6 @@ impl<T> Units<T> {
             .map(|u| &u.data)
     }
 
-    /// A unit's sync times and data, read only.
-    pub fn get_syncs(&self, key: &UnitKey) -> Option<(&SyncTimes, &T)> {
-        self.units
-            .values()
-            .find(|u| *u.key == *key)
-            .map(|u| (&u.syncs, &u.data))
-    }
-
     /// A unit's sync times and data.
     pub fn get_mut(&mut self, key: &UnitKey) -> Option<(&mut SyncTimes, &mut T)> {
         self.units
@@ -184,6 +176,31 @@ impl<T> Units<T> {
             .values_mut()
             .take_while(move |u| u.start() <= now)
             .map(|u| (&u.syncs, &mut u.data))
+    }
+
+    /// Appends to `out` the sound of every unit running at `now` that has one: `clip` gives a
+    /// unit's samples and volume (0–1); the unit plays from its first sync to its last.
+    pub fn playing(
+        &self,
+        now: f64,
+        out: &mut Vec<crate::sound::Playing>,
+        clip: impl Fn(&T) -> Option<(Arc<crate::voice::Audio>, f32)>,
+    ) {
+        for u in self.units.values().take_while(|u| u.start() <= now) {
+            let (Some(start), Some(stop)) = (u.syncs.first(), u.syncs.last()) else {
+                continue;
+            };
+            let Some((audio, volume)) = clip(&u.data).filter(|_| now < stop.1) else {
+                continue;
+            };
+            out.push(crate::sound::Playing {
+                id: u.key.to_string(),
+                start: start.1,
+                stop: stop.1,
+                volume,
+                audio,
+            });
+        }
     }
 
     /// The units running at `now` (start ≤ now < end) with their progress (0 at start, 1 at end;

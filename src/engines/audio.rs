@@ -129,21 +129,9 @@ impl Engine for AudioEngine {
 
 impl crate::engine::Sound for AudioEngine {
     fn sounds(&self, now: f64, out: &mut Vec<crate::sound::Playing>) {
-        for (key, _, clip) in self.units.running(now) {
-            let (Some(audio), Some((syncs, _))) = (&clip.audio, self.units.get_syncs(key)) else {
-                continue;
-            };
-            let (Some(start), Some(stop)) = (syncs.first(), syncs.last()) else {
-                continue;
-            };
-            out.push(crate::sound::Playing {
-                id: key.to_string(),
-                start: start.1,
-                stop: stop.1,
-                volume: (clip.volume / 100.0) as f32,
-                audio: audio.clone(),
-            });
-        }
+        self.units.playing(now, out, |c| {
+            Some((c.audio.clone()?, (c.volume / 100.0) as f32))
+        });
     }
 }
 

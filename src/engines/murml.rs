@@ -62,11 +62,10 @@ pub fn duration(content: &str) -> Result<f64, String> {
     Ok(last.filter(|&d| d > 0.0).unwrap_or(DEFAULT_DURATION))
 }
 
-/// The body keys of a keyframed description: every frame's `<posture>` joint rotations, sorted
-/// by time; `None` if it has no frame with a posture.
-pub fn body_keys(content: &str) -> Result<Option<Keys>, String> {
+/// Every `<frame ftime>`'s `<posture>` text, with the frame's time, in document order.
+fn postures(content: &str) -> Result<Vec<(f64, String)>, String> {
     let mut reader = Reader::from_str(content);
-    let mut frames: Vec<(f64, Vec<(String, Quat)>)> = Vec::new();
+    let mut out = Vec::new();
     let (mut time, mut in_posture, mut text) = (None, false, String::new());
     loop {
         match reader.read_event() {
@@ -89,13 +88,22 @@ pub fn body_keys(content: &str) -> Result<Option<Keys>, String> {
             Ok(Event::End(e)) if e.local_name().as_ref() == b"posture" => {
                 in_posture = false;
                 let t = time.ok_or("a MURML <posture> outside a <frame>")?;
-                frames.push((t, posture(&text)?));
+                out.push((t, std::mem::take(&mut text)));
             }
             Ok(Event::Eof) => break,
             Err(e) => return Err(format!("the MURML description is not well-formed: {e}")),
             Ok(_) => {}
         }
     }
+    Ok(out)
+}
+
+/// The body keys of a keyframed description: every frame's `<posture>` joint rotations, sorted
+/// by time; `None` if it has no frame with a posture.
+pub fn body_keys(content: &str) -> Result<Option<Keys>, String> {
+    let mut frames: Vec<(f64, Vec<(String, Quat)>)> = (postures(content)?.into_iter())
+        .map(|(t, text)| Ok((t, posture(&text)?)))
+        .collect::<Result<_, String>>()?;
     if frames.is_empty() {
         return Ok(None);
     }
@@ -199,40 +207,18 @@ pub type MorphKeys = Vec<(f64, Vec<(usize, f32)>)>;
 /// MURML gives percent) of each ARKit blendshape its `(NAME 1 PERCENT)` groups name. Groups with
 /// other names (a rig's own morph targets) are left out.
 pub fn morph_keys(content: &str) -> Result<MorphKeys, String> {
-    let mut reader = Reader::from_str(content);
     let mut frames: MorphKeys = Vec::new();
-    let (mut time, mut in_posture, mut text) = (None, false, String::new());
-    loop {
-        match reader.read_event() {
-            Ok(Event::Start(e)) | Ok(Event::Empty(e)) if e.local_name().as_ref() == b"frame" => {
-                time = (e.attributes().flatten())
-                    .find(|a| a.key.local_name().as_ref() == b"ftime")
-                    .and_then(|a| a.unescape_value().ok()?.trim().parse::<f64>().ok())
-                    .filter(|t| t.is_finite() && *t >= 0.0);
-            }
-            Ok(Event::Start(e)) if e.local_name().as_ref() == b"posture" => {
-                in_posture = true;
-                text.clear();
-            }
-            Ok(Event::Text(t)) if in_posture => text.push_str(&String::from_utf8_lossy(&t)),
-            Ok(Event::End(e)) if e.local_name().as_ref() == b"posture" => {
-                in_posture = false;
-                let t = time.ok_or("a MURML <posture> outside a <frame>")?;
-                let morphs = (groups(&text)?.into_iter())
-                    .filter_map(|(name, v)| match v.as_slice() {
-                        [percent] => Some((
-                            crate::face::model::morph_index(&name)?,
-                            (percent / 100.0).clamp(0.0, 1.0),
-                        )),
-                        _ => None,
-                    })
-                    .collect();
-                frames.push((t, morphs));
-            }
-            Ok(Event::Eof) => break,
-            Err(e) => return Err(format!("the MURML description is not well-formed: {e}")),
-            Ok(_) => {}
-        }
+    for (t, text) in postures(content)? {
+        let morphs = (groups(&text)?.into_iter())
+            .filter_map(|(name, v)| match v.as_slice() {
+                [percent] => Some((
+                    crate::face::model::morph_index(&name)?,
+                    (percent / 100.0).clamp(0.0, 1.0),
+                )),
+                _ => None,
+            })
+            .collect();
+        frames.push((t, morphs));
     }
     frames.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(frames)

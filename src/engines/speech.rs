@@ -292,21 +292,9 @@ impl crate::engine::Sound for SpeechEngine {
     /// The synthesized sound of every speech being said, from its start peg at its volume (its
     /// own rate: a rate change moves the lips, not the sound), until its end or interrupt.
     fn sounds(&self, now: f64, out: &mut Vec<crate::sound::Playing>) {
-        for (key, _, u) in self.units.running(now) {
-            let (Some(audio), Some((syncs, _))) = (&u.audio, self.units.get_syncs(key)) else {
-                continue;
-            };
-            let (Some(start), Some(stop)) = (syncs.first(), syncs.last()) else {
-                continue;
-            };
-            out.push(crate::sound::Playing {
-                id: key.to_string(),
-                start: start.1,
-                stop: stop.1,
-                volume: (u.volume / 100.0) as f32,
-                audio: audio.clone(),
-            });
-        }
+        self.units.playing(now, out, |u| {
+            Some((u.audio.clone()?, (u.volume / 100.0) as f32))
+        });
     }
 }
 
