@@ -1,12 +1,13 @@
 //! Dynamics for mixed dynamics (van Welbergen et al., JGT 2009; the thesis' chapter 3), in f64:
 //! the recursive Newton–Euler inverse dynamics of a kinematic chain of ball joints on a moving
 //! connector ([`rnea`]), the angular velocity and acceleration of a joint from its rotations
-//! sampled in time ([`kinematics`]), and the zero-phase Butterworth low-pass for stored motion
-//! ([`butterworth`]). The physical simulation itself (rapier3d, balance, switching) is not here
+//! sampled in time ([`kinematics`]), segments' mass properties and spatial inertia ([`mass`]),
+//! and the zero-phase Butterworth low-pass for stored motion ([`butterworth`]). The physical simulation itself (rapier3d, balance, switching) is not here
 //! yet.
 
 pub mod butterworth;
 pub mod kinematics;
+pub mod mass;
 pub mod rnea;
 
 /// Gravity (m/s², world frame, y up).
