@@ -2,10 +2,12 @@
 //! the recursive Newton–Euler inverse dynamics of a kinematic chain of ball joints on a moving
 //! connector ([`rnea`]), the angular velocity and acceleration of a joint from its rotations
 //! sampled in time ([`kinematics`]), segments' mass properties and spatial inertia ([`mass`]),
-//! and the zero-phase Butterworth low-pass for stored motion ([`butterworth`]). The physical simulation itself (rapier3d, balance, switching) is not here
+//! the zero-phase Butterworth low-pass for stored motion ([`butterworth`]), and body
+//! configurations — which joints are simulated, which form kinematic chains ([`config`]). The physical simulation itself (rapier3d, balance, switching) is not here
 //! yet.
 
 pub mod butterworth;
+pub mod config;
 pub mod kinematics;
 pub mod mass;
 pub mod rnea;
