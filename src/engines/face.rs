@@ -161,7 +161,6 @@ impl FaceEngine {
     /// Starts moving the rest expression for every faceShift that has begun by `now`.
     fn begin_shifts(&mut self, now: f64) {
         let n = self.slots() + ARKIT.len();
-        let mut current = vec![0.0; n];
         for (syncs, u) in self.units.started_mut(now) {
             let (Some(start), Some(end)) = (sync(syncs, "start"), sync(syncs, "end")) else {
                 continue;
@@ -170,13 +169,14 @@ impl FaceEngine {
                 continue;
             }
             u.begun = true;
-            self.rest.at(start, &mut current);
+            let mut from = vec![0.0; n];
+            self.rest.at(start, &mut from);
             let mut to = vec![0.0; n];
             for &(k, w) in &u.targets {
                 to[k] = (w * u.amount as f32).clamp(0.0, 1.0);
             }
             self.rest = Rest {
-                from: current.clone(),
+                from,
                 to,
                 start,
                 end,

@@ -263,6 +263,8 @@ struct MurmlUnit {
     /// Blendshape keys of a keyframed `murmlface`, and the length they were written for.
     morphs: MorphKeys,
     length: f64,
+    /// The blendshapes its keys name, each once.
+    shapes: Vec<usize>,
     /// The skeleton joint of each part, resolved on first use.
     joints: Option<Vec<Option<usize>>>,
 }
@@ -303,10 +305,16 @@ impl Engine for MurmlEngine {
             Kind::Gesture => (body_keys(content).map_err(fail)?, Vec::new()),
             Kind::Face => (None, morph_keys(content).map_err(fail)?),
         };
+        let mut shapes: Vec<usize> = (morphs.iter())
+            .flat_map(|k| k.1.iter().map(|x| x.0))
+            .collect();
+        shapes.sort_unstable();
+        shapes.dedup();
         let data = MurmlUnit {
             keys,
             morphs,
             length,
+            shapes,
             joints: None,
         };
         self.units.add(unit, data);
@@ -338,14 +346,7 @@ impl crate::engine::Expression for MurmlEngine {
                 continue;
             }
             let t = (now - start.1) / (end.1 - start.1) * u.length;
-            let mut names: Vec<usize> = u
-                .morphs
-                .iter()
-                .flat_map(|k| k.1.iter().map(|x| x.0))
-                .collect();
-            names.sort_unstable();
-            names.dedup();
-            for m in names {
+            for &m in &u.shapes {
                 face.raise_morph(m, morph_at(&u.morphs, m, t));
             }
         }

@@ -34,6 +34,8 @@ pub struct Blinker {
     started: Vec<f64>,
     /// Recent eye directions (time, direction in the head's frame).
     eyes: Vec<(f64, Vec3)>,
+    /// The face slots of AU45 (blink), AU43 (lids lowered) and AU5 (lids raised), both sides.
+    lids: [Vec<usize>; 3],
 }
 
 /// A number in 0..1 from `seed` and `k` (splitmix64).
@@ -73,6 +75,8 @@ impl Blinker {
             count: 0,
             started: Vec::new(),
             eyes: Vec::new(),
+            lids: [45, 43, 5]
+                .map(|au| (FaceModel::default_model().slots(au, Side::Both)).unwrap_or_default()),
         };
         b.next = b.interval(0) * unit(seed, u64::MAX);
         b
@@ -84,7 +88,6 @@ impl Blinker {
 
     /// Closes and opens the lids of `face` at `now`, for the eyes of `pose`.
     pub fn apply(&mut self, now: f64, skeleton: &Skeleton, pose: &Pose, face: &mut Face) {
-        let model = FaceModel::default_model();
         while self.next <= now {
             self.started.push(self.next);
             self.count += 1;
@@ -97,16 +100,17 @@ impl Blinker {
         let closed = (self.started.iter())
             .map(|&s| closure(now, s))
             .fold(0.0, f64::max) as f32;
-        let raise = |face: &mut Face, au: u32, v: f32| {
-            for s in model.slots(au, Side::Both).unwrap_or_default() {
+        let [blink, lowered, raised] = &self.lids;
+        let raise = |face: &mut Face, slots: &[usize], v: f32| {
+            for &s in slots {
                 face.raise(s, v);
             }
         };
-        raise(face, 45, closed);
+        raise(face, blink, closed);
         if pitch < 0.0 {
-            raise(face, 43, (-pitch * LID_FOLLOW).min(0.6));
+            raise(face, lowered, (-pitch * LID_FOLLOW).min(0.6));
         } else {
-            raise(face, 5, (pitch * LID_FOLLOW).min(0.6));
+            raise(face, raised, (pitch * LID_FOLLOW).min(0.6));
         }
     }
 

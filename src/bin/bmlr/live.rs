@@ -43,9 +43,17 @@ impl LiveView {
         let (listener, at) = web::bind(addr)?;
         let skeleton = Skeleton::adult();
         let header = bml_realizer::body::frames::header(&skeleton, FPS, &[""]);
-        let data = crate::view::data("bmlr serve", &header, &[], &[], world);
-        let data = data.replacen("\"live\":false", "\"live\":true", 1);
-        let live = Live::default();
+        let data = crate::view::PageData {
+            title: "bmlr serve",
+            live: true,
+            header: &header,
+            lines: &[],
+            log: &[],
+            world,
+            audio: None,
+        }
+        .to_json();
+        let live = Live::new(BACKLOG);
         let page = Arc::new(web::page(&data));
         let hub = live.clone();
         std::thread::spawn(move || web::serve(listener, page, Some(hub)));
@@ -83,14 +91,13 @@ impl LiveView {
             })
             .collect();
         let line = bml_realizer::body::frames::line(&self.skeleton, t, &poses);
-        self.live.send(format!("{{\"frame\":{line}}}"), false);
+        self.live.send(format!("{{\"frame\":{line}}}"));
     }
 
     /// A feedback message sent at time `t`.
     pub fn feedback(&mut self, t: f64, fb: &Feedback) {
         let message = json!({ "feedback": crate::view::message(t, fb) });
-        self.live.send(message.to_string(), true);
-        self.live.trim(BACKLOG + 1); // + the timeline
+        self.live.feedback(message.to_string());
         self.recent.push_back((t, fb.clone()));
         while self.recent.front().is_some_and(|(at, _)| *at < t - WINDOW) {
             self.recent.pop_front();
@@ -101,8 +108,7 @@ impl LiveView {
     fn timeline(&mut self, t: f64) {
         let feedback: Vec<Feedback> = self.recent.iter().map(|(_, f)| f.clone()).collect();
         let message = json!({ "timeline": crate::view::timeline(&feedback) });
-        self.live.forget(|m| m.starts_with("{\"timeline\""));
-        self.live.send(message.to_string(), true);
+        self.live.timeline(message.to_string());
         self.stale = false;
         self.drawn_at = t;
     }

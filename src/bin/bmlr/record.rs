@@ -19,6 +19,9 @@ pub struct Recording {
     /// Every sound heard, from every tick (not only the recorded frames: an interrupt's cut
     /// falls between them), and whether it still plays.
     heard: Vec<(String, Track, bool)>,
+    /// Sounds that started or stopped since the last recorded frame, by character: the ticks
+    /// between frames report them, the next frame carries them.
+    pending: Vec<(Option<String>, SoundEvent)>,
 }
 
 impl Recording {
@@ -30,12 +33,30 @@ impl Recording {
             frames: Vec::new(),
             fps,
             heard: Vec::new(),
+            pending: Vec::new(),
         }
+    }
+
+    /// Records a frame at `time`: the poses, each with the sound events heard since the last
+    /// recorded frame (call [`Recording::observe`] for this tick first).
+    pub fn push_frame(&mut self, time: f64, mut poses: Vec<CharacterPose>) {
+        for p in &mut poses {
+            let (mine, rest): (Vec<_>, Vec<_>) = std::mem::take(&mut self.pending)
+                .into_iter()
+                .partition(|(c, _)| *c == p.character);
+            p.events = mine.into_iter().map(|(_, e)| e).collect();
+            self.pending = rest;
+        }
+        self.frames.push((time, poses));
     }
 
     /// Notes the sounds playing at tick `t`: new ones, volume changes, and sounds gone before
     /// their end (cut there).
     pub fn observe(&mut self, t: f64, poses: &[CharacterPose]) {
+        for p in poses {
+            self.pending
+                .extend(p.events.iter().map(|e| (p.character.clone(), e.clone())));
+        }
         let playing: Vec<&bml_realizer::sound::Playing> =
             poses.iter().flat_map(|p| &p.sounds).collect();
         for s in &playing {
@@ -163,23 +184,18 @@ impl Recording {
         let skeleton = Skeleton::adult();
         let header = bml_realizer::body::frames::header(&skeleton, self.fps, ids);
         let per_character: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
-        let times: Vec<f64> = self.frames.iter().map(|f| f.0).collect();
-        let events: Vec<Vec<Vec<SoundEvent>>> = per_character
-            .iter()
-            .map(|p| sound_events(&times, p))
-            .collect();
         let lines = (self.frames.iter().enumerate())
             .map(|(k, (time, _))| {
                 let poses: Vec<bml_realizer::body::frames::Character> = (ids.iter())
                     .zip(&per_character)
-                    .zip(&events)
-                    .map(|((&id, p), e)| {
+                    .map(|(&id, p)| {
+                        let p = &p[k];
                         (
                             id,
-                            &p[k].pose,
-                            p[k].clamped.as_slice(),
-                            Some(&p[k].face),
-                            e[k].as_slice(),
+                            &p.pose,
+                            p.clamped.as_slice(),
+                            Some(&p.face),
+                            p.events.as_slice(),
                         )
                     })
                     .collect();
@@ -248,36 +264,6 @@ impl Recording {
             })
             .collect()
     }
-}
-
-/// The sounds that started or stopped between recorded frames (the first frame starts what plays
-/// in it).
-fn sound_events(times: &[f64], frames: &[CharacterPose]) -> Vec<Vec<SoundEvent>> {
-    let mut before: Vec<&str> = Vec::new();
-    let mut out = Vec::with_capacity(frames.len());
-    for (k, f) in frames.iter().enumerate() {
-        let now: Vec<&str> = f.sounds.iter().map(|s| s.id.as_str()).collect();
-        let mut events: Vec<SoundEvent> = (f.sounds.iter())
-            .filter(|s| !before.contains(&s.id.as_str()))
-            .map(|s| SoundEvent {
-                start: true,
-                id: s.id.clone(),
-                offset: (times[k] - s.start).max(0.0),
-            })
-            .collect();
-        events.extend(
-            (before.iter())
-                .filter(|id| !now.contains(id))
-                .map(|id| SoundEvent {
-                    start: false,
-                    id: id.to_string(),
-                    offset: 0.0,
-                }),
-        );
-        out.push(events);
-        before = now;
-    }
-    out
 }
 
 /// Every character that received blocks, sorted by id (the default character is `""`).

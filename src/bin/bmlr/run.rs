@@ -368,11 +368,11 @@ impl VirtualRun {
 
     fn record(&mut self, time: f64, poses: Vec<bml_realizer::engine::CharacterPose>) {
         if let Some(m) = self.motion.as_mut() {
-            m.frames.push((time, poses));
+            m.push_frame(time, poses);
         }
     }
 
-    /// Lets the recording hear the sounds of a tick that is not a recorded frame.
+    /// Lets the recording hear the sounds of every tick (recorded frames and the ticks between).
     fn hear(&mut self, time: f64, poses: &[bml_realizer::engine::CharacterPose]) {
         if let Some(m) = self.motion.as_mut() {
             m.observe(time, poses);
@@ -436,7 +436,8 @@ impl VirtualRun {
         let now = self.realizer.now();
         if m.frames.is_empty() || m.next <= now + 1e-9 {
             let frame = self.realizer.tick(now);
-            m.frames.push((now, frame.poses));
+            m.observe(now, &frame.poses);
+            m.push_frame(now, frame.poses);
         }
         Some(m)
     }

@@ -88,22 +88,21 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
         characters.push(""); // the default character, standing
     }
     let (header, lines) = motion.lines(&characters);
-    let mut data = data(
-        &title(&args.items),
-        &header,
-        &lines,
-        &log,
-        run.realizer.world(),
-    );
-    if motion.heard_any() {
-        // the sound goes in as a WAV data: URL, played in step with the cursor
-        use base64::Engine as _;
-        let (wav, _, _, _) = motion.wav(&run.realizer)?;
-        let url = base64::engine::general_purpose::STANDARD.encode(wav);
-        data.truncate(data.len() - 1);
-        data.push_str(&format!(",\"audio\":\"data:audio/wav;base64,{url}\"}}"));
-    }
-    let page = web::page(&data);
+    // the sound goes in as a WAV data: URL, played in step with the cursor
+    let audio = match motion.heard_any() {
+        true => Some(motion.wav(&run.realizer)?.0),
+        false => None,
+    };
+    let data = PageData {
+        title: &title(&args.items),
+        live: false,
+        header: &header,
+        lines: &lines,
+        log: &log,
+        world: run.realizer.world(),
+        audio,
+    };
+    let page = web::page(&data.to_json());
     let s = if characters.len() == 1 { "" } else { "s" };
     let summary = format!(
         "{} frames at {} fps, {} character{s}, {} kB",
@@ -123,40 +122,50 @@ fn title(items: &[String]) -> String {
     names.join(" ")
 }
 
-/// The page's data (see the module comment) as JSON; `header` and `lines` are JSON already.
-pub fn data(
-    title: &str,
-    header: &str,
-    lines: &[String],
-    log: &[(f64, Feedback)],
-    world: &World,
-) -> String {
-    let feedback: Vec<Value> = log.iter().map(|(t, f)| message(*t, f)).collect();
-    let messages: Vec<Feedback> = log.iter().map(|(_, f)| f.clone()).collect();
-    let head = json!({
-        "title": title,
-        "live": false,
-        "segments": mannequin::segments(&Skeleton::adult()),
-        "feedback": feedback,
-        "timeline": timeline(&messages),
-        "world": world_data(world),
-    });
-    let head = serde_json::to_string(&head).expect("the page data encodes");
-    // the frames file's lines go in as they are
-    let mut out =
-        String::with_capacity(head.len() + lines.iter().map(|l| l.len() + 1).sum::<usize>());
-    out.push_str(&head[..head.len() - 1]);
-    out.push_str(",\"header\":");
-    out.push_str(header);
-    out.push_str(",\"frames\":[");
-    for (k, line) in lines.iter().enumerate() {
-        if k > 0 {
-            out.push(',');
-        }
-        out.push_str(line);
+/// The page's data (see the module comment).
+pub struct PageData<'a> {
+    /// The heading.
+    pub title: &'a str,
+    /// Whether frames and feedback come over the WebSocket as they happen.
+    pub live: bool,
+    /// The frames file's header line.
+    pub header: &'a str,
+    /// Its frame lines.
+    pub lines: &'a [String],
+    /// Every feedback message with the time it was sent.
+    pub log: &'a [(f64, Feedback)],
+    /// The world's points and paths.
+    pub world: &'a World,
+    /// The run's sound as a WAV file, if it made any.
+    pub audio: Option<Vec<u8>>,
+}
+
+impl PageData<'_> {
+    /// As JSON; the frames file's lines go in as they are.
+    pub fn to_json(&self) -> String {
+        use serde_json::value::RawValue;
+        let raw = |line: &str| -> Box<RawValue> {
+            RawValue::from_string(line.to_string()).expect("a frames line is JSON")
+        };
+        let messages: Vec<Feedback> = self.log.iter().map(|(_, f)| f.clone()).collect();
+        let audio = self.audio.as_ref().map(|wav| {
+            use base64::Engine as _;
+            let b64 = base64::engine::general_purpose::STANDARD.encode(wav);
+            format!("data:audio/wav;base64,{b64}")
+        });
+        let data = json!({
+            "title": self.title,
+            "live": self.live,
+            "segments": mannequin::segments(&Skeleton::adult()),
+            "feedback": self.log.iter().map(|(t, f)| message(*t, f)).collect::<Vec<_>>(),
+            "timeline": timeline(&messages),
+            "world": world_data(self.world),
+            "header": raw(self.header),
+            "frames": self.lines.iter().map(|l| raw(l)).collect::<Vec<_>>(),
+            "audio": audio,
+        });
+        serde_json::to_string(&data).expect("the page data encodes")
     }
-    out.push_str("]}");
-    out
 }
 
 /// A feedback message for the page: when it was sent, its element name and its XML.

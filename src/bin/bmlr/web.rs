@@ -76,54 +76,55 @@ pub struct Live {
 #[derive(Default)]
 struct Watchers {
     queues: Vec<SyncSender<Arc<str>>>,
-    /// Sent to a watcher when it connects (the feedback so far and the latest timeline).
+    /// The last feedback messages, sent to a watcher when it connects, at most `keep` of them.
     backlog: std::collections::VecDeque<Arc<str>>,
+    keep: usize,
+    /// The latest timeline, sent after the backlog.
+    timeline: Option<Arc<str>>,
 }
 
 impl Live {
+    /// Watchers that are sent the last `keep` feedback messages when they connect.
+    pub fn new(keep: usize) -> Live {
+        let live = Live::default();
+        live.lock().keep = keep;
+        live
+    }
+
     /// Whether anyone watches (frames need not be encoded otherwise).
     pub fn watched(&self) -> bool {
         !self.lock().queues.is_empty()
     }
 
-    /// Sends `message` to every watcher; `keep` also sends it to those who connect later.
-    /// A watcher that has fallen [`WATCHER_QUEUE`] messages behind is cut off.
-    pub fn send(&self, message: String, keep: bool) {
-        let message: Arc<str> = message.into();
-        let mut w = self.lock();
-        w.queues.retain(|q| match q.try_send(message.clone()) {
-            Ok(()) => true,
-            Err(TrySendError::Full(_)) => {
-                eprintln!(
-                    "bmlr serve: a viewer fell {WATCHER_QUEUE} messages behind; disconnected"
-                );
-                false
-            }
-            Err(TrySendError::Disconnected(_)) => false,
-        });
-        if keep {
-            w.backlog.push_back(message);
-        }
+    /// Sends `message` (a frame) to every watcher.
+    pub fn send(&self, message: String) {
+        self.lock().broadcast(message.into());
     }
 
-    /// Keeps only the last `n` messages for those who connect later.
-    pub fn trim(&self, n: usize) {
+    /// Sends a feedback message to every watcher and keeps it for those who connect later.
+    pub fn feedback(&self, message: String) {
+        let message: Arc<str> = message.into();
         let mut w = self.lock();
-        while w.backlog.len() > n {
+        w.broadcast(message.clone());
+        w.backlog.push_back(message);
+        while w.backlog.len() > w.keep {
             w.backlog.pop_front();
         }
     }
 
-    /// Replaces the kept messages that `stale` says are out of date (an older timeline).
-    pub fn forget(&self, stale: impl Fn(&str) -> bool) {
-        self.lock().backlog.retain(|m| !stale(m));
+    /// Sends a timeline to every watcher; it replaces the one those who connect later get.
+    pub fn timeline(&self, message: String) {
+        let message: Arc<str> = message.into();
+        let mut w = self.lock();
+        w.broadcast(message.clone());
+        w.timeline = Some(message);
     }
 
-    /// A new watcher: its queue, filled with the backlog.
+    /// A new watcher: its queue, filled with the backlog and the latest timeline.
     fn watch(&self) -> Receiver<Arc<str>> {
         let mut w = self.lock();
-        let (tx, rx) = mpsc::sync_channel(WATCHER_QUEUE + w.backlog.len());
-        for m in &w.backlog {
+        let (tx, rx) = mpsc::sync_channel(WATCHER_QUEUE + w.backlog.len() + 1);
+        for m in w.backlog.iter().chain(&w.timeline) {
             let _ = tx.try_send(m.clone());
         }
         w.queues.push(tx);
@@ -259,6 +260,23 @@ fn watch(mut stream: TcpStream, key: &str, live: &Live) -> std::io::Result<()> {
         }
     }
     Ok(())
+}
+
+impl Watchers {
+    /// Queues `message` for every watcher; one that has fallen [`WATCHER_QUEUE`] messages
+    /// behind is cut off.
+    fn broadcast(&mut self, message: Arc<str>) {
+        self.queues.retain(|q| match q.try_send(message.clone()) {
+            Ok(()) => true,
+            Err(TrySendError::Full(_)) => {
+                eprintln!(
+                    "bmlr serve: a viewer fell {WATCHER_QUEUE} messages behind; disconnected"
+                );
+                false
+            }
+            Err(TrySendError::Disconnected(_)) => false,
+        });
+    }
 }
 
 #[cfg(test)]
