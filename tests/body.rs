@@ -542,3 +542,46 @@ fn a_transition_leads_the_raised_arm_into_the_lift_without_dropping_it() {
         wrist(3.5)
     );
 }
+
+/// The fastest a hand moves in conversational gestures (m/s): measured peak hand speeds stay
+/// around 1–2.5 m/s (fast beats at the top of that range).
+const NATURAL_HAND_SPEED: f32 = 2.5;
+
+/// The peak speed of each wrist in every example and lexeme, in world coordinates.
+fn peak_hand_speeds() -> Vec<(String, f32, f64)> {
+    let body = Body::new();
+    let mut out = Vec::new();
+    for (name, frames) in everything() {
+        for wrist in ["l_wrist", "r_wrist"] {
+            let (mut peak, mut at) = (0.0f32, 0.0);
+            for w in frames.windows(2) {
+                let d = body.at(&w[1].1, wrist).distance(body.at(&w[0].1, wrist));
+                let v = d / (w[1].0 - w[0].0) as f32;
+                if v > peak {
+                    (peak, at) = (v, w[0].0);
+                }
+            }
+            out.push((format!("{name} {wrist}"), peak, at));
+        }
+    }
+    out
+}
+
+/// Not yet true: with the default gesture timing (0.3 s from start to ready, 0.2 s from relax to
+/// end) a hand that starts at the thigh reaches about 4 m/s — BEAT's preparation in welcome.xml
+/// peaks at 3.97 m/s — which reads as a flick, not a person talking. Longer default preparation
+/// and retraction phases (or shorter travel) are the fix; they move every gesture's timing.
+#[test]
+#[ignore = "fails: gesture preparations reach ~4 m/s at the wrist; natural is under 2.5 m/s"]
+fn hands_move_no_faster_than_a_person_gestures() {
+    let too_fast: Vec<String> = (peak_hand_speeds().into_iter())
+        .filter(|(_, v, _)| *v > NATURAL_HAND_SPEED)
+        .map(|(name, v, at)| format!("{name}: {v:.2} m/s at {at:.2} s"))
+        .collect();
+    assert!(
+        too_fast.is_empty(),
+        "{} too fast:\n{}",
+        too_fast.len(),
+        too_fast.join("\n")
+    );
+}
