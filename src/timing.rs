@@ -175,6 +175,40 @@ impl TimingModel {
         self
     }
 
+    /// The same model with the span from key `from` to key `to` lasting at least `seconds` by
+    /// preference: a shorter span is stretched uniformly (its phases, and the limits of those
+    /// phases where the stretched phase would exceed them) and the keys after it move later by
+    /// as much. Unknown names, or `to` not after `from`, leave the model as it is.
+    pub fn with_span_at_least(mut self, from: &str, to: &str, seconds: f64) -> Self {
+        let (Some(a), Some(b)) = (self.key(from), self.key(to)) else {
+            return self;
+        };
+        let span = self.keys.get(b).map_or(0.0, |k| k.at) - self.keys[a].at;
+        if b <= a || span >= seconds || !seconds.is_finite() {
+            return self;
+        }
+        let origin = self.keys[a].at;
+        let mut previous = origin;
+        for i in a + 1..self.keys.len() {
+            let old = self.keys[i].at;
+            let at = if i <= b && span > 0.0 {
+                origin + (old - origin) * seconds / span
+            } else if i <= b {
+                // a span of length zero: its keys spread evenly
+                origin + seconds * (i - a) as f64 / (b - a) as f64
+            } else {
+                old + seconds - span
+            };
+            let key = &mut self.keys[i];
+            key.at = at;
+            if i <= b {
+                key.max_phase = key.max_phase.max(at - previous);
+            }
+            previous = at;
+        }
+        self
+    }
+
     /// The preferred duration (offset of `end`).
     pub fn preferred_duration(&self) -> f64 {
         self.keys.last().map_or(0.0, |k| k.at)
@@ -578,6 +612,29 @@ mod tests {
         let m = DefaultTimingModels::default().model(&b[0]).unwrap();
         assert!((m.preferred_duration() - 1.8).abs() < 1e-12);
         assert!((m.keys[m.key("stroke").unwrap()].at - 0.9).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_span_stretched_to_a_minimum_moves_the_later_keys() {
+        // the gesture: ready 0.3, strokeStart 0.4, stroke 0.5, ..., end 1.0; ready limited to 1 s
+        let m = limited(GESTURE, 1.0);
+        let longer = m.clone().with_span_at_least("start", "strokeStart", 1.6);
+        let at = |m: &TimingModel, k: &str| m.keys[m.key(k).unwrap()].at;
+        assert!((at(&longer, "ready") - 1.2).abs() < 1e-12);
+        assert!((at(&longer, "strokeStart") - 1.6).abs() < 1e-12);
+        assert!((at(&longer, "stroke") - 1.7).abs() < 1e-12);
+        assert!((at(&longer, "end") - 2.2).abs() < 1e-12);
+        // the preparation's limit grew with it, so the model is still valid
+        assert_eq!(longer.keys[longer.key("ready").unwrap()].max_phase, 1.2);
+        longer.check().unwrap();
+        // long enough already, reversed or unknown: unchanged
+        for same in [
+            m.clone().with_span_at_least("start", "ready", 0.2),
+            m.clone().with_span_at_least("stroke", "ready", 5.0),
+            m.clone().with_span_at_least("start", "nope", 5.0),
+        ] {
+            assert_eq!(same.keys, m.keys);
+        }
     }
 
     #[test]

@@ -62,16 +62,16 @@ fn plan_prints_block_relative_and_global_times() {
     ]);
     assert_eq!((code, err.as_str()), (0, ""));
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines[0], "greet start 0.000 end 2.680");
-    assert_eq!(lines[2], "  greet:hello:stress 0.619 (0.619)");
-    assert!(lines.contains(&"  greet:beat:stroke 0.619 (0.619)"));
+    assert_eq!(lines[0], "greet start 0.000 end 2.882");
+    assert_eq!(lines[2], "  greet:hello:stress 0.821 (0.821)");
+    assert!(lines.contains(&"  greet:beat:stroke 0.821 (0.821)"));
     // the appended block is planned after the greeting
     assert_eq!(
         &lines[lines.len() - 3..],
         [
-            "bml2 start 2.680 end 4.409",
-            "  bml2:speech1:start 0.000 (2.680)",
-            "  bml2:speech1:end 1.729 (4.409)",
+            "bml2 start 2.882 end 4.611",
+            "  bml2:speech1:start 0.000 (2.882)",
+            "  bml2:speech1:end 1.729 (4.611)",
         ]
     );
 }
@@ -327,11 +327,11 @@ fn run_bvh_records_frames_without_changing_the_feedback() {
     assert_eq!(code, 0, "{err}");
     let (_, without, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
     assert_eq!(with, without, "frames do not change the feedback");
-    // 0 .. 2.68 s every 1/50 s: 134 frames
-    assert!(err.contains("(134 frames at 50 fps, 57 joints)"), "{err}");
+    // 0 .. 2.882 s every 1/50 s: 145 frames
+    assert!(err.contains("(145 frames at 50 fps, 57 joints)"), "{err}");
     let text = std::fs::read_to_string(&bvh).unwrap();
     assert!(text.starts_with("HIERARCHY\nROOT HumanoidRoot\n"));
-    assert!(text.contains("MOTION\nFrames: 134\nFrame Time: 0.020000\n"));
+    assert!(text.contains("MOTION\nFrames: 145\nFrame Time: 0.020000\n"));
     let (code, _, err) = bmlr(&[
         "run",
         "--realtime",
@@ -402,9 +402,9 @@ fn run_frames_writes_the_skeleton_and_every_frame_without_changing_the_feedback(
     assert_eq!(code, 0, "{err}");
     let (_, without, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
     assert_eq!(with, without, "frames do not change the feedback");
-    // 0 .. 2.68 s every 1/60 s: 161 frames
+    // 0 .. 2.882 s every 1/60 s: 173 frames
     assert!(
-        err.contains("(161 frames at 60 fps, 1 character(s))"),
+        err.contains("(173 frames at 60 fps, 1 character(s))"),
         "{err}"
     );
     let text = std::fs::read_to_string(&path).unwrap();
@@ -416,10 +416,10 @@ fn run_frames_writes_the_skeleton_and_every_frame_without_changing_the_feedback(
     let joints = lines[0]["skeleton"]["joints"].as_array().unwrap();
     assert_eq!(joints.len(), skeleton.len());
     assert_eq!(lines[0]["characters"], serde_json::json!([""]));
-    assert_eq!(lines.len(), 1 + 161);
-    // rebuild a pose from the file: at the beat's stroke (0.619 s, on "welcome") the right hand
+    assert_eq!(lines.len(), 1 + 173);
+    // rebuild a pose from the file: at the beat's stroke (0.821 s, on "welcome") the right hand
     // is in front
-    let near = |l: &&serde_json::Value| (l["time"].as_f64().unwrap_or(-9.0) - 0.619).abs();
+    let near = |l: &&serde_json::Value| (l["time"].as_f64().unwrap_or(-9.0) - 0.821).abs();
     let stroke = lines
         .iter()
         .min_by(|a, b| near(a).total_cmp(&near(b)))
@@ -499,7 +499,7 @@ fn run_gltf_writes_a_skinned_mannequin_with_the_motion() {
     assert_eq!(code, 0, "{err}");
     let (_, without, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
     assert_eq!(with, without, "the glTF does not change the feedback");
-    assert!(err.contains("(161 frames at 60 fps, 57 joints,"), "{err}");
+    assert!(err.contains("(173 frames at 60 fps, 57 joints,"), "{err}");
     let glb = std::fs::read(&path).unwrap();
     assert_eq!(&glb[0..4], b"glTF");
     let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
@@ -511,10 +511,10 @@ fn run_gltf_writes_a_skinned_mannequin_with_the_motion() {
     );
     let animation = &gltf["animations"][0];
     let input = animation["samplers"][0]["input"].as_u64().unwrap() as usize;
-    assert_eq!(gltf["accessors"][input]["count"], 161);
+    assert_eq!(gltf["accessors"][input]["count"], 173);
     assert_eq!(
         gltf["accessors"][input]["max"],
-        serde_json::json!([160.0f32 / 60.0])
+        serde_json::json!([172.0f32 / 60.0])
     );
     // the skinned mesh: positions with bounds, one joint per vertex, two materials
     let primitive = &gltf["meshes"][0]["primitives"][0];

@@ -206,12 +206,7 @@ proptest! {
 /// The block of the report: two chained speeches and a beat whose stroke phase spans them.
 #[test]
 fn a_beat_between_two_speeches_keeps_its_preparation_and_the_speech_starts_at_once() {
-    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b1">
-      <speech id="s2"><text>I am fine thank you <sync id="d"/>very much.</text></speech>
-      <speech id="s3" start="s2:end"><text>Goodbye <sync id="e"/>now.</text></speech>
-      <gesture id="g2" lexeme="BEAT" strokeStart="s2:d" stroke="s3:e"/>
-    </bml>"#;
-    let parsed = bml::load(src).unwrap().block;
+    let parsed = bml::load(REPORT).unwrap().block;
     let s = Optimal
         .schedule(&parsed, &DefaultTimingModels::syllable_timed(), &NoExternal)
         .unwrap();
@@ -250,22 +245,35 @@ fn preparation_and_retraction_stay_within_their_limits_however_far_apart_the_key
     }
 }
 
+/// The block of the report.
+const REPORT: &str = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b1">
+      <speech id="s2"><text>I am fine thank you <sync id="d"/>very much.</text></speech>
+      <speech id="s3" start="s2:end"><text>Goodbye <sync id="e"/>now.</text></speech>
+      <gesture id="g2" lexeme="BEAT" strokeStart="s2:d" stroke="s3:e"/>
+    </bml>"#;
+
+/// The beat's start, strokeStart and end in the block of the report as the realizer schedules
+/// it (its gesture engine paces BEAT's preparation by the distance the hand travels).
+fn beat_times() -> [f64; 3] {
+    let models = DefaultTimingModels::syllable_timed();
+    let parsed = bml::load(REPORT).unwrap().block;
+    let engines = bml_realizer::engines::default_registry(models);
+    let s = Optimal.schedule(&parsed, &engines, &NoExternal).unwrap();
+    let beat = s.behaviours.iter().find(|b| b.id == "g2").unwrap();
+    ["start", "strokeStart", "end"].map(|k| beat.time(k).unwrap())
+}
+
 /// The right wrist of the character realizing the block of the report, in the world, at `t`
 /// seconds (frames from 0 at 60 Hz up to `t`).
 fn beat_wrist_at(times: &[f64]) -> Vec<glam::Vec3> {
     use bml_realizer::body::Skeleton;
     use bml_realizer::realizer::Realizer;
-    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b1">
-      <speech id="s2"><text>I am fine thank you <sync id="d"/>very much.</text></speech>
-      <speech id="s3" start="s2:end"><text>Goodbye <sync id="e"/>now.</text></speech>
-      <gesture id="g2" lexeme="BEAT" strokeStart="s2:d" stroke="s3:e"/>
-    </bml>"#;
-    // without the idle layer: the wrist moves only with the beat; the metronome voice gives the
-    // times below
+    // without the idle layer: the wrist moves only with the beat; the metronome voice gives
+    // hand-computable times
     let mut r = Realizer::new()
         .with_speech_timing(bml_realizer::timing::SpeechTiming::syllables())
         .with_idle(false);
-    r.perform_bml(src).unwrap();
+    r.perform_bml(REPORT).unwrap();
     let skeleton = Skeleton::adult();
     let wrist = skeleton.joint("r_wrist").unwrap();
     times
@@ -277,12 +285,24 @@ fn beat_wrist_at(times: &[f64]) -> Vec<glam::Vec3> {
         .collect()
 }
 
-/// In the world: the hand stays at rest until the beat starts (0.6 s), gets where the stroke
-/// phase begins in the 0.4 s of its preparation (not in seconds of slow motion), and is back at
-/// rest by its end (2.8 s).
+/// In the world: the hand stays at rest until the beat starts, gets where the stroke phase
+/// begins in its preparation (about 0.7 s: not seconds of slow motion, nor a flick), and is
+/// back at rest by its end.
 #[test]
 fn the_beat_between_two_speeches_prepares_at_a_natural_pace() {
-    let p = beat_wrist_at(&[0.0, 0.55, 0.8, 1.0, 2.85]);
+    let [start, stroke_start, end] = beat_times();
+    // "I am fine thank you": five syllables of 0.2 s before the strokeStart
+    assert!(
+        (stroke_start - 1.0).abs() < 1e-9,
+        "strokeStart {stroke_start}"
+    );
+    let preparation = stroke_start - start;
+    assert!(
+        (0.6..0.9).contains(&preparation),
+        "{preparation} s to the strokeStart"
+    );
+    let mid = (start + stroke_start) / 2.0;
+    let p = beat_wrist_at(&[0.0, start - 0.05, mid, stroke_start, end + 0.05]);
     let (rest, before, half, stroke_start, after) = (p[0], p[1], p[2], p[3], p[4]);
     assert!(
         before.distance(rest) < 1e-4,
@@ -319,4 +339,54 @@ fn at_the_stroke_of_a_beat_the_hand_is_in_front_of_the_torso() {
         "the hand is {} m up",
         stroke.y
     );
+}
+
+/// Timing models with one gesture shaped like a paced WAVE: a long preparation, a short stroke
+/// phase, a long way back (1.3 s to the stroke, 1.5 s after it).
+struct WaveLike;
+
+impl TimingModels for WaveLike {
+    fn model(&self, _: &bml::Behaviour) -> Option<bml_realizer::timing::TimingModel> {
+        Some(bml_realizer::timing::TimingModel::stretchable(&[
+            ("start", 0.0),
+            ("ready", 1.0),
+            ("strokeStart", 1.1),
+            ("stroke", 1.3),
+            ("strokeEnd", 1.5),
+            ("relax", 2.4),
+            ("end", 2.8),
+        ]))
+    }
+}
+
+/// Constrained at start, stroke and end, the gesture is compressed before the stroke (1.3 s into
+/// 1 s) and after it (1.5 s into 1 s); each span's phases keep their proportions (thesis §8.3.2).
+/// Before, the earliest times took all of the second span's compression out of its first phase:
+/// strokeEnd fell on the stroke, and the wrist swung 50° in no time.
+#[test]
+fn the_phases_between_constrained_keys_are_scaled_alike() {
+    let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b">
+      <gesture id="g" lexeme="WAVE" start="0" stroke="1" end="2"/>
+    </bml>"#;
+    let parsed = bml::load(src).unwrap().block;
+    for strategy in [&Optimal as &dyn SchedulingStrategy, &LinearProgram] {
+        let s = strategy.schedule(&parsed, &WaveLike, &NoExternal).unwrap();
+        let t = |k: &str| s.behaviours[0].time(k).unwrap();
+        let expected = [
+            ("ready", 1.0 / 1.3),
+            ("strokeStart", 1.1 / 1.3),
+            ("stroke", 1.0),
+            ("strokeEnd", 1.0 + 0.2 / 1.5),
+            ("relax", 1.0 + 1.1 / 1.5),
+            ("end", 2.0),
+        ];
+        for (k, at) in expected {
+            assert!(
+                (t(k) - at).abs() < 1e-9,
+                "{}: {k} at {} instead of {at}",
+                strategy.name(),
+                t(k)
+            );
+        }
+    }
 }

@@ -93,15 +93,15 @@ fn the_page_holds_the_run_frames_feedback_timeline_and_world() {
     let header = &d["header"];
     assert_eq!(header["skeleton"]["joints"].as_array().unwrap().len(), 57);
     assert_eq!(header["characters"], serde_json::json!([""]));
-    // frames every 1/30 s from 0 to the block's end (2.68 s)
+    // frames every 1/30 s from 0 to the block's end (2.882 s)
     let frames = d["frames"].as_array().unwrap();
     let times: Vec<f64> = frames.iter().map(|f| f["time"].as_f64().unwrap()).collect();
     assert_eq!(times[0], 0.0);
-    assert!((2.68 - times.last().unwrap()) < 1.0 / 30.0, "{times:?}");
+    assert!((2.882 - times.last().unwrap()) < 1.0 / 30.0, "{times:?}");
     assert!(times
         .windows(2)
         .all(|w| w[1] > w[0] && w[1] - w[0] <= 1.0 / 30.0 + 1e-6));
-    // at rest the right wrist hangs at the side; at the beat's stroke (0.619 s, on "welcome") it
+    // at rest the right wrist hangs at the side; at the beat's stroke (0.821 s, on "welcome") it
     // is in front of the torso between waist and chest
     let frame_at = |t: f64| {
         let near = |x: &f64| (x - t).abs();
@@ -112,7 +112,7 @@ fn the_page_holds_the_run_frames_feedback_timeline_and_world() {
     };
     let rest = frame_at(0.0);
     assert!(at(&rest, "r_wrist").y < at(&rest, "r_hip").y + 0.25);
-    let stroke = frame_at(0.619);
+    let stroke = frame_at(0.821);
     let (wrist, pelvis, neck) = (
         at(&stroke, "r_wrist"),
         at(&stroke, "sacroiliac"),
@@ -140,12 +140,12 @@ fn the_page_holds_the_run_frames_feedback_timeline_and_world() {
                 .contains(r#"id="greet:beat:stroke""#)
         })
         .unwrap();
-    assert!((stroke_message["time"].as_f64().unwrap() - 0.619).abs() < 1e-3);
+    assert!((stroke_message["time"].as_f64().unwrap() - 0.821).abs() < 1e-3);
     assert_eq!(stroke_message["kind"], "syncPointProgress");
     // the timeline picture and where its times are
     assert!(d["timeline"]["svg"].as_str().unwrap().starts_with("<svg"));
     assert_eq!(d["timeline"]["axis"]["t0"], 0.0);
-    assert!((d["timeline"]["axis"]["t1"].as_f64().unwrap() - 2.68).abs() < 1e-3);
+    assert!((d["timeline"]["axis"]["t1"].as_f64().unwrap() - 2.882).abs() < 1e-3);
     // the world's points, and the mannequin's boxes (one per bone and the head)
     assert_eq!(
         d["world"]["points"]["bluebox"],
@@ -424,7 +424,7 @@ fn headless_chromium_draws_the_character_and_the_beat_moves_the_arm() {
         &dom[..dom.len().min(400)]
     );
     assert!(console.is_empty(), "the page logs nothing: {console:?}");
-    let shots: Vec<Shot> = ["0", "0.619"]
+    let shots: Vec<Shot> = ["0", "0.821"]
         .iter()
         .map(|t| {
             let out = dir.join(format!("t{t}.png"));

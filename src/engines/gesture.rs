@@ -3,8 +3,10 @@
 //! right arm's local joint rotations at some of the gesture's sync points (Z, X, Y Euler degrees).
 //! The arm is at those rotations exactly at those syncs, slerps between them, moves from where it
 //! was at `start` to the first key and back by `end`. `LEFT_HAND` mirrors the keys onto the left
-//! arm (across the body's middle plane), `BOTH_HANDS` plays both arms. A lexeme the lexicon lacks
-//! is played with its timing only.
+//! arm (across the body's middle plane), `BOTH_HANDS` plays both arms. Each lexeme's timing is
+//! the default gesture timing with every span between its keys (and from rest and back) at least
+//! as long as the hand needs to move it at a person's pace ([`HAND_SPEED`], [`JOINT_SPEED`]). A
+//! lexeme the lexicon lacks is played with its timing only.
 
 use std::sync::Arc;
 
@@ -44,6 +46,110 @@ struct Binding {
     /// name.
     when: Vec<(String, String)>,
     bound: Bound,
+    /// The least time each span between the keys (and from rest and back) takes by preference.
+    paces: Vec<Pace>,
+}
+
+/// The fastest a hand moves by preference (m/s), at the peak of a minimum-jerk move between a
+/// gesture's keys. Measured conversational gestures peak at about 1–2.5 m/s; 2 keeps a hand
+/// that starts somewhere other than rest below the top of that range.
+pub const HAND_SPEED: f64 = 2.0;
+
+/// The fastest a gesture's joint turns by preference (rad/s), at the peak of a minimum-jerk
+/// move: a wave's wrist swinging ±25° at 2.5 Hz peaks near 7 rad/s.
+pub const JOINT_SPEED: f64 = 8.0;
+
+/// The peak of a minimum-jerk move's speed relative to its mean: the largest slope of
+/// 10u³ − 15u⁴ + 6u⁵, at u = ½.
+const MIN_JERK_PEAK: f64 = 1.875;
+
+/// The sync points of a gesture in order (the default gesture timing model's keys).
+const GESTURE_SYNCS: [&str; 7] = [
+    "start",
+    "ready",
+    "strokeStart",
+    "stroke",
+    "strokeEnd",
+    "relax",
+    "end",
+];
+
+/// The least time from one sync of a gesture to another for the hand to keep under
+/// [`HAND_SPEED`] and every joint under [`JOINT_SPEED`] between the keys there.
+#[derive(Debug, Clone)]
+struct Pace {
+    from: &'static str,
+    to: &'static str,
+    seconds: f64,
+}
+
+/// The paces of `keys` (right-arm rotations at syncs, rest at `start` and `end`), measured on
+/// the default adult: for each pair of neighbouring keys, the minimum-jerk peak times the larger
+/// of the fastest the right wrist moves per unit of interpolation over [`HAND_SPEED`] and the
+/// largest angle a joint turns over [`JOINT_SPEED`].
+fn paces(keys: &GestureKeys) -> Vec<Pace> {
+    static ADULT: std::sync::LazyLock<Skeleton> = std::sync::LazyLock::new(Skeleton::adult);
+    let rest: &[(String, Quat)] = &[];
+    let mut chain: Vec<(&'static str, &[(String, Quat)])> = GESTURE_SYNCS
+        .iter()
+        .filter_map(|&sync| keys.iter().find(|k| k.0 == sync).map(|k| (sync, &k.1[..])))
+        .collect();
+    if chain.first().is_none_or(|k| k.0 != "start") {
+        chain.insert(0, ("start", rest));
+    }
+    if chain.last().is_none_or(|k| k.0 != "end") {
+        chain.push(("end", rest));
+    }
+    chain
+        .windows(2)
+        .map(|w| Pace {
+            from: w[0].0,
+            to: w[1].0,
+            seconds: MIN_JERK_PEAK
+                * (wrist_rate(&ADULT, w[0].1, w[1].1) / HAND_SPEED)
+                    .max(largest_turn(w[0].1, w[1].1) / JOINT_SPEED),
+        })
+        .collect()
+}
+
+/// The rotation a key gives `joint` (rest if it leaves the joint out).
+fn rot(key: &[(String, Quat)], joint: &str) -> Quat {
+    key.iter()
+        .find(|x| x.0 == joint)
+        .map_or(Quat::IDENTITY, |x| x.1)
+}
+
+/// The largest angle (radians) a joint turns from the rotations `from` to `to` (joints left out
+/// are at rest).
+fn largest_turn(from: &[(String, Quat)], to: &[(String, Quat)]) -> f64 {
+    (from.iter().chain(to))
+        .map(|(j, _)| f64::from(rot(from, j).angle_between(rot(to, j))))
+        .fold(0.0, f64::max)
+}
+
+/// The largest distance the right wrist moves per unit of a slerp from the rotations `from` to
+/// `to` (joints left out are at rest), sampled at 64 steps (metres).
+fn wrist_rate(skeleton: &Skeleton, from: &[(String, Quat)], to: &[(String, Quat)]) -> f64 {
+    const STEPS: usize = 64;
+    let Some(wrist) = skeleton.joint("r_wrist") else {
+        return 0.0;
+    };
+    let joints: Vec<(usize, Quat, Quat)> = (from.iter().chain(to))
+        .filter_map(|(name, _)| Some((skeleton.joint(name)?, rot(from, name), rot(to, name))))
+        .collect();
+    let at = |w: f32| {
+        let mut pose = Pose::rest(skeleton);
+        for &(j, a, b) in &joints {
+            pose.rotate(j, a.slerp(b, w));
+        }
+        pose.joint_world(skeleton, wrist).0
+    };
+    (1..=STEPS)
+        .map(|i| {
+            let (u0, u1) = ((i - 1) as f32 / STEPS as f32, i as f32 / STEPS as f32);
+            f64::from(at(u1).distance(at(u0))) * STEPS as f64
+        })
+        .fold(0.0, f64::max)
 }
 
 /// Gesture lexemes bound to keys or procedural units.
@@ -99,10 +205,15 @@ impl Lexicon {
                     ))
                 }
             };
+            let paces = match &bound {
+                Bound::Keys(k) => paces(k),
+                Bound::Procedural(..) => Vec::new(),
+            };
             bindings.push(Binding {
                 lexeme,
                 when: g.when.into_iter().collect(),
                 bound,
+                paces,
             });
         }
         Ok(Lexicon { bindings })
@@ -130,6 +241,10 @@ impl Lexicon {
 
     /// What `behaviour` (a gesture) plays: the first binding of its lexeme whose filter it passes.
     pub fn find(&self, behaviour: &Behaviour) -> Option<&Bound> {
+        self.binding(behaviour).map(|b| &b.bound)
+    }
+
+    fn binding(&self, behaviour: &Behaviour) -> Option<&Binding> {
         let BehaviourKind::Gesture(g) = &behaviour.kind else {
             return None;
         };
@@ -143,12 +258,9 @@ impl Lexicon {
                 .find(|a| a.name == name)
                 .map(|a| a.value.as_str())
         };
-        self.bindings
-            .iter()
-            .find(|b| {
-                b.lexeme == g.lexeme && b.when.iter().all(|(k, v)| attr(k) == Some(v.as_str()))
-            })
-            .map(|b| &b.bound)
+        self.bindings.iter().find(|b| {
+            b.lexeme == g.lexeme && b.when.iter().all(|(k, v)| attr(k) == Some(v.as_str()))
+        })
     }
 
     /// The joints that the bindings' keys rotate (procedural units not included).
@@ -382,9 +494,15 @@ impl Engine for GestureEngine {
         if !matches!(behaviour.kind, BehaviourKind::Gesture(_)) {
             return None;
         }
-        match self.lexicon.find(behaviour) {
-            Some(Bound::Procedural(unit, _)) => Some(unit.timing()),
-            _ => self.models.model(behaviour),
+        let Some(binding) = self.lexicon.binding(behaviour) else {
+            return self.models.model(behaviour);
+        };
+        match &binding.bound {
+            Bound::Procedural(unit, _) => Some(unit.timing()),
+            // the default timing, with each span long enough for the hand to move unhurried
+            Bound::Keys(_) => self.models.model(behaviour).map(|m| {
+                (binding.paces.iter()).fold(m, |m, p| m.with_span_at_least(p.from, p.to, p.seconds))
+            }),
         }
     }
 
@@ -508,6 +626,46 @@ mod tests {
     use super::*;
     use crate::bml::Mode;
     use glam::Vec3;
+
+    /// A lexeme whose keys barely move the hand keeps the default timing; one that raises the
+    /// arm gets a preparation as long as the hand needs at [`HAND_SPEED`], and a wrist swing as
+    /// long as the joint needs at [`JOINT_SPEED`].
+    #[test]
+    fn a_lexeme_is_paced_by_how_far_its_keys_move_the_hand() {
+        let lib = Library::default_library();
+        let engine = |json: &str| GestureEngine::new(Lexicon::from_json(json, &lib).unwrap());
+        let gesture = |lexeme: &str| {
+            let src = format!(
+                r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gesture id="g" lexeme="{lexeme}"/></bml>"#
+            );
+            crate::bml::load(&src).unwrap().block.behaviours.remove(0)
+        };
+        let at = |m: &TimingModel, k: &str| m.keys[m.key(k).unwrap()].at;
+        let still = engine(
+            r#"{"gestures": [{"lexeme": "X", "keys": {"stroke": {"r_wrist": [0, 0, 1]}}}]}"#,
+        );
+        let m = still.timing(&gesture("X")).unwrap();
+        assert_eq!(
+            m.keys,
+            DefaultTimingModels::default()
+                .model(&gesture("X"))
+                .unwrap()
+                .keys
+        );
+        // the arm forward and up: the wrist sweeps an arc of the arm's length (0.55 m) through
+        // 90°, about 0.86 m per unit of the slerp at its fastest
+        let up = engine(
+            r#"{"gestures": [{"lexeme": "X", "keys": {"ready": {"r_shoulder": [0, -90, 0]}, "strokeStart": {"r_shoulder": [0, -90, 0], "r_wrist": [0, 0, 60]}}}]}"#,
+        );
+        let m = up.timing(&gesture("X")).unwrap();
+        let rate = wrist_rate(&Skeleton::adult(), &[], &up.lexicon.keys("X").unwrap()[0].1);
+        assert!((0.7..1.0).contains(&rate), "{rate}");
+        assert!((at(&m, "ready") - MIN_JERK_PEAK * rate / HAND_SPEED).abs() < 1e-9);
+        // 60° at the wrist between ready and strokeStart
+        let swing = MIN_JERK_PEAK * 60f64.to_radians() / JOINT_SPEED;
+        assert!((at(&m, "strokeStart") - at(&m, "ready") - swing).abs() < 1e-6);
+        m.check().unwrap();
+    }
 
     #[test]
     fn the_default_lexicon_has_the_gestures_the_issue_names() {
