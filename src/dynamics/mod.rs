@@ -8,9 +8,12 @@
 
 pub mod butterworth;
 pub mod config;
+pub mod controllers;
+pub mod humanoid;
 pub mod kinematics;
 pub mod mass;
 pub mod rnea;
+pub mod sim;
 
 /// Gravity (m/s², world frame, y up).
 pub const GRAVITY: glam::DVec3 = glam::DVec3::new(0.0, -9.81, 0.0);

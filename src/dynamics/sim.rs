@@ -1,0 +1,736 @@
+//! One character's simulated body on rapier3d, stepped with mixed dynamics. The humanoid's parts
+//! in the physical set are dynamic rigid bodies joined by impulse joints (balls; hinges at knees
+//! and elbows, with their anatomical ranges) standing on a ground box; the others follow the
+//! kinematic pose. Each step: the controllers' joint torques are summed and applied (each joint
+//! torque turns the child part one way and its parent the other); every kinematic chain's
+//! inverse dynamics, on the connector's velocity and its acceleration from the step before,
+//! gives the wrench the chain puts on its connector, applied −k times; rapier integrates. The
+//! simulated parts' rotations then go back into the pose the host sees.
+
+use glam::{DQuat, DVec3, Quat, Vec3};
+use rapier3d::prelude as rp;
+
+use super::controllers::{Drive, Pull};
+use super::humanoid::Humanoid;
+use super::kinematics::derivatives;
+use super::rnea::{inverse_dynamics, reaction, with_gravity, BaseMotion, JointMotion, Link};
+use crate::body::{Pose, Skeleton};
+
+/// The default physics step (s): 200 Hz, as the thesis ran it.
+pub const STEP: f64 = 1.0 / 200.0;
+
+/// Solver iterations per step (see [`Simulation::new`]).
+pub const SOLVER_ITERATIONS: usize = 16;
+
+/// Friction between the feet and the ground.
+const GROUND_FRICTION: f32 = 1.0;
+
+/// How a kinematic chain's inverse dynamics reaches its connector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Coupling {
+    /// As the thesis does it: the chain's inverse dynamics on the connector's velocity, its
+    /// acceleration over the step before and gravity, applied as a wrench. One step late, so
+    /// it is stable only while the chain's inertia is small against what the connector moves
+    /// with; on the humanoid (arms and head on a ball-jointed trunk) it is not: the loop gain
+    /// exceeds one and the body flies apart within 0.1 s (docs/physics.md).
+    Lagged,
+    /// The chain's inertia, as a rigid body in its current configuration, added to the
+    /// connector's mass properties (so rapier moves it with the connector, gravity included,
+    /// within the step), and only what the chain's motion relative to the connector adds
+    /// applied as a wrench: the inverse dynamics with the connector's velocity, less the same
+    /// with the chain held still. The two together are the chain's inverse dynamics on the
+    /// connector's motion within the step; both are scaled by k.
+    #[default]
+    Implicit,
+}
+
+/// A rigid body made of links: mass, centre of mass and inertia about it (connector frame).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Composite {
+    mass: f64,
+    moment: DVec3,
+    /// Σ (R I Rᵀ + m (|c|² 1 − c cᵀ)) about the connector's origin.
+    inertia: glam::DMat3,
+}
+
+impl Composite {
+    /// Adds the links of a chain, placed by `motions` (connector frame).
+    fn add(&mut self, links: &[Link], motions: &[JointMotion]) {
+        let mut frames: Vec<(DVec3, DQuat)> = Vec::with_capacity(links.len());
+        for (l, m) in links.iter().zip(motions) {
+            let (p, q) = l
+                .parent
+                .map_or((DVec3::ZERO, DQuat::IDENTITY), |i| frames[i]);
+            let (at, turn) = (p + q * l.offset, q * m.rotation);
+            frames.push((at, turn));
+            let c = at + turn * l.com;
+            let r = glam::DMat3::from_quat(turn);
+            let shift = glam::DMat3::from_diagonal(DVec3::splat(c.length_squared()))
+                - glam::DMat3::from_cols(c * c.x, c * c.y, c * c.z);
+            self.mass += l.mass;
+            self.moment += l.mass * c;
+            self.inertia += r * l.inertia * r.transpose() + shift * l.mass;
+        }
+    }
+
+    fn scaled(&self, k: f64) -> Composite {
+        Composite {
+            mass: self.mass * k,
+            moment: self.moment * k,
+            inertia: self.inertia * k,
+        }
+    }
+
+    /// As rapier's mass properties (inertia about the centre of mass).
+    fn rapier(&self) -> rp::MassProperties {
+        if self.mass <= 1e-12 {
+            return rp::MassProperties::default();
+        }
+        let c = self.moment / self.mass;
+        let shift = glam::DMat3::from_diagonal(DVec3::splat(c.length_squared()))
+            - glam::DMat3::from_cols(c * c.x, c * c.y, c * c.z);
+        let about = self.inertia - shift * self.mass;
+        let m = |col: DVec3| rp::Vector::new(col.x as f32, col.y as f32, col.z as f32);
+        let matrix = rp::Matrix::from_cols(m(about.x_axis), m(about.y_axis), m(about.z_axis));
+        rp::MassProperties::with_inertia_matrix(v(c), self.mass as f32, matrix)
+    }
+}
+
+/// What a chain's motion relative to its connector adds to the wrench on it: the inverse
+/// dynamics with the connector turning at `omega` (connector frame) and no acceleration or
+/// gravity, less the same with every joint still (the rigid chain's own share, which rapier
+/// applies to the added mass).
+fn relative_wrench(links: &[Link], motions: &[JointMotion], omega: DVec3) -> (DVec3, DVec3) {
+    let base = BaseMotion {
+        velocity: omega,
+        ..BaseMotion::default()
+    };
+    let moving = inverse_dynamics(links, motions, base);
+    let still: Vec<JointMotion> = (motions.iter())
+        .map(|m| JointMotion {
+            velocity: DVec3::ZERO,
+            acceleration: DVec3::ZERO,
+            ..*m
+        })
+        .collect();
+    let rigid = inverse_dynamics(links, &still, base);
+    (
+        moving.base_force - rigid.base_force,
+        moving.base_moment - rigid.base_moment,
+    )
+}
+
+/// The state of one part after a step, in the world (joint origin, orientation, velocities).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PartState {
+    /// Where its joint is (m).
+    pub position: DVec3,
+    /// Its orientation.
+    pub orientation: DQuat,
+    /// The velocity of its joint's origin (m/s).
+    pub velocity: DVec3,
+    /// Its angular velocity (rad/s, world frame).
+    pub angular: DVec3,
+    /// Its centre of mass (m).
+    pub com: DVec3,
+    /// Its mass (kg).
+    pub mass: f64,
+}
+
+/// A simulated character (see the module documentation).
+pub struct Simulation {
+    world: rp::PhysicsWorld,
+    humanoid: Humanoid,
+    skeleton: Skeleton,
+    handles: Vec<rp::RigidBodyHandle>,
+    /// Per part: simulated (`true`) or following the kinematic pose.
+    physical: Vec<bool>,
+    /// Per part, its state after the last step.
+    state: Vec<PartState>,
+    /// Per part, its accelerations over the last step (linear of the joint origin, angular).
+    accel: Vec<(DVec3, DVec3)>,
+    /// The kinematic pose one step ago and now (inputs of the chains' differences).
+    history: [Pose; 2],
+    /// Per part, the joint to its parent part (simulated parts only).
+    joints: Vec<Option<rp::ImpulseJointHandle>>,
+    /// Per part, its joint's anchor on the parent (parent's frame).
+    anchors: Vec<rp::Vector>,
+    /// The ground's body (for the feet's glue).
+    floor: rp::RigidBodyHandle,
+    /// The joints that hold the feet where they stand (empty when let go).
+    glue: Vec<rp::ImpulseJointHandle>,
+    /// The reaction gain k (1: exact).
+    pub reaction_gain: f64,
+    /// How the chains' inverse dynamics reaches their connectors.
+    pub coupling: Coupling,
+    /// Seconds simulated.
+    pub time: f64,
+    /// Per part, the wrench its chain put on it at the last step (force, moment; world).
+    pub last_reaction: Vec<(DVec3, DVec3)>,
+}
+
+fn v(x: DVec3) -> rp::Vector {
+    rp::Vector::new(x.x as f32, x.y as f32, x.z as f32)
+}
+
+fn dv(x: rp::Vector) -> DVec3 {
+    DVec3::new(f64::from(x.x), f64::from(x.y), f64::from(x.z))
+}
+
+fn rot(q: DQuat) -> rp::Rotation {
+    rp::Rotation::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32).normalize()
+}
+
+fn drot(q: &rp::Rotation) -> DQuat {
+    DQuat::from_xyzw(
+        f64::from(q.x),
+        f64::from(q.y),
+        f64::from(q.z),
+        f64::from(q.w),
+    )
+    .normalize()
+}
+
+impl Simulation {
+    /// A character on `skeleton` standing in `pose`, its parts listed in `physical` simulated
+    /// (the others follow the kinematic pose), stepping every `step` seconds.
+    pub fn new(
+        skeleton: &Skeleton,
+        pose: &Pose,
+        physical: &[usize],
+        step: f64,
+    ) -> Result<Simulation, String> {
+        if !(step > 0.0 && step <= 0.05) {
+            return Err(format!("a physics step of {step} s: between 0 and 0.05"));
+        }
+        let humanoid = Humanoid::new(skeleton)?;
+        let mut world = rp::PhysicsWorld::new();
+        world.integration_parameters.dt = step as f32;
+        // rapier's default of 4 solver iterations leaves the 14 joints of a standing body soft:
+        // it leans 1.6 cm in a second under stiff joint motors; 16 hold it (docs/physics.md)
+        world.integration_parameters.num_solver_iterations = SOLVER_ITERATIONS;
+        let ground = rp::ColliderBuilder::cuboid(50.0, 0.1, 50.0)
+            .translation(rp::Vector::new(0.0, -0.1, 0.0))
+            .friction(GROUND_FRICTION)
+            .collision_groups(rp::InteractionGroups::new(
+                rp::Group::GROUP_2,
+                rp::Group::GROUP_1,
+                rp::InteractionTestMode::And,
+            ));
+        let floor = world.bodies.insert(rp::RigidBodyBuilder::fixed());
+        world
+            .colliders
+            .insert_with_parent(ground, floor, &mut world.bodies);
+        let n = humanoid.parts.len();
+        let mut sim = Simulation {
+            world,
+            skeleton: skeleton.clone(),
+            handles: Vec::with_capacity(n),
+            physical: (0..n).map(|i| physical.contains(&i)).collect(),
+            state: vec![PartState::default(); n],
+            accel: vec![(DVec3::ZERO, DVec3::ZERO); n],
+            history: [pose.clone(), pose.clone()],
+            joints: vec![None; n],
+            anchors: vec![rp::Vector::ZERO; n],
+            floor,
+            glue: Vec::new(),
+            reaction_gain: 1.0,
+            coupling: Coupling::default(),
+            time: 0.0,
+            last_reaction: vec![(DVec3::ZERO, DVec3::ZERO); n],
+            humanoid,
+        };
+        sim.build(pose);
+        sim.measure(0.0);
+        sim.glue_feet();
+        Ok(sim)
+    }
+
+    /// The humanoid's parts and their skeleton joints.
+    pub fn humanoid(&self) -> &Humanoid {
+        &self.humanoid
+    }
+
+    /// The physics step (s).
+    pub fn step_size(&self) -> f64 {
+        f64::from(self.world.integration_parameters.dt)
+    }
+
+    /// Whether part `i` is simulated.
+    pub fn is_physical(&self, i: usize) -> bool {
+        self.physical[i]
+    }
+
+    /// Every part's state after the last step.
+    pub fn parts(&self) -> &[PartState] {
+        &self.state
+    }
+
+    /// Inserts one body per part at its place in `pose`, and a joint from each simulated part
+    /// to its simulated parent.
+    fn build(&mut self, pose: &Pose) {
+        let frames = self.humanoid.frames(&self.skeleton, pose);
+        for (i, p) in self.humanoid.parts.iter().enumerate() {
+            let (at, q) = frames[i];
+            let builder = if self.physical[i] {
+                rp::RigidBodyBuilder::dynamic()
+            } else {
+                rp::RigidBodyBuilder::kinematic_position_based()
+            };
+            let body = builder
+                .pose(rp::Pose::from_parts(v(at.as_dvec3()), rot(q.as_dquat())))
+                .can_sleep(false)
+                .linear_damping(0.0)
+                .angular_damping(0.0);
+            let h = self.world.bodies.insert(body);
+            let half = DVec3::from_array(p.size) / 2.0;
+            // only simulated parts touch the ground; parts never collide with each other
+            let groups = if self.physical[i] {
+                rp::InteractionGroups::new(
+                    rp::Group::GROUP_1,
+                    rp::Group::GROUP_2,
+                    rp::InteractionTestMode::And,
+                )
+            } else {
+                rp::InteractionGroups::none()
+            };
+            let collider = rp::ColliderBuilder::cuboid(half.x as f32, half.y as f32, half.z as f32)
+                .translation(v(DVec3::from_array(p.centre)))
+                .density((p.density * 1000.0) as f32)
+                .friction(GROUND_FRICTION)
+                .collision_groups(groups);
+            self.world
+                .colliders
+                .insert_with_parent(collider, h, &mut self.world.bodies);
+            self.handles.push(h);
+        }
+        for i in 0..self.humanoid.parts.len() {
+            let Some(parent) = self.humanoid.parts[i].parent else {
+                continue;
+            };
+            if self.physical[i] && self.physical[parent] {
+                self.join(parent, i, &frames);
+            }
+        }
+    }
+
+    /// A joint from `parent` to `child` at the child's joint: a ball, or a hinge about the
+    /// child's x axis within its anatomical range (knee −5°..135°, elbow −150°..5°). Angles
+    /// count from the rest pose, where every part's frame is the world's; a hinge that starts
+    /// bent about another axis is pulled onto its own.
+    fn join(&mut self, parent: usize, child: usize, frames: &[(Vec3, Quat)]) {
+        let (pp, pq) = (frames[parent].0.as_dvec3(), frames[parent].1.as_dquat());
+        let cp = frames[child].0.as_dvec3();
+        let anchor = pq.inverse() * (cp - pp);
+        let frame1 = rp::Pose::from_parts(v(anchor), rp::Rotation::IDENTITY);
+        let frame2 = rp::Pose::from_parts(rp::Vector::ZERO, rp::Rotation::IDENTITY);
+        let p = &self.humanoid.parts[child];
+        let mut joint = if p.hinge {
+            let range = if p.name.ends_with("shank") {
+                [-5f32.to_radians(), 135f32.to_radians()]
+            } else {
+                [-150f32.to_radians(), 5f32.to_radians()]
+            };
+            rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_REVOLUTE_AXES)
+                .limits(rp::JointAxis::AngX, range)
+        } else {
+            rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_SPHERICAL_AXES)
+        };
+        joint = joint
+            .local_frame1(frame1)
+            .local_frame2(frame2)
+            .contacts_enabled(false);
+        for axis in [
+            rp::JointAxis::AngX,
+            rp::JointAxis::AngY,
+            rp::JointAxis::AngZ,
+        ] {
+            joint = joint.motor_model(axis, rp::MotorModel::ForceBased);
+        }
+        let (a, b) = (self.handles[parent], self.handles[child]);
+        let handle = self.world.impulse_joints.insert(a, b, joint.build(), true);
+        self.joints[child] = Some(handle);
+        self.anchors[child] = v(anchor);
+    }
+
+    /// Reads every part's state from rapier; with `dt` > 0 also its accelerations since the
+    /// last reading.
+    fn measure(&mut self, dt: f64) {
+        for (i, p) in self.humanoid.parts.iter().enumerate() {
+            let b = &self.world.bodies[self.handles[i]];
+            let position = dv(b.translation());
+            let orientation = drot(b.rotation());
+            let angular = dv(b.angvel());
+            let com = dv(b.center_of_mass());
+            let velocity = dv(b.linvel()) + angular.cross(position - com);
+            let mass = p.mass().mass;
+            if dt > 0.0 {
+                let before = self.state[i];
+                self.accel[i] = (
+                    (velocity - before.velocity) / dt,
+                    (angular - before.angular) / dt,
+                );
+            }
+            self.state[i] = PartState {
+                position,
+                orientation,
+                velocity,
+                angular,
+                com,
+                mass,
+            };
+        }
+    }
+
+    /// The world centre of mass of the whole body and its velocity.
+    pub fn centre_of_mass(&self) -> (DVec3, DVec3) {
+        let mass: f64 = self.state.iter().map(|s| s.mass).sum();
+        let c = self.state.iter().map(|s| s.mass * s.com).sum::<DVec3>() / mass;
+        let vel = (self.state.iter())
+            .map(|s| s.mass * (s.velocity + s.angular.cross(s.com - s.position)))
+            .sum::<DVec3>()
+            / mass;
+        (c, vel)
+    }
+
+    /// The corners of the feet's soles that touch the ground (y below 2 cm), in the world.
+    pub fn contacts(&self) -> Vec<DVec3> {
+        let mut out = Vec::new();
+        for (i, p) in self.humanoid.parts.iter().enumerate() {
+            if !(p.name.ends_with("_foot") && self.physical[i]) {
+                continue;
+            }
+            let s = self.state[i];
+            let (c, h) = (DVec3::from_array(p.centre), DVec3::from_array(p.size) / 2.0);
+            for (x, z) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                let corner = s.position + s.orientation * (c + DVec3::new(x * h.x, -h.y, z * h.z));
+                if corner.y < 0.02 {
+                    out.push(corner);
+                }
+            }
+        }
+        out
+    }
+
+    /// Holds every simulated foot whose sole touches the ground where it stands, as the
+    /// thesis' foot glue does (§3.6): a standing character's feet do not slide or lift while
+    /// the balance controller keeps the centre of mass over them, which is what the
+    /// controller's limit on the ankle torques (the centre of pressure inside the sole) stands
+    /// for. [`let_go`](Self::let_go) ends it (a fall).
+    pub fn glue_feet(&mut self) {
+        if !self.glue.is_empty() {
+            return;
+        }
+        for (i, p) in self.humanoid.parts.iter().enumerate() {
+            if !(p.name.ends_with("_foot") && self.physical[i]) || self.sole_centre(i).y > 0.01 {
+                continue;
+            }
+            let s = self.state[i];
+            let frame1 = rp::Pose::from_parts(v(s.position), rot(s.orientation));
+            let joint = rp::FixedJointBuilder::new()
+                .local_frame1(frame1)
+                .local_frame2(rp::Pose::from_parts(
+                    rp::Vector::ZERO,
+                    rp::Rotation::IDENTITY,
+                ))
+                .contacts_enabled(false);
+            let h = self
+                .world
+                .impulse_joints
+                .insert(self.floor, self.handles[i], joint, true);
+            self.glue.push(h);
+        }
+    }
+
+    /// Lets go of the feet (see [`glue_feet`](Self::glue_feet)).
+    pub fn let_go(&mut self) {
+        for h in self.glue.drain(..) {
+            self.world.impulse_joints.remove(h, true);
+        }
+    }
+
+    /// Whether the feet are held.
+    pub fn glued(&self) -> bool {
+        !self.glue.is_empty()
+    }
+
+    /// The middle of part `i`'s box's underside, in the world (for a foot: its sole).
+    pub fn sole_centre(&self, i: usize) -> DVec3 {
+        let p = &self.humanoid.parts[i];
+        let s = self.state[i];
+        let c = DVec3::from_array(p.centre) - DVec3::new(0.0, p.size[1] / 2.0, 0.0);
+        s.position + s.orientation * c
+    }
+
+    /// Pushes part `part` with `impulse` (N s, world) at its centre of mass.
+    pub fn push(&mut self, part: usize, impulse: DVec3) {
+        if let Some(h) = self.handles.get(part) {
+            self.world.bodies[*h].apply_impulse(v(impulse), true);
+        }
+    }
+
+    /// One step: the `drive`'s torques applied to the simulated parts and its PD pulls set on
+    /// their joints' motors, the kinematic chains' reactions on their connectors from
+    /// `kinematic` (the kinematic pose one step ahead), and rapier's integration.
+    pub fn step(&mut self, kinematic: &Pose, drive: &Drive) {
+        let torques = &drive.torques;
+        let h = f64::from(self.world.integration_parameters.dt);
+        for &handle in &self.handles {
+            let b = &mut self.world.bodies[handle];
+            b.reset_forces(false);
+            b.reset_torques(false);
+        }
+        for (i, p) in self.humanoid.parts.iter().enumerate() {
+            let t = torques.get(i).copied().unwrap_or(DVec3::ZERO);
+            if t == DVec3::ZERO || !self.physical[i] {
+                continue;
+            }
+            self.world.bodies[self.handles[i]].add_torque(v(t), true);
+            if let Some(parent) = p.parent.filter(|&q| self.physical[q]) {
+                self.world.bodies[self.handles[parent]].add_torque(v(-t), true);
+            }
+        }
+        self.set_motors(&drive.pulls);
+        self.react(kinematic, h);
+        self.follow(kinematic);
+        self.world.step();
+        self.history = [self.history[1].clone(), kinematic.clone()];
+        self.time += h;
+        self.measure(h);
+    }
+
+    /// Sets every simulated joint's motors to its pull (free where there is none): a hinge's
+    /// about its axis, a ball's as a spring toward its target, by turning its frame on the
+    /// parent to the target and pulling every axis to zero.
+    fn set_motors(&mut self, pulls: &[Option<Pull>]) {
+        for (i, handle) in self.joints.iter().enumerate() {
+            let Some(handle) = *handle else { continue };
+            let pull = pulls.get(i).copied().flatten();
+            let Some(joint) = self.world.impulse_joints.get_mut(handle, false) else {
+                continue;
+            };
+            let (kp, kd) = pull.map_or((0.0, 0.0), |p| (p.kp as f32, p.kd as f32));
+            let target = pull.map_or(DQuat::IDENTITY, |p| p.target);
+            if self.humanoid.parts[i].hinge {
+                let angle = 2.0 * target.x.atan2(target.w);
+                joint
+                    .data
+                    .set_motor(rp::JointAxis::AngX, angle as f32, 0.0, kp, kd);
+            } else {
+                let frame = rp::Pose::from_parts(self.anchors[i], rot(target));
+                joint.data.set_local_frame1(frame);
+                for axis in [
+                    rp::JointAxis::AngX,
+                    rp::JointAxis::AngY,
+                    rp::JointAxis::AngZ,
+                ] {
+                    joint.data.set_motor(axis, 0.0, 0.0, kp, kd);
+                }
+            }
+        }
+    }
+
+    /// Moves the kinematic parts to where `kinematic` puts them relative to their simulated
+    /// connector (they carry no weight in rapier: their effect is the chains' reaction).
+    fn follow(&mut self, kinematic: &Pose) {
+        let frames = self.humanoid.frames(&self.skeleton, kinematic);
+        for i in 0..self.humanoid.parts.len() {
+            if self.physical[i] {
+                continue;
+            }
+            let Some(root) = self.connector_of(i) else {
+                continue;
+            };
+            let (kp, kq) = (frames[root].0.as_dvec3(), frames[root].1.as_dquat());
+            let s = self.state[root];
+            let (at, q) = (frames[i].0.as_dvec3(), frames[i].1.as_dquat());
+            let place = s.position + s.orientation * (kq.inverse() * (at - kp));
+            let turn = s.orientation * kq.inverse() * q;
+            self.world.bodies[self.handles[i]]
+                .set_next_kinematic_position(rp::Pose::from_parts(v(place), rot(turn)));
+        }
+    }
+
+    /// The simulated part a kinematic part's chain hangs from.
+    fn connector_of(&self, mut i: usize) -> Option<usize> {
+        while !self.physical[i] {
+            i = self.humanoid.parts[i].parent?;
+        }
+        Some(i)
+    }
+
+    /// The inverse dynamics of every kinematic chain, applied −k times to its connector (see
+    /// [`Coupling`]).
+    fn react(&mut self, kinematic: &Pose, h: f64) {
+        for r in &mut self.last_reaction {
+            *r = (DVec3::ZERO, DVec3::ZERO);
+        }
+        let poses = [&self.history[0], &self.history[1], kinematic];
+        let frames: Vec<Vec<(Vec3, Quat)>> = (poses.iter())
+            .map(|p| self.humanoid.frames(&self.skeleton, p))
+            .collect();
+        let n = self.humanoid.parts.len();
+        let mut carried = vec![Composite::default(); n];
+        for top in 0..n {
+            let parent = self.humanoid.parts[top].parent;
+            let Some(connector) = parent.filter(|&c| self.physical[c] && !self.physical[top])
+            else {
+                continue;
+            };
+            let chain = self.chain_from(top);
+            let (links, motions) = self.chain_links(&chain, connector, &frames, h);
+            let s = self.state[connector];
+            let back = s.orientation.inverse();
+            let (force, moment) = match self.coupling {
+                Coupling::Lagged => {
+                    let base = with_gravity(
+                        BaseMotion {
+                            velocity: back * s.angular,
+                            acceleration: back * self.accel[connector].1,
+                            linear: back * self.accel[connector].0,
+                        },
+                        s.orientation,
+                    );
+                    let d = inverse_dynamics(&links, &motions, base);
+                    (d.base_force, d.base_moment)
+                }
+                Coupling::Implicit => {
+                    carried[connector].add(&links, &motions);
+                    relative_wrench(&links, &motions, back * s.angular)
+                }
+            };
+            let d = super::rnea::Dynamics {
+                torques: Vec::new(),
+                base_force: force,
+                base_moment: moment,
+            };
+            let (f, m) = reaction(&d, self.reaction_gain);
+            let (f, m) = (s.orientation * f, s.orientation * m);
+            let b = &mut self.world.bodies[self.handles[connector]];
+            b.add_force_at_point(v(f), v(s.position), true);
+            b.add_torque(v(m), true);
+            let r = &mut self.last_reaction[connector];
+            r.0 += f;
+            r.1 += m;
+        }
+        if self.coupling == Coupling::Implicit {
+            for (i, c) in carried.iter().enumerate() {
+                if self.physical[i] {
+                    let props = c.scaled(self.reaction_gain).rapier();
+                    self.world.bodies[self.handles[i]].set_additional_mass_properties(props, true);
+                }
+            }
+        }
+    }
+
+    /// The parts of the kinematic chain that starts at `top`, parents first.
+    fn chain_from(&self, top: usize) -> Vec<usize> {
+        let mut chain = vec![top];
+        for (i, p) in self.humanoid.parts.iter().enumerate() {
+            if p.parent.is_some_and(|q| chain.contains(&q)) && !self.physical[i] {
+                chain.push(i);
+            }
+        }
+        chain
+    }
+
+    /// The links of `chain` (hanging from `connector`) and their motions at the middle of the
+    /// three kinematic poses in `frames` (one step apart).
+    fn chain_links(
+        &self,
+        chain: &[usize],
+        connector: usize,
+        frames: &[Vec<(Vec3, Quat)>],
+        h: f64,
+    ) -> (Vec<Link>, Vec<JointMotion>) {
+        let mut links = Vec::with_capacity(chain.len());
+        let mut motions = Vec::with_capacity(chain.len());
+        let now = &frames[1];
+        for &i in chain {
+            let p = self.humanoid.parts[i];
+            let up = p.parent.unwrap_or(connector);
+            let offset = now[up].1.as_dquat().inverse() * (now[i].0 - now[up].0).as_dvec3();
+            let relative =
+                |f: &Vec<(Vec3, Quat)>| (f[up].1.inverse() * f[i].1).as_dquat().normalize();
+            let (w, dw, _) = derivatives(
+                relative(&frames[0]),
+                relative(&frames[1]),
+                relative(&frames[2]),
+                h,
+            );
+            let m = p.mass();
+            links.push(Link {
+                parent: chain.iter().position(|&c| Some(c) == p.parent),
+                offset,
+                mass: m.mass,
+                com: m.com,
+                inertia: m.inertia,
+            });
+            motions.push(JointMotion {
+                rotation: relative(&frames[1]),
+                velocity: w,
+                acceleration: dw,
+            });
+        }
+        (links, motions)
+    }
+
+    /// Writes the simulated parts into `pose`: the root's place and turn from the sacroiliac,
+    /// each simulated part's joint turned so that it ends up as its body is (the skeleton joints
+    /// lumped into a part keep the rotations `pose` gives them, as the kinematic parts that hang
+    /// from them were placed with those).
+    pub fn write(&self, pose: &mut Pose) {
+        let joints = self.skeleton.joints();
+        for (i, p) in self.humanoid.parts.iter().enumerate() {
+            if !self.physical[i] {
+                continue;
+            }
+            let j = self.humanoid.joints[i];
+            let s = self.state[i];
+            // the world orientation of the skeleton joint above j (through lumped joints)
+            let parent_world = match p.parent {
+                Some(q) => self.state[q].orientation,
+                None => DQuat::IDENTITY,
+            };
+            let lumped = lumped_turn(&self.skeleton, pose, &self.humanoid, j);
+            let local = (parent_world * lumped).inverse() * s.orientation;
+            if p.parent.is_none() {
+                // the root carries the place and the turn; the sacroiliac stays at rest
+                let root = self
+                    .skeleton
+                    .joints()
+                    .iter()
+                    .position(|x| x.parent.is_none());
+                if let Some(r) = root {
+                    pose.rotations[r] = s.orientation.as_quat();
+                    let offset = joints[j].offset.as_dvec3();
+                    pose.root = (s.position - s.orientation * offset).as_vec3();
+                }
+                pose.rotations[j] = Quat::IDENTITY;
+            } else {
+                pose.rotations[j] = local.as_quat().normalize();
+            }
+        }
+    }
+}
+
+fn is_part_joint(h: &Humanoid, k: usize) -> bool {
+    h.joints.contains(&k)
+}
+
+/// The rotation from part-joint `j`'s parent part's frame to the frame of `j`'s skeleton
+/// parent: the turns of the skeleton joints between them, as `pose` has them (identity where
+/// the simulation holds them straight).
+fn lumped_turn(skeleton: &Skeleton, pose: &Pose, h: &Humanoid, j: usize) -> DQuat {
+    let joints = skeleton.joints();
+    let mut q = DQuat::IDENTITY;
+    let mut a = joints[j].parent;
+    while let Some(k) = a {
+        if is_part_joint(h, k) || joints[k].parent.is_none() {
+            break;
+        }
+        q = pose.rotations[k].as_dquat() * q;
+        a = joints[k].parent;
+    }
+    q
+}

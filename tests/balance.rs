@@ -1,0 +1,122 @@
+//! The simulated body standing on its own (thesis §3.6): the balance controller keeps the
+//! centre of mass over the feet for a minute, with and without gestures playing on the
+//! kinematic arms, recovers from a small push and falls from a large one.
+
+use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::dynamics::controllers::{outside, support_polygon, Balance, Controller, Drive};
+use bml_realizer::dynamics::sim::{Simulation, STEP};
+use glam::DVec2;
+
+/// The lower body and the trunk simulated; head and arms kinematic.
+const LOWER_BODY: [usize; 8] = [0, 1, 9, 10, 11, 12, 13, 14];
+
+fn standing() -> (Skeleton, Simulation) {
+    let skeleton = Skeleton::adult();
+    let sim = Simulation::new(&skeleton, &Pose::rest(&skeleton), &LOWER_BODY, STEP).unwrap();
+    (skeleton, sim)
+}
+
+fn step(sim: &mut Simulation, balance: &Balance, kinematic: &Pose) {
+    let mut drive = Drive::new(sim.humanoid().parts.len());
+    balance.drive(sim, &mut drive);
+    sim.step(kinematic, &drive);
+}
+
+#[test]
+fn the_balance_controller_stands_for_a_minute() {
+    let (skeleton, mut sim) = standing();
+    let balance = Balance::default();
+    let rest = Pose::rest(&skeleton);
+    let target = balance.target_height(&sim);
+    let (mut worst_out, mut worst_height) = (0.0f64, 0.0f64);
+    let steps = (60.0 / STEP) as usize;
+    for k in 0..steps {
+        step(&mut sim, &balance, &rest);
+        let (c, _) = sim.centre_of_mass();
+        let feet = sim.contacts();
+        assert!(
+            !feet.is_empty(),
+            "no foot on the ground at {:.2} s",
+            sim.time
+        );
+        let out = outside(&support_polygon(&feet), DVec2::new(c.x, c.z));
+        worst_out = worst_out.max(out);
+        assert!(c.is_finite());
+        if k * 6 > steps {
+            worst_height = worst_height.max((sim.parts()[0].position.y - target).abs());
+        }
+    }
+    assert_eq!(
+        worst_out, 0.0,
+        "the centre of mass left the support polygon"
+    );
+    assert!(
+        worst_height < 0.02,
+        "the pelvis is {worst_height} m off its set point"
+    );
+}
+
+/// The kinematic poses of a realizer playing `bml` without idle motion, every physics step for
+/// `seconds`.
+fn kinematic(bml: &str, seconds: f64) -> Vec<Pose> {
+    let mut r = bml_realizer::realizer::Realizer::new().with_idle(false);
+    r.perform_bml(bml).unwrap();
+    (0..=(seconds / STEP) as usize)
+        .map(|k| r.tick(k as f64 * STEP).poses[0].pose.clone())
+        .collect()
+}
+
+const GESTURES: &str = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="g">
+  <gesture id="beat" lexeme="BEAT" mode="RIGHT_HAND" start="0"/>
+  <gesture id="wave" lexeme="WAVE" mode="RIGHT_HAND" start="beat:end"/>
+  <gesture id="frame" lexeme="FRAME" mode="BOTH_HANDS" start="wave:end"/>
+</bml>"#;
+
+/// Stands through `poses` with reaction gain `k`: the pelvis' path (x, z) and the worst
+/// distance of the centre of mass outside the feet.
+fn stand_through(poses: &[Pose], k: f64) -> (Vec<DVec2>, f64) {
+    let (_, mut sim) = standing();
+    sim.reaction_gain = k;
+    let balance = Balance::default();
+    let mut path = Vec::new();
+    let mut worst: f64 = 0.0;
+    for pose in poses.iter().skip(1) {
+        step(&mut sim, &balance, pose);
+        let p = sim.parts()[0].position;
+        path.push(DVec2::new(p.x, p.z));
+        let (c, _) = sim.centre_of_mass();
+        worst = worst.max(outside(
+            &support_polygon(&sim.contacts()),
+            DVec2::new(c.x, c.z),
+        ));
+    }
+    (path, worst)
+}
+
+/// BEAT, WAVE and a two-handed FRAME played on the kinematic arms: the body stays standing,
+/// and with mixed dynamics on (k = 1) the pelvis moves with the arms' motion, against what it
+/// does with the arms' dynamics off (k = 0).
+#[test]
+fn gestures_push_the_standing_body_through_their_dynamics() {
+    let poses = kinematic(GESTURES, 7.0);
+    let (on, worst_on) = stand_through(&poses, 1.0);
+    let (off, worst_off) = stand_through(&poses, 0.0);
+    assert_eq!(worst_on, 0.0, "the centre of mass left the feet");
+    assert_eq!(worst_off, 0.0);
+    let apart = on
+        .iter()
+        .zip(&off)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    let moved = |p: &[DVec2]| p.iter().map(|q| q.distance(p[0])).fold(0.0, f64::max);
+    eprintln!(
+        "pelvis: {:.1} mm apart at most; moved {:.1} mm (k = 1), {:.1} mm (k = 0)",
+        apart * 1e3,
+        moved(&on) * 1e3,
+        moved(&off) * 1e3
+    );
+    assert!(
+        apart > 0.002,
+        "the arms' dynamics move the pelvis only {apart} m"
+    );
+}
