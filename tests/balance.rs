@@ -120,3 +120,81 @@ fn gestures_push_the_standing_body_through_their_dynamics() {
         "the arms' dynamics move the pelvis only {apart} m"
     );
 }
+
+/// Stands 1 s, is pushed at the pelvis with `impulse` (N s, forward), then balances on until
+/// it falls or `seconds` pass: the centre of mass a second before the push, and after it
+/// every step's (time since the push, centre of mass, its speed, fallen, its height).
+fn pushed(impulse: f64, seconds: f64) -> (DVec2, Vec<(f64, DVec2, f64, bool, f64)>) {
+    let (skeleton, mut sim) = standing();
+    let balance = Balance::default();
+    let rest = Pose::rest(&skeleton);
+    for _ in 0..(1.0 / STEP) as usize {
+        step(&mut sim, &balance, &rest);
+    }
+    let (c, _) = sim.centre_of_mass();
+    let before = DVec2::new(c.x, c.z);
+    sim.push(0, glam::DVec3::new(0.0, 0.0, impulse));
+    let mut after = Vec::new();
+    let mut fallen = false;
+    for k in 1..=(seconds / STEP) as usize {
+        fallen = fallen || balance.fallen(&sim);
+        if fallen {
+            sim.let_go();
+            sim.step(&rest, &Drive::new(15));
+        } else {
+            step(&mut sim, &balance, &rest);
+        }
+        let (c, v) = sim.centre_of_mass();
+        assert!(c.is_finite() && v.is_finite(), "not a number at {k}");
+        after.push((
+            k as f64 * STEP,
+            DVec2::new(c.x, c.z),
+            v.length(),
+            fallen,
+            c.y,
+        ));
+    }
+    (before, after)
+}
+
+/// A push of 20 N s at the pelvis (0.25 m/s for the whole body) sways the body forward and the
+/// controller brings it back: within 2 s the centre of mass is within 1 cm of where it stood and
+/// nearly still, and it never falls.
+#[test]
+fn a_small_push_is_recovered_within_two_seconds() {
+    let (before, after) = pushed(20.0, 3.0);
+    let sway = after
+        .iter()
+        .map(|a| a.1.distance(before))
+        .fold(0.0, f64::max);
+    assert!(
+        sway > 0.01,
+        "the push moved the centre of mass only {sway} m"
+    );
+    assert!(after.iter().all(|a| !a.3), "it fell");
+    let settled = after
+        .iter()
+        .filter(|a| a.0 >= 2.0)
+        .all(|a| a.1.distance(before) < 0.01 && a.2 < 0.05);
+    assert!(settled, "not back within 2 s: sway {sway} m");
+    eprintln!("swayed {:.1} cm", sway * 100.0);
+}
+
+/// A push of 150 N s (2 m/s) throws the centre of mass out over the toes: the controller gives
+/// up (the feet let go) and the body falls to the ground, with no number going wrong.
+#[test]
+fn a_large_push_makes_it_fall() {
+    let (_, after) = pushed(150.0, 3.0);
+    let first = after.iter().position(|a| a.3).expect("it never fell");
+    assert!(
+        after[first].0 < 1.0,
+        "it fell only after {} s",
+        after[first].0
+    );
+    let last = after.last().unwrap();
+    assert!(last.4 < 0.4, "the centre of mass is still {} m up", last.4);
+    eprintln!(
+        "fell {:.2} s after the push; lies with the centre of mass {:.2} m up",
+        after[first].0, last.4
+    );
+}
