@@ -121,10 +121,14 @@ fn gestures_push_the_standing_body_through_their_dynamics() {
     );
 }
 
+/// One step after a push: time since the push, the centre of mass on the ground, its speed,
+/// whether the body has fallen, the centre of mass' height.
+type AfterPush = (f64, DVec2, f64, bool, f64);
+
 /// Stands 1 s, is pushed at the pelvis with `impulse` (N s, forward), then balances on until
-/// it falls or `seconds` pass: the centre of mass a second before the push, and after it
-/// every step's (time since the push, centre of mass, its speed, fallen, its height).
-fn pushed(impulse: f64, seconds: f64) -> (DVec2, Vec<(f64, DVec2, f64, bool, f64)>) {
+/// it falls or `seconds` pass: the centre of mass a second before the push, and every step
+/// after it.
+fn pushed(impulse: f64, seconds: f64) -> (DVec2, Vec<AfterPush>) {
     let (skeleton, mut sim) = standing();
     let balance = Balance::default();
     let rest = Pose::rest(&skeleton);
