@@ -145,6 +145,7 @@ impl BlockManager {
         let mut pose = self.base_pose(to);
         let model = crate::face::FaceModel::default_model();
         let mut face = crate::face::Face::neutral(model);
+        let mut warnings = Vec::new();
         for e in self.registry.engines_mut() {
             e.play(to, frame);
             if let Some(m) = e.as_motion() {
@@ -153,6 +154,10 @@ impl BlockManager {
             if let Some(x) = e.as_expression() {
                 x.express(to, &mut face);
             }
+            warnings.extend(e.take_warnings());
+        }
+        for (key, text) in warnings {
+            self.warn(key.to_string(), KnownWarning::ExecutionFailure, text);
         }
         if let Some(b) = self.blinks.as_mut() {
             b.apply(to, &self.skeleton, &pose, &mut face);

@@ -179,6 +179,11 @@ impl BlockManager {
         self.now
     }
 
+    /// The engines, to change (a host pushing a simulated body).
+    pub fn registry_mut(&mut self) -> &mut Registry {
+        &mut self.registry
+    }
+
     /// The engines.
     pub fn registry(&self) -> &Registry {
         &self.registry

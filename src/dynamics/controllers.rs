@@ -186,6 +186,35 @@ impl Balance {
         f64::from(h.rest[0].y) - (1.0 - self.pelvis_height) * hip
     }
 
+    /// The leg's standing pose at the pelvis height it holds (hip, knee, ankle rotations): the
+    /// hip-to-ankle distance that height leaves, the knee bent to make it (law of cosines), the
+    /// pelvis upright and the foot flat. Hips flex about −x, knees bend about +x.
+    pub fn crouch(&self, sim: &Simulation) -> [DQuat; 3] {
+        let h = sim.humanoid();
+        let (Some(thigh), Some(shank), Some(foot)) = (
+            part(sim, "l_thigh"),
+            part(sim, "l_shank"),
+            part(sim, "l_foot"),
+        ) else {
+            return [DQuat::IDENTITY; 3];
+        };
+        let y = |i: usize| f64::from(h.rest[i].y);
+        let (a, b) = (y(thigh) - y(shank), y(shank) - y(foot));
+        let drop = y(0) - self.target_height(sim);
+        let d = (a + b - drop).clamp((a - b).abs() + 0.05, a + b);
+        let angle = |x: f64, y: f64, opposite: f64| {
+            ((x * x + y * y - opposite * opposite) / (2.0 * x * y))
+                .clamp(-1.0, 1.0)
+                .acos()
+        };
+        let (hip, ankle) = (angle(a, d, b), angle(b, d, a));
+        [
+            DQuat::from_rotation_x(-hip),
+            DQuat::from_rotation_x(hip + ankle),
+            DQuat::from_rotation_x(-ankle),
+        ]
+    }
+
     /// Whether the body has fallen: the centre of mass more than 5 cm outside the support
     /// polygon, no foot on the ground, or the pelvis down to half its standing height.
     pub fn fallen(&self, sim: &Simulation) -> bool {
@@ -243,14 +272,14 @@ impl Controller for Balance {
             })
             .collect();
         let shares = weight_shares(sim, &standing, c);
+        let crouch = self.crouch(sim);
         for (leg, &share) in standing.iter().zip(&shares) {
-            for &i in leg {
-                // the part above this joint carries the share of the force at the centre of mass
+            for (&i, &target) in leg.iter().zip(&crouch) {
                 // the part above this joint (toward the pelvis) carries its share of the virtual
                 // wrench: the force at the centre of mass and the pelvis' upright torque
                 let wrench = (c - parts[i].position).cross(force) + upright;
                 drive.torques[i] -= wrench * share;
-                drive.pull(i, DQuat::IDENTITY, gains::LEG.0 * k, gains::LEG.1 * k);
+                drive.pull(i, target, gains::LEG.0 * k, gains::LEG.1 * k);
             }
             // a foot can only turn the body as far as its sole pushes on the ground: the ankle's
             // torque about the ground's axes stays within what keeps the centre of pressure

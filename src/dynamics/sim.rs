@@ -450,6 +450,34 @@ impl Simulation {
         s.position + s.orientation * c
     }
 
+    /// The part named `name`: a part's own name (`l_thigh`), or a skeleton joint's, meaning the
+    /// part that joint moves with.
+    pub fn part_named(&self, name: &str) -> Option<usize> {
+        let h = &self.humanoid;
+        h.parts
+            .iter()
+            .position(|p| p.name == name)
+            .or_else(|| h.part_of[self.skeleton.joint(name)?])
+    }
+
+    /// Gives the simulated parts the velocities of `from` (the states of an earlier
+    /// simulation of the same humanoid): a body handed from one simulation to the next keeps
+    /// moving as it did.
+    pub fn carry_velocities(&mut self, from: &[PartState]) {
+        for (i, s) in from.iter().enumerate().take(self.handles.len()) {
+            if !self.physical[i] {
+                continue;
+            }
+            let b = &mut self.world.bodies[self.handles[i]];
+            let com = dv(b.center_of_mass());
+            let linear = s.velocity + s.angular.cross(com - s.position);
+            b.set_linvel(v(linear), true);
+            b.set_angvel(v(s.angular), true);
+            self.state[i].velocity = s.velocity;
+            self.state[i].angular = s.angular;
+        }
+    }
+
     /// Pushes part `part` with `impulse` (N s, world) at its centre of mass.
     pub fn push(&mut self, part: usize, impulse: DVec3) {
         if let Some(h) = self.handles.get(part) {

@@ -96,6 +96,15 @@ pub trait Control {
     fn sync_passed(&mut self, key: &UnitKey, sync: &str, time: f64, actions: &mut Vec<Action>);
 }
 
+/// An engine that simulates the body (mixed dynamics): the host can push it.
+pub trait Physics {
+    /// Pushes the simulated body part `part` (a body part of the physical humanoid, such as
+    /// `sacroiliac` or `l_thigh`, or a skeleton joint, meaning the part it moves with) with
+    /// `impulse` (N s, world frame). `Err` says why nothing was pushed: no simulated body now,
+    /// an unknown part, a part not simulated, an impulse that is not finite.
+    fn push(&mut self, part: &str, impulse: [f64; 3]) -> Result<(), String>;
+}
+
 /// How a motion unit moves its joints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MotionKind {

@@ -16,8 +16,8 @@ mod units;
 use std::fmt;
 
 pub use capabilities::{
-    Action, Control, Expression, Motion, MotionKind, Parameters, Prediction, Resources, Sound,
-    Steering,
+    Action, Control, Expression, Motion, MotionKind, Parameters, Physics, Prediction, Resources,
+    Sound, Steering,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};
@@ -199,6 +199,17 @@ pub trait Engine {
     /// The body resources and exclusive groups of its behaviours, if they have any.
     fn as_resources(&self) -> Option<&dyn Resources> {
         None
+    }
+
+    /// Its simulated body, if it simulates one (the host's pushes go there).
+    fn as_physics(&mut self) -> Option<&mut dyn Physics> {
+        None
+    }
+
+    /// Warnings about its units since it was last asked (a simulated body that fell), as
+    /// (unit, what happened); the runtime sends each as a warning feedback.
+    fn take_warnings(&mut self) -> Vec<(UnitKey, String)> {
+        Vec::new()
     }
 
     /// Its actions on the plan, if it realizes control behaviours.

@@ -35,6 +35,7 @@ pub mod keyframe;
 pub mod motion;
 pub mod murml;
 pub mod noise;
+pub mod physical;
 pub mod pointing;
 pub mod posture;
 pub mod procedural;
@@ -47,7 +48,7 @@ use crate::engine::{KindKey, Registry};
 use crate::timing::DefaultTimingModels;
 
 /// Kinds the timing-only motion engine realizes (namespace, element).
-pub const MOTION_KINDS: &[(&str, &str)] = &[(NS_BML, "locomotion"), (NS_BMLT, "controller")];
+pub const MOTION_KINDS: &[(&str, &str)] = &[(NS_BML, "locomotion")];
 
 /// Kinds the face engine realizes (namespace, element).
 pub const FACE_KINDS: &[(&str, &str)] = &[
@@ -146,6 +147,11 @@ pub fn registry_with(models: DefaultTimingModels, assets: &assets::Assets) -> Re
     r.register(
         Box::new(transition::TransitionEngine::default()),
         &keys(&[(NS_BMLT, "transition")]),
+    );
+    // last of all: the simulated body takes the kinematic pose the others made as its input
+    r.register(
+        Box::new(physical::PhysicalEngine::default()),
+        &keys(&[(NS_BMLT, "controller")]),
     );
     r
 }

@@ -196,6 +196,28 @@ impl Realizer {
         })
     }
 
+    /// Pushes the simulated body of `character` ("" for the default character): `impulse`
+    /// (N s, world frame: +y up, the character facing +z) on body part `part` (a part of the
+    /// physical humanoid, `sacroiliac`, `upper-body`, `l_thigh`, …, or a skeleton joint,
+    /// meaning the part it moves with). The body is simulated while a `bmlt:controller` runs;
+    /// `Err` says why nothing was pushed (no such character, nothing simulated, an unknown
+    /// part).
+    pub fn push(&mut self, character: &str, part: &str, impulse: [f64; 3]) -> Result<(), String> {
+        let Some(m) = self.characters.get_mut(character) else {
+            return Err(format!("no character '{character}'"));
+        };
+        let mut why = String::from("no engine simulates the body");
+        for e in m.registry_mut().engines_mut() {
+            if let Some(p) = e.as_physics() {
+                match p.push(part, impulse) {
+                    Ok(()) => return Ok(()),
+                    Err(e) => why = e,
+                }
+            }
+        }
+        Err(why)
+    }
+
     /// Registers an anticipator for `character` (None: blocks without a characterId). Blocks
     /// can then refer to its predictions as `anticipators:ID:SYNC`; when they change, what hangs
     /// on them moves without rescheduling.

@@ -1,0 +1,416 @@
+//! The physical engine: BMLT `controller` behaviours as physical controllers of a simulated body
+//! (mixed dynamics, `dynamics::sim`). While a controller runs, the character's lower body and
+//! trunk (for a rag doll, the whole body) are simulated on rapier3d at 200 Hz; the arms and
+//! head keep playing what the kinematic engines set, and push back on the trunk through their
+//! inverse dynamics. Classes and parameters (changeable while they run):
+//!
+//! - `BalanceController`: stands and balances (`pelvisheight`, relative to the leg's length,
+//!   0.98; `stiffnessmultiplier` 1; `reactiongain`, the k of the arms' push, 1). When the centre
+//!   of mass leaves the feet, it lets go: the body falls as a rag doll, with a warning.
+//! - `PoseController`: PD tracking of what the kinematic engines would set on the simulated
+//!   joints (`stiffnessmultiplier` 1: 300 N m/rad, 30 N m s/rad).
+//! - `RagDoll`: no torque; the whole body simulated.
+//!
+//! A class is named in any case, with or without its `Controller` suffix (`Balance`).
+//!
+//! Several controllers at once add their torques and pulls. The simulated set is the smallest of
+//! the two configurations (lower body and trunk; whole body) that covers every running
+//! controller, and it changes when they do, the new simulation starting where the body is, at
+//! the speeds it has. With no controller left the body returns to the kinematic pose over 0.3 s.
+//! The engine registers last: it steps the simulation up to each frame with the kinematic pose
+//! the others made (interpolated between frames) and writes the simulated joints over it.
+
+use glam::DVec3;
+
+use crate::bml::{Behaviour, BehaviourKind};
+use crate::body::{Pose, Skeleton};
+use crate::dynamics::controllers::{Balance, Controller, Drive, PoseController, RagDoll};
+use crate::dynamics::sim::{Simulation, STEP};
+use crate::engine::{
+    named_param, named_params, set_named_param, Engine, EngineError, MotionKind, Params, Steering,
+    Unit, UnitKey, Units,
+};
+use crate::engines::motion::min_jerk;
+use crate::timing::{Flexibility, TimingModel, MIN_DURATION};
+use crate::world::World;
+
+/// The lower body and the trunk (parts of `dynamics::humanoid::PARTS`).
+pub const LOWER_BODY: [usize; 8] = [0, 1, 9, 10, 11, 12, 13, 14];
+/// Every part.
+pub const WHOLE_BODY: [usize; 15] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14];
+
+/// Seconds over which the body returns to the kinematic pose when the last controller ends.
+const RELEASE: f64 = 0.3;
+
+/// The classes and their parameters (defaults).
+const CLASSES: &[(&str, &[(&str, f64)])] = &[
+    (
+        "BalanceController",
+        &[
+            ("pelvisheight", 0.98),
+            ("stiffnessmultiplier", 1.0),
+            ("reactiongain", 1.0),
+        ],
+    ),
+    ("PoseController", &[("stiffnessmultiplier", 1.0)]),
+    ("RagDoll", &[]),
+];
+
+#[derive(Debug, Clone)]
+struct ControllerUnit {
+    class: &'static str,
+    params: Params,
+}
+
+impl ControllerUnit {
+    fn value(&self, name: &str) -> f64 {
+        named_param(&self.params, name).unwrap_or(0.0)
+    }
+
+    /// The parts it needs simulated.
+    fn needs(&self) -> &'static [usize] {
+        if self.class == "RagDoll" {
+            &WHOLE_BODY
+        } else {
+            &LOWER_BODY
+        }
+    }
+}
+
+/// The physical engine (see the module documentation).
+#[derive(Default)]
+pub struct PhysicalEngine {
+    units: Units<ControllerUnit>,
+    sim: Option<Simulation>,
+    /// Global time the simulation has reached.
+    clock: f64,
+    /// The kinematic pose of the last frame, and its time.
+    last: Option<(f64, Pose)>,
+    /// The pose the simulation last wrote (where the body is).
+    written: Option<Pose>,
+    /// Releasing to the kinematic pose: since when, from which pose.
+    release: Option<(f64, Pose)>,
+    /// The balance gave up (until the controllers change).
+    fallen: bool,
+    warnings: Vec<(UnitKey, String)>,
+}
+
+impl std::fmt::Debug for PhysicalEngine {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PhysicalEngine")
+            .field("units", &self.units.len())
+            .field("simulating", &self.sim.is_some())
+            .field("clock", &self.clock)
+            .finish()
+    }
+}
+
+impl PhysicalEngine {
+    /// The simulation, while one runs.
+    pub fn simulation(&self) -> Option<&Simulation> {
+        self.sim.as_ref()
+    }
+
+    /// The running controllers at `now`.
+    fn active(&self, now: f64) -> Vec<(UnitKey, ControllerUnit)> {
+        self.units
+            .running(now)
+            .map(|(k, _, u)| ((**k).clone(), u.clone()))
+            .collect()
+    }
+
+    /// The parts the running controllers need: the smallest configuration covering them.
+    fn configuration(active: &[(UnitKey, ControllerUnit)]) -> &'static [usize] {
+        if active
+            .iter()
+            .any(|(_, u)| u.needs().len() > LOWER_BODY.len())
+        {
+            &WHOLE_BODY
+        } else {
+            &LOWER_BODY
+        }
+    }
+
+    /// Starts (or restarts with other parts) the simulation from where the body is.
+    fn start(&mut self, skeleton: &Skeleton, kinematic: &Pose, parts: &[usize], now: f64) {
+        let from = self.written.clone().unwrap_or_else(|| kinematic.clone());
+        let before = self.sim.take();
+        match Simulation::new(skeleton, &from, parts, STEP) {
+            Ok(mut sim) => {
+                if let Some(b) = &before {
+                    sim.carry_velocities(b.parts());
+                }
+                self.sim = Some(sim);
+                self.clock = now;
+            }
+            Err(e) => {
+                if let Some((k, _)) = self.active(now).first() {
+                    self.warnings.push((k.clone(), e));
+                }
+            }
+        }
+    }
+
+    /// What the running controllers ask of the joints, with the kinematic pose as the pose
+    /// controller's target.
+    fn drive(
+        &self,
+        sim: &Simulation,
+        active: &[(UnitKey, ControllerUnit)],
+        kinematic: &Pose,
+        skeleton: &Skeleton,
+    ) -> Drive {
+        let mut drive = Drive::new(sim.humanoid().parts.len());
+        for (_, u) in active {
+            match u.class {
+                "BalanceController" if !self.fallen => Balance {
+                    pelvis_height: u.value("pelvisheight"),
+                    stiffness: u.value("stiffnessmultiplier"),
+                }
+                .drive(sim, &mut drive),
+                "PoseController" => {
+                    let k = u.value("stiffnessmultiplier");
+                    let frames = sim.humanoid().frames(skeleton, kinematic);
+                    let targets = (1..sim.humanoid().parts.len())
+                        .filter(|&i| sim.is_physical(i))
+                        .filter_map(|i| {
+                            let p = sim.humanoid().parts[i].parent?;
+                            let q = (frames[p].1.inverse() * frames[i].1).as_dquat();
+                            Some((i, q.normalize(), 300.0 * k, 30.0 * k))
+                        })
+                        .collect();
+                    PoseController { targets }.drive(sim, &mut drive);
+                }
+                _ => RagDoll.drive(sim, &mut drive),
+            }
+        }
+        drive
+    }
+
+    /// Steps the simulation up to `now`, the kinematic pose interpolated from the last frame's.
+    fn run(&mut self, now: f64, skeleton: &Skeleton, kinematic: &Pose) {
+        let active = self.active(now);
+        let (t0, p0) = self.last.clone().unwrap_or((now, kinematic.clone()));
+        let mut sim = self.sim.take().expect("running");
+        let balance = active.iter().find(|(_, u)| u.class == "BalanceController");
+        sim.reaction_gain = balance.map_or(1.0, |(_, u)| u.value("reactiongain"));
+        while self.clock + STEP <= now + 1e-9 {
+            self.clock += STEP;
+            let a = if now > t0 {
+                ((self.clock - t0) / (now - t0)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            let pose = blend(&p0, kinematic, a as f32);
+            if let Some((key, u)) = balance {
+                let b = Balance {
+                    pelvis_height: u.value("pelvisheight"),
+                    stiffness: u.value("stiffnessmultiplier"),
+                };
+                if !self.fallen && b.fallen(&sim) {
+                    self.fallen = true;
+                    sim.let_go();
+                    let (c, _) = sim.centre_of_mass();
+                    self.warnings.push((
+                        key.clone(),
+                        format!(
+                            "the character fell at {:.3} s: its centre of mass ({:.2}, {:.2}) m left its feet; the balance controller lets go and the body falls as a rag doll",
+                            self.clock, c.x, c.z
+                        ),
+                    ));
+                }
+            }
+            let drive = self.drive(&sim, &active, &pose, skeleton);
+            sim.step(&pose, &drive);
+        }
+        self.sim = Some(sim);
+    }
+}
+
+/// Whether `given` names the class `name`: its name in any case, with or without the
+/// `Controller` suffix (`Balance`, `balancecontroller`).
+fn same_class(name: &str, given: &str) -> bool {
+    let short = |n: &str| {
+        let lower = n.to_ascii_lowercase();
+        lower
+            .strip_suffix("controller")
+            .map(str::to_string)
+            .unwrap_or(lower)
+    };
+    short(name) == short(given)
+}
+
+/// `a` and `b` mixed: the root's place linearly, each rotation by slerp (`w` = 0: `a`).
+fn blend(a: &Pose, b: &Pose, w: f32) -> Pose {
+    let mut out = b.clone();
+    out.root = a.root.lerp(b.root, w);
+    for (o, (x, y)) in out
+        .rotations
+        .iter_mut()
+        .zip(a.rotations.iter().zip(&b.rotations))
+    {
+        *o = x.slerp(*y, w);
+    }
+    out
+}
+
+impl Engine for PhysicalEngine {
+    crate::units_remove!();
+    crate::units_retime_len!();
+    crate::units_play!("physical");
+    crate::units_interrupt!(crate::engine::stop_now);
+
+    fn name(&self) -> &'static str {
+        "physical"
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        matches!(behaviour.kind, BehaviourKind::Controller(_)).then(|| {
+            // persistent: a controller runs until it is ended or replaced
+            let mut m = TimingModel::new(
+                &[("start", 0.0), ("end", 1.0)],
+                Flexibility::Stretchable {
+                    min_duration: MIN_DURATION,
+                    max_duration: f64::INFINITY,
+                },
+            );
+            m.persistent = true;
+            m
+        })
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let BehaviourKind::Controller(c) = &unit.behaviour.kind else {
+            return Err(EngineError(
+                "the physical engine realizes bmlt:controller".into(),
+            ));
+        };
+        let fail = |why: String| EngineError(format!("{}: {why}", unit.key));
+        let Some((class, defaults)) = CLASSES.iter().find(|(name, _)| same_class(name, &c.class))
+        else {
+            let known: Vec<&str> = CLASSES.iter().map(|c| c.0).collect();
+            return Err(fail(format!(
+                "controller class '{}' is not known ({})",
+                c.class,
+                known.join(", ")
+            )));
+        };
+        let params = named_params(class, defaults.iter().copied(), &c.params).map_err(fail)?;
+        self.units.add(unit, ControllerUnit { class, params });
+        Ok(())
+    }
+
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+        Some(self)
+    }
+
+    fn as_physics(&mut self) -> Option<&mut dyn crate::engine::Physics> {
+        Some(self)
+    }
+
+    fn take_warnings(&mut self) -> Vec<(UnitKey, String)> {
+        std::mem::take(&mut self.warnings)
+    }
+}
+
+impl crate::engine::Motion for PhysicalEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        let BehaviourKind::Controller(c) = &behaviour.kind else {
+            return None;
+        };
+        let parts: &[usize] = if same_class("RagDoll", &c.class) {
+            &WHOLE_BODY
+        } else {
+            &LOWER_BODY
+        };
+        let h = crate::dynamics::humanoid::Humanoid::new(skeleton).ok()?;
+        let mut joints: Vec<usize> = (0..skeleton.len())
+            .filter(|&j| h.part_of[j].is_some_and(|p| parts.contains(&p)))
+            .collect();
+        joints.sort_unstable();
+        Some(Steering {
+            joints,
+            kind: MotionKind::Physical,
+            additive: false,
+        })
+    }
+
+    fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
+        let active = self.active(now);
+        if active.is_empty() {
+            if self.sim.take().is_some() {
+                self.release = self.written.take().map(|p| (now, p));
+            }
+            self.fallen = false;
+            if let Some((since, from)) = &self.release {
+                let w = min_jerk((now - since) / RELEASE) as f32;
+                if w >= 1.0 {
+                    self.release = None;
+                } else {
+                    *pose = blend(from, pose, w);
+                }
+            }
+            self.last = Some((now, pose.clone()));
+            return;
+        }
+        let parts = Self::configuration(&active);
+        let differs = self.sim.as_ref().is_none_or(|s| {
+            (0..s.humanoid().parts.len()).any(|i| s.is_physical(i) != parts.contains(&i))
+        });
+        if differs {
+            self.start(skeleton, pose, parts, now);
+        }
+        if self.sim.is_none() {
+            return;
+        }
+        let kinematic = pose.clone();
+        self.run(now, skeleton, &kinematic);
+        if let Some(sim) = &self.sim {
+            sim.write(pose);
+        }
+        self.written = Some(pose.clone());
+        self.last = Some((now, kinematic));
+    }
+}
+
+impl crate::engine::Parameters for PhysicalEngine {
+    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
+        named_param(&self.units.get(key)?.params, name)
+    }
+
+    fn set_parameter(
+        &mut self,
+        key: &UnitKey,
+        name: &str,
+        value: f64,
+        _now: f64,
+    ) -> Result<Option<Vec<f64>>, EngineError> {
+        let params = self.units.get_mut(key).map(|(_, u)| &mut u.params);
+        set_named_param(key, "controller", params, name, value)
+    }
+}
+
+impl crate::engine::Physics for PhysicalEngine {
+    fn push(&mut self, part: &str, impulse: [f64; 3]) -> Result<(), String> {
+        let impulse = DVec3::from_array(impulse);
+        if !impulse.is_finite() {
+            return Err(format!("an impulse of {impulse} N s is not a number"));
+        }
+        let Some(sim) = self.sim.as_mut() else {
+            return Err("no body is simulated now (no controller runs)".into());
+        };
+        let Some(i) = sim.part_named(part) else {
+            let names: Vec<&str> = sim.humanoid().parts.iter().map(|p| p.name).collect();
+            return Err(format!("no body part '{part}' ({})", names.join(", ")));
+        };
+        if !sim.is_physical(i) {
+            return Err(format!("the part '{part}' is not simulated now"));
+        }
+        sim.push(i, impulse);
+        Ok(())
+    }
+}

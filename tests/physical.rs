@@ -1,0 +1,186 @@
+//! `bmlt:controller` through the realizer: the simulated body in the frames, pushes from the
+//! host, a fall reported as a warning, parameters changed while the controller runs, and the
+//! body handed back to the kinematic engines when it ends.
+
+use bml_realizer::body::Skeleton;
+use bml_realizer::feedback::Feedback;
+use bml_realizer::realizer::Realizer;
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" xmlns:bmla="http://www.asap-project.org/bmla""#;
+const FPS: f64 = 60.0;
+
+/// Where the pelvis (the sacroiliac joint) is in a frame.
+fn pelvis(r: &mut Realizer, t: f64) -> (glam::Vec3, Vec<Feedback>) {
+    let frame = r.tick(t);
+    let skeleton = Skeleton::adult();
+    let p = frame.poses[0]
+        .pose
+        .joint_world(&skeleton, skeleton.joint("sacroiliac").unwrap());
+    (p.0, frame.feedback)
+}
+
+fn warnings(fb: &[Feedback]) -> Vec<String> {
+    fb.iter()
+        .filter_map(|f| match f {
+            Feedback::Warning(w) => Some(w.text.clone()),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Runs `bml` for `seconds` at 60 Hz, calling `at` before each frame: the pelvis' path and
+/// every warning.
+fn run(
+    bml: &str,
+    seconds: f64,
+    mut at: impl FnMut(&mut Realizer, f64),
+) -> (Vec<(f64, glam::Vec3)>, Vec<String>) {
+    let mut r = Realizer::new().with_idle(false);
+    r.perform_bml(bml).unwrap();
+    let mut path = Vec::new();
+    let mut warned = Vec::new();
+    for k in 0..=(seconds * FPS) as usize {
+        let t = k as f64 / FPS;
+        at(&mut r, t);
+        let (p, fb) = pelvis(&mut r, t);
+        assert!(p.is_finite(), "not a number at {t}");
+        path.push((t, p));
+        warned.extend(warnings(&fb));
+    }
+    (path, warned)
+}
+
+fn balance(extra: &str) -> String {
+    format!(
+        r#"<bml {NS} id="b"><bmlt:controller id="c" class="BalanceController" start="0"/>{extra}</bml>"#
+    )
+}
+
+/// Standing under the balance controller while the arms gesture: the pelvis stays at its height
+/// (0.93 m, within 2 cm after the first second) and over the feet, and nothing is warned.
+#[test]
+fn the_balance_controller_keeps_the_character_standing_while_it_gestures() {
+    let gestures = r#"<gesture id="w" lexeme="WAVE" mode="RIGHT_HAND" start="1"/><gesture id="f" lexeme="FRAME" mode="BOTH_HANDS" start="w:end"/>"#;
+    let (path, warned) = run(&balance(gestures), 10.0, |_, _| {});
+    assert!(warned.is_empty(), "{warned:?}");
+    for (t, p) in path.iter().filter(|(t, _)| *t >= 1.0) {
+        assert!((p.y - 0.932).abs() < 0.02, "pelvis at {} m at {t} s", p.y);
+        assert!(
+            p.x.abs() < 0.1 && p.z.abs() < 0.15,
+            "pelvis at {p} at {t} s"
+        );
+    }
+    // the simulated pelvis is not the kinematic one: it moves with the arms' dynamics
+    let moved = path
+        .iter()
+        .map(|(_, p)| p.distance(path[0].1))
+        .fold(0.0, f32::max);
+    assert!(moved > 0.005, "the pelvis moved only {moved} m");
+}
+
+/// A push from the host sways the body and it recovers; a large one throws it over: a warning
+/// says it fell, and it lies on the ground.
+#[test]
+fn pushes_from_the_host_sway_it_or_make_it_fall() {
+    let push = |n: f64| {
+        move |r: &mut Realizer, t: f64| {
+            if (t - 1.0).abs() < 1e-9 {
+                r.push("", "sacroiliac", [0.0, 0.0, n]).unwrap();
+            }
+        }
+    };
+    let (path, warned) = run(&balance(""), 4.0, push(20.0));
+    assert!(warned.is_empty(), "{warned:?}");
+    let at = |t: f64| path.iter().find(|(u, _)| (u - t).abs() < 1e-9).unwrap().1;
+    let sway = path
+        .iter()
+        .map(|(_, p)| (p.z - at(1.0).z).abs())
+        .fold(0.0, f32::max);
+    assert!(sway > 0.01, "swayed {sway} m");
+    assert!(
+        (at(3.0) - at(1.0)).length() < 0.02,
+        "not back: {} vs {}",
+        at(3.0),
+        at(1.0)
+    );
+    let (path, warned) = run(&balance(""), 4.0, push(150.0));
+    assert_eq!(warned.len(), 1, "{warned:?}");
+    assert!(warned[0].contains("fell"), "{warned:?}");
+    assert!(
+        path.last().unwrap().1.y < 0.5,
+        "still up: {}",
+        path.last().unwrap().1
+    );
+}
+
+#[test]
+fn a_push_without_a_simulated_body_says_why() {
+    let mut r = Realizer::new();
+    let e = r.push("", "sacroiliac", [1.0, 0.0, 0.0]).unwrap_err();
+    assert!(e.contains("no character ''"), "{e}");
+    r.perform_bml(&format!(
+        r#"<bml {NS} id="a"><gesture id="g" lexeme="BEAT"/></bml>"#
+    ))
+    .unwrap();
+    r.tick(0.0);
+    let e = r.push("", "sacroiliac", [1.0, 0.0, 0.0]).unwrap_err();
+    assert!(e.contains("no body is simulated"), "{e}");
+    r.perform_bml(&balance("")).unwrap();
+    r.tick(0.1);
+    let e = r.push("", "tail", [1.0, 0.0, 0.0]).unwrap_err();
+    assert!(e.contains("no body part 'tail'"), "{e}");
+    let e = r.push("", "l_hand", [1.0, 0.0, 0.0]).unwrap_err();
+    assert!(e.contains("not simulated"), "{e}");
+    assert!(
+        r.push("", "l_knee", [1.0, 0.0, 0.0]).is_ok(),
+        "a skeleton joint names its part"
+    );
+    assert!(r
+        .push("nobody", "sacroiliac", [1.0, 0.0, 0.0])
+        .unwrap_err()
+        .contains("no character"));
+}
+
+/// `pelvisheight` changed while the controller runs: the body lowers to the new height.
+#[test]
+fn the_pelvis_height_changes_while_the_controller_runs() {
+    let change = r#"<bmla:parametervaluechange id="p" target="b:c" paramId="pelvisheight" start="2" end="2.1"><bmla:trajectory type="instant" targetValue="0.9"/></bmla:parametervaluechange>"#;
+    let (path, warned) = run(&balance(change), 5.0, |_, _| {});
+    assert!(warned.is_empty(), "{warned:?}");
+    let at = |t: f64| path.iter().find(|(u, _)| (u - t).abs() < 1e-9).unwrap().1;
+    // 0.95 − (1 − 0.9) × 0.9 m of leg
+    assert!((at(1.9).y - 0.932).abs() < 0.02, "{}", at(1.9));
+    assert!((at(5.0).y - 0.86).abs() < 0.02, "{}", at(5.0));
+}
+
+/// A controller with an end: the body is simulated until then and back in the kinematic pose
+/// 0.3 s later, without a jump on the way.
+#[test]
+fn when_the_controller_ends_the_body_returns_to_the_kinematic_pose() {
+    let bml = format!(
+        r#"<bml {NS} id="b"><bmlt:controller id="c" class="Balance" start="0" end="2"/></bml>"#
+    );
+    let (path, warned) = run(&bml, 3.0, |_, _| {});
+    assert!(warned.is_empty(), "{warned:?}");
+    let rest = glam::Vec3::new(0.0, 0.95, 0.0);
+    let at = |t: f64| path.iter().find(|(u, _)| (u - t).abs() < 1e-9).unwrap().1;
+    assert!(at(1.9).distance(rest) > 0.01, "simulated: {}", at(1.9));
+    assert!(at(2.5).distance(rest) < 1e-5, "{}", at(2.5));
+    let step = path
+        .windows(2)
+        .map(|w| w[1].1.distance(w[0].1))
+        .fold(0.0, f32::max);
+    assert!(step < 0.01, "the pelvis jumped {step} m in a frame");
+}
+
+#[test]
+fn an_unknown_controller_class_is_refused_with_the_known_ones() {
+    let bml = format!(r#"<bml {NS} id="b"><bmlt:controller id="c" class="Juggler"/></bml>"#);
+    let (_, warned) = run(&bml, 0.1, |_, _| {});
+    assert!(
+        warned
+            .iter()
+            .any(|w| w.contains("'Juggler' is not known") && w.contains("BalanceController")),
+        "{warned:?}"
+    );
+}
