@@ -162,3 +162,13 @@ fn motion_from_data() {
     assert_eq!(ms(sync(&fb, "moves:sway:end")), 3.0);
     assert_eq!(block(&fb, "moves", "end"), (3.5, Some(BlockStatus::Done)));
 }
+
+#[test]
+fn balancing_while_gesturing() {
+    let fb = run("run fixtures/examples/balance.xml");
+    no_warnings(&fb);
+    assert_eq!(ms(sync(&fb, "stand:balance:start")), 0.0);
+    assert_eq!(ms(sync(&fb, "stand:wave:start")), 0.5);
+    assert_eq!(sync(&fb, "stand:frame:start"), sync(&fb, "stand:wave:end"));
+    assert_eq!(block(&fb, "stand", "end"), (6.0, Some(BlockStatus::Done)));
+}
