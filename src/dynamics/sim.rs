@@ -247,6 +247,12 @@ impl Simulation {
         &self.humanoid
     }
 
+    /// Sets gravity (m/s², world; −9.81 in y by default), e.g. zero for tests of the joints
+    /// alone.
+    pub fn set_gravity(&mut self, g: DVec3) {
+        self.world.gravity = v(g);
+    }
+
     /// The physics step (s).
     pub fn step_size(&self) -> f64 {
         f64::from(self.world.integration_parameters.dt)
