@@ -184,3 +184,51 @@ fn an_unknown_controller_class_is_refused_with_the_known_ones() {
         "{warned:?}"
     );
 }
+
+/// The largest turn of any joint between two neighbouring frames (radians), and where.
+fn largest_turn(frames: &[(f64, bml_realizer::body::Pose)]) -> (f32, f64, usize) {
+    let mut worst = (0.0f32, 0.0, 0);
+    for w in frames.windows(2) {
+        for (j, (a, b)) in w[0].1.rotations.iter().zip(&w[1].1.rotations).enumerate() {
+            let turn = a.angle_between(*b);
+            if turn > worst.0 {
+                worst = (turn, w[1].0, j);
+            }
+        }
+    }
+    worst
+}
+
+/// A rag doll starting while the balance holds the body and the right arm waves: the arms
+/// (kinematic until then) become simulated where they are, moving as they were, and no joint
+/// jumps. Bound: 0.3 rad in a 60 Hz frame (18 rad/s), above what the wave itself turns a joint
+/// (0.13 rad) and far below a jump to another pose.
+#[test]
+fn switching_the_arms_from_kinematic_to_simulated_is_continuous() {
+    let bml = format!(
+        r#"<bml {NS} id="b"><bmlt:controller id="c" class="BalanceController" start="0"/><bmlt:controller id="r" class="RagDoll" start="2"/><gesture id="w" lexeme="WAVE" mode="RIGHT_HAND" start="0.5"/></bml>"#
+    );
+    let mut r = Realizer::new().with_idle(false);
+    r.perform_bml(&bml).unwrap();
+    let frames: Vec<(f64, bml_realizer::body::Pose)> = (0..=(3.0 * FPS) as usize)
+        .map(|k| {
+            let t = k as f64 / FPS;
+            (t, r.tick(t).poses[0].pose.clone())
+        })
+        .collect();
+    let before: Vec<_> = frames.iter().filter(|f| f.0 < 2.0).cloned().collect();
+    let around: Vec<_> = frames.iter().filter(|f| (1.9..2.3).contains(&f.0)).cloned().collect();
+    let (kinematic, ..) = largest_turn(&before);
+    let (switch, at, joint) = largest_turn(&around);
+    eprintln!("largest turn in a frame: {kinematic:.3} rad before the switch, {switch:.3} rad around it ({at:.3} s, joint {joint})");
+    assert!(switch < 0.3, "joint {joint} turned {switch} rad in the frame at {at} s");
+    // the arm was raised at the switch and falls from there, not from rest
+    let skeleton = Skeleton::adult();
+    let wrist = skeleton.joint("r_wrist").unwrap();
+    let height = |t: f64| {
+        let f = frames.iter().find(|f| (f.0 - t).abs() < 1e-9).unwrap();
+        f.1.joint_world(&skeleton, wrist).0.y
+    };
+    assert!(height(2.0) > 1.3, "the wrist is at {} m at the switch", height(2.0));
+    assert!(height(2.0 + 1.0 / FPS) > 1.25, "it dropped at once: {}", height(2.0 + 1.0 / FPS));
+}
