@@ -202,3 +202,51 @@ fn a_large_push_makes_it_fall() {
         after[first].0, last.4
     );
 }
+
+/// The measurement behind the choice of joints (docs/physics.md): the balance controller on a
+/// body of impulse joints and on one multibody, 20 s standing, then a 20 N s push: how far the
+/// pelvis strays from its set point, whether the centre of mass stays over the feet, and the
+/// wall time of the 20 s (`cargo test --release --test balance joints -- --nocapture`).
+#[test]
+fn impulse_joints_and_a_multibody_measured_on_the_standing_body() {
+    use bml_realizer::dynamics::sim::Joints;
+    let skeleton = Skeleton::adult();
+    let rest = Pose::rest(&skeleton);
+    let balance = Balance::default();
+    for kind in [Joints::Impulse, Joints::Multibody] {
+        let mut sim = Simulation::with_joints(&skeleton, &rest, &LOWER_BODY, STEP, kind).unwrap();
+        let target = balance.target_height(&sim);
+        let (mut height, mut out, mut fell) = (0.0f64, 0.0f64, false);
+        let clock = std::time::Instant::now();
+        for k in 0..(20.0 / STEP) as usize {
+            if k == (10.0 / STEP) as usize {
+                sim.push(0, glam::DVec3::new(0.0, 0.0, 20.0));
+            }
+            step(&mut sim, &balance, &rest);
+            let (c, _) = sim.centre_of_mass();
+            fell |= !c.is_finite() || balance.fallen(&sim);
+            if fell {
+                eprintln!("{kind:?}: fell {:.3} s after the start", k as f64 * STEP);
+            }
+            if fell {
+                break;
+            }
+            if k as f64 * STEP > 2.0 {
+                height = height.max((sim.parts()[0].position.y - target).abs());
+            }
+            out = out.max(outside(
+                &support_polygon(&sim.contacts()),
+                DVec2::new(c.x, c.z),
+            ));
+        }
+        let took = clock.elapsed();
+        eprintln!(
+            "{kind:?}: pelvis off its set point by at most {:.1} mm, centre of mass outside the feet by {:.1} mm, fell: {fell}, 4000 steps in {took:?}",
+            height * 1e3,
+            out * 1e3
+        );
+        if kind == Joints::Impulse {
+            assert!(!fell && height < 0.02 && out == 0.0);
+        }
+    }
+}

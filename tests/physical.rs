@@ -217,11 +217,18 @@ fn switching_the_arms_from_kinematic_to_simulated_is_continuous() {
         })
         .collect();
     let before: Vec<_> = frames.iter().filter(|f| f.0 < 2.0).cloned().collect();
-    let around: Vec<_> = frames.iter().filter(|f| (1.9..2.3).contains(&f.0)).cloned().collect();
+    let around: Vec<_> = frames
+        .iter()
+        .filter(|f| (1.9..2.3).contains(&f.0))
+        .cloned()
+        .collect();
     let (kinematic, ..) = largest_turn(&before);
     let (switch, at, joint) = largest_turn(&around);
     eprintln!("largest turn in a frame: {kinematic:.3} rad before the switch, {switch:.3} rad around it ({at:.3} s, joint {joint})");
-    assert!(switch < 0.3, "joint {joint} turned {switch} rad in the frame at {at} s");
+    assert!(
+        switch < 0.3,
+        "joint {joint} turned {switch} rad in the frame at {at} s"
+    );
     // the arm was raised at the switch and falls from there, not from rest
     let skeleton = Skeleton::adult();
     let wrist = skeleton.joint("r_wrist").unwrap();
@@ -229,6 +236,14 @@ fn switching_the_arms_from_kinematic_to_simulated_is_continuous() {
         let f = frames.iter().find(|f| (f.0 - t).abs() < 1e-9).unwrap();
         f.1.joint_world(&skeleton, wrist).0.y
     };
-    assert!(height(2.0) > 1.3, "the wrist is at {} m at the switch", height(2.0));
-    assert!(height(2.0 + 1.0 / FPS) > 1.25, "it dropped at once: {}", height(2.0 + 1.0 / FPS));
+    assert!(
+        height(2.0) > 1.3,
+        "the wrist is at {} m at the switch",
+        height(2.0)
+    );
+    assert!(
+        height(2.0 + 1.0 / FPS) > 1.25,
+        "it dropped at once: {}",
+        height(2.0 + 1.0 / FPS)
+    );
 }

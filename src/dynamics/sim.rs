@@ -27,6 +27,28 @@ pub const SOLVER_ITERATIONS: usize = 10;
 /// Friction between the feet and the ground.
 const GROUND_FRICTION: f32 = 1.0;
 
+/// Which of rapier's joints hold the simulated parts together (docs/physics.md measures both
+/// on the standing body).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Joints {
+    /// Impulse joints: constraints between bodies, solved iteratively; the held feet are
+    /// fixed bodies.
+    #[default]
+    Impulse,
+    /// One multibody (reduced coordinates) from the sacroiliac down; the held feet are fixed
+    /// to the ground by impulse joints (a multibody cannot hold a fixed link). Kept for the
+    /// measurement in docs/physics.md: with the balance controller the body is thrown over
+    /// within 25 ms (the glue's constraints against the reduced coordinates), so the realizer
+    /// does not use it.
+    Multibody,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum JointHandle {
+    Impulse(rp::ImpulseJointHandle),
+    Multibody(rp::MultibodyJointHandle),
+}
+
 /// How a kinematic chain's inverse dynamics reaches its connector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Coupling {
@@ -154,7 +176,13 @@ pub struct Simulation {
     /// The kinematic pose one step ago and now (inputs of the chains' differences).
     history: [Pose; 2],
     /// Per part, the joint to its parent part (simulated parts only).
-    joints: Vec<Option<rp::ImpulseJointHandle>>,
+    joints: Vec<Option<JointHandle>>,
+    /// Which kind of joint.
+    kind: Joints,
+    /// The ground as a body (for the multibody's glue joints).
+    floor: rp::RigidBodyHandle,
+    /// The multibody's glue joints.
+    glue_joints: Vec<rp::ImpulseJointHandle>,
     /// Per part, its joint's anchor on the parent (parent's frame).
     anchors: Vec<rp::Vector>,
     /// The feet held where they stand (empty when let go).
@@ -200,6 +228,17 @@ impl Simulation {
         physical: &[usize],
         step: f64,
     ) -> Result<Simulation, String> {
+        Self::with_joints(skeleton, pose, physical, step, Joints::default())
+    }
+
+    /// [`new`](Self::new) with the parts held together by `kind` joints.
+    pub fn with_joints(
+        skeleton: &Skeleton,
+        pose: &Pose,
+        physical: &[usize],
+        step: f64,
+        kind: Joints,
+    ) -> Result<Simulation, String> {
         if !(step > 0.0 && step <= 0.05) {
             return Err(format!("a physics step of {step} s: between 0 and 0.05"));
         }
@@ -217,7 +256,10 @@ impl Simulation {
                 rp::Group::GROUP_1,
                 rp::InteractionTestMode::And,
             ));
-        world.colliders.insert(ground);
+        let floor = world.bodies.insert(rp::RigidBodyBuilder::fixed());
+        world
+            .colliders
+            .insert_with_parent(ground, floor, &mut world.bodies);
         let n = humanoid.parts.len();
         let mut sim = Simulation {
             world,
@@ -228,6 +270,9 @@ impl Simulation {
             accel: vec![(DVec3::ZERO, DVec3::ZERO); n],
             history: [pose.clone(), pose.clone()],
             joints: vec![None; n],
+            kind,
+            floor,
+            glue_joints: Vec::new(),
             anchors: vec![rp::Vector::ZERO; n],
             glue: Vec::new(),
             reaction_gain: 1.0,
@@ -350,8 +395,20 @@ impl Simulation {
             joint = joint.motor_model(axis, rp::MotorModel::ForceBased);
         }
         let (a, b) = (self.handles[parent], self.handles[child]);
-        let handle = self.world.impulse_joints.insert(a, b, joint.build(), true);
-        self.joints[child] = Some(handle);
+        let handle = match self.kind {
+            Joints::Impulse => Some(JointHandle::Impulse(self.world.impulse_joints.insert(
+                a,
+                b,
+                joint.build(),
+                true,
+            ))),
+            Joints::Multibody => self
+                .world
+                .multibody_joints
+                .insert(a, b, joint.build(), true)
+                .map(JointHandle::Multibody),
+        };
+        self.joints[child] = handle;
         self.anchors[child] = v(anchor);
     }
 
@@ -429,17 +486,36 @@ impl Simulation {
             if !(p.name.ends_with("_foot") && self.physical[i]) || self.sole_centre(i).y > 0.01 {
                 continue;
             }
-            let body = &mut self.world.bodies[self.handles[i]];
-            body.set_body_type(rp::RigidBodyType::Fixed, true);
+            if self.kind == Joints::Multibody {
+                let st = self.state[i];
+                let joint = rp::FixedJointBuilder::new()
+                    .local_frame1(rp::Pose::from_parts(v(st.position), rot(st.orientation)))
+                    .local_frame2(rp::Pose::from_parts(
+                        rp::Vector::ZERO,
+                        rp::Rotation::IDENTITY,
+                    ))
+                    .contacts_enabled(false);
+                let h =
+                    (self.world.impulse_joints).insert(self.floor, self.handles[i], joint, true);
+                self.glue_joints.push(h);
+            } else {
+                let body = &mut self.world.bodies[self.handles[i]];
+                body.set_body_type(rp::RigidBodyType::Fixed, true);
+            }
             self.glue.push(i);
         }
     }
 
     /// Lets go of the feet (see [`glue_feet`](Self::glue_feet)).
     pub fn let_go(&mut self) {
+        for h in self.glue_joints.drain(..) {
+            self.world.impulse_joints.remove(h, true);
+        }
         for i in self.glue.drain(..) {
-            let body = &mut self.world.bodies[self.handles[i]];
-            body.set_body_type(rp::RigidBodyType::Dynamic, true);
+            if self.kind == Joints::Impulse {
+                let body = &mut self.world.bodies[self.handles[i]];
+                body.set_body_type(rp::RigidBodyType::Dynamic, true);
+            }
         }
     }
 
@@ -528,25 +604,34 @@ impl Simulation {
         for (i, handle) in self.joints.iter().enumerate() {
             let Some(handle) = *handle else { continue };
             let pull = pulls.get(i).copied().flatten();
-            let Some(joint) = self.world.impulse_joints.get_mut(handle, false) else {
-                continue;
+            let joint = match handle {
+                JointHandle::Impulse(h) => self
+                    .world
+                    .impulse_joints
+                    .get_mut(h, false)
+                    .map(|j| &mut j.data),
+                JointHandle::Multibody(h) => self
+                    .world
+                    .multibody_joints
+                    .get_mut(h)
+                    .and_then(|(m, link)| m.link_mut(link))
+                    .map(|l| &mut l.joint.data),
             };
+            let Some(joint) = joint else { continue };
             let (kp, kd) = pull.map_or((0.0, 0.0), |p| (p.kp as f32, p.kd as f32));
             let target = pull.map_or(DQuat::IDENTITY, |p| p.target);
             if self.humanoid.parts[i].hinge {
                 let angle = 2.0 * target.x.atan2(target.w);
-                joint
-                    .data
-                    .set_motor(rp::JointAxis::AngX, angle as f32, 0.0, kp, kd);
+                joint.set_motor(rp::JointAxis::AngX, angle as f32, 0.0, kp, kd);
             } else {
                 let frame = rp::Pose::from_parts(self.anchors[i], rot(target));
-                joint.data.set_local_frame1(frame);
+                joint.set_local_frame1(frame);
                 for axis in [
                     rp::JointAxis::AngX,
                     rp::JointAxis::AngY,
                     rp::JointAxis::AngZ,
                 ] {
-                    joint.data.set_motor(axis, 0.0, 0.0, kp, kd);
+                    joint.set_motor(axis, 0.0, 0.0, kp, kd);
                 }
             }
         }
