@@ -2,9 +2,12 @@
 //! the recursive Newton–Euler inverse dynamics of a kinematic chain of ball joints on a moving
 //! connector ([`rnea`]), the angular velocity and acceleration of a joint from its rotations
 //! sampled in time ([`kinematics`]), segments' mass properties and spatial inertia ([`mass`]),
-//! the zero-phase Butterworth low-pass for stored motion ([`butterworth`]), and body
-//! configurations — which joints are simulated, which form kinematic chains ([`config`]). The physical simulation itself (rapier3d, balance, switching) is not here
-//! yet.
+//! the zero-phase Butterworth low-pass for stored motion ([`butterworth`]), body
+//! configurations — which joints are simulated, which form kinematic chains ([`config`]) — and
+//! the simulated body itself: the physical humanoid's parts ([`humanoid`]), one character on
+//! rapier3d stepped with its kinematic chains' inverse dynamics ([`sim`]), and the controllers
+//! that turn its joints ([`controllers`]). docs/physics.md explains the choices and their
+//! measurements.
 
 pub mod butterworth;
 pub mod config;
