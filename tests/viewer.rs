@@ -463,3 +463,30 @@ fn headless_chromium_draws_the_character_and_the_beat_moves_the_arm() {
         "figure {drawn:.2} drawn, background {blank:.2}, arm {arm_moved:.2} changed, legs {legs_moved:.2}"
     );
 }
+
+/// With `#com` the page of balance.xml draws the centre of mass (a red ball with a line down to
+/// the floor, between the feet) and the support polygon; without it, no such red.
+#[test]
+#[ignore = "needs Debian's chromium; .ci/run installs it and runs this with --ignored"]
+fn headless_chromium_draws_the_centre_of_mass_when_asked() {
+    let (_, dir) = page("view-com", &["--no-idle", "fixtures/examples/balance.xml"]);
+    let shot = |hash: &str| {
+        let url = format!("file://{}#t=1.8{hash}", dir.join("index.html").display());
+        let out = dir.join(format!("com{}.png", hash.len()));
+        let (_, console) = browse(&url, &format!("--screenshot={}", out.display()));
+        assert!(console.is_empty(), "{hash}: {console:?}");
+        Shot::load(&out)
+    };
+    let (plain, marked) = (shot(""), shot("&com"));
+    // the marks' red (0xd03030), in the column under the body
+    let red = |s: &Shot| {
+        s.share((400, 500, 60, 700), |x, y| {
+            let [r, g, b] = s.px(x, y);
+            r > 180 && g < 90 && b < 90
+        })
+    };
+    let (without, with) = (red(&plain), red(&marked));
+    eprintln!("red under the body: {without:.4} without #com, {with:.4} with it");
+    assert!(without < 1e-4, "red without #com: {without}");
+    assert!(with > 5e-4, "no centre of mass drawn: {with}");
+}

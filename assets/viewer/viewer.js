@@ -136,6 +136,23 @@
     return keys[keys.length - 1][1];
   }
 
+  /** The convex hull of points [x, z] (monotone chain), counter-clockwise. */
+  function convexHull(points) {
+    const p = points.slice().sort((a, b) => a[0] - b[0] || a[1] - b[1]);
+    if (p.length < 3) return p;
+    const cross = (o, a, b) => (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    const half = (list) => {
+      const out = [];
+      for (const q of list) {
+        while (out.length >= 2 && cross(out[out.length - 2], out[out.length - 1], q) <= 0) out.pop();
+        out.push(q);
+      }
+      out.pop();
+      return out;
+    };
+    return half(p).concat(half(p.slice().reverse()));
+  }
+
   function fmt(t) {
     return t.toFixed(3) + ' s';
   }
@@ -155,6 +172,8 @@
       this.drawn = false;
       this.last = null;
       this.sound = data.audio ? new Audio(data.audio) : null;
+      // the centre of mass and the support polygon: #com in the address, or the C key
+      this.showBalance = /(?:^#|&)com(?:&|$)/.test(location.hash);
     }
 
     start() {
@@ -257,7 +276,65 @@
         nodes[s.joint].add(box);
       }
       const face = this.face(index, rest, nodes);
-      return { nodes, face, pose: new Float32Array(7 + 4 * joints.length), k };
+      const balance = this.balanceMarks(index);
+      return { nodes, face, balance, pose: new Float32Array(7 + 4 * joints.length), k };
+    }
+
+    /**
+     * The centre of mass (a red ball with a line down to the floor) and the support polygon (the
+     * hull of the soles' corners on the floor), from the physical humanoid's parts in the page
+     * data; shown with #com in the address or the C key.
+     */
+    balanceMarks(index) {
+      const THREE = this.THREE;
+      const parts = (this.data.parts || []).filter((p) => index.has(p.joint));
+      if (!parts.length) return null;
+      const red = new THREE.MeshBasicMaterial({ color: 0xd03030, depthTest: false });
+      const ball = new THREE.Mesh(new THREE.SphereGeometry(0.03, 16, 12), red);
+      ball.renderOrder = 2;
+      const line = (color) => {
+        const l = new THREE.Line(
+          new THREE.BufferGeometry(),
+          new THREE.LineBasicMaterial({ color, depthTest: false }),
+        );
+        l.renderOrder = 2;
+        return l;
+      };
+      const drop = line(0xd03030);
+      const polygon = line(0x2060c0);
+      const group = new THREE.Group();
+      group.add(ball, drop, polygon);
+      group.visible = this.showBalance;
+      this.scene.add(group);
+      return { parts: parts.map((p) => ({ ...p, j: index.get(p.joint) })), ball, drop, polygon, group };
+    }
+
+    /** Moves figure `f`'s centre of mass and support polygon to its pose. */
+    balance(f) {
+      const b = f.balance;
+      if (!b) return;
+      b.group.visible = this.showBalance;
+      if (!this.showBalance) return;
+      const THREE = this.THREE;
+      f.nodes[0].updateMatrixWorld(true);
+      const c = new THREE.Vector3();
+      const corners = [];
+      let mass = 0;
+      for (const p of b.parts) {
+        const m = f.nodes[p.j].matrixWorld;
+        c.addScaledVector(new THREE.Vector3().fromArray(p.com).applyMatrix4(m), p.mass);
+        mass += p.mass;
+        for (const s of p.sole || []) {
+          const q = new THREE.Vector3().fromArray(s).applyMatrix4(m);
+          if (q.y < 0.02) corners.push([q.x, q.z]);
+        }
+      }
+      c.multiplyScalar(1 / mass);
+      b.ball.position.copy(c);
+      b.drop.geometry.setFromPoints([c, new THREE.Vector3(c.x, 0.002, c.z)]);
+      const hull = convexHull(corners).map(([x, z]) => new THREE.Vector3(x, 0.003, z));
+      if (hull.length) hull.push(hull[0]);
+      b.polygon.geometry.setFromPoints(hull);
     }
 
     /** Brows, lids and a mouth on the front of the head box, moved by the blendshapes. */
@@ -390,6 +467,7 @@
         if (e.key === 'f' || e.key === 'F') {
           this.view = { ...(this.view.height === this.body.height ? this.close : this.body) };
         }
+        if (e.key === 'c' || e.key === 'C') this.showBalance = !this.showBalance;
       });
       let drag = null;
       this.canvas.addEventListener('pointerdown', (e) => {
@@ -471,6 +549,7 @@
           f.nodes[0].quaternion.fromArray(pose, 3);
           for (let j = 1; j < f.nodes.length; j++) f.nodes[j].quaternion.fromArray(pose, 7 + 4 * j);
           this.expression(f, this.t);
+          this.balance(f);
         }
       }
       for (const p of this.points) if (p.keys) p.ball.position.fromArray(along(p.keys, this.t));

@@ -157,6 +157,7 @@ impl PageData<'_> {
             "title": self.title,
             "live": self.live,
             "segments": mannequin::segments(&Skeleton::adult()),
+            "parts": balance_parts(&Skeleton::adult()),
             "feedback": self.log.iter().map(|(t, f)| message(*t, f)).collect::<Vec<_>>(),
             "timeline": timeline(&messages),
             "world": world_data(self.world),
@@ -166,6 +167,30 @@ impl PageData<'_> {
         });
         serde_json::to_string(&data).expect("the page data encodes")
     }
+}
+
+/// The physical humanoid's parts for the page's centre of mass and support polygon: per part,
+/// the skeleton joint it follows, its mass, its centre of mass in that joint's frame, and for
+/// the feet the corners of the sole.
+fn balance_parts(skeleton: &Skeleton) -> Value {
+    let Ok(h) = bml_realizer::dynamics::humanoid::Humanoid::new(skeleton) else {
+        return Value::Array(Vec::new());
+    };
+    let parts = h.parts.iter().map(|p| {
+        let m = p.mass();
+        let sole = p.name.ends_with("_foot").then(|| {
+            let (c, s) = (p.centre, p.size);
+            [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, z)| {
+                [
+                    c[0] + x * s[0] / 2.0,
+                    c[1] - s[1] / 2.0,
+                    c[2] + z * s[2] / 2.0,
+                ]
+            })
+        });
+        json!({ "joint": p.joint, "mass": m.mass, "com": m.com.to_array(), "sole": sole })
+    });
+    Value::Array(parts.collect())
 }
 
 /// A feedback message for the page: when it was sent, its element name and its XML.
