@@ -12,6 +12,7 @@
 pub mod butterworth;
 pub mod config;
 pub mod controllers;
+pub mod coupling;
 pub mod humanoid;
 pub mod kinematics;
 pub mod mass;

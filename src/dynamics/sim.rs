@@ -11,6 +11,7 @@ use glam::{DQuat, DVec3, Quat, Vec3};
 use rapier3d::prelude as rp;
 
 use super::controllers::{Drive, Pull};
+use super::coupling::{relative_wrench, Composite};
 use super::humanoid::Humanoid;
 use super::kinematics::derivatives;
 use super::rnea::{inverse_dynamics, reaction, with_gravity, BaseMotion, JointMotion, Link};
@@ -66,82 +67,6 @@ pub enum Coupling {
     /// connector's motion within the step; both are scaled by k.
     #[default]
     Implicit,
-}
-
-/// A rigid body made of links: mass, centre of mass and inertia about it (connector frame).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct Composite {
-    mass: f64,
-    moment: DVec3,
-    /// Σ (R I Rᵀ + m (|c|² 1 − c cᵀ)) about the connector's origin.
-    inertia: glam::DMat3,
-}
-
-impl Composite {
-    /// Adds the links of a chain, placed by `motions` (connector frame).
-    fn add(&mut self, links: &[Link], motions: &[JointMotion]) {
-        let mut frames: Vec<(DVec3, DQuat)> = Vec::with_capacity(links.len());
-        for (l, m) in links.iter().zip(motions) {
-            let (p, q) = l
-                .parent
-                .map_or((DVec3::ZERO, DQuat::IDENTITY), |i| frames[i]);
-            let (at, turn) = (p + q * l.offset, q * m.rotation);
-            frames.push((at, turn));
-            let c = at + turn * l.com;
-            let r = glam::DMat3::from_quat(turn);
-            let shift = glam::DMat3::from_diagonal(DVec3::splat(c.length_squared()))
-                - glam::DMat3::from_cols(c * c.x, c * c.y, c * c.z);
-            self.mass += l.mass;
-            self.moment += l.mass * c;
-            self.inertia += r * l.inertia * r.transpose() + shift * l.mass;
-        }
-    }
-
-    fn scaled(&self, k: f64) -> Composite {
-        Composite {
-            mass: self.mass * k,
-            moment: self.moment * k,
-            inertia: self.inertia * k,
-        }
-    }
-
-    /// As rapier's mass properties (inertia about the centre of mass).
-    fn rapier(&self) -> rp::MassProperties {
-        if self.mass <= 1e-12 {
-            return rp::MassProperties::default();
-        }
-        let c = self.moment / self.mass;
-        let shift = glam::DMat3::from_diagonal(DVec3::splat(c.length_squared()))
-            - glam::DMat3::from_cols(c * c.x, c * c.y, c * c.z);
-        let about = self.inertia - shift * self.mass;
-        let m = |col: DVec3| rp::Vector::new(col.x as f32, col.y as f32, col.z as f32);
-        let matrix = rp::Matrix::from_cols(m(about.x_axis), m(about.y_axis), m(about.z_axis));
-        rp::MassProperties::with_inertia_matrix(v(c), self.mass as f32, matrix)
-    }
-}
-
-/// What a chain's motion relative to its connector adds to the wrench on it: the inverse
-/// dynamics with the connector turning at `omega` (connector frame) and no acceleration or
-/// gravity, less the same with every joint still (the rigid chain's own share, which rapier
-/// applies to the added mass).
-fn relative_wrench(links: &[Link], motions: &[JointMotion], omega: DVec3) -> (DVec3, DVec3) {
-    let base = BaseMotion {
-        velocity: omega,
-        ..BaseMotion::default()
-    };
-    let moving = inverse_dynamics(links, motions, base);
-    let still: Vec<JointMotion> = (motions.iter())
-        .map(|m| JointMotion {
-            velocity: DVec3::ZERO,
-            acceleration: DVec3::ZERO,
-            ..*m
-        })
-        .collect();
-    let rigid = inverse_dynamics(links, &still, base);
-    (
-        moving.base_force - rigid.base_force,
-        moving.base_moment - rigid.base_moment,
-    )
 }
 
 /// The state of one part after a step, in the world (joint origin, orientation, velocities).
