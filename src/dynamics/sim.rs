@@ -25,6 +25,10 @@ pub const STEP: f64 = 1.0 / 200.0;
 /// margin at 37 µs per character step (16: 61 µs).
 pub const SOLVER_ITERATIONS: usize = 10;
 
+/// The time constant (s) of the low-pass on the parts' measured accelerations (see
+/// `Simulation::measure`).
+pub const ACCELERATION_SMOOTHING: f64 = 0.02;
+
 /// Friction between the feet and the ground.
 const GROUND_FRICTION: f32 = 1.0;
 
@@ -120,6 +124,8 @@ pub struct Simulation {
     pub time: f64,
     /// Per part, the wrench its chain put on it at the last step (force, moment; world).
     pub last_reaction: Vec<(DVec3, DVec3)>,
+    /// Per kinematic part, the torque its joint needed at the last step (world frame).
+    torques: Vec<DVec3>,
 }
 
 fn v(x: DVec3) -> rp::Vector {
@@ -204,6 +210,7 @@ impl Simulation {
             coupling: Coupling::default(),
             time: 0.0,
             last_reaction: vec![(DVec3::ZERO, DVec3::ZERO); n],
+            torques: vec![DVec3::ZERO; n],
             humanoid,
         };
         sim.build(pose);
@@ -226,6 +233,14 @@ impl Simulation {
     /// The physics step (s).
     pub fn step_size(&self) -> f64 {
         f64::from(self.world.integration_parameters.dt)
+    }
+
+    /// Per part, the torque (N m, world frame) its joint needed at the last step to move as
+    /// the kinematic pose moved it — the inverse dynamics of the kinematic chains, on the
+    /// connector's motion over the step before, gravity included; zero for simulated parts.
+    /// What a planner reads to judge effort or strength.
+    pub fn kinematic_torques(&self) -> &[DVec3] {
+        &self.torques
     }
 
     /// Whether part `i` is simulated.
@@ -349,11 +364,18 @@ impl Simulation {
             let velocity = dv(b.linvel()) + angular.cross(position - com);
             let mass = p.mass().mass;
             if dt > 0.0 {
+                // a step's difference of rapier's velocities jitters (the solver's iterations
+                // leave m/s² of noise: a held arm's shoulder torque swung by 6 N m from one step
+                // to the next); a first-order low-pass over ACCELERATION_SMOOTHING seconds keeps
+                // the connector's acceleration what the body does
                 let before = self.state[i];
-                self.accel[i] = (
+                let raw = (
                     (velocity - before.velocity) / dt,
                     (angular - before.angular) / dt,
                 );
+                let a = dt / (ACCELERATION_SMOOTHING + dt);
+                let (l, w) = self.accel[i];
+                self.accel[i] = (l + (raw.0 - l) * a, w + (raw.1 - w) * a);
             }
             self.state[i] = PartState {
                 position,
@@ -613,19 +635,26 @@ impl Simulation {
             let (links, motions) = self.chain_links(&chain, connector, &frames, h);
             let s = self.state[connector];
             let back = s.orientation.inverse();
+            // the chain's inverse dynamics on the connector's motion over the step before: the
+            // lagged coupling's wrench, and the torques its joints make (exposed either way)
+            let base = with_gravity(
+                BaseMotion {
+                    velocity: back * s.angular,
+                    acceleration: back * self.accel[connector].1,
+                    linear: back * self.accel[connector].0,
+                },
+                s.orientation,
+            );
+            let d = inverse_dynamics(&links, &motions, base);
+            for (&part, t) in chain.iter().zip(&d.torques) {
+                // the torque in the link's frame; the link is turned as the kinematic pose
+                // turns it on the simulated connector
+                let turn = s.orientation
+                    * (frames[1][connector].1.inverse() * frames[1][part].1).as_dquat();
+                self.torques[part] = turn * *t;
+            }
             let (force, moment) = match self.coupling {
-                Coupling::Lagged => {
-                    let base = with_gravity(
-                        BaseMotion {
-                            velocity: back * s.angular,
-                            acceleration: back * self.accel[connector].1,
-                            linear: back * self.accel[connector].0,
-                        },
-                        s.orientation,
-                    );
-                    let d = inverse_dynamics(&links, &motions, base);
-                    (d.base_force, d.base_moment)
-                }
+                Coupling::Lagged => (d.base_force, d.base_moment),
                 Coupling::Implicit => {
                     carried[connector].add(&links, &motions);
                     relative_wrench(&links, &motions, back * s.angular)
