@@ -2,10 +2,11 @@
 //! in the physical set are dynamic rigid bodies joined by impulse joints (balls; hinges at knees
 //! and elbows, with their anatomical ranges) standing on a ground box; the others follow the
 //! kinematic pose. Each step: the controllers' joint torques are summed and applied (each joint
-//! torque turns the child part one way and its parent the other); every kinematic chain's
-//! inverse dynamics, on the connector's velocity and its acceleration from the step before,
-//! gives the wrench the chain puts on its connector, applied −k times; rapier integrates. The
-//! simulated parts' rotations then go back into the pose the host sees.
+//! torque turns the child part one way and its parent the other); every kinematic chain reaches
+//! the part it hangs from through its inverse dynamics, scaled by k (by default as its rigid
+//! inertia added to that part plus the wrench of its relative motion, `dynamics::coupling`; or,
+//! as the thesis does, as the whole wrench on the connector's acceleration of the step before);
+//! rapier integrates. The simulated parts' rotations then go back into the pose the host sees.
 
 use glam::{DQuat, DVec3, Quat, Vec3};
 use rapier3d::prelude as rp;
@@ -102,8 +103,9 @@ pub struct Simulation {
     state: Vec<PartState>,
     /// Per part, its accelerations over the last step (linear of the joint origin, angular).
     accel: Vec<(DVec3, DVec3)>,
-    /// The kinematic pose one step ago and now (inputs of the chains' differences).
-    history: [Pose; 2],
+    /// The parts' frames (joint position, orientation) in the kinematic pose one step ago and
+    /// now (inputs of the chains' differences).
+    history: [Vec<(Vec3, Quat)>; 2],
     /// Per part, the joint to its parent part (simulated parts only).
     joints: Vec<Option<JointHandle>>,
     /// Which kind of joint.
@@ -199,7 +201,7 @@ impl Simulation {
             physical: (0..n).map(|i| physical.contains(&i)).collect(),
             state: vec![PartState::default(); n],
             accel: vec![(DVec3::ZERO, DVec3::ZERO); n],
-            history: [pose.clone(), pose.clone()],
+            history: [Vec::new(), Vec::new()],
             joints: vec![None; n],
             kind,
             floor,
@@ -213,6 +215,8 @@ impl Simulation {
             torques: vec![DVec3::ZERO; n],
             humanoid,
         };
+        let frames = sim.humanoid.frames(skeleton, pose);
+        sim.history = [frames.clone(), frames];
         sim.build(pose);
         sim.measure(0.0);
         sim.glue_feet();
@@ -536,10 +540,12 @@ impl Simulation {
             }
         }
         self.set_motors(&drive.pulls);
-        self.react(kinematic, h);
-        self.follow(kinematic);
+        let frames = self.humanoid.frames(&self.skeleton, kinematic);
+        self.react(&frames, h);
+        self.follow(&frames);
         self.world.step();
-        self.history = [self.history[1].clone(), kinematic.clone()];
+        let [_, now] = std::mem::take(&mut self.history);
+        self.history = [now, frames];
         self.time += h;
         self.measure(h);
     }
@@ -586,8 +592,7 @@ impl Simulation {
 
     /// Moves the kinematic parts to where `kinematic` puts them relative to their simulated
     /// connector (they carry no weight in rapier: their effect is the chains' reaction).
-    fn follow(&mut self, kinematic: &Pose) {
-        let frames = self.humanoid.frames(&self.skeleton, kinematic);
+    fn follow(&mut self, frames: &[(Vec3, Quat)]) {
         for i in 0..self.humanoid.parts.len() {
             if self.physical[i] {
                 continue;
@@ -615,14 +620,11 @@ impl Simulation {
 
     /// The inverse dynamics of every kinematic chain, applied −k times to its connector (see
     /// [`Coupling`]).
-    fn react(&mut self, kinematic: &Pose, h: f64) {
+    fn react(&mut self, now: &[(Vec3, Quat)], h: f64) {
         for r in &mut self.last_reaction {
             *r = (DVec3::ZERO, DVec3::ZERO);
         }
-        let poses = [&self.history[0], &self.history[1], kinematic];
-        let frames: Vec<Vec<(Vec3, Quat)>> = (poses.iter())
-            .map(|p| self.humanoid.frames(&self.skeleton, p))
-            .collect();
+        let frames: [&[(Vec3, Quat)]; 3] = [&self.history[0], &self.history[1], now];
         let n = self.humanoid.parts.len();
         let mut carried = vec![Composite::default(); n];
         for top in 0..n {
@@ -701,18 +703,17 @@ impl Simulation {
         &self,
         chain: &[usize],
         connector: usize,
-        frames: &[Vec<(Vec3, Quat)>],
+        frames: &[&[(Vec3, Quat)]; 3],
         h: f64,
     ) -> (Vec<Link>, Vec<JointMotion>) {
         let mut links = Vec::with_capacity(chain.len());
         let mut motions = Vec::with_capacity(chain.len());
-        let now = &frames[1];
+        let now = frames[1];
         for &i in chain {
             let p = self.humanoid.parts[i];
             let up = p.parent.unwrap_or(connector);
             let offset = now[up].1.as_dquat().inverse() * (now[i].0 - now[up].0).as_dvec3();
-            let relative =
-                |f: &Vec<(Vec3, Quat)>| (f[up].1.inverse() * f[i].1).as_dquat().normalize();
+            let relative = |f: &[(Vec3, Quat)]| (f[up].1.inverse() * f[i].1).as_dquat().normalize();
             let (w, dw, _) = derivatives(
                 relative(&frames[0]),
                 relative(&frames[1]),
