@@ -715,9 +715,9 @@ impl Simulation {
             let offset = now[up].1.as_dquat().inverse() * (now[i].0 - now[up].0).as_dvec3();
             let relative = |f: &[(Vec3, Quat)]| (f[up].1.inverse() * f[i].1).as_dquat().normalize();
             let (w, dw, _) = derivatives(
-                relative(&frames[0]),
-                relative(&frames[1]),
-                relative(&frames[2]),
+                relative(frames[0]),
+                relative(frames[1]),
+                relative(frames[2]),
                 h,
             );
             let m = p.mass();
@@ -729,7 +729,7 @@ impl Simulation {
                 inertia: m.inertia,
             });
             motions.push(JointMotion {
-                rotation: relative(&frames[1]),
+                rotation: relative(frames[1]),
                 velocity: w,
                 acceleration: dw,
             });
