@@ -129,6 +129,21 @@ impl TimingModel {
         }
     }
 
+    /// A persistent behaviour's model (noise, a physical controller): `start` and `end`, any
+    /// duration above [`MIN_DURATION`], and without a constrained end it runs until its block
+    /// is interrupted or replaced.
+    pub fn persistent_span() -> Self {
+        let mut m = Self::new(
+            &[("start", 0.0), ("end", 1.0)],
+            Flexibility::Stretchable {
+                min_duration: MIN_DURATION,
+                max_duration: f64::INFINITY,
+            },
+        );
+        m.persistent = true;
+        m
+    }
+
     /// A stretchable model with the default bounds (any duration above [`MIN_DURATION`]).
     pub fn stretchable(keys: &[(&'static str, f64)]) -> Self {
         Self::new(

@@ -63,17 +63,6 @@ pub const JOINT_SPEED: f64 = 8.0;
 /// 10u³ − 15u⁴ + 6u⁵, at u = ½.
 const MIN_JERK_PEAK: f64 = 1.875;
 
-/// The sync points of a gesture in order (the default gesture timing model's keys).
-const GESTURE_SYNCS: [&str; 7] = [
-    "start",
-    "ready",
-    "strokeStart",
-    "stroke",
-    "strokeEnd",
-    "relax",
-    "end",
-];
-
 /// The least time from one sync of a gesture to another for the hand to keep under
 /// [`HAND_SPEED`] and every joint under [`JOINT_SPEED`] between the keys there.
 #[derive(Debug, Clone)]
@@ -90,7 +79,8 @@ struct Pace {
 fn paces(keys: &GestureKeys) -> Vec<Pace> {
     static ADULT: std::sync::LazyLock<Skeleton> = std::sync::LazyLock::new(Skeleton::adult);
     let rest: &[(String, Quat)] = &[];
-    let mut chain: Vec<(&'static str, &[(String, Quat)])> = GESTURE_SYNCS
+    // the sync points of a gesture, in order
+    let mut chain: Vec<(&'static str, &[(String, Quat)])> = crate::bml::GESTURE_SYNCS
         .iter()
         .filter_map(|&sync| keys.iter().find(|k| k.0 == sync).map(|k| (sync, &k.1[..])))
         .collect();

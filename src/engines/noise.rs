@@ -26,7 +26,7 @@ use crate::engine::{
 };
 use crate::engines::motion::min_jerk;
 use crate::engines::procedural::perlin;
-use crate::timing::{Flexibility, TimingModel, MIN_DURATION};
+use crate::timing::TimingModel;
 use crate::world::World;
 
 /// Parameter names and defaults.
@@ -91,17 +91,8 @@ impl Engine for NoiseEngine {
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        matches!(behaviour.kind, BehaviourKind::Noise(_)).then(|| {
-            let mut m = TimingModel::new(
-                &[("start", 0.0), ("end", 1.0)],
-                Flexibility::Stretchable {
-                    min_duration: MIN_DURATION,
-                    max_duration: f64::INFINITY,
-                },
-            );
-            m.persistent = true;
-            m
-        })
+        // persistent: it runs until it is ended or replaced
+        matches!(behaviour.kind, BehaviourKind::Noise(_)).then(TimingModel::persistent_span)
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {

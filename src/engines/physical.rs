@@ -31,7 +31,7 @@ use crate::engine::{
     Unit, UnitKey, Units,
 };
 use crate::engines::motion::min_jerk;
-use crate::timing::{Flexibility, TimingModel, MIN_DURATION};
+use crate::timing::TimingModel;
 use crate::world::World;
 
 /// The lower body and the trunk (parts of `dynamics::humanoid::PARTS`).
@@ -265,18 +265,8 @@ impl Engine for PhysicalEngine {
     }
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        matches!(behaviour.kind, BehaviourKind::Controller(_)).then(|| {
-            // persistent: a controller runs until it is ended or replaced
-            let mut m = TimingModel::new(
-                &[("start", 0.0), ("end", 1.0)],
-                Flexibility::Stretchable {
-                    min_duration: MIN_DURATION,
-                    max_duration: f64::INFINITY,
-                },
-            );
-            m.persistent = true;
-            m
-        })
+        // persistent: it runs until it is ended or replaced
+        matches!(behaviour.kind, BehaviourKind::Controller(_)).then(TimingModel::persistent_span)
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
