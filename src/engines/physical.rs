@@ -9,18 +9,19 @@
 //!   of mass leaves the feet, it lets go: the body falls as a rag doll, with a warning.
 //! - `PoseController`: PD tracking of what the kinematic engines would set on the simulated
 //!   joints (`stiffnessmultiplier` 1: 300 N m/rad, 30 N m s/rad).
-//! - `RagDoll`: no torque; the whole body simulated.
+//! - `RagDoll`: no torque; the whole body simulated (alone, it lets go of the feet).
 //!
 //! A class is named in any case, with or without its `Controller` suffix (`Balance`).
 //!
 //! Several controllers at once add their torques and pulls. The simulated set is the smallest of
 //! the two configurations (lower body and trunk; whole body) that covers every running
 //! controller, and it changes when they do, the new simulation starting where the body is, at
-//! the speeds it has. With no controller left the body returns to the kinematic pose over 0.3 s.
+//! the speeds it has. With no controller left the body returns to the kinematic pose over 0.3 s,
+//! along a Hermite curve that starts with the pose and the speed it had.
 //! The engine registers last: it steps the simulation up to each frame with the kinematic pose
 //! the others made (interpolated between frames) and writes the simulated joints over it.
 
-use glam::DVec3;
+use glam::{DVec3, Quat};
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
@@ -30,7 +31,6 @@ use crate::engine::{
     named_param, named_params, set_named_param, Engine, EngineError, MotionKind, Params, Steering,
     Unit, UnitKey, Units,
 };
-use crate::engines::motion::min_jerk;
 use crate::timing::TimingModel;
 use crate::world::World;
 
@@ -88,8 +88,11 @@ pub struct PhysicalEngine {
     last: Option<(f64, Pose)>,
     /// The pose the simulation last wrote (where the body is).
     written: Option<Pose>,
-    /// Releasing to the kinematic pose: since when, from which pose.
-    release: Option<(f64, Pose)>,
+    /// How the simulated pose differed from the kinematic one at the last two simulated
+    /// frames (for a release that keeps the body's speed).
+    offsets: [Option<Offset>; 2],
+    /// Releasing to the kinematic pose.
+    release: Option<Release>,
     /// The balance gave up (until the controllers change).
     fallen: bool,
     warnings: Vec<(UnitKey, String)>,
@@ -193,6 +196,10 @@ impl PhysicalEngine {
         let (t0, p0) = self.last.clone().unwrap_or((now, kinematic.clone()));
         let mut sim = self.sim.take().expect("running");
         let balance = active.iter().find(|(_, u)| u.class == "BalanceController");
+        // the feet are held while something stands the body; a rag doll alone lets them go
+        if active.iter().all(|(_, u)| u.class == "RagDoll") {
+            sim.let_go();
+        }
         sim.reaction_gain = balance.map_or(1.0, |(_, u)| u.value("reactiongain"));
         while self.clock + STEP <= now + 1e-9 {
             self.clock += STEP;
@@ -224,6 +231,92 @@ impl PhysicalEngine {
             sim.step(&pose, &drive);
         }
         self.sim = Some(sim);
+    }
+}
+
+/// How far a pose is from the kinematic one at a moment: the root's displacement and each
+/// joint's turn (rotation vectors, kinematic⁻¹ · pose).
+#[derive(Debug, Clone)]
+struct Offset {
+    time: f64,
+    root: glam::Vec3,
+    turns: Vec<glam::Vec3>,
+}
+
+impl Offset {
+    fn between(time: f64, kinematic: &Pose, pose: &Pose) -> Offset {
+        let turns = (kinematic.rotations.iter().zip(&pose.rotations))
+            .map(|(k, p)| {
+                let d = k.inverse() * *p;
+                if d.w < 0.0 { -d } else { d }.to_scaled_axis()
+            })
+            .collect();
+        Offset {
+            time,
+            root: pose.root - kinematic.root,
+            turns,
+        }
+    }
+}
+
+/// The way back from the simulated pose to the kinematic one: the offset eases to nothing along
+/// a cubic Hermite curve over [`RELEASE`] seconds, starting at the last simulated offset with
+/// its rate of change, so the body keeps its pose and its speed at the hand-over.
+#[derive(Debug, Clone)]
+struct Release {
+    from: Offset,
+    /// The offset's rate of change (per second) at the hand-over.
+    rate: Offset,
+}
+
+impl Release {
+    fn new(last: &Offset, before: Option<&Offset>) -> Release {
+        let dt = before.map_or(0.0, |b| last.time - b.time);
+        let rate = |a: glam::Vec3, b: glam::Vec3| {
+            if dt > 0.0 {
+                (a - b) / dt as f32
+            } else {
+                glam::Vec3::ZERO
+            }
+        };
+        let rate = match before {
+            Some(b) if dt > 0.0 => Offset {
+                time: last.time,
+                root: rate(last.root, b.root),
+                turns: (last.turns.iter().zip(&b.turns))
+                    .map(|(a, b)| rate(*a, *b))
+                    .collect(),
+            },
+            _ => Offset {
+                time: last.time,
+                root: glam::Vec3::ZERO,
+                turns: vec![glam::Vec3::ZERO; last.turns.len()],
+            },
+        };
+        Release {
+            from: last.clone(),
+            rate,
+        }
+    }
+
+    /// Puts the eased offset on `pose` (the kinematic pose) at `now`; false once it is over.
+    fn apply(&self, now: f64, pose: &mut Pose) -> bool {
+        let s = ((now - self.from.time) / RELEASE).clamp(0.0, 1.0);
+        if s >= 1.0 {
+            return false;
+        }
+        // cubic Hermite weights of the start value and the start tangent (the end is zero)
+        let h00 = (2.0 * s * s * s - 3.0 * s * s + 1.0) as f32;
+        let h10 = ((s * s * s - 2.0 * s * s + s) * RELEASE) as f32;
+        pose.root += self.from.root * h00 + self.rate.root * h10;
+        for (q, (r, dr)) in pose
+            .rotations
+            .iter_mut()
+            .zip(self.from.turns.iter().zip(&self.rate.turns))
+        {
+            *q = (*q * Quat::from_scaled_axis(*r * h00 + *dr * h10)).normalize();
+        }
+        true
     }
 }
 
@@ -333,18 +426,15 @@ impl crate::engine::Motion for PhysicalEngine {
         let active = self.active(now);
         if active.is_empty() {
             if self.sim.take().is_some() {
-                self.release = self.written.take().map(|p| (now, p));
+                let [before, last] = std::mem::take(&mut self.offsets);
+                self.release = last.map(|l| Release::new(&l, before.as_ref()));
+                self.written = None;
             }
             self.fallen = false;
-            if let Some((since, from)) = &self.release {
-                let w = min_jerk((now - since) / RELEASE) as f32;
-                if w >= 1.0 {
-                    self.release = None;
-                } else {
-                    *pose = blend(from, pose, w);
-                }
-            }
             self.last = Some((now, pose.clone()));
+            if self.release.as_ref().is_some_and(|r| !r.apply(now, pose)) {
+                self.release = None;
+            }
             return;
         }
         let parts = Self::configuration(&active);
@@ -363,6 +453,8 @@ impl crate::engine::Motion for PhysicalEngine {
             sim.write(pose);
         }
         self.written = Some(pose.clone());
+        let [_, last] = std::mem::take(&mut self.offsets);
+        self.offsets = [last, Some(Offset::between(now, &kinematic, pose))];
         self.last = Some((now, kinematic));
     }
 }
