@@ -89,7 +89,15 @@ fn one_multiplier_scales_every_balance_gain() {
         d
     };
     let (zero, one, three) = (drive(0.0), drive(1.0), drive(3.0));
+    // the legs and the spine are pulled, and the pushed body is off its set point
+    let pulled = one.pulls.iter().filter(|p| p.is_some()).count();
+    assert_eq!(pulled, 7, "{:?}", one.pulls);
+    let off = (0..15)
+        .filter(|&i| (one.torques[i] - zero.torques[i]).length() > 1.0)
+        .count();
+    assert!(off >= 4, "only {off} torques answer the error");
     for i in 0..15 {
+        assert_eq!(one.pulls[i].is_some(), three.pulls[i].is_some(), "part {i}");
         if let (Some(a), Some(b)) = (one.pulls[i], three.pulls[i]) {
             assert!((b.kp - 3.0 * a.kp).abs() < 1e-9 && (b.kd - 3.0 * a.kd).abs() < 1e-9);
         }

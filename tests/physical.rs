@@ -50,6 +50,11 @@ fn run(
     (path, warned)
 }
 
+/// Where the pelvis is at time `t` (a frame time) on `path`.
+fn at(path: &[(f64, glam::Vec3)], t: f64) -> glam::Vec3 {
+    path.iter().find(|(u, _)| (u - t).abs() < 1e-9).unwrap().1
+}
+
 fn balance(extra: &str) -> String {
     format!(
         r#"<bml {NS} id="b"><bmlt:controller id="c" class="BalanceController" start="0"/>{extra}</bml>"#
@@ -91,7 +96,7 @@ fn pushes_from_the_host_sway_it_or_make_it_fall() {
     };
     let (path, warned) = run(&balance(""), 4.0, push(20.0));
     assert!(warned.is_empty(), "{warned:?}");
-    let at = |t: f64| path.iter().find(|(u, _)| (u - t).abs() < 1e-9).unwrap().1;
+    let at = |t: f64| at(&path, t);
     let sway = path
         .iter()
         .map(|(_, p)| (p.z - at(1.0).z).abs())
@@ -147,7 +152,7 @@ fn the_pelvis_height_changes_while_the_controller_runs() {
     let change = r#"<bmla:parametervaluechange id="p" target="b:c" paramId="pelvisheight" start="2" end="2.1"><bmla:trajectory type="instant" targetValue="0.9"/></bmla:parametervaluechange>"#;
     let (path, warned) = run(&balance(change), 5.0, |_, _| {});
     assert!(warned.is_empty(), "{warned:?}");
-    let at = |t: f64| path.iter().find(|(u, _)| (u - t).abs() < 1e-9).unwrap().1;
+    let at = |t: f64| at(&path, t);
     // 0.95 − (1 − 0.9) × 0.9 m of leg
     assert!((at(1.9).y - 0.932).abs() < 0.02, "{}", at(1.9));
     assert!((at(5.0).y - 0.86).abs() < 0.02, "{}", at(5.0));
@@ -163,7 +168,7 @@ fn when_the_controller_ends_the_body_returns_to_the_kinematic_pose() {
     let (path, warned) = run(&bml, 3.0, |_, _| {});
     assert!(warned.is_empty(), "{warned:?}");
     let rest = glam::Vec3::new(0.0, 0.95, 0.0);
-    let at = |t: f64| path.iter().find(|(u, _)| (u - t).abs() < 1e-9).unwrap().1;
+    let at = |t: f64| at(&path, t);
     assert!(at(1.9).distance(rest) > 0.01, "simulated: {}", at(1.9));
     assert!(at(2.5).distance(rest) < 1e-5, "{}", at(2.5));
     let step = path

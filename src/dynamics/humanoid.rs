@@ -182,6 +182,25 @@ impl PartSpec {
         self
     }
 
+    /// Whether it is a foot (its box's underside is a sole).
+    pub fn is_foot(&self) -> bool {
+        self.name.ends_with("_foot")
+    }
+
+    /// The middle of its box's underside, in its joint's frame.
+    pub fn underside(&self) -> DVec3 {
+        DVec3::from_array(self.centre) - DVec3::new(0.0, self.size[1] / 2.0, 0.0)
+    }
+
+    /// For a foot, the corners of its sole, in its joint's frame.
+    pub fn sole(&self) -> Option<[DVec3; 4]> {
+        let (mid, h) = (self.underside(), DVec3::from_array(self.size) / 2.0);
+        self.is_foot().then(|| {
+            [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .map(|(x, z)| mid + DVec3::new(x * h.x, 0.0, z * h.z))
+        })
+    }
+
     /// Its mass properties, in a frame at its joint aligned with the world in the rest pose.
     pub fn mass(&self) -> MassProperties {
         cuboid(

@@ -305,8 +305,17 @@ impl Simulation {
         }
     }
 
+    /// The range (radians) of the bend about x of part `i`'s skeleton joint, from the
+    /// skeleton's joint limits (`None`: the joint is not limited about x).
+    fn bend_range(&self, i: usize) -> Option<[f32; 2]> {
+        let limit = self.skeleton.limits().of(self.humanoid.joints[i])?;
+        let &(_, lo, hi) = limit.swing.iter().find(|s| s.0 == 0)?;
+        Some([lo, hi])
+    }
+
     /// A joint from `parent` to `child` at the child's joint: a ball, or a hinge about the
-    /// child's x axis within its anatomical range (knee −5°..135°, elbow −150°..5°). Angles
+    /// child's x axis within the skeleton's range for it (the adult's knee −5°..135°, elbow
+    /// −150°..5°). Angles
     /// count from the rest pose, where every part's frame is the world's; a hinge that starts
     /// bent about another axis is pulled onto its own.
     fn join(&mut self, parent: usize, child: usize, frames: &[(Vec3, Quat)]) {
@@ -317,13 +326,11 @@ impl Simulation {
         let frame2 = rp::Pose::from_parts(rp::Vector::ZERO, rp::Rotation::IDENTITY);
         let p = &self.humanoid.parts[child];
         let mut joint = if p.hinge {
-            let range = if p.name.ends_with("shank") {
-                [-5f32.to_radians(), 135f32.to_radians()]
-            } else {
-                [-150f32.to_radians(), 5f32.to_radians()]
-            };
-            rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_REVOLUTE_AXES)
-                .limits(rp::JointAxis::AngX, range)
+            let hinge = rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_REVOLUTE_AXES);
+            match self.bend_range(child) {
+                Some(range) => hinge.limits(rp::JointAxis::AngX, range),
+                None => hinge,
+            }
         } else {
             rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_SPHERICAL_AXES)
         };
@@ -407,17 +414,12 @@ impl Simulation {
     pub fn contacts(&self) -> Vec<DVec3> {
         let mut out = Vec::new();
         for (i, p) in self.humanoid.parts.iter().enumerate() {
-            if !(p.name.ends_with("_foot") && self.physical[i]) {
+            let Some(sole) = p.sole().filter(|_| self.physical[i]) else {
                 continue;
-            }
+            };
             let s = self.state[i];
-            let (c, h) = (DVec3::from_array(p.centre), DVec3::from_array(p.size) / 2.0);
-            for (x, z) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                let corner = s.position + s.orientation * (c + DVec3::new(x * h.x, -h.y, z * h.z));
-                if corner.y < 0.02 {
-                    out.push(corner);
-                }
-            }
+            let corners = sole.map(|c| s.position + s.orientation * c);
+            out.extend(corners.into_iter().filter(|c| c.y < 0.02));
         }
         out
     }
@@ -434,7 +436,7 @@ impl Simulation {
             return;
         }
         for (i, p) in self.humanoid.parts.iter().enumerate() {
-            if !(p.name.ends_with("_foot") && self.physical[i]) || self.sole_centre(i).y > 0.01 {
+            if !(p.is_foot() && self.physical[i]) || self.sole_centre(i).y > 0.01 {
                 continue;
             }
             if self.kind == Joints::Multibody {
@@ -477,10 +479,8 @@ impl Simulation {
 
     /// The middle of part `i`'s box's underside, in the world (for a foot: its sole).
     pub fn sole_centre(&self, i: usize) -> DVec3 {
-        let p = &self.humanoid.parts[i];
         let s = self.state[i];
-        let c = DVec3::from_array(p.centre) - DVec3::new(0.0, p.size[1] / 2.0, 0.0);
-        s.position + s.orientation * c
+        s.position + s.orientation * self.humanoid.parts[i].underside()
     }
 
     /// The part named `name`: a part's own name (`l_thigh`), or a skeleton joint's, meaning the

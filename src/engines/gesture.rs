@@ -77,7 +77,7 @@ struct Pace {
 /// of the fastest the right wrist moves per unit of interpolation over [`HAND_SPEED`] and the
 /// largest angle a joint turns over [`JOINT_SPEED`].
 fn paces(keys: &GestureKeys) -> Vec<Pace> {
-    static ADULT: std::sync::LazyLock<Skeleton> = std::sync::LazyLock::new(Skeleton::adult);
+    let adult = Skeleton::adult();
     let rest: &[(String, Quat)] = &[];
     // the sync points of a gesture, in order
     let mut chain: Vec<(&'static str, &[(String, Quat)])> = crate::bml::GESTURE_SYNCS
@@ -96,7 +96,7 @@ fn paces(keys: &GestureKeys) -> Vec<Pace> {
             from: w[0].0,
             to: w[1].0,
             seconds: MIN_JERK_PEAK
-                * (wrist_rate(&ADULT, w[0].1, w[1].1) / HAND_SPEED)
+                * (wrist_rate(&adult, w[0].1, w[1].1) / HAND_SPEED)
                     .max(largest_turn(w[0].1, w[1].1) / JOINT_SPEED),
         })
         .collect()

@@ -67,6 +67,14 @@ impl ControllerUnit {
         named_param(&self.params, name).unwrap_or(0.0)
     }
 
+    /// The balance controller its parameters make (for a `BalanceController`).
+    fn balance(&self) -> Balance {
+        Balance {
+            pelvis_height: self.value("pelvisheight"),
+            stiffness: self.value("stiffnessmultiplier"),
+        }
+    }
+
     /// The parts it needs simulated.
     fn needs(&self) -> &'static [usize] {
         if self.class == "RagDoll" {
@@ -166,11 +174,7 @@ impl PhysicalEngine {
         let mut drive = Drive::new(sim.humanoid().parts.len());
         for (_, u) in active {
             match u.class {
-                "BalanceController" if !self.fallen => Balance {
-                    pelvis_height: u.value("pelvisheight"),
-                    stiffness: u.value("stiffnessmultiplier"),
-                }
-                .drive(sim, &mut drive),
+                "BalanceController" if !self.fallen => u.balance().drive(sim, &mut drive),
                 "PoseController" => {
                     let k = u.value("stiffnessmultiplier");
                     let frames = sim.humanoid().frames(skeleton, kinematic);
@@ -210,10 +214,7 @@ impl PhysicalEngine {
             };
             let pose = blend(&p0, kinematic, a as f32);
             if let Some((key, u)) = balance {
-                let b = Balance {
-                    pelvis_height: u.value("pelvisheight"),
-                    stiffness: u.value("stiffnessmultiplier"),
-                };
+                let b = u.balance();
                 if !self.fallen && b.fallen(&sim) {
                     self.fallen = true;
                     sim.let_go();

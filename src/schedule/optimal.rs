@@ -604,9 +604,9 @@ fn anchored_keys(items: &[Item], links: &[Link]) -> Vec<Vec<usize>> {
 /// duration), each phase at most its limit. For a given σ the best phases are known in closed
 /// form (see [`Spans::cost`]), so the best σ minimises a convex piecewise-linear function of σ,
 /// whose least value lies at one of its kinks. At that σ, a phase outside the anchors is σ times
-/// its preferred length (or its limit); the phases between two anchors start from the same and
-/// make up their fixed distance with the earliest times: what is missing goes into the last
-/// phases first (up to their limits), what is too much comes out of the first phases first.
+/// its preferred length (or its limit); the phases between two anchors are scaled alike to make
+/// up their fixed distance ([`uniform_phases`]), which costs the deviation the same as any other
+/// split of the change.
 fn best_timing(item: &Item, anchors: &[usize], at: &[f64]) -> Option<Vec<f64>> {
     let keys = &item.model.keys[..item.len];
     let phase = |k: usize| (keys[k].at - keys[k - 1].at, keys[k].max_phase);
@@ -630,24 +630,9 @@ fn best_timing(item: &Item, anchors: &[usize], at: &[f64]) -> Option<Vec<f64>> {
         offsets[k] = offsets[k + 1] - fitted(k + 1);
     }
     for (j, w) in anchors.windows(2).enumerate() {
-        let mut phases: Vec<f64> = (w[0] + 1..=w[1]).map(fitted).collect();
-        let limits: Vec<f64> = (w[0] + 1..=w[1]).map(|k| phase(k).1).collect();
-        let mut missing = spans.inner[j].0 - phases.iter().sum::<f64>();
-        // too long a distance: the last phases take it, as far as their limits let them
-        for (x, max) in phases.iter_mut().zip(&limits).rev() {
-            let take = missing.clamp(0.0, max - *x);
-            *x += take;
-            missing -= take;
-        }
-        // too short: the first phases give it up
-        for x in phases.iter_mut() {
-            let give = (-missing).clamp(0.0, *x);
-            *x -= give;
-            missing += give;
-        }
-        if missing.abs() > EPSILON {
-            return None; // the limits cannot make up the distance
-        }
+        // the span's phases scaled alike to its fixed distance (None: the limits cannot make
+        // it up)
+        let phases = uniform_phases(&keys[w[0]..=w[1]], at[j + 1] - at[j])?;
         offsets[w[0]] = at[j];
         for (i, x) in phases.iter().enumerate() {
             offsets[w[0] + 1 + i] = offsets[w[0] + i] + x;

@@ -178,16 +178,7 @@ fn balance_parts(skeleton: &Skeleton) -> Value {
     };
     let parts = h.parts.iter().map(|p| {
         let m = p.mass();
-        let sole = p.name.ends_with("_foot").then(|| {
-            let (c, s) = (p.centre, p.size);
-            [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, z)| {
-                [
-                    c[0] + x * s[0] / 2.0,
-                    c[1] - s[1] / 2.0,
-                    c[2] + z * s[2] / 2.0,
-                ]
-            })
-        });
+        let sole = p.sole().map(|corners| corners.map(|c| c.to_array()));
         json!({ "joint": p.joint, "mass": m.mass, "com": m.com.to_array(), "sole": sole })
     });
     Value::Array(parts.collect())
