@@ -282,3 +282,33 @@ fn the_hand_back_to_the_kinematic_pose_keeps_the_speed() {
         path.last().unwrap().1
     );
 }
+
+/// A rag doll that has fallen to the floor, handed back: the body returns to the kinematic
+/// pose without a flick — the pelvis never faster than 1.5 m/s on the way (a 0.3 s hand-back
+/// from the floor moved it at 6.5 m/s) — and is standing again within 2 s. It floats up, as
+/// there is no getting-up motion (docs/physics.md).
+#[test]
+fn the_hand_back_from_the_floor_is_unhurried() {
+    let bml = format!(
+        r#"<bml {NS} id="b"><bmlt:controller id="c" class="RagDoll" start="0" end="1.5"/></bml>"#
+    );
+    let (path, warned) = run(&bml, 4.0, |_, _| {});
+    assert!(warned.is_empty(), "{warned:?}");
+    assert!(
+        at(&path, 1.45).y < 0.5,
+        "it did not fall: {}",
+        at(&path, 1.45)
+    );
+    let fastest = (path.windows(2))
+        .filter(|w| w[0].0 >= 1.5)
+        .map(|w| w[1].1.distance(w[0].1) * FPS as f32)
+        .fold(0.0, f32::max);
+    eprintln!("fastest pelvis on the way back: {fastest:.2} m/s");
+    assert!(fastest < 1.5, "the pelvis flew back at {fastest} m/s");
+    let rest = glam::Vec3::new(0.0, 0.95, 0.0);
+    assert!(
+        at(&path, 3.5).distance(rest) < 1e-5,
+        "not standing: {}",
+        at(&path, 3.5)
+    );
+}

@@ -16,8 +16,8 @@
 //! Several controllers at once add their torques and pulls. The simulated set is the smallest of
 //! the two configurations (lower body and trunk; whole body) that covers every running
 //! controller, and it changes when they do, the new simulation starting where the body is, at
-//! the speeds it has. With no controller left the body returns to the kinematic pose over 0.3 s,
-//! along a Hermite curve that starts with the pose and the speed it had.
+//! the speeds it has. With no controller left the body returns to the kinematic pose over 0.3 s
+//! (longer from far away), along a Hermite curve that starts with the pose and the speed it had.
 //! The engine registers last: it steps the simulation up to each frame with the kinematic pose
 //! the others made (interpolated between frames) and writes the simulated joints over it.
 
@@ -39,8 +39,12 @@ pub const LOWER_BODY: [usize; 8] = [0, 1, 9, 10, 11, 12, 13, 14];
 /// Every part.
 pub const WHOLE_BODY: [usize; 15] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14];
 
-/// Seconds over which the body returns to the kinematic pose when the last controller ends.
+/// The shortest hand-back to the kinematic pose when the last controller ends (s); a body far
+/// from that pose takes longer, so that the way back keeps under [`RELEASE_SPEED`].
 const RELEASE: f64 = 0.3;
+
+/// The peak speeds of the way back: of the root (m/s) and of any joint (rad/s).
+const RELEASE_SPEED: (f64, f64) = (1.0, 3.0);
 
 /// The classes and their parameters (defaults).
 const CLASSES: &[(&str, &[(&str, f64)])] = &[
@@ -261,11 +265,15 @@ impl Offset {
 }
 
 /// The way back from the simulated pose to the kinematic one: the offset eases to nothing along
-/// a cubic Hermite curve over [`RELEASE`] seconds, starting at the last simulated offset with
-/// its rate of change, so the body keeps its pose and its speed at the hand-over.
+/// a cubic Hermite curve, starting at the last simulated offset with its rate of change, so the
+/// body keeps its pose and its speed at the hand-over. It lasts [`RELEASE`] seconds, or longer
+/// for a large offset: the curve's peak rate is 1.5 times the offset over the duration, kept
+/// under [`RELEASE_SPEED`] (a body lying on the floor takes about 1.3 s to stand again).
 #[derive(Debug, Clone)]
 struct Release {
     from: Offset,
+    /// How long it takes (s).
+    duration: f64,
     /// The offset's rate of change (per second) at the hand-over.
     rate: Offset,
 }
@@ -294,21 +302,30 @@ impl Release {
                 turns: vec![glam::Vec3::ZERO; last.turns.len()],
             },
         };
+        let turn = last
+            .turns
+            .iter()
+            .map(|t| f64::from(t.length()))
+            .fold(0.0, f64::max);
+        let duration = RELEASE
+            .max(1.5 * f64::from(last.root.length()) / RELEASE_SPEED.0)
+            .max(1.5 * turn / RELEASE_SPEED.1);
         Release {
             from: last.clone(),
+            duration,
             rate,
         }
     }
 
     /// Puts the eased offset on `pose` (the kinematic pose) at `now`; false once it is over.
     fn apply(&self, now: f64, pose: &mut Pose) -> bool {
-        let s = ((now - self.from.time) / RELEASE).clamp(0.0, 1.0);
+        let s = ((now - self.from.time) / self.duration).clamp(0.0, 1.0);
         if s >= 1.0 {
             return false;
         }
         // cubic Hermite weights of the start value and the start tangent (the end is zero)
         let h00 = (2.0 * s * s * s - 3.0 * s * s + 1.0) as f32;
-        let h10 = ((s * s * s - 2.0 * s * s + s) * RELEASE) as f32;
+        let h10 = ((s * s * s - 2.0 * s * s + s) * self.duration) as f32;
         pose.root += self.from.root * h00 + self.rate.root * h10;
         for (q, (r, dr)) in pose
             .rotations
