@@ -256,7 +256,7 @@ fn switching_the_arms_from_kinematic_to_simulated_is_continuous() {
 /// Handed back while it moves: a rag doll falls for 0.4 s, then its controller ends. The
 /// pelvis goes on at the speed it had and eases back to the kinematic pose within 0.3 s: its
 /// speed across the hand-over (last simulated frame to first released one) is within 35 % of
-/// its speed in the frame before (measured: 0.308 → 0.246 m/s; the fall was gaining 0.16 m/s a
+/// its speed in the frame before (measured: 0.248 → 0.188 m/s; the fall was gaining 0.16 m/s a
 /// frame, the ease-back loses it; a release that starts at rest, as the minimum-jerk blend from
 /// a frozen pose did, gives 0.02 m/s).
 #[test]
@@ -270,7 +270,7 @@ fn the_hand_back_to_the_kinematic_pose_keeps_the_speed() {
     // frame 24 is at 0.4 s: the first without the controller
     let (before, after) = (speed(22), speed(23));
     eprintln!("pelvis speed {before:.3} m/s before the hand-over, {after:.3} m/s after");
-    assert!(before > 0.3, "the rag doll did not fall: {before} m/s");
+    assert!(before > 0.2, "the rag doll did not fall: {before} m/s");
     assert!(
         (after - before).abs() < 0.35 * before,
         "{before} → {after} m/s"
@@ -285,30 +285,51 @@ fn the_hand_back_to_the_kinematic_pose_keeps_the_speed() {
 
 /// A rag doll that has fallen to the floor, handed back: the body returns to the kinematic
 /// pose without a flick — the pelvis never faster than 1.5 m/s on the way (a 0.3 s hand-back
-/// from the floor moved it at 6.5 m/s) — and is standing again within 2 s. It floats up, as
+/// from the floor moved it at 6.5 m/s) — and is standing again within 2.5 s. It floats up, as
 /// there is no getting-up motion (docs/physics.md).
 #[test]
 fn the_hand_back_from_the_floor_is_unhurried() {
     let bml = format!(
-        r#"<bml {NS} id="b"><bmlt:controller id="c" class="RagDoll" start="0" end="1.5"/></bml>"#
+        r#"<bml {NS} id="b"><bmlt:controller id="c" class="RagDoll" start="0" end="2.5"/></bml>"#
     );
-    let (path, warned) = run(&bml, 4.0, |_, _| {});
+    let (path, warned) = run(&bml, 5.5, |_, _| {});
     assert!(warned.is_empty(), "{warned:?}");
     assert!(
-        at(&path, 1.45).y < 0.5,
+        at(&path, 2.45).y < 0.5,
         "it did not fall: {}",
-        at(&path, 1.45)
+        at(&path, 2.45)
     );
     let fastest = (path.windows(2))
-        .filter(|w| w[0].0 >= 1.5)
+        .filter(|w| w[0].0 >= 2.5)
         .map(|w| w[1].1.distance(w[0].1) * FPS as f32)
         .fold(0.0, f32::max);
     eprintln!("fastest pelvis on the way back: {fastest:.2} m/s");
     assert!(fastest < 1.5, "the pelvis flew back at {fastest} m/s");
     let rest = glam::Vec3::new(0.0, 0.95, 0.0);
     assert!(
-        at(&path, 3.5).distance(rest) < 1e-5,
+        at(&path, 5.0).distance(rest) < 1e-5,
         "not standing: {}",
-        at(&path, 3.5)
+        at(&path, 5.0)
     );
+}
+
+/// Handed back in the middle of a fast fall (a rag doll let go for 1.5 s, the pelvis falling at
+/// 3 m/s): the way back carries the body on only a little, never through the floor (the
+/// pelvis stays 5 cm above it; keeping the whole speed took it 0.45 m under).
+#[test]
+fn a_hand_back_during_a_fall_does_not_go_through_the_floor() {
+    let bml = format!(
+        r#"<bml {NS} id="b"><bmlt:controller id="c" class="RagDoll" start="0" end="1.5"/></bml>"#
+    );
+    let (path, warned) = run(&bml, 4.0, |_, _| {});
+    assert!(warned.is_empty(), "{warned:?}");
+    let speed = |t: f64| at(&path, t).distance(at(&path, t - 1.0 / FPS)) * FPS as f32;
+    eprintln!(
+        "pelvis at {:.3} m falling at {:.2} m/s when handed back",
+        at(&path, 1.5 - 1.0 / FPS).y,
+        speed(1.5 - 1.0 / FPS)
+    );
+    assert!(speed(1.5 - 1.0 / FPS) > 2.0, "not falling fast");
+    let lowest = path.iter().map(|p| p.1.y).fold(f32::INFINITY, f32::min);
+    assert!(lowest > 0.05, "the pelvis went down to {lowest} m");
 }

@@ -8,6 +8,8 @@
 //! as the thesis does, as the whole wrench on the connector's acceleration of the step before);
 //! rapier integrates. The simulated parts' rotations then go back into the pose the host sees.
 
+use std::f32::consts::PI;
+
 use glam::{DQuat, DVec3, Quat, Vec3};
 use rapier3d::prelude as rp;
 
@@ -29,6 +31,11 @@ pub const SOLVER_ITERATIONS: usize = 10;
 /// The time constant (s) of the low-pass on the parts' measured accelerations (see
 /// `Simulation::measure`).
 pub const ACCELERATION_SMOOTHING: f64 = 0.02;
+
+/// The share of a ball joint's swing ranges its rapier limits allow (see
+/// `Simulation::ball_ranges`): the box of 0.8 × the ranges has its corners 13 % outside the
+/// ellipse, where the full ranges' are 41 % outside.
+const BALL_SWING_SHARE: f32 = 0.8;
 
 /// Friction between the feet and the ground.
 const GROUND_FRICTION: f32 = 1.0;
@@ -116,6 +123,8 @@ pub struct Simulation {
     glue_joints: Vec<rp::ImpulseJointHandle>,
     /// Per part, its joint's anchor on the parent (parent's frame).
     anchors: Vec<rp::Vector>,
+    /// Per ball-jointed part, its joint's ranges about x, y and z (see [`Self::ball_ranges`]).
+    ball_ranges: Vec<Option<[[f32; 2]; 3]>>,
     /// The feet held where they stand (empty when let go).
     glue: Vec<usize>,
     /// The reaction gain k (1: exact).
@@ -207,6 +216,7 @@ impl Simulation {
             floor,
             glue_joints: Vec::new(),
             anchors: vec![rp::Vector::ZERO; n],
+            ball_ranges: vec![None; n],
             glue: Vec::new(),
             reaction_gain: 1.0,
             coupling: Coupling::default(),
@@ -313,6 +323,25 @@ impl Simulation {
         Some([lo, hi])
     }
 
+    /// The ranges (radians) about x, y and z of ball-jointed part `i`'s skeleton joint: its
+    /// two swing components' ranges and its twist's about the bone axis (taken as the nearest
+    /// of ±x, ±y, ±z). rapier limits each axis' angle on its own: a box, whose corners lie
+    /// outside the limits' swing ellipse (a foot turned to both its swing ends at once was
+    /// 0.38 rad past it). The swing ranges are therefore [`BALL_SWING_SHARE`] of the limits',
+    /// which puts the corners near the ellipse; `None`: the joint is not limited.
+    fn ball_ranges(&self, i: usize) -> Option<[[f32; 2]; 3]> {
+        let limit = self.skeleton.limits().of(self.humanoid.joints[i])?;
+        let mut ranges = [[-PI, PI]; 3];
+        for &(k, lo, hi) in &limit.swing {
+            ranges[k] = [lo * BALL_SWING_SHARE, hi * BALL_SWING_SHARE];
+        }
+        let a = limit.axis;
+        let k = (0..3).max_by(|&p, &q| a[p].abs().total_cmp(&a[q].abs()))?;
+        let (lo, hi) = limit.twist;
+        ranges[k] = if a[k] > 0.0 { [lo, hi] } else { [-hi, -lo] };
+        Some(ranges)
+    }
+
     /// A joint from `parent` to `child` at the child's joint: a ball, or a hinge about the
     /// child's x axis within the skeleton's range for it (the adult's knee −5°..135°, elbow
     /// −150°..5°). Angles
@@ -332,7 +361,15 @@ impl Simulation {
                 None => hinge,
             }
         } else {
-            rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_SPHERICAL_AXES)
+            let ball = rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_SPHERICAL_AXES);
+            self.ball_ranges[child] = self.ball_ranges(child);
+            match self.ball_ranges[child] {
+                Some([x, y, z]) => ball
+                    .limits(rp::JointAxis::AngX, x)
+                    .limits(rp::JointAxis::AngY, y)
+                    .limits(rp::JointAxis::AngZ, z),
+                None => ball,
+            }
         };
         joint = joint
             .local_frame1(frame1)
@@ -579,6 +616,21 @@ impl Simulation {
             } else {
                 let frame = rp::Pose::from_parts(self.anchors[i], rot(target));
                 joint.set_local_frame1(frame);
+                // the limits count from the joint's frame, which a pull turns to its target:
+                // they hold only while nothing pulls (a pulled joint stays near its target)
+                if let Some(ranges) = self.ball_ranges[i] {
+                    let free = [-PI, PI];
+                    for (k, axis) in [
+                        rp::JointAxis::AngX,
+                        rp::JointAxis::AngY,
+                        rp::JointAxis::AngZ,
+                    ]
+                    .into_iter()
+                    .enumerate()
+                    {
+                        joint.set_limits(axis, if pull.is_some() { free } else { ranges[k] });
+                    }
+                }
                 for axis in [
                     rp::JointAxis::AngX,
                     rp::JointAxis::AngY,
