@@ -608,11 +608,19 @@ impl Simulation {
                     .map(|l| &mut l.joint.data),
             };
             let Some(joint) = joint else { continue };
+            // a joint nothing pulls has its motors off: a motor with zero gains is not free in
+            // rapier but holds the joint still (no compliance: a rigid velocity constraint),
+            // which made a rag doll fall over stiff as a statue
+            if pull.is_none() {
+                joint.motor_axes.remove(rp::JointAxesMask::ANG_AXES);
+            }
             let (kp, kd) = pull.map_or((0.0, 0.0), |p| (p.kp as f32, p.kd as f32));
             let target = pull.map_or(DQuat::IDENTITY, |p| p.target);
             if self.humanoid.parts[i].hinge {
-                let angle = 2.0 * target.x.atan2(target.w);
-                joint.set_motor(rp::JointAxis::AngX, angle as f32, 0.0, kp, kd);
+                if pull.is_some() {
+                    let angle = 2.0 * target.x.atan2(target.w);
+                    joint.set_motor(rp::JointAxis::AngX, angle as f32, 0.0, kp, kd);
+                }
             } else {
                 let frame = rp::Pose::from_parts(self.anchors[i], rot(target));
                 joint.set_local_frame1(frame);
@@ -636,7 +644,9 @@ impl Simulation {
                     rp::JointAxis::AngY,
                     rp::JointAxis::AngZ,
                 ] {
-                    joint.set_motor(axis, 0.0, 0.0, kp, kd);
+                    if pull.is_some() {
+                        joint.set_motor(axis, 0.0, 0.0, kp, kd);
+                    }
                 }
             }
         }
