@@ -120,3 +120,40 @@ fn a_compound_alone_says_that_nothing_holds_the_legs() {
         "{warned:?}"
     );
 }
+
+/// A left-hand BEAT while `HangingLeftArm` simulates that arm: the arm keeps hanging (the beat
+/// does not show), and one warning, on the compound, names the left-arm joints it hides; the right
+/// arm's WAVE, kinematic, plays and warns nothing.
+#[test]
+fn kinematic_motion_on_a_simulated_arm_is_hidden_and_said() {
+    let bml = format!(
+        r#"<bml {NS} id="b"><bmlt:controller id="c" class="BalanceController" start="0"/><bmlt:controller id="arm" class="HangingLeftArm" start="0.5" end="4"/><gesture id="w" lexeme="WAVE" mode="RIGHT_HAND" start="1"/><gesture id="l" lexeme="BEAT" mode="LEFT_HAND" start="2"/></bml>"#
+    );
+    let mut r = Realizer::new().with_idle(false);
+    r.perform_bml(&bml).unwrap();
+    let s = Skeleton::adult();
+    let mut warned = Vec::new();
+    let mut highest: f32 = f32::NEG_INFINITY;
+    for k in 0..=(3.5 * FPS) as usize {
+        let frame = r.tick(k as f64 / FPS);
+        for f in &frame.feedback {
+            if let Feedback::Warning(w) = f {
+                warned.push((w.id.clone(), w.text.clone()));
+            }
+        }
+        let pose = &frame.poses[0].pose;
+        highest = highest.max(world(pose, &s, "l_wrist").y - world(pose, &s, "l_elbow").y);
+    }
+    assert_eq!(warned.len(), 1, "{warned:?}");
+    let (id, text) = &warned[0];
+    assert_eq!(id, "b:arm");
+    assert!(
+        text.contains("l_elbow") || text.contains("l_shoulder"),
+        "{text}"
+    );
+    assert!(!text.contains("r_shoulder"), "{text}");
+    assert!(
+        highest < -0.2,
+        "the left wrist rose to {highest} m from the elbow"
+    );
+}

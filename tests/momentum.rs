@@ -15,31 +15,35 @@ use glam::{DMat3, DVec3, Quat};
 const LOWER_BODY: [usize; 8] = [0, 1, 9, 10, 11, 12, 13, 14];
 
 /// The whole body's angular momentum about its centre of mass (kg m²/s), each part with its own
-/// box (the simulation carries a chain's inertia on its connector; here every part counts once).
-fn angular_momentum(sim: &Simulation) -> DVec3 {
+/// box (the simulation carries a chain's inertia on its connector; here every part counts once):
+/// of every part, or with `kinematic_only` of the kinematic chains' parts alone.
+fn angular_momentum(sim: &Simulation, kinematic_only: bool) -> DVec3 {
     let parts = sim.parts();
     let specs = &sim.humanoid().parts;
-    let bodies: Vec<(f64, DVec3, DVec3, DMat3, DVec3)> = (parts.iter().zip(specs))
-        .map(|(s, spec)| {
+    let bodies: Vec<(bool, f64, DVec3, DVec3, DMat3, DVec3)> = (parts.iter().zip(specs))
+        .enumerate()
+        .map(|(i, (s, spec))| {
             let m = spec.mass();
-            let r = glam::DMat3::from_quat(s.orientation);
+            let r = DMat3::from_quat(s.orientation);
             let com = s.position + s.orientation * m.com;
             let velocity = s.velocity + s.angular.cross(com - s.position);
+            let inertia = r * m.inertia * r.transpose();
             (
+                sim.is_physical(i),
                 m.mass,
                 com,
                 velocity,
-                r * m.inertia * r.transpose(),
+                inertia,
                 s.angular,
             )
         })
         .collect();
-    let mass: f64 = bodies.iter().map(|b| b.0).sum();
-    let centre = bodies.iter().map(|b| b.1 * b.0).sum::<DVec3>() / mass;
-    let drift = bodies.iter().map(|b| b.2 * b.0).sum::<DVec3>() / mass;
-    bodies
-        .iter()
-        .map(|&(m, c, v, inertia, w)| m * (c - centre).cross(v - drift) + inertia * w)
+    let mass: f64 = bodies.iter().map(|b| b.1).sum();
+    let centre = bodies.iter().map(|b| b.2 * b.1).sum::<DVec3>() / mass;
+    let com_velocity = bodies.iter().map(|b| b.3 * b.1).sum::<DVec3>() / mass;
+    (bodies.iter())
+        .filter(|b| !(kinematic_only && b.0))
+        .map(|&(_, m, c, v, inertia, w)| m * (c - centre).cross(v - com_velocity) + inertia * w)
         .sum()
 }
 
@@ -56,7 +60,7 @@ fn drift(joint: &str, amplitude: f64, step: f64, k: f64) -> (f64, f64) {
     sim.set_gravity(DVec3::ZERO);
     sim.reaction_gain = k;
     let j = skeleton.joint(joint).unwrap();
-    let start = angular_momentum(&sim);
+    let start = angular_momentum(&sim, false);
     let drive = Drive::new(15);
     let (mut worst, mut scale): (f64, f64) = (0.0, 0.0);
     let mut n = 0;
@@ -68,25 +72,10 @@ fn drift(joint: &str, amplitude: f64, step: f64, k: f64) -> (f64, f64) {
         let angle = amplitude * ramp * ramp * (2.0 * std::f64::consts::PI * t).sin();
         pose.rotations[j] = Quat::from_rotation_x(-angle as f32);
         sim.step(&pose, &drive);
-        worst = worst.max((angular_momentum(&sim) - start).length());
-        scale = scale.max(chain_momentum(&sim).length());
+        worst = worst.max((angular_momentum(&sim, false) - start).length());
+        scale = scale.max(angular_momentum(&sim, true).length());
     }
     (worst, scale)
-}
-
-/// The angular momentum of the kinematic parts about the body's centre of mass.
-fn chain_momentum(sim: &Simulation) -> DVec3 {
-    let (centre, drift) = sim.centre_of_mass();
-    (sim.parts().iter().zip(&sim.humanoid().parts).enumerate())
-        .filter(|(i, _)| !sim.is_physical(*i))
-        .map(|(_, (s, spec))| {
-            let m = spec.mass();
-            let r = glam::DMat3::from_quat(s.orientation);
-            let com = s.position + s.orientation * m.com;
-            let v = s.velocity + s.angular.cross(com - s.position);
-            m.mass * (com - centre).cross(v - drift) + r * m.inertia * r.transpose() * s.angular
-        })
-        .sum()
 }
 
 /// Swinging the right arm at the shoulder by 0.1 rad: with the arm's reaction on the trunk

@@ -7,8 +7,7 @@
 //! the simulated body itself: the physical humanoid's parts ([`humanoid`]), one character on
 //! rapier3d stepped with its kinematic chains' inverse dynamics ([`sim`]), and the controllers
 //! that turn its joints ([`controllers`]), several of them bound together as one ([`compound`]).
-//! docs/physics.md explains the choices and their
-//! measurements.
+//! docs/physics.md explains the choices and their measurements.
 
 pub mod butterworth;
 pub mod compound;

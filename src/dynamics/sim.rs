@@ -37,6 +37,13 @@ pub const ACCELERATION_SMOOTHING: f64 = 0.02;
 /// ellipse, where the full ranges' are 41 % outside.
 const BALL_SWING_SHARE: f32 = 0.8;
 
+/// The angular axes of a joint.
+const ANGULAR: [rp::JointAxis; 3] = [
+    rp::JointAxis::AngX,
+    rp::JointAxis::AngY,
+    rp::JointAxis::AngZ,
+];
+
 /// Friction between the feet and the ground.
 const GROUND_FRICTION: f32 = 1.0;
 
@@ -361,25 +368,15 @@ impl Simulation {
                 None => hinge,
             }
         } else {
-            let ball = rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_SPHERICAL_AXES);
+            // its limits are set with its motors before every step (`set_motors`)
             self.ball_ranges[child] = self.ball_ranges(child);
-            match self.ball_ranges[child] {
-                Some([x, y, z]) => ball
-                    .limits(rp::JointAxis::AngX, x)
-                    .limits(rp::JointAxis::AngY, y)
-                    .limits(rp::JointAxis::AngZ, z),
-                None => ball,
-            }
+            rp::GenericJointBuilder::new(rp::JointAxesMask::LOCKED_SPHERICAL_AXES)
         };
         joint = joint
             .local_frame1(frame1)
             .local_frame2(frame2)
             .contacts_enabled(false);
-        for axis in [
-            rp::JointAxis::AngX,
-            rp::JointAxis::AngY,
-            rp::JointAxis::AngZ,
-        ] {
+        for axis in ANGULAR {
             joint = joint.motor_model(axis, rp::MotorModel::ForceBased);
         }
         let (a, b) = (self.handles[parent], self.handles[child]);
@@ -608,48 +605,40 @@ impl Simulation {
                     .map(|l| &mut l.joint.data),
             };
             let Some(joint) = joint else { continue };
-            // a joint nothing pulls has its motors off: a motor with zero gains is not free in
-            // rapier but holds the joint still (no compliance: a rigid velocity constraint),
-            // which made a rag doll fall over stiff as a statue
-            if pull.is_none() {
-                joint.motor_axes.remove(rp::JointAxesMask::ANG_AXES);
-            }
-            let (kp, kd) = pull.map_or((0.0, 0.0), |p| (p.kp as f32, p.kd as f32));
-            let target = pull.map_or(DQuat::IDENTITY, |p| p.target);
-            if self.humanoid.parts[i].hinge {
-                if pull.is_some() {
-                    let angle = 2.0 * target.x.atan2(target.w);
-                    joint.set_motor(rp::JointAxis::AngX, angle as f32, 0.0, kp, kd);
-                }
-            } else {
-                let frame = rp::Pose::from_parts(self.anchors[i], rot(target));
-                joint.set_local_frame1(frame);
-                // the limits count from the joint's frame, which a pull turns to its target:
-                // they hold only while nothing pulls (a pulled joint stays near its target).
-                // Off, not widened: each limited axis costs a constraint row (100 standing
-                // characters stepped in 4.85 ms with the limits at ±π, 3.8 without them)
-                match (self.ball_ranges[i], pull) {
-                    (Some(ranges), None) => {
-                        for (k, axis) in [
-                            rp::JointAxis::AngX,
-                            rp::JointAxis::AngY,
-                            rp::JointAxis::AngZ,
-                        ]
-                        .into_iter()
-                        .enumerate()
+            let hinge = self.humanoid.parts[i].hinge;
+            match pull {
+                // motors off: a rapier motor with zero gains is not free but holds its joint
+                // still (a rigid velocity constraint), which made a rag doll fall over stiff
+                // as a statue
+                None => {
+                    joint.motor_axes.remove(rp::JointAxesMask::ANG_AXES);
+                    if !hinge {
+                        let frame = rp::Pose::from_parts(self.anchors[i], rp::Rotation::IDENTITY);
+                        joint.set_local_frame1(frame);
+                        for (axis, range) in ANGULAR
+                            .into_iter()
+                            .zip(self.ball_ranges[i].iter().flatten())
                         {
-                            joint.set_limits(axis, ranges[k]);
+                            joint.set_limits(axis, *range);
                         }
                     }
-                    _ => joint.limit_axes.remove(rp::JointAxesMask::ANG_AXES),
                 }
-                for axis in [
-                    rp::JointAxis::AngX,
-                    rp::JointAxis::AngY,
-                    rp::JointAxis::AngZ,
-                ] {
-                    if pull.is_some() {
-                        joint.set_motor(axis, 0.0, 0.0, kp, kd);
+                Some(p) => {
+                    let (kp, kd) = (p.kp as f32, p.kd as f32);
+                    if hinge {
+                        let angle = 2.0 * p.target.x.atan2(p.target.w);
+                        joint.set_motor(rp::JointAxis::AngX, angle as f32, 0.0, kp, kd);
+                    } else {
+                        let frame = rp::Pose::from_parts(self.anchors[i], rot(p.target));
+                        joint.set_local_frame1(frame);
+                        // the limits count from the joint's frame, which the pull turns to its
+                        // target: off while it pulls (the joint stays near its target). Off,
+                        // not widened: each limited axis costs a constraint row (100 standing
+                        // characters stepped in 4.85 ms with the limits at ±π, 3.8 without)
+                        joint.limit_axes.remove(rp::JointAxesMask::ANG_AXES);
+                        for axis in ANGULAR {
+                            joint.set_motor(axis, 0.0, 0.0, kp, kd);
+                        }
                     }
                 }
             }

@@ -19,19 +19,19 @@
 //!
 //! Several controllers at once add their torques and pulls. The simulated set is the smallest of
 //! the [`CONFIGURATIONS`] (lower body and trunk, with one arm, with both, the whole body) that
-//! covers every running controller, and it changes when they do, the new simulation starting where the body is, at
-//! the speeds it has. With no controller left the body returns to the kinematic pose over 0.3 s
+//! covers every running controller, and it changes when they do, the new simulation starting
+//! where the body is, at the speeds it has. With no controller left the body returns to the kinematic pose over 0.3 s
 //! (longer from far away), along a Hermite curve that starts with the pose and the speed it had.
 //! The engine registers last: it steps the simulation up to each frame with the kinematic pose
 //! the others made (interpolated between frames) and writes the simulated joints over it.
 
 use glam::{DVec3, Quat};
 
-use crate::bml::{Behaviour, BehaviourKind};
 use std::sync::Arc;
 
+use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::dynamics::compound::{self, CompoundSpec};
+use crate::dynamics::compound::{self, Compound, CompoundSpec};
 use crate::dynamics::config::{smallest_covering, Configuration};
 use crate::dynamics::controllers::{Balance, Controller, Drive, PoseController, RagDoll};
 use crate::dynamics::sim::{Simulation, STEP};
@@ -65,6 +65,53 @@ pub const CONFIGURATIONS: [(&str, &[usize]); 5] = [
     ),
     ("whole body", &WHOLE_BODY),
 ];
+
+/// [`CONFIGURATIONS`] over a skeleton's joints (as `dynamics::config` chooses among them).
+#[derive(Debug)]
+struct Catalogue {
+    /// Per skeleton joint, the part it moves with.
+    part_of: Vec<Option<usize>>,
+    /// One per entry of [`CONFIGURATIONS`], in its order.
+    configurations: Vec<Configuration>,
+}
+
+impl Catalogue {
+    fn new(skeleton: &Skeleton) -> Catalogue {
+        let part_of = crate::dynamics::humanoid::Humanoid::new(skeleton)
+            .map(|h| h.part_of)
+            .unwrap_or_default();
+        let mut catalogue = Catalogue {
+            part_of,
+            configurations: Vec::new(),
+        };
+        catalogue.configurations = (CONFIGURATIONS.iter())
+            .map(|(name, parts)| {
+                Configuration::from_physical(name, skeleton, &catalogue.joints(parts))
+            })
+            .collect();
+        catalogue
+    }
+
+    /// The skeleton joints that move with `parts`.
+    fn joints(&self, parts: &[usize]) -> Vec<usize> {
+        (0..self.part_of.len())
+            .filter(|&j| self.part_of[j].is_some_and(|p| parts.contains(&p)))
+            .collect()
+    }
+
+    /// The parts of the smallest configuration whose simulated joints cover those of `parts`
+    /// (the whole body if none does).
+    fn smallest_covering(&self, parts: &[usize]) -> &'static [usize] {
+        let chosen = smallest_covering(&self.configurations, &self.joints(parts));
+        chosen
+            .and_then(|c| self.configurations.iter().position(|x| std::ptr::eq(x, c)))
+            .map_or(&WHOLE_BODY, |k| CONFIGURATIONS[k].1)
+    }
+}
+
+/// How far (rad) the kinematic engines may turn a simulated joint from rest before the engine
+/// warns that the simulation hides it (the idle layer's weight shift stays below).
+const HIDDEN: f32 = 0.1;
 
 /// The shortest hand-back to the kinematic pose when the last controller ends (s); a body far
 /// from that pose takes longer, so that the way back keeps under [`RELEASE_SPEED`].
@@ -153,9 +200,11 @@ pub struct PhysicalEngine {
     /// The balance gave up (until the controllers change).
     fallen: bool,
     /// The configurations over the skeleton's joints (made at the first frame).
-    configurations: Vec<Configuration>,
+    catalogue: Option<Catalogue>,
     /// Warned that no controller holds the legs (until the controllers change).
     unheld: bool,
+    /// Warned that the simulation hides kinematic motion (until the controllers change).
+    hidden: bool,
     warnings: Vec<(UnitKey, String)>,
 }
 
@@ -189,28 +238,11 @@ impl PhysicalEngine {
         active: &[(UnitKey, ControllerUnit)],
         skeleton: &Skeleton,
     ) -> &'static [usize] {
-        let Ok(h) = crate::dynamics::humanoid::Humanoid::new(skeleton) else {
-            return &WHOLE_BODY;
-        };
-        let joints_of = |parts: &[usize]| -> Vec<usize> {
-            (0..skeleton.len())
-                .filter(|&j| h.part_of[j].is_some_and(|p| parts.contains(&p)))
-                .collect()
-        };
-        if self.configurations.is_empty() {
-            self.configurations = (CONFIGURATIONS.iter())
-                .map(|(name, parts)| {
-                    Configuration::from_physical(name, skeleton, &joints_of(parts))
-                })
-                .collect();
-        }
-        let mut needed: Vec<usize> = active.iter().flat_map(|(_, u)| u.needs()).collect();
-        needed.sort_unstable();
-        needed.dedup();
-        let chosen = smallest_covering(&self.configurations, &joints_of(&needed));
-        chosen
-            .and_then(|c| CONFIGURATIONS.iter().find(|(name, _)| *name == c.name))
-            .map_or(&WHOLE_BODY, |(_, parts)| parts)
+        let catalogue = self
+            .catalogue
+            .get_or_insert_with(|| Catalogue::new(skeleton));
+        let needed: Vec<usize> = active.iter().flat_map(|(_, u)| u.needs()).collect();
+        catalogue.smallest_covering(&needed)
     }
 
     /// The way back to the kinematic pose for the joints of the parts `sim` simulates and
@@ -236,6 +268,45 @@ impl PhysicalEngine {
             &last,
             before.as_ref().map(only_leaving).as_ref(),
         ))
+    }
+
+    /// Warns once (until the controllers change) when the kinematic engines turn a simulated
+    /// joint more than [`HIDDEN`] from rest while no `PoseController` tracks them: the
+    /// simulation decides that joint, so their motion there is not shown (a left-hand BEAT
+    /// under `HangingLeftArm`).
+    fn warn_hidden(
+        &mut self,
+        active: &[(UnitKey, ControllerUnit)],
+        skeleton: &Skeleton,
+        kinematic: &Pose,
+    ) {
+        let Some(sim) = &self.sim else { return };
+        if self.hidden || active.iter().any(|(_, u)| u.class == "PoseController") {
+            return;
+        }
+        let h = sim.humanoid();
+        let moved: Vec<usize> = (0..h.parts.len())
+            .filter(|&i| sim.is_physical(i))
+            .filter(|&i| kinematic.rotations[h.joints[i]].angle_between(Quat::IDENTITY) > HIDDEN)
+            .collect();
+        let Some(&first) = moved.first() else { return };
+        // told to the controller that makes that part simulated (the narrowest that needs it)
+        let owner = (active.iter())
+            .filter(|(_, u)| u.needs().contains(&first))
+            .min_by_key(|(_, u)| u.needs().len())
+            .or(active.first());
+        let Some((key, _)) = owner else { return };
+        let names: Vec<&str> = (moved.iter())
+            .map(|&i| skeleton.joints()[h.joints[i]].name.as_str())
+            .collect();
+        self.hidden = true;
+        self.warnings.push((
+            key.clone(),
+            format!(
+                "the simulated body hides what other behaviours move on {}: no PoseController tracks them",
+                names.join(", ")
+            ),
+        ));
     }
 
     /// Starts (or restarts with other parts) the simulation from where the body is.
@@ -264,11 +335,15 @@ impl PhysicalEngine {
         &self,
         sim: &Simulation,
         active: &[(UnitKey, ControllerUnit)],
+        compounds: &[Compound],
         kinematic: &Pose,
         skeleton: &Skeleton,
     ) -> Drive {
         let mut drive = Drive::new(sim.humanoid().parts.len());
-        for (_, u) in active {
+        for c in compounds {
+            c.drive(sim, &mut drive);
+        }
+        for (_, u) in active.iter().filter(|(_, u)| u.compound.is_none()) {
             match u.class {
                 "BalanceController" if !self.fallen => u.balance().drive(sim, &mut drive),
                 "PoseController" => {
@@ -283,16 +358,6 @@ impl PhysicalEngine {
                         })
                         .collect();
                     PoseController { targets }.drive(sim, &mut drive);
-                }
-                COMPOUND => {
-                    let spec = u
-                        .compound
-                        .as_ref()
-                        .expect("a compound unit has its definition");
-                    // the configuration covers its required parts: binding cannot fail
-                    if let Ok(c) = spec.bind(sim, u.value("stiffnessmultiplier")) {
-                        c.drive(sim, &mut drive);
-                    }
                 }
                 _ => RagDoll.drive(sim, &mut drive),
             }
@@ -321,6 +386,16 @@ impl PhysicalEngine {
                 ));
             }
         }
+        // the compounds bound to this frame's simulated parts (the configuration covers their
+        // required parts: binding cannot fail)
+        let compounds: Vec<Compound> = (active.iter())
+            .filter_map(|(_, u)| {
+                u.compound
+                    .as_ref()?
+                    .bind(&sim, u.value("stiffnessmultiplier"))
+                    .ok()
+            })
+            .collect();
         while self.clock + STEP <= now + 1e-9 {
             self.clock += STEP;
             let a = if now > t0 {
@@ -344,7 +419,7 @@ impl PhysicalEngine {
                     ));
                 }
             }
-            let drive = self.drive(&sim, &active, &pose, skeleton);
+            let drive = self.drive(&sim, &active, &compounds, &pose, skeleton);
             sim.step(&pose, &drive);
         }
         self.sim = Some(sim);
@@ -471,6 +546,13 @@ fn overshoot_capped(offset: glam::Vec3, rate: glam::Vec3, duration: f64, least: 
     }
 }
 
+/// The built-in compound controller named `class` (as [`same_class`] reads names).
+fn built_in_compound(class: &str) -> Option<CompoundSpec> {
+    compound::built_in()
+        .into_iter()
+        .find(|s| same_class(&s.name, class))
+}
+
 /// Whether `given` names the class `name`: its name in any case, with or without the
 /// `Controller` suffix (`Balance`, `balancecontroller`).
 fn same_class(name: &str, given: &str) -> bool {
@@ -521,9 +603,7 @@ impl Engine for PhysicalEngine {
         };
         let fail = |why: String| EngineError(format!("{}: {why}", unit.key));
         let found = CLASSES.iter().find(|(name, _)| same_class(name, &c.class));
-        let compound = compound::built_in()
-            .into_iter()
-            .find(|s| same_class(&s.name, &c.class));
+        let compound = built_in_compound(&c.class);
         let (class, defaults): (&'static str, &[(&str, f64)]) = match (found, &compound) {
             (Some((class, defaults)), _) => (class, defaults),
             (None, Some(_)) => (COMPOUND, &[("stiffnessmultiplier", 1.0)]),
@@ -573,10 +653,7 @@ impl crate::engine::Motion for PhysicalEngine {
         let BehaviourKind::Controller(c) = &behaviour.kind else {
             return None;
         };
-        let compound = compound::built_in()
-            .into_iter()
-            .find(|s| same_class(&s.name, &c.class));
-        let parts: Vec<usize> = match compound {
+        let parts: Vec<usize> = match built_in_compound(&c.class) {
             Some(spec) => spec.parts(),
             None if same_class("RagDoll", &c.class) => WHOLE_BODY.to_vec(),
             None => LOWER_BODY.to_vec(),
@@ -603,6 +680,7 @@ impl crate::engine::Motion for PhysicalEngine {
             }
             self.fallen = false;
             self.unheld = false;
+            self.hidden = false;
             self.last = Some((now, pose.clone()));
             if self.release.as_ref().is_some_and(|r| !r.apply(now, pose)) {
                 self.release = None;
@@ -621,6 +699,7 @@ impl crate::engine::Motion for PhysicalEngine {
             return;
         }
         let kinematic = pose.clone();
+        self.warn_hidden(&active, skeleton, &kinematic);
         self.run(now, skeleton, &kinematic);
         if let Some(sim) = &self.sim {
             sim.write(pose);
@@ -680,8 +759,8 @@ mod tests {
 
     /// Handed back 0.8 m below the kinematic pose while falling at 3 m/s: the way back keeps
     /// part of the speed and carries the body on at most 15 % (0.12 m; measured 0.04 m)
-    /// further; uncapped, it went on another 0.38 m (through the floor, from a pelvis 0.2 m
-    /// above it).
+    /// further; uncapped, it went on another 0.38 m (through the floor for a pelvis less than
+    /// that above it).
     #[test]
     fn the_way_back_carries_a_falling_body_on_only_a_little() {
         let offset = |time: f64, y: f32| Offset {
@@ -695,12 +774,12 @@ mod tests {
             "{}",
             release.duration
         );
+        let rest = Pose::rest(&Skeleton::adult());
         let mut lowest: f32 = 0.0;
         for k in 0..=120 {
-            let mut pose = Pose::rest(&Skeleton::adult());
-            let rest = pose.root;
+            let mut pose = rest.clone();
             release.apply(1.0 + k as f64 * 0.01, &mut pose);
-            lowest = lowest.min(pose.root.y - rest.y);
+            lowest = lowest.min(pose.root.y - rest.root.y);
         }
         assert!(lowest >= -0.8 * 1.15 - 1e-4, "it went down to {lowest} m");
         assert!(lowest < -0.82, "it stopped at once: {lowest} m");
