@@ -338,7 +338,12 @@ fn chromium() -> Option<PathBuf> {
 fn browse(url: &str, what: &str) -> (String, Vec<String>) {
     let chromium =
         chromium().expect("Debian's chromium (apt-get install chromium; .ci/run installs it)");
-    let profile = scratch(&format!("chromium-{}", what.len() + url.len()));
+    // one profile per run: Chromium locks its profile, and the tests run browsers in parallel
+    // (a profile named by the arguments' lengths was shared, now and then, by two of them, and
+    // one wrote no screenshot)
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let profile = scratch(&format!("chromium-{run}"));
     let out = Command::new(chromium)
         .args([
             "--headless",
