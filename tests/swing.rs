@@ -1,12 +1,12 @@
 //! A swing pumped by a kinematic rider (the thesis' check after Isaacs and Cohen): a seat on a
 //! 2 m rod, simulated on rapier3d, carries a rider whose torso leans back and forth by a set
 //! motion (kinematic). The rider reaches the seat only through mixed dynamics — its rigid
-//! inertia added to the seat, the wrench of its lean applied (`dynamics::coupling`) — so the
+//! inertia added to the seat, the momentum of its lean passed on (`dynamics::coupling`) — so the
 //! swing gains amplitude when the lean keeps time with it (much less when the lean is well off
 //! its frequency), and keeps it when the rider sits still.
 
-use bml_realizer::dynamics::coupling::{relative_wrench, Composite};
-use bml_realizer::dynamics::mass::cuboid;
+use bml_realizer::dynamics::coupling::{relative_momentum, Carrier, Composite};
+use bml_realizer::dynamics::mass::{cuboid, MassProperties};
 use bml_realizer::dynamics::rnea::{JointMotion, Link};
 use glam::{DQuat, DVec3};
 use rapier3d::prelude::*;
@@ -49,8 +49,11 @@ fn swing(seconds: f32, lean: impl Fn(f64) -> (f64, f64, f64)) -> Vec<f64> {
             .angular_damping(0.0)
             .linear_damping(0.0),
     );
+    // a 5 kg seat, 0.4 × 0.05 × 0.3 m
+    let density = 5.0 / (0.4 * 0.05 * 0.3);
+    let own: MassProperties = cuboid(DVec3::new(0.4, 0.05, 0.3), density, DVec3::ZERO);
     let collider = ColliderBuilder::cuboid(0.2, 0.025, 0.15)
-        .density(5.0 / (0.4 * 0.05 * 0.3))
+        .density(density as f32)
         .collision_groups(InteractionGroups::none());
     w.colliders
         .insert_with_parent(collider, seat, &mut w.bodies);
@@ -59,6 +62,8 @@ fn swing(seconds: f32, lean: impl Fn(f64) -> (f64, f64, f64)) -> Vec<f64> {
         .local_anchor2(Vector::new(0.0, ROD, 0.0));
     w.impulse_joints.insert(anchor, seat, joint, true);
     let link = [torso()];
+    let own = Composite::of(&own);
+    let mut carrier = Carrier::default();
     let mut angles = Vec::new();
     for k in 0..(seconds / STEP) as usize {
         let t = f64::from(k as f32 * STEP);
@@ -68,21 +73,13 @@ fn swing(seconds: f32, lean: impl Fn(f64) -> (f64, f64, f64)) -> Vec<f64> {
             velocity: DVec3::new(0.0, 0.0, dphi),
             acceleration: DVec3::new(0.0, 0.0, ddphi),
         }];
-        let body = &mut w.bodies[seat];
         let mut rider = Composite::default();
         rider.add(&link, &motion);
-        body.set_additional_mass_properties(rider.rapier(), true);
-        let q = body.rotation();
-        let turn = DQuat::from_xyzw(q.x.into(), q.y.into(), q.z.into(), q.w.into());
-        let omega = turn.inverse() * DVec3::new(0.0, 0.0, body.angvel().z.into());
-        let (f, m) = relative_wrench(&link, &motion, omega);
-        // the seat gets the opposite of what the rider needs, in the world
-        let (f, m) = (turn * -f, turn * -m);
-        let p = body.translation();
+        let moving = relative_momentum(&link, &motion);
+        let body = &mut w.bodies[seat];
         body.reset_forces(false);
         body.reset_torques(false);
-        body.add_force_at_point(Vector::new(f.x as f32, f.y as f32, f.z as f32), p, true);
-        body.add_torque(Vector::new(m.x as f32, m.y as f32, m.z as f32), true);
+        carrier.load(body, &own, rider, moving, f64::from(STEP));
         w.step();
         let d = w.bodies[seat].translation() - pivot;
         angles.push(f64::from(d.x.atan2(-d.y)));

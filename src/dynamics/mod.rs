@@ -20,5 +20,34 @@ pub mod mass;
 pub mod rnea;
 pub mod sim;
 
+use glam::{DQuat, DVec3};
+use rapier3d::prelude as rp;
+
+/// A vector as rapier's (f32).
+fn v(x: DVec3) -> rp::Vector {
+    rp::Vector::new(x.x as f32, x.y as f32, x.z as f32)
+}
+
+/// A rapier vector in f64.
+fn dv(x: rp::Vector) -> DVec3 {
+    DVec3::new(f64::from(x.x), f64::from(x.y), f64::from(x.z))
+}
+
+/// A rotation as rapier's (f32, normalized).
+fn rot(q: DQuat) -> rp::Rotation {
+    rp::Rotation::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32).normalize()
+}
+
+/// A rapier rotation in f64 (normalized).
+fn drot(q: &rp::Rotation) -> DQuat {
+    DQuat::from_xyzw(
+        f64::from(q.x),
+        f64::from(q.y),
+        f64::from(q.z),
+        f64::from(q.w),
+    )
+    .normalize()
+}
+
 /// Gravity (m/s², world frame, y up).
 pub const GRAVITY: glam::DVec3 = glam::DVec3::new(0.0, -9.81, 0.0);

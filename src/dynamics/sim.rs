@@ -14,10 +14,11 @@ use glam::{DQuat, DVec3, Quat, Vec3};
 use rapier3d::prelude as rp;
 
 use super::controllers::{Drive, Pull};
-use super::coupling::{relative_wrench, Composite};
+use super::coupling::{relative_momentum, Carrier, Composite};
 use super::humanoid::Humanoid;
 use super::kinematics::derivatives;
 use super::rnea::{inverse_dynamics, reaction, with_gravity, BaseMotion, JointMotion, Link};
+use super::{drot, dv, rot, v};
 use crate::body::{Pose, Skeleton};
 
 /// The default physics step (s): 200 Hz, as the thesis ran it.
@@ -144,28 +145,8 @@ pub struct Simulation {
     pub last_reaction: Vec<(DVec3, DVec3)>,
     /// Per kinematic part, the torque its joint needed at the last step (world frame).
     torques: Vec<DVec3>,
-}
-
-fn v(x: DVec3) -> rp::Vector {
-    rp::Vector::new(x.x as f32, x.y as f32, x.z as f32)
-}
-
-fn dv(x: rp::Vector) -> DVec3 {
-    DVec3::new(f64::from(x.x), f64::from(x.y), f64::from(x.z))
-}
-
-fn rot(q: DQuat) -> rp::Rotation {
-    rp::Rotation::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32).normalize()
-}
-
-fn drot(q: &rp::Rotation) -> DQuat {
-    DQuat::from_xyzw(
-        f64::from(q.x),
-        f64::from(q.y),
-        f64::from(q.z),
-        f64::from(q.w),
-    )
-    .normalize()
+    /// Per part, what it carries as a connector of kinematic chains.
+    carriers: Vec<Carrier>,
 }
 
 impl Simulation {
@@ -230,6 +211,7 @@ impl Simulation {
             time: 0.0,
             last_reaction: vec![(DVec3::ZERO, DVec3::ZERO); n],
             torques: vec![DVec3::ZERO; n],
+            carriers: vec![Carrier::default(); n],
             humanoid,
         };
         let frames = sim.humanoid.frames(skeleton, pose);
@@ -401,13 +383,19 @@ impl Simulation {
     /// last reading.
     fn measure(&mut self, dt: f64) {
         for (i, p) in self.humanoid.parts.iter().enumerate() {
-            let b = &self.world.bodies[self.handles[i]];
-            let position = dv(b.translation());
-            let orientation = drot(b.rotation());
-            let angular = dv(b.angvel());
-            let com = dv(b.center_of_mass());
-            let velocity = dv(b.linvel()) + angular.cross(position - com);
-            let mass = p.mass().mass;
+            let (position, orientation, velocity, angular) = match self.connector_of(i) {
+                Some(c) if c != i => self.carried_state(i, c, dt),
+                _ => {
+                    let b = &self.world.bodies[self.handles[i]];
+                    let angular = dv(b.angvel());
+                    // rapier's centre of mass counts the chains a connector carries
+                    let at = dv(b.translation());
+                    let velocity = dv(b.linvel()) + angular.cross(at - dv(b.center_of_mass()));
+                    (at, drot(b.rotation()), velocity, angular)
+                }
+            };
+            let m = p.mass();
+            let (com, mass) = (position + orientation * m.com, m.mass);
             if dt > 0.0 {
                 // a step's difference of rapier's velocities jitters (the solver's iterations
                 // leave m/s² of noise: a held arm's shoulder torque swung by 6 N m from one step
@@ -431,6 +419,34 @@ impl Simulation {
                 mass,
             };
         }
+    }
+
+    /// Where kinematic part `i` is after a step and how it moves: placed by the kinematic pose on
+    /// its simulated connector `c` (already measured) as the connector is now, moving with it
+    /// plus the pose's own motion over the step (the last two kinematic poses, `dt` apart).
+    fn carried_state(&self, i: usize, c: usize, dt: f64) -> (DVec3, DQuat, DVec3, DVec3) {
+        let on = |f: &[(Vec3, Quat)]| {
+            let back = f[c].1.as_dquat().inverse();
+            (
+                back * (f[i].0 - f[c].0).as_dvec3(),
+                (back * f[i].1.as_dquat()).normalize(),
+            )
+        };
+        let (before, now) = (on(&self.history[0]), on(&self.history[1]));
+        let s = self.state[c];
+        let (position, orientation) = (s.position + s.orientation * now.0, s.orientation * now.1);
+        let (mut velocity, mut angular) = (
+            s.velocity + s.angular.cross(position - s.position),
+            s.angular,
+        );
+        if dt > 0.0 {
+            let turn = now.1 * before.1.inverse();
+            let turn = if turn.w < 0.0 { -turn } else { turn };
+            let (axis, angle) = turn.to_axis_angle();
+            velocity += s.orientation * (now.0 - before.0) / dt;
+            angular += s.orientation * axis * (angle / dt);
+        }
+        (position, orientation, velocity, angular)
     }
 
     /// The world centre of mass of the whole body and its velocity.
@@ -682,6 +698,7 @@ impl Simulation {
         let frames: [&[(Vec3, Quat)]; 3] = [&self.history[0], &self.history[1], now];
         let n = self.humanoid.parts.len();
         let mut carried = vec![Composite::default(); n];
+        let mut moving = vec![(DVec3::ZERO, DVec3::ZERO); n];
         for top in 0..n {
             let parent = self.humanoid.parts[top].parent;
             let Some(connector) = parent.filter(|&c| self.physical[c] && !self.physical[top])
@@ -710,35 +727,41 @@ impl Simulation {
                     * (frames[1][connector].1.inverse() * frames[1][part].1).as_dquat();
                 self.torques[part] = turn * *t;
             }
-            let (force, moment) = match self.coupling {
-                Coupling::Lagged => (d.base_force, d.base_moment),
+            match self.coupling {
+                Coupling::Lagged => {
+                    let (f, m) = reaction(&d, self.reaction_gain);
+                    let (f, m) = (s.orientation * f, s.orientation * m);
+                    let b = &mut self.world.bodies[self.handles[connector]];
+                    b.add_force_at_point(v(f), v(s.position), true);
+                    b.add_torque(v(m), true);
+                    self.last_reaction[connector] = (f, m);
+                }
                 Coupling::Implicit => {
                     carried[connector].add(&links, &motions);
-                    relative_wrench(&links, &motions, back * s.angular)
-                }
-            };
-            let d = super::rnea::Dynamics {
-                torques: Vec::new(),
-                base_force: force,
-                base_moment: moment,
-            };
-            let (f, m) = reaction(&d, self.reaction_gain);
-            let (f, m) = (s.orientation * f, s.orientation * m);
-            let b = &mut self.world.bodies[self.handles[connector]];
-            b.add_force_at_point(v(f), v(s.position), true);
-            b.add_torque(v(m), true);
-            let r = &mut self.last_reaction[connector];
-            r.0 += f;
-            r.1 += m;
-        }
-        if self.coupling == Coupling::Implicit {
-            for (i, c) in carried.iter().enumerate() {
-                if self.physical[i] {
-                    let props = c.scaled(self.reaction_gain).rapier();
-                    self.world.bodies[self.handles[i]].set_additional_mass_properties(props, true);
+                    let (l, a) = relative_momentum(&links, &motions);
+                    moving[connector].0 += l;
+                    moving[connector].1 += a;
                 }
             }
         }
+        if self.coupling == Coupling::Implicit {
+            for i in 0..n {
+                if self.physical[i] && carried[i].mass > 0.0 {
+                    self.carry(i, carried[i], moving[i], h);
+                }
+            }
+        }
+    }
+
+    /// Loads connector `i` with its chains for the coming step (`dynamics::coupling`): their
+    /// `composite` and the momentum of their relative motion (`moving`), scaled by k.
+    fn carry(&mut self, i: usize, composite: Composite, moving: (DVec3, DVec3), h: f64) {
+        let k = self.reaction_gain;
+        let own = Composite::of(&self.humanoid.parts[i].mass());
+        let body = &mut self.world.bodies[self.handles[i]];
+        let moving = (moving.0 * k, moving.1 * k);
+        let wrench = self.carriers[i].load(body, &own, composite.scaled(k), moving, h);
+        self.last_reaction[i] = wrench;
     }
 
     /// The parts of the kinematic chain that starts at `top`, parents first.
