@@ -28,11 +28,17 @@ fn the_balance_controller_stands_for_a_minute() {
     let balance = Balance::default();
     let rest = Pose::rest(&skeleton);
     let target = balance.target_height(&sim);
-    let (mut worst_out, mut worst_height) = (0.0f64, 0.0f64);
+    let (mut worst_out, mut worst_height, mut worst_zmp) = (0.0f64, 0.0f64, 0.0f64);
     let steps = (60.0 / STEP) as usize;
     for k in 0..steps {
         step(&mut sim, &balance, &rest);
         let (c, _) = sim.centre_of_mass();
+        if sim.time > 10.0 {
+            let p = sim
+                .zero_moment_point()
+                .expect("standing presses on the ground");
+            worst_zmp = worst_zmp.max(DVec2::new(p.x - c.x, p.z - c.z).length());
+        }
         let feet = sim.contacts();
         assert!(
             !feet.is_empty(),
@@ -50,6 +56,16 @@ fn the_balance_controller_stands_for_a_minute() {
         worst_out, 0.0,
         "the centre of mass left the support polygon"
     );
+    eprintln!(
+        "after 10 s the zero-moment point is within {:.3} mm of the centre of mass' ground projection; outside the feet after {:?} (of all) steps",
+        worst_zmp * 1e3,
+        sim.zmp_outside()
+    );
+    assert!(
+        worst_zmp < 0.001,
+        "the zero-moment point is {worst_zmp} m off"
+    );
+    assert_eq!(sim.zmp_outside().1, 0, "standing still, outside the feet");
     assert!(
         worst_height < 0.02,
         "the pelvis is {worst_height} m off its set point"
@@ -72,25 +88,29 @@ const GESTURES: &str = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0"
   <gesture id="frame" lexeme="FRAME" mode="BOTH_HANDS" start="wave:end"/>
 </bml>"#;
 
-/// Stands through `poses` with reaction gain `k`: the pelvis' path (x, z) and the worst
-/// distance of the centre of mass outside the feet.
-fn stand_through(poses: &[Pose], k: f64) -> (Vec<DVec2>, f64) {
+/// Stands through `poses` with reaction gain `k`: the pelvis' path (x, z), the worst
+/// distance of the centre of mass outside the feet, the zero-moment point's farthest from the
+/// centre of mass' ground projection, and the steps it lay outside the feet.
+fn stand_through(poses: &[Pose], k: f64) -> (Vec<DVec2>, f64, f64, usize) {
     let (_, mut sim) = standing();
     sim.reaction_gain = k;
     let balance = Balance::default();
     let mut path = Vec::new();
-    let mut worst: f64 = 0.0;
+    let (mut worst, mut zmp): (f64, f64) = (0.0, 0.0);
     for pose in poses.iter().skip(1) {
         step(&mut sim, &balance, pose);
         let p = sim.parts()[0].position;
         path.push(DVec2::new(p.x, p.z));
         let (c, _) = sim.centre_of_mass();
+        if let Some(z) = sim.zero_moment_point() {
+            zmp = zmp.max(DVec2::new(z.x - c.x, z.z - c.z).length());
+        }
         worst = worst.max(outside(
             &support_polygon(&sim.contacts()),
             DVec2::new(c.x, c.z),
         ));
     }
-    (path, worst)
+    (path, worst, zmp, sim.zmp_outside().1)
 }
 
 /// BEAT, WAVE and a two-handed FRAME played on the kinematic arms: the body stays standing,
@@ -99,8 +119,8 @@ fn stand_through(poses: &[Pose], k: f64) -> (Vec<DVec2>, f64) {
 #[test]
 fn gestures_push_the_standing_body_through_their_dynamics() {
     let poses = kinematic(GESTURES, 7.0);
-    let (on, worst_on) = stand_through(&poses, 1.0);
-    let (off, worst_off) = stand_through(&poses, 0.0);
+    let (on, worst_on, zmp_on, out_on) = stand_through(&poses, 1.0);
+    let (off, worst_off, zmp_off, out_off) = stand_through(&poses, 0.0);
     assert_eq!(worst_on, 0.0, "the centre of mass left the feet");
     assert_eq!(worst_off, 0.0);
     let apart = on
@@ -110,10 +130,23 @@ fn gestures_push_the_standing_body_through_their_dynamics() {
         .fold(0.0, f64::max);
     let moved = |p: &[DVec2]| p.iter().map(|q| q.distance(p[0])).fold(0.0, f64::max);
     eprintln!(
-        "pelvis: {:.1} mm apart at most; moved {:.1} mm (k = 1), {:.1} mm (k = 0)",
+        "pelvis: {:.1} mm apart at most; moved {:.1} mm (k = 1), {:.1} mm (k = 0); the zero-moment point up to {:.1} mm from the centre of mass (k = 1), {:.1} mm (k = 0), outside the feet for {out_on} and {out_off} of {} steps",
         apart * 1e3,
         moved(&on) * 1e3,
-        moved(&off) * 1e3
+        moved(&off) * 1e3,
+        zmp_on * 1e3,
+        zmp_off * 1e3,
+        on.len()
+    );
+    // the zero-moment point counts the arms' accelerations: with their dynamics on, the body
+    // balances them and it stays on the feet; off, the body ignores them and it strays
+    assert_eq!(
+        out_on, 0,
+        "with the arms' dynamics, the zero-moment point left the feet"
+    );
+    assert!(
+        zmp_off > zmp_on && out_off > 0,
+        "{zmp_off} m, {out_off} steps without"
     );
     assert!(
         apart > 0.002,
@@ -126,9 +159,9 @@ fn gestures_push_the_standing_body_through_their_dynamics() {
 type AfterPush = (f64, DVec2, f64, bool, f64);
 
 /// Stands 1 s, is pushed at the pelvis with `impulse` (N s, forward), then balances on until
-/// it falls or `seconds` pass: the centre of mass a second before the push, and every step
-/// after it.
-fn pushed(impulse: f64, seconds: f64) -> (DVec2, Vec<AfterPush>) {
+/// it falls or `seconds` pass: the centre of mass a second before the push, every step after
+/// it, and the steps whose zero-moment point lay outside the feet before it fell.
+fn pushed(impulse: f64, seconds: f64) -> (DVec2, Vec<AfterPush>, usize) {
     let (skeleton, mut sim) = standing();
     let balance = Balance::default();
     let rest = Pose::rest(&skeleton);
@@ -140,8 +173,12 @@ fn pushed(impulse: f64, seconds: f64) -> (DVec2, Vec<AfterPush>) {
     sim.push(0, glam::DVec3::new(0.0, 0.0, impulse));
     let mut after = Vec::new();
     let mut fallen = false;
+    let mut zmp_outside = 0;
     for k in 1..=(seconds / STEP) as usize {
         fallen = fallen || balance.fallen(&sim);
+        if !fallen {
+            zmp_outside = sim.zmp_outside().1;
+        }
         if fallen {
             sim.let_go();
             sim.step(&rest, &Drive::new(15));
@@ -158,7 +195,7 @@ fn pushed(impulse: f64, seconds: f64) -> (DVec2, Vec<AfterPush>) {
             c.y,
         ));
     }
-    (before, after)
+    (before, after, zmp_outside)
 }
 
 /// A push of 20 N s at the pelvis (0.25 m/s for the whole body) sways the body forward and the
@@ -166,7 +203,7 @@ fn pushed(impulse: f64, seconds: f64) -> (DVec2, Vec<AfterPush>) {
 /// nearly still, and it never falls.
 #[test]
 fn a_small_push_is_recovered_within_two_seconds() {
-    let (before, after) = pushed(20.0, 3.0);
+    let (before, after, zmp_outside) = pushed(20.0, 3.0);
     let sway = after
         .iter()
         .map(|a| a.1.distance(before))
@@ -181,14 +218,18 @@ fn a_small_push_is_recovered_within_two_seconds() {
         .filter(|a| a.0 >= 2.0)
         .all(|a| a.1.distance(before) < 0.01 && a.2 < 0.05);
     assert!(settled, "not back within 2 s: sway {sway} m");
-    eprintln!("swayed {:.1} cm", sway * 100.0);
+    eprintln!(
+        "swayed {:.1} cm; the zero-moment point outside the feet for {zmp_outside} steps",
+        sway * 100.0
+    );
 }
 
 /// A push of 150 N s (2 m/s) throws the centre of mass out over the toes: the controller gives
-/// up (the feet let go) and the body falls to the ground, with no number going wrong.
+/// up (the feet let go) and the body falls to the ground, with no number going wrong. Before
+/// it falls, the zero-moment point has left the feet.
 #[test]
 fn a_large_push_makes_it_fall() {
-    let (_, after) = pushed(150.0, 3.0);
+    let (_, after, zmp_outside) = pushed(150.0, 3.0);
     let first = after.iter().position(|a| a.3).expect("it never fell");
     assert!(
         after[first].0 < 1.0,
@@ -198,9 +239,10 @@ fn a_large_push_makes_it_fall() {
     let last = after.last().unwrap();
     assert!(last.4 < 0.4, "the centre of mass is still {} m up", last.4);
     eprintln!(
-        "fell {:.2} s after the push; lies with the centre of mass {:.2} m up",
+        "fell {:.2} s after the push; lies with the centre of mass {:.2} m up; the zero-moment point was outside the feet for {zmp_outside} steps before",
         after[first].0, last.4
     );
+    assert!(zmp_outside > 0, "the zero-moment point never left the feet");
 }
 
 /// The measurement behind the choice of joints (docs/physics.md): the balance controller on a

@@ -146,6 +146,65 @@ fn a_push_without_a_simulated_body_says_why() {
         .contains("no character"));
 }
 
+/// The host reads how the body stands: while it stands and gestures, the zero-moment point and
+/// the centre of mass lie over the feet at every frame and the steps are counted (200 a
+/// second); a large push sends the zero-moment point off the feet before the body falls; with
+/// no controller there is no reading, and the message says why.
+#[test]
+fn the_host_reads_the_centre_of_mass_and_the_zero_moment_point() {
+    let inside = |polygon: &[[f64; 2]], p: [f64; 3]| {
+        let n = polygon.len();
+        n >= 3
+            && (0..n).all(|i| {
+                let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+                (b[0] - a[0]) * (p[2] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) >= 0.0
+            })
+    };
+    let gestures = r#"<gesture id="w" lexeme="WAVE" mode="RIGHT_HAND" start="0.5"/><gesture id="f" lexeme="FRAME" mode="BOTH_HANDS" start="w:end"/>"#;
+    let mut readings = Vec::new();
+    run(&balance(gestures), 6.0, |r, t| {
+        if t > 0.0 {
+            readings.push(r.balance("").unwrap());
+        }
+    });
+    for b in &readings {
+        let zmp = b.zero_moment_point.expect("standing presses on the ground");
+        assert!(inside(&b.support, zmp), "{b:?}");
+        assert!(inside(&b.support, b.centre_of_mass), "{b:?}");
+    }
+    let last = readings.last().unwrap();
+    assert_eq!(last.zmp_outside, 0);
+    // read before the last frame: 200 steps a second up to the frame before it
+    let want = (6.0 - 1.0 / FPS) * 200.0;
+    assert!(
+        (last.steps as f64 - want).abs() <= 1.0,
+        "{} steps",
+        last.steps
+    );
+    let mut fell_after = None;
+    run(&balance(""), 3.0, |r, t| {
+        if (t - 1.0).abs() < 1e-9 {
+            r.push("", "sacroiliac", [0.0, 0.0, 150.0]).unwrap();
+        }
+        if t > 1.0 && fell_after.is_none() {
+            fell_after = Some(r.balance("").unwrap().zmp_outside);
+        }
+    });
+    assert!(
+        fell_after.unwrap() > 0,
+        "the push never sent the zero-moment point off the feet"
+    );
+    let mut r = Realizer::new();
+    r.perform_bml(&format!(
+        r#"<bml {NS} id="a"><gesture id="g" lexeme="BEAT"/></bml>"#
+    ))
+    .unwrap();
+    r.tick(0.0);
+    let e = r.balance("").unwrap_err();
+    assert!(e.contains("no body is simulated"), "{e}");
+    assert!(r.balance("nobody").unwrap_err().contains("no character"));
+}
+
 /// `pelvisheight` changed while the controller runs: the body lowers to the new height.
 #[test]
 fn the_pelvis_height_changes_while_the_controller_runs() {

@@ -6,7 +6,8 @@
 //! configurations — which joints are simulated, which form kinematic chains ([`config`]) — and
 //! the simulated body itself: the physical humanoid's parts ([`humanoid`]), one character on
 //! rapier3d stepped with its kinematic chains' inverse dynamics ([`sim`]), and the controllers
-//! that turn its joints ([`controllers`]), several of them bound together as one ([`compound`]).
+//! that turn its joints ([`controllers`]), several of them bound together as one ([`compound`]),
+//! and the zero-moment point that says how hard the motion is to balance ([`zmp`]).
 //! docs/physics.md explains the choices and their measurements.
 
 pub mod butterworth;
@@ -19,6 +20,7 @@ pub mod kinematics;
 pub mod mass;
 pub mod rnea;
 pub mod sim;
+pub mod zmp;
 
 use glam::{DQuat, DVec3};
 use rapier3d::prelude as rp;

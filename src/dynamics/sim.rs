@@ -3,21 +3,23 @@
 //! and elbows, with their anatomical ranges) standing on a ground box; the others follow the
 //! kinematic pose. Each step: the controllers' joint torques are summed and applied (each joint
 //! torque turns the child part one way and its parent the other); every kinematic chain reaches
-//! the part it hangs from through its inverse dynamics, scaled by k (by default as its rigid
-//! inertia added to that part plus the wrench of its relative motion, `dynamics::coupling`; or,
-//! as the thesis does, as the whole wrench on the connector's acceleration of the step before);
-//! rapier integrates. The simulated parts' rotations then go back into the pose the host sees.
+//! the part it hangs from, scaled by k (by default as its rigid inertia added to that part plus
+//! the impulse of its relative motion's momentum change, `dynamics::coupling`; or, as the
+//! thesis does, as its inverse dynamics' wrench on the connector's acceleration of the step
+//! before); rapier integrates. The kinematic parts are then placed on their connectors as they
+//! are after the step, and the simulated parts' rotations go back into the pose the host sees.
 
 use std::f32::consts::PI;
 
-use glam::{DQuat, DVec3, Quat, Vec3};
+use glam::{DMat3, DQuat, DVec2, DVec3, Quat, Vec3};
 use rapier3d::prelude as rp;
 
-use super::controllers::{Drive, Pull};
+use super::controllers::{outside, support_polygon, Drive, Pull};
 use super::coupling::{relative_momentum, Carrier, Composite};
 use super::humanoid::Humanoid;
 use super::kinematics::derivatives;
 use super::rnea::{inverse_dynamics, reaction, with_gravity, BaseMotion, JointMotion, Link};
+use super::zmp::{zero_moment_point, Segment};
 use super::{drot, dv, rot, v};
 use crate::body::{Pose, Skeleton};
 
@@ -81,10 +83,11 @@ pub enum Coupling {
     Lagged,
     /// The chain's inertia, as a rigid body in its current configuration, added to the
     /// connector's mass properties (so rapier moves it with the connector, gravity included,
-    /// within the step), and only what the chain's motion relative to the connector adds
-    /// applied as a wrench: the inverse dynamics with the connector's velocity, less the same
-    /// with the chain held still. The two together are the chain's inverse dynamics on the
-    /// connector's motion within the step; both are scaled by k.
+    /// within the step), and what the chain's motion relative to the connector adds given to
+    /// the connector as momentum: over each step, the opposite of the change of that motion's
+    /// momentum and of rapier's own when the composite changes (`dynamics::coupling::Carrier`).
+    /// The impulses add up to the chain's inverse dynamics integrated over the steps, so the
+    /// whole keeps its momentum; both parts are scaled by k.
     #[default]
     Implicit,
 }
@@ -147,6 +150,9 @@ pub struct Simulation {
     torques: Vec<DVec3>,
     /// Per part, what it carries as a connector of kinematic chains.
     carriers: Vec<Carrier>,
+    /// Steps taken, and those after which the zero-moment point lay outside the support
+    /// polygon while the feet stood on the ground.
+    zmp_count: (usize, usize),
 }
 
 impl Simulation {
@@ -212,6 +218,7 @@ impl Simulation {
             last_reaction: vec![(DVec3::ZERO, DVec3::ZERO); n],
             torques: vec![DVec3::ZERO; n],
             carriers: vec![Carrier::default(); n],
+            zmp_count: (0, 0),
             humanoid,
         };
         let frames = sim.humanoid.frames(skeleton, pose);
@@ -598,6 +605,54 @@ impl Simulation {
         self.history = [now, frames];
         self.time += h;
         self.measure(h);
+        self.count_zmp();
+    }
+
+    /// The zero-moment point of the whole body on the ground (`dynamics::zmp`), from every
+    /// part's motion over the last steps (accelerations through the 20 ms low-pass of
+    /// [`ACCELERATION_SMOOTHING`], so it trails sudden changes by about that); `None` while
+    /// nothing presses on the ground.
+    pub fn zero_moment_point(&self) -> Option<DVec3> {
+        let segments: Vec<Segment> = (self.humanoid.parts.iter().enumerate())
+            .map(|(i, p)| {
+                let (s, (linear, angular)) = (self.state[i], self.accel[i]);
+                let m = p.mass();
+                let r = DMat3::from_quat(s.orientation);
+                let arm = s.com - s.position;
+                Segment {
+                    mass: m.mass,
+                    com: s.com,
+                    acceleration: linear
+                        + angular.cross(arm)
+                        + s.angular.cross(s.angular.cross(arm)),
+                    inertia: r * m.inertia * r.transpose(),
+                    spin: s.angular,
+                    spin_rate: angular,
+                }
+            })
+            .collect();
+        zero_moment_point(&segments, dv(self.world.gravity), 0.0)
+    }
+
+    /// Steps taken, and how many of them ended with the zero-moment point outside the
+    /// support polygon (the hull of the sole corners on the ground) while feet stood on it:
+    /// a balance metric (a body standing still scores none).
+    pub fn zmp_outside(&self) -> (usize, usize) {
+        self.zmp_count
+    }
+
+    /// Counts the step (see [`zmp_outside`](Self::zmp_outside)).
+    fn count_zmp(&mut self) {
+        self.zmp_count.0 += 1;
+        let polygon = support_polygon(&self.contacts());
+        if polygon.len() < 3 {
+            return;
+        }
+        if let Some(p) = self.zero_moment_point() {
+            if outside(&polygon, DVec2::new(p.x, p.z)) > 0.0 {
+                self.zmp_count.1 += 1;
+            }
+        }
     }
 
     /// Sets every simulated joint's motors to its pull (free where there is none): a hinge's
@@ -689,8 +744,8 @@ impl Simulation {
         Some(i)
     }
 
-    /// The inverse dynamics of every kinematic chain, applied −k times to its connector (see
-    /// [`Coupling`]).
+    /// Every kinematic chain's effect on its connector, scaled by k (see [`Coupling`]), and the
+    /// torques its joints need (its inverse dynamics, whatever the coupling).
     fn react(&mut self, now: &[(Vec3, Quat)], h: f64) {
         for r in &mut self.last_reaction {
             *r = (DVec3::ZERO, DVec3::ZERO);

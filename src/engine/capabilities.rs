@@ -96,13 +96,37 @@ pub trait Control {
     fn sync_passed(&mut self, key: &UnitKey, sync: &str, time: f64, actions: &mut Vec<Action>);
 }
 
-/// An engine that simulates the body (mixed dynamics): the host can push it.
+/// An engine that simulates the body (mixed dynamics): the host can push it and read how it
+/// stands.
 pub trait Physics {
     /// Pushes the simulated body part `part` (a body part of the physical humanoid, such as
     /// `sacroiliac` or `l_thigh`, or a skeleton joint, meaning the part it moves with) with
     /// `impulse` (N s, world frame). `Err` says why nothing was pushed: no simulated body now,
     /// an unknown part, a part not simulated, an impulse that is not finite.
     fn push(&mut self, part: &str, impulse: [f64; 3]) -> Result<(), String>;
+
+    /// How the simulated body stands now; `Err` says why there is no reading (no body is
+    /// simulated now).
+    fn balance(&self) -> Result<BalanceReading, String>;
+}
+
+/// How a simulated body stands, for hosts and planners that judge balance (world frame, m).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BalanceReading {
+    /// The whole body's centre of mass.
+    pub centre_of_mass: [f64; 3],
+    /// The zero-moment point on the ground: where the ground's push must act to balance
+    /// gravity and the body's accelerations (`None` while nothing presses on the ground).
+    pub zero_moment_point: Option<[f64; 3]>,
+    /// The support polygon: the convex hull of the sole corners on the ground, as (x, z),
+    /// counter-clockwise (empty when no foot stands).
+    pub support: Vec<[f64; 2]>,
+    /// Physics steps simulated for this character so far.
+    pub steps: usize,
+    /// Of those, the steps that ended with the zero-moment point outside the support polygon
+    /// while a foot stood: moments where the feet, had they not been held, would have rolled
+    /// over an edge.
+    pub zmp_outside: usize,
 }
 
 /// How a motion unit moves its joints.

@@ -16,8 +16,8 @@ mod units;
 use std::fmt;
 
 pub use capabilities::{
-    Action, Control, Expression, Motion, MotionKind, Parameters, Physics, Prediction, Resources,
-    Sound, Steering,
+    Action, BalanceReading, Control, Expression, Motion, MotionKind, Parameters, Physics,
+    Prediction, Resources, Sound, Steering,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};

@@ -205,6 +205,8 @@ pub struct PhysicalEngine {
     unheld: bool,
     /// Warned that the simulation hides kinematic motion (until the controllers change).
     hidden: bool,
+    /// The zero-moment point counts (steps, outside the feet) of the simulations before this one.
+    zmp_before: (usize, usize),
     warnings: Vec<(UnitKey, String)>,
 }
 
@@ -222,6 +224,15 @@ impl PhysicalEngine {
     /// The simulation, while one runs.
     pub fn simulation(&self) -> Option<&Simulation> {
         self.sim.as_ref()
+    }
+
+    /// Adds an ended simulation's zero-moment point counts to the character's.
+    fn count_zmp(&mut self, ended: Option<&Simulation>) {
+        if let Some(sim) = ended {
+            let (steps, outside) = sim.zmp_outside();
+            self.zmp_before.0 += steps;
+            self.zmp_before.1 += outside;
+        }
     }
 
     /// The running controllers at `now`.
@@ -313,6 +324,7 @@ impl PhysicalEngine {
     fn start(&mut self, skeleton: &Skeleton, kinematic: &Pose, parts: &[usize], now: f64) {
         let from = self.written.clone().unwrap_or_else(|| kinematic.clone());
         let before = self.sim.take();
+        self.count_zmp(before.as_ref());
         match Simulation::new(skeleton, &from, parts, STEP) {
             Ok(mut sim) => {
                 if let Some(b) = &before {
@@ -673,7 +685,8 @@ impl crate::engine::Motion for PhysicalEngine {
     fn animate(&mut self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
         let active = self.active(now);
         if active.is_empty() {
-            if self.sim.take().is_some() {
+            if let Some(sim) = self.sim.take() {
+                self.count_zmp(Some(&sim));
                 let [before, last] = std::mem::take(&mut self.offsets);
                 self.release = last.map(|l| Release::new(&l, before.as_ref()));
                 self.written = None;
@@ -749,6 +762,21 @@ impl crate::engine::Physics for PhysicalEngine {
         }
         sim.push(i, impulse);
         Ok(())
+    }
+
+    fn balance(&self) -> Result<crate::engine::BalanceReading, String> {
+        let Some(sim) = self.sim.as_ref() else {
+            return Err("no body is simulated now (no controller runs)".into());
+        };
+        let (steps, outside) = sim.zmp_outside();
+        let support = crate::dynamics::controllers::support_polygon(&sim.contacts());
+        Ok(crate::engine::BalanceReading {
+            centre_of_mass: sim.centre_of_mass().0.to_array(),
+            zero_moment_point: sim.zero_moment_point().map(|p| p.to_array()),
+            support: support.iter().map(|p| p.to_array()).collect(),
+            steps: self.zmp_before.0 + steps,
+            zmp_outside: self.zmp_before.1 + outside,
+        })
     }
 }
 

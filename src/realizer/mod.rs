@@ -218,6 +218,26 @@ impl Realizer {
         Err(why)
     }
 
+    /// How the simulated body of `character` ("" for the default character) stands now: its
+    /// centre of mass, zero-moment point, support polygon, and how many physics steps the
+    /// zero-moment point lay outside the feet (`dynamics::zmp`). `Err` says why there is no
+    /// reading (no such character, no body simulated now: no `bmlt:controller` runs).
+    pub fn balance(&mut self, character: &str) -> Result<crate::engine::BalanceReading, String> {
+        let Some(m) = self.characters.get_mut(character) else {
+            return Err(format!("no character '{character}'"));
+        };
+        let mut why = String::from("no engine simulates the body");
+        for e in m.registry_mut().engines_mut() {
+            if let Some(p) = e.as_physics() {
+                match p.balance() {
+                    Ok(reading) => return Ok(reading),
+                    Err(e) => why = e,
+                }
+            }
+        }
+        Err(why)
+    }
+
     /// Registers an anticipator for `character` (None: blocks without a characterId). Blocks
     /// can then refer to its predictions as `anticipators:ID:SYNC`; when they change, what hangs
     /// on them moves without rescheduling.
