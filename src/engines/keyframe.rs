@@ -16,6 +16,13 @@
 //! slerp between neighbouring keys, or, with `<bmlt:parameter name="interpolation"
 //! value="hermite"/>` (or `squad`), by a C¹ Hermite spline (see [`Interpolation`]). The named joints take the keyframe's rotations (they replace,
 //! not add to, what other engines set).
+//!
+//! Densely sampled keys (motion capture: at least [`SAMPLED_KEYS`] keys evenly spaced, more
+//! than 40 a second) are smoothed once when the unit is added, by a zero-phase Butterworth
+//! low-pass at [`MOTION_CUTOFF`] Hz on each quaternion component (then renormalized) and on the
+//! root's translation (thesis §3.5): recorded jitter would otherwise become large accelerations
+//! in the inverse dynamics of a simulated body's kinematic chains. Sparse, authored keys and
+//! procedural motion are never filtered.
 
 use glam::{Quat, Vec3};
 use quick_xml::events::Event;
@@ -23,6 +30,8 @@ use quick_xml::Reader;
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
+use crate::dynamics::butterworth::Butterworth;
+use crate::dynamics::kinematics::same_hemisphere;
 use crate::engine::{Engine, EngineError, Steering, Unit, Units};
 use crate::timing::SyncName;
 use crate::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
@@ -186,7 +195,53 @@ pub fn read_keys(content: &str) -> Result<Keys, String> {
     })
 }
 
+/// The cut-off (Hz) of the low-pass on sampled motion: the thesis uses 15–25 Hz.
+pub const MOTION_CUTOFF: f64 = 20.0;
+
+/// Keys counted as sampled motion (not authored keyframes) from this many on.
+pub const SAMPLED_KEYS: usize = 8;
+
 impl Keys {
+    /// The keys smoothed as sampled motion (see the module documentation), or `None` when
+    /// they are not sampled motion: fewer than [`SAMPLED_KEYS`], unevenly spaced (a gap more
+    /// than 1 % off the mean), or 40 a second or fewer (the cut-off would not be below half
+    /// the rate).
+    pub fn smoothed(&self) -> Option<Keys> {
+        let n = self.keys.len();
+        if n < SAMPLED_KEYS {
+            return None;
+        }
+        let dt = self.duration() / (n - 1) as f64;
+        let even = (self.keys.windows(2)).all(|w| ((w[1].0 - w[0].0) - dt).abs() <= 0.01 * dt);
+        if !even || dt <= 0.0 || 1.0 / dt <= 2.0 * MOTION_CUTOFF {
+            return None;
+        }
+        let filter = Butterworth::zero_phase(MOTION_CUTOFF, 1.0 / dt);
+        let smooth = |values: Vec<f64>| filter.filtfilt(&values);
+        let mut out = self.clone();
+        let roots: [Vec<f64>; 3] =
+            std::array::from_fn(|c| smooth(self.keys.iter().map(|k| f64::from(k.1[c])).collect()));
+        for (i, key) in out.keys.iter_mut().enumerate() {
+            key.1 = Vec3::new(roots[0][i] as f32, roots[1][i] as f32, roots[2][i] as f32);
+        }
+        for part in 0..self.parts.len() {
+            // one hemisphere, so that q and −q do not average to nothing
+            let turns = same_hemisphere(
+                &(self.keys.iter())
+                    .map(|k| k.2[part].as_dquat())
+                    .collect::<Vec<_>>(),
+            );
+            let comps: [Vec<f64>; 4] =
+                std::array::from_fn(|c| smooth(turns.iter().map(|q| q.to_array()[c]).collect()));
+            for (i, key) in out.keys.iter_mut().enumerate() {
+                let q =
+                    glam::DQuat::from_array([comps[0][i], comps[1][i], comps[2][i], comps[3][i]]);
+                key.2[part] = q.normalize().as_quat();
+            }
+        }
+        Some(out)
+    }
+
     /// Length from the first key to the last.
     pub fn duration(&self) -> f64 {
         self.keys.last().map_or(0.0, |l| l.0) - self.keys.first().map_or(0.0, |f| f.0)
@@ -330,6 +385,7 @@ impl Engine for KeyframeEngine {
         let c = content(unit.behaviour)
             .ok_or_else(|| EngineError("the keyframe engine realizes bmlt:keyframe".into()))?;
         let keys = read_keys(c).map_err(|e| EngineError(format!("{}: {e}", unit.key)))?;
+        let keys = keys.smoothed().unwrap_or(keys);
         let mut how = Interpolation::Slerp;
         if let BehaviourKind::Keyframe(a) = &unit.behaviour.kind {
             for p in &a.params {
@@ -492,5 +548,94 @@ mod tests {
             r#"<SkeletonInterpolator parts="a" encoding="Q">0 1 0 0 0</SkeletonInterpolator>"#
         )
         .contains("encoding 'Q'"));
+    }
+
+    /// Keys of one joint turning about x by `angle(t)` at `times`.
+    fn swing(times: impl Iterator<Item = f64>, angle: impl Fn(f64) -> f64) -> Keys {
+        Keys {
+            parts: vec!["r_shoulder".into()],
+            root_translation: false,
+            keys: times
+                .map(|t| (t, Vec3::ZERO, vec![Quat::from_rotation_x(angle(t) as f32)]))
+                .collect(),
+        }
+    }
+
+    fn angle_of(q: Quat) -> f64 {
+        f64::from(2.0 * q.x.atan2(q.w))
+    }
+
+    /// Motion capture at 100 Hz — a 1 Hz swing with ±0.02 rad of white jitter — is smoothed:
+    /// it keeps closer to the swing (the jitter above 20 Hz, most of it, is gone), its largest
+    /// second difference (the acceleration the inverse dynamics would see) drops by more than
+    /// half, its quaternions stay unit. Authored keys, uneven keys and
+    /// motion sampled at 40 Hz or less are left as they are.
+    #[test]
+    fn sampled_motion_is_smoothed_and_authored_keys_are_not() {
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        let mut jitter = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 0.04 - 0.02
+        };
+        let clean = |t: f64| 0.6 * (2.0 * std::f64::consts::PI * t).sin();
+        let noise: Vec<f64> = (0..=200).map(|_| jitter()).collect();
+        let raw = swing((0..=200).map(|k| k as f64 / 100.0), |t| {
+            clean(t) + noise[(t * 100.0).round() as usize]
+        });
+        let smooth = raw
+            .smoothed()
+            .expect("100 keys a second are sampled motion");
+        let angles = |k: &Keys| {
+            k.keys
+                .iter()
+                .map(|key| angle_of(key.2[0]))
+                .collect::<Vec<_>>()
+        };
+        let (a, b) = (angles(&raw), angles(&smooth));
+        let off = |x: &[f64]| {
+            let sum: f64 = (x.iter().enumerate())
+                .map(|(i, v)| (v - clean(i as f64 / 100.0)).powi(2))
+                .sum();
+            (sum / x.len() as f64).sqrt()
+        };
+        let jerk = |x: &[f64]| {
+            x.windows(3)
+                .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+                .fold(0.0, f64::max)
+        };
+        eprintln!(
+            "off the swing (rms): {:.4} rad raw, {:.4} smoothed; largest second difference {:.4} raw, {:.4} smoothed",
+            off(&a),
+            off(&b),
+            jerk(&a),
+            jerk(&b)
+        );
+        assert!(
+            off(&b) < 0.8 * off(&a),
+            "smoothed {} raw {}",
+            off(&b),
+            off(&a)
+        );
+        assert!(
+            jerk(&b) < 0.4 * jerk(&a),
+            "smoothed {} raw {}",
+            jerk(&b),
+            jerk(&a)
+        );
+        assert!(smooth
+            .keys
+            .iter()
+            .all(|k| (k.2[0].length() - 1.0).abs() < 1e-6));
+        // authored: few keys, uneven keys, or slow sampling
+        assert!(swing([0.0, 0.5, 1.0].into_iter(), clean)
+            .smoothed()
+            .is_none());
+        let uneven = (0..20).map(|k| k as f64 * 0.01 + if k == 7 { 0.003 } else { 0.0 });
+        assert!(swing(uneven, clean).smoothed().is_none());
+        assert!(swing((0..40).map(|k| k as f64 / 40.0), clean)
+            .smoothed()
+            .is_none());
     }
 }
