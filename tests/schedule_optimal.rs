@@ -326,6 +326,27 @@ fn persistent_controller_has_no_end_unless_a_constraint_names_it() {
     assert!(close(at(&s, "g", "start"), at(&s, "c", "end")) && at(&s, "c", "end").is_finite());
 }
 
+/// A persistent behaviour has no length of its own to keep: tied to another behaviour's end, it
+/// lasts as long as that one, which keeps its own timing (it was squeezed to the controller's
+/// nominal second before).
+#[test]
+fn a_persistent_controller_tied_to_a_gesture_does_not_squeeze_it() {
+    let alone = schedule(&block(r#"<gesture id="g" lexeme="BEAT" start="0.5"/>"#));
+    let length = at(&alone, "g", "end") - at(&alone, "g", "start");
+    for (start, end) in [("0", "g:end"), ("g:start", "g:end"), ("0", "g:relax")] {
+        let s = schedule(&block(&format!(
+            r#"<gesture id="g" lexeme="BEAT" start="0.5"/><bmlt:controller xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="c" class="Balance" start="{start}" end="{end}"/>"#
+        )));
+        assert!(s.dropped.is_empty(), "{:?}", s.dropped);
+        let got = at(&s, "g", "end") - at(&s, "g", "start");
+        assert!(
+            close(got, length),
+            "{start}..{end}: the gesture lasts {got}, not {length}"
+        );
+        assert!(close(at(&s, "g", "start"), 0.5));
+    }
+}
+
 #[test]
 fn an_invalid_engine_timing_model_drops_the_behaviour_instead_of_panicking() {
     use bml_realizer::timing::{TimingModel, TimingModels};

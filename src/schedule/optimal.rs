@@ -18,7 +18,8 @@
 //!    to check them against.
 //! 4. Otherwise a linear program (good_lp + microlp) first minimises the total deviation from
 //!    preferred timing, measured as stretch `|σ − 1| · duration` plus non-uniformity
-//!    `2 · Σ |phase − σ · preferred phase|`. It then minimises the sum of all sync times with the deviation
+//!    `2 · Σ |phase − σ · preferred phase|` (a persistent behaviour's at a thousandth: it has no
+//!    length of its own to keep). It then minimises the sum of all sync times with the deviation
 //!    kept at that minimum. The program is built in a canonical order (behaviours sorted by id), so the
 //!    same block in any order gives the same program and the same answer.
 //! 5. Whichever step answered, the keys between two constrained keys of a stretchable behaviour
@@ -44,6 +45,13 @@ use crate::timing::{Flexibility, TimingModels, MIN_DURATION};
 /// 1, so a behaviour that must change length stretches all its phases alike (as Elckerlyc's
 /// linear stretch does) instead of putting the change into one phase.
 pub const NON_UNIFORM_WEIGHT: f64 = 2.0;
+
+/// Weight of a persistent behaviour's deviation (a physical controller, noise) against everyone
+/// else's. Such a behaviour has no length of its own: its nominal second only places an end that
+/// a constraint names without fixing it (`start="c:end"`). Counted in full, tying its end to a
+/// gesture's (`end="g:end"`) made stretching the controller cost as much as squeezing the gesture,
+/// and the tie went to the earlier times: the gesture squeezed into the controller's second.
+pub const PERSISTENT_WEIGHT: f64 = 1e-3;
 
 /// The optimal strategy (see the module documentation).
 #[derive(Debug, Clone, Copy, Default)]
@@ -866,6 +874,11 @@ impl Program {
                     .push(constraint!(t[end] - t[0] <= max_duration));
             }
         }
+        let weight = if it.model.persistent {
+            PERSISTENT_WEIGHT
+        } else {
+            1.0
+        };
         let sigma = self.vars.add(variable().min(0.0));
         let stretch = self.vars.add(variable().min(0.0));
         let duration = it.model.preferred_duration().max(EPSILON);
@@ -873,7 +886,7 @@ impl Program {
             .push(constraint!(stretch >= (sigma - 1.0) * duration));
         self.constraints
             .push(constraint!(stretch >= (1.0 - sigma) * duration));
-        self.deviation += stretch;
+        self.deviation += weight * stretch;
         for k in 1..it.len {
             let p = keys[k].at - keys[k - 1].at;
             let d = self.vars.add(variable().min(0.0));
@@ -881,7 +894,7 @@ impl Program {
                 .push(constraint!(d >= t[k] - t[k - 1] - sigma * p));
             self.constraints
                 .push(constraint!(d >= sigma * p - (t[k] - t[k - 1])));
-            self.deviation += NON_UNIFORM_WEIGHT * d;
+            self.deviation += weight * NON_UNIFORM_WEIGHT * d;
         }
     }
 
