@@ -429,6 +429,24 @@ fn headless_chromium_draws_the_character_and_the_beat_moves_the_arm() {
         &dom[..dom.len().min(400)]
     );
     assert!(console.is_empty(), "the page logs nothing: {console:?}");
+    // the feedback list at the cursor, to the millisecond it prints: at 0.821 s the stroke
+    // the feedback reports at 0.821 (0.8213 s) is shown, a millisecond earlier it is not
+    let stroke_shown = |t: &str| {
+        let (dom, _) = browse(&url(t), "--dump-dom");
+        let line = (dom.lines())
+            .flat_map(|l| l.split("<li"))
+            .find(|li| {
+                li.contains("greet:beat:stroke&quot;") || li.contains(r#"greet:beat:stroke""#)
+            })
+            .unwrap_or_else(|| panic!("no stroke message in the page at {t}"))
+            .to_string();
+        !line.contains("hidden")
+    };
+    assert!(stroke_shown("0.821"), "the stroke is not listed at 0.821 s");
+    assert!(
+        !stroke_shown("0.820"),
+        "the stroke is listed before it happens"
+    );
     let shots: Vec<Shot> = ["0", "0.821"]
         .iter()
         .map(|t| {

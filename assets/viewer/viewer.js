@@ -637,9 +637,12 @@
       }
     }
 
+    /** Shows the messages sent by `t`, to the millisecond the page prints times in: at
+     *  `#t=0.821` the stroke the feedback reports at 0.821 (really 0.8213) is in the list. */
     showFeedbackUpTo(t) {
+      const upTo = Math.round(t * 1000) + 0.5;
       let n = 0;
-      while (n < this.feedback.length && this.feedback[n].time <= t + 1e-9) n++;
+      while (n < this.feedback.length && this.feedback[n].time * 1000 < upTo) n++;
       if (n === this.shown) return;
       const [lo, hi] = n > this.shown ? [this.shown, n] : [n, this.shown];
       for (let i = lo; i < hi; i++) this.feedback[i].li.hidden = i >= n;
