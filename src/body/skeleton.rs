@@ -3,14 +3,24 @@
 //! format: `{"name": …, "joints": [{"name": …, "parent": … | null, "offset": [x, y, z]}, …]}`,
 //! parents before children.
 
-use std::collections::HashMap;
-
 use glam::Vec3;
+use rustc_hash::FxHashMap;
 
 use super::limits::Limits;
 
 /// The embedded default adult.
 const ADULT: &str = include_str!("../../fixtures/skeletons/adult.json");
+
+/// The other side's joint name: `l_…` ↔ `r_…`; other joints are their own mirror image.
+pub fn mirror_name(joint: &str) -> String {
+    if let Some(rest) = joint.strip_prefix("r_") {
+        format!("l_{rest}")
+    } else if let Some(rest) = joint.strip_prefix("l_") {
+        format!("r_{rest}")
+    } else {
+        joint.to_string()
+    }
+}
 
 /// One joint.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,7 +39,11 @@ pub struct Skeleton {
     /// Its name.
     pub name: String,
     joints: Vec<Joint>,
-    index: HashMap<String, usize>,
+    /// Joint indices by name. Engines look joints up by name every frame (a procedural unit's
+    /// rotations are data): with the std hasher this was a tenth of a mixed 100-character frame.
+    index: FxHashMap<String, usize>,
+    /// Each joint's mirror image (`l_…` ↔ `r_…`, others themselves), if the skeleton has it.
+    mirror: Vec<Option<usize>>,
     limits: Limits,
 }
 
@@ -83,7 +97,8 @@ impl Skeleton {
         let mut s = Skeleton {
             name: file.name,
             joints: Vec::new(),
-            index: HashMap::new(),
+            index: FxHashMap::default(),
+            mirror: Vec::new(),
             limits: Limits::default(),
         };
         for (i, j) in file.joints.into_iter().enumerate() {
@@ -120,6 +135,9 @@ impl Skeleton {
         if s.joints.is_empty() {
             return Err(e("no joints".into()));
         }
+        s.mirror = (s.joints.iter())
+            .map(|j| s.joint(&mirror_name(&j.name)))
+            .collect();
         Ok(s)
     }
 
@@ -157,12 +175,13 @@ impl Skeleton {
 
     /// The index of joint `name`, or of its mirror image (`l_…` ↔ `r_…`) when `mirrored`.
     pub fn joint_mirrored(&self, name: &str, mirrored: bool) -> Option<usize> {
-        let other = match name.as_bytes() {
-            [b'l', b'_', ..] if mirrored => 'r',
-            [b'r', b'_', ..] if mirrored => 'l',
-            _ => return self.joint(name),
-        };
-        self.joint(&format!("{other}{}", &name[1..]))
+        match self.joint(name) {
+            Some(i) if mirrored => self.mirror[i],
+            Some(i) => Some(i),
+            // a joint this skeleton lacks may still have its mirror image here
+            None if mirrored => self.joint(&mirror_name(name)),
+            None => None,
+        }
     }
 
     /// The children of joint `i`.

@@ -471,16 +471,7 @@ fn three(e: &[Expr; 3], names: &Names) -> Result<[f64; 3], String> {
     Ok([e[0].eval(&var)?, e[1].eval(&var)?, e[2].eval(&var)?])
 }
 
-/// The other side's joint name: `l_…` ↔ `r_…`; other joints are their own mirror image.
-pub fn mirror_name(joint: &str) -> String {
-    if let Some(rest) = joint.strip_prefix("r_") {
-        format!("l_{rest}")
-    } else if let Some(rest) = joint.strip_prefix("l_") {
-        format!("r_{rest}")
-    } else {
-        joint.to_string()
-    }
-}
+pub use crate::body::skeleton::mirror_name;
 
 /// A rotation reflected in the mid-sagittal (y-z) plane.
 pub fn mirror_rotation(q: Quat) -> Quat {
