@@ -5,8 +5,11 @@
 //! are not; the bound compound then drives like any other controller, its pulls adding to the
 //! others' on a shared joint. The thesis' example is the loosely hanging arm: soft pulls toward
 //! the arm hanging down on the shoulder and elbow (required) and the wrist (desired).
+//!
+//! Definitions are data: the embedded `fixtures/physics/compounds.json` (the hanging arms), to
+//! which a host or an `--assets` directory adds its own ([`CompoundLibrary`]).
 
-use glam::DQuat;
+use glam::{DQuat, EulerRot};
 
 use super::controllers::{Controller, Drive};
 use super::humanoid::PARTS;
@@ -136,33 +139,156 @@ impl Controller for Compound {
     }
 }
 
-/// The built-in compounds: an arm hanging down loosely, left and right (soft pulls toward
-/// rest on the shoulder and elbow, a damper on the wrist).
+/// The embedded definitions.
+const COMPOUNDS: &str = include_str!("../../fixtures/physics/compounds.json");
+
+/// The compounds the embedded data defines: an arm hanging down loosely, left and right (soft
+/// pulls toward rest on the shoulder and elbow, a damper on the wrist).
 pub fn built_in() -> Vec<CompoundSpec> {
-    let arm = |side: &str, name: &str| CompoundSpec {
-        name: name.to_string(),
-        members: vec![
-            member(&format!("{side}_upperarm"), 15.0, 3.0, Need::Required),
-            member(&format!("{side}_forearm"), 5.0, 1.0, Need::Required),
-            member(&format!("{side}_hand"), 1.0, 0.2, Need::Desired),
-        ],
+    CompoundLibrary::default().specs
+}
+
+/// Compound definitions by name, in the order defined (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompoundLibrary {
+    specs: Vec<CompoundSpec>,
+}
+
+impl Default for CompoundLibrary {
+    /// The embedded definitions (read once per process, then copied).
+    fn default() -> Self {
+        static LIBRARY: std::sync::LazyLock<CompoundLibrary> = std::sync::LazyLock::new(|| {
+            CompoundLibrary::from_json(COMPOUNDS).expect("the embedded compounds are valid")
+        });
+        LIBRARY.clone()
+    }
+}
+
+impl CompoundLibrary {
+    /// Reads definitions from JSON: `{"compounds": {NAME: {"members": [{"part", "kp", "kd",
+    /// "need": "required" | "desired", "target": [z, x, y] degrees}]}}}`, each checked with
+    /// [`CompoundSpec::validate`]. The error names the field or the compound.
+    pub fn from_json(text: &str) -> Result<CompoundLibrary, String> {
+        let file: CompoundsFile = crate::data::from_json(text)?;
+        let specs: Vec<CompoundSpec> = (file.compounds.into_iter())
+            .map(|(name, c)| CompoundSpec {
+                name,
+                members: c.members.into_iter().map(MemberFile::member).collect(),
+            })
+            .collect();
+        for spec in &specs {
+            if spec.name.trim().is_empty() {
+                return Err("a compound controller needs a name".into());
+            }
+            spec.validate()?;
+        }
+        Ok(CompoundLibrary { specs })
+    }
+
+    /// These definitions and `more`'s, a definition of `more` replacing one of the same name
+    /// (compared as [`CompoundLibrary::find`] does).
+    pub fn extended(mut self, more: CompoundLibrary) -> CompoundLibrary {
+        for spec in more.specs {
+            match self
+                .specs
+                .iter_mut()
+                .find(|s| same_name(&s.name, &spec.name))
+            {
+                Some(old) => *old = spec,
+                None => self.specs.push(spec),
+            }
+        }
+        self
+    }
+
+    /// The definition named `class`: in any case, with or without a `Controller` suffix.
+    pub fn find(&self, class: &str) -> Option<&CompoundSpec> {
+        self.specs.iter().find(|s| same_name(&s.name, class))
+    }
+
+    /// Every definition, in order.
+    pub fn specs(&self) -> &[CompoundSpec] {
+        &self.specs
+    }
+}
+
+/// Whether two controller class names are the same: in any case, with or without the
+/// `Controller` suffix (`HangingLeftArm`, `hangingleftarmcontroller`).
+pub fn same_name(a: &str, b: &str) -> bool {
+    let short = |n: &str| {
+        let lower = n.to_ascii_lowercase();
+        match lower.strip_suffix("controller") {
+            Some(s) => s.to_string(),
+            None => lower,
+        }
     };
-    vec![arm("l", "HangingLeftArm"), arm("r", "HangingRightArm")]
+    short(a) == short(b)
+}
+
+/// The definitions file as written.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CompoundsFile {
+    #[serde(default, rename = "description")]
+    _description: crate::data::Note,
+    #[serde(default, rename = "units")]
+    _units: crate::data::Note,
+    compounds: indexmap::IndexMap<String, CompoundFile>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CompoundFile {
+    #[serde(default, rename = "description")]
+    _description: crate::data::Note,
+    members: Vec<MemberFile>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MemberFile {
+    part: String,
+    kp: f64,
+    kd: f64,
+    need: NeedFile,
+    /// z, x, y Euler degrees (ZXY); the rest pose when omitted.
+    #[serde(default)]
+    target: Option<[f64; 3]>,
+}
+
+#[derive(serde::Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum NeedFile {
+    Required,
+    Desired,
+}
+
+impl MemberFile {
+    fn member(self) -> Member {
+        let target = self.target.map_or(DQuat::IDENTITY, |[z, x, y]| {
+            DQuat::from_euler(
+                EulerRot::ZXY,
+                z.to_radians(),
+                x.to_radians(),
+                y.to_radians(),
+            )
+        });
+        Member {
+            part: self.part,
+            target,
+            kp: self.kp,
+            kd: self.kd,
+            need: match self.need {
+                NeedFile::Required => Need::Required,
+                NeedFile::Desired => Need::Desired,
+            },
+        }
+    }
 }
 
 /// The index of the body part `name` in [`PARTS`].
 fn part(name: &str) -> Option<usize> {
     PARTS.iter().position(|p| p.name == name)
-}
-
-fn member(part: &str, kp: f64, kd: f64, need: Need) -> Member {
-    Member {
-        part: part.to_string(),
-        target: DQuat::IDENTITY,
-        kp,
-        kd,
-        need,
-    }
 }
 
 #[cfg(test)]

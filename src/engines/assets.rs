@@ -1,9 +1,10 @@
-//! The motion data the built-in engines read: the procedural unit library and the bindings of
-//! gesture lexemes, posture poses and head lexemes. The defaults are embedded in the crate
-//! (`fixtures/procedural/units.json`, `fixtures/bindings/{gestures,poses,heads}.json`); a
-//! directory with files of the same names adds to them: its units join the library (replacing
-//! units of the same name) and its bindings come before the embedded ones (so they win for the
-//! lexemes and poses they bind).
+//! The motion data the built-in engines read: the procedural unit library, the bindings of
+//! gesture lexemes, posture poses and head lexemes, and the compound physical controllers. The
+//! defaults are embedded in the crate (`fixtures/procedural/units.json`,
+//! `fixtures/bindings/{gestures,poses,heads}.json`, `fixtures/physics/compounds.json`); a
+//! directory with files of the same names adds to them: its units and compounds join the
+//! library (replacing those of the same name) and its bindings come before the embedded ones
+//! (so they win for the lexemes and poses they bind).
 
 use std::path::Path;
 
@@ -12,6 +13,7 @@ use super::head::HeadLexicon;
 use super::posture::PoseBindings;
 use super::procedural::Library;
 use crate::body::Skeleton;
+use crate::dynamics::compound::CompoundLibrary;
 
 /// The data of the motion engines.
 #[derive(Debug, Clone)]
@@ -24,6 +26,8 @@ pub struct Assets {
     pub poses: PoseBindings,
     /// Head lexemes (`heads.json`).
     pub heads: HeadLexicon,
+    /// Compound physical controllers (`compounds.json`).
+    pub compounds: CompoundLibrary,
 }
 
 impl Default for Assets {
@@ -33,13 +37,14 @@ impl Default for Assets {
             gestures: Lexicon::default_lexicon(),
             poses: PoseBindings::default_bindings(),
             heads: HeadLexicon::default_lexicon(),
+            compounds: CompoundLibrary::default(),
         }
     }
 }
 
 impl Assets {
-    /// The defaults extended by each of `units.json`, `gestures.json`, `poses.json` and
-    /// `heads.json` that `dir` has (see the module documentation). The directory's bindings may
+    /// The defaults extended by each of `units.json`, `gestures.json`, `poses.json`,
+    /// `heads.json` and `compounds.json` that `dir` has (see the module documentation). The directory's bindings may
     /// name its own units and the embedded ones. The error names the file and what is wrong.
     pub fn from_dir(dir: &Path) -> Result<Assets, String> {
         if !dir.is_dir() {
@@ -93,6 +98,18 @@ impl Assets {
         if let Some((path, text)) = read("heads.json")? {
             let first = HeadLexicon::from_json(&text).map_err(|e| format!("{path}: {e}"))?;
             assets.heads = assets.heads.extended_by(first);
+        }
+        if let Some((path, text)) = read("compounds.json")? {
+            let more = CompoundLibrary::from_json(&text).map_err(|e| format!("{path}: {e}"))?;
+            if let Some(s) =
+                (more.specs().iter()).find(|s| super::physical::is_built_in_class(&s.name))
+            {
+                return Err(format!(
+                    "{path}: compound '{}' takes the name of a built-in controller class",
+                    s.name
+                ));
+            }
+            assets.compounds = assets.compounds.extended(more);
         }
         Ok(assets)
     }

@@ -150,7 +150,7 @@ pub fn registry_with(models: DefaultTimingModels, assets: &assets::Assets) -> Re
     );
     // last of all: the simulated body takes the kinematic pose the others made as its input
     r.register(
-        Box::new(physical::PhysicalEngine::default()),
+        Box::new(physical::PhysicalEngine::new(assets.compounds.clone())),
         &keys(&[(NS_BMLT, "controller")]),
     );
     r

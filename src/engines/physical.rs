@@ -10,10 +10,11 @@
 //! - `PoseController`: PD tracking of what the kinematic engines would set on the simulated
 //!   joints (`stiffnessmultiplier` 1: 300 N m/rad, 30 N m s/rad).
 //! - `RagDoll`: no torque; the whole body simulated (alone, it lets go of the feet).
-//! - `HangingLeftArm`, `HangingRightArm`: compound controllers (`dynamics::compound`), the arm
-//!   simulated and hanging down loosely (`stiffnessmultiplier` 1). They hold only the arm: run
-//!   them with a `BalanceController` (alone, the legs and trunk have no controller and the
-//!   realizer warns).
+//! - compound controllers (`dynamics::compound`), defined as data: the embedded
+//!   `HangingLeftArm` and `HangingRightArm` (the arm simulated and hanging down loosely) and any
+//!   an `--assets` directory's `compounds.json` adds (`stiffnessmultiplier` 1 scales their
+//!   gains). They hold only their own parts: run them with a `BalanceController` (alone, the
+//!   legs and trunk have no controller and the realizer warns).
 //!
 //! A class is named in any case, with or without its `Controller` suffix (`Balance`).
 //!
@@ -31,7 +32,7 @@ use std::sync::Arc;
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::dynamics::compound::{self, Compound, CompoundSpec};
+use crate::dynamics::compound::{self, Compound, CompoundLibrary, CompoundSpec};
 use crate::dynamics::config::{smallest_covering, Configuration};
 use crate::dynamics::controllers::{Balance, Controller, Drive, PoseController, RagDoll};
 use crate::dynamics::sim::{Simulation, STEP};
@@ -207,6 +208,8 @@ pub struct PhysicalEngine {
     hidden: bool,
     /// The zero-moment point counts (steps, outside the feet) of the simulations before this one.
     zmp_before: (usize, usize),
+    /// The compound controllers BML may name.
+    compounds: CompoundLibrary,
     warnings: Vec<(UnitKey, String)>,
 }
 
@@ -221,6 +224,14 @@ impl std::fmt::Debug for PhysicalEngine {
 }
 
 impl PhysicalEngine {
+    /// An engine whose compound controllers are `compounds` (the built-in classes besides).
+    pub fn new(compounds: CompoundLibrary) -> PhysicalEngine {
+        PhysicalEngine {
+            compounds,
+            ..PhysicalEngine::default()
+        }
+    }
+
     /// The simulation, while one runs.
     pub fn simulation(&self) -> Option<&Simulation> {
         self.sim.as_ref()
@@ -558,24 +569,16 @@ fn overshoot_capped(offset: glam::Vec3, rate: glam::Vec3, duration: f64, least: 
     }
 }
 
-/// The built-in compound controller named `class` (as [`same_class`] reads names).
-fn built_in_compound(class: &str) -> Option<CompoundSpec> {
-    compound::built_in()
-        .into_iter()
-        .find(|s| same_class(&s.name, class))
-}
-
 /// Whether `given` names the class `name`: its name in any case, with or without the
 /// `Controller` suffix (`Balance`, `balancecontroller`).
 fn same_class(name: &str, given: &str) -> bool {
-    let short = |n: &str| {
-        let lower = n.to_ascii_lowercase();
-        lower
-            .strip_suffix("controller")
-            .map(str::to_string)
-            .unwrap_or(lower)
-    };
-    short(name) == short(given)
+    compound::same_name(name, given)
+}
+
+/// Whether `name` is one of the built-in controller classes (`BalanceController`, …), which a
+/// compound definition may not take.
+pub fn is_built_in_class(name: &str) -> bool {
+    CLASSES.iter().any(|(class, _)| same_class(class, name))
 }
 
 /// `a` and `b` mixed: the root's place linearly, each rotation by slerp (`w` = 0: `a`).
@@ -615,13 +618,13 @@ impl Engine for PhysicalEngine {
         };
         let fail = |why: String| EngineError(format!("{}: {why}", unit.key));
         let found = CLASSES.iter().find(|(name, _)| same_class(name, &c.class));
-        let compound = built_in_compound(&c.class);
+        let compound = self.compounds.find(&c.class).cloned();
         let (class, defaults): (&'static str, &[(&str, f64)]) = match (found, &compound) {
             (Some((class, defaults)), _) => (class, defaults),
             (None, Some(_)) => (COMPOUND, &[("stiffnessmultiplier", 1.0)]),
             (None, None) => {
                 let known: Vec<String> = (CLASSES.iter().map(|c| c.0.to_string()))
-                    .chain(compound::built_in().into_iter().map(|s| s.name))
+                    .chain(self.compounds.specs().iter().map(|s| s.name.clone()))
                     .collect();
                 return Err(fail(format!(
                     "controller class '{}' is not known ({})",
@@ -665,7 +668,7 @@ impl crate::engine::Motion for PhysicalEngine {
         let BehaviourKind::Controller(c) = &behaviour.kind else {
             return None;
         };
-        let parts: Vec<usize> = match built_in_compound(&c.class) {
+        let parts: Vec<usize> = match self.compounds.find(&c.class) {
             Some(spec) => spec.parts(),
             None if same_class("RagDoll", &c.class) => WHOLE_BODY.to_vec(),
             None => LOWER_BODY.to_vec(),

@@ -84,7 +84,7 @@ pub struct SetupArgs {
     pub character: Option<String>,
     /// A directory of motion data adding to the embedded defaults: any of units.json (procedural
     /// units), gestures.json, poses.json and heads.json (bindings, which win over the embedded
-    /// ones for what they bind).
+    /// ones for what they bind) and compounds.json (compound physical controllers).
     #[arg(long, value_name = "DIR")]
     pub assets: Option<std::path::PathBuf>,
     /// A world file (JSON): named points and points moving along keyed paths, as targets of
