@@ -8,7 +8,8 @@
 //!   WHOLE the root. Each joint takes a fixed share of the aim as a yaw-then-pitch rotation (no
 //!   torsion: Donders' law), so the head's orientation depends on the aim only, not on where it
 //!   came from. The eyes then take what is left, aimed exactly from their real position
-//!   (vergence), within ±35° yaw and ±30° pitch.
+//!   (vergence), within ±35° yaw and ±30° pitch and within the eye joint's limits (its swing
+//!   ellipse is smaller at the box's corners).
 //! - Timing: from `start` to `ready` the aim moves from the rest aim to the target along a
 //!   minimum-jerk profile (single-peaked velocity). The eyes lead with a saccade whose duration is
 //!   affine in its amplitude (21 ms + 3.8 ms per degree, the slope that keeps the symmetric
@@ -378,6 +379,14 @@ impl Aim {
             let yaw = ry + we * (ty - ry);
             let pitch = rp + we * (tp - rp);
             pose.rotate(e, donders(yaw, pitch));
+            // the eye's anatomical range (a swing ellipse and a little twist, which the yaw and
+            // pitch box only approximates: its corners lie outside): an aim beyond it holds the
+            // eye at its edge
+            if let Some(inside) =
+                (skeleton.limits().of(e)).and_then(|l| l.clamped(pose.rotations[e]))
+            {
+                pose.rotations[e] = inside;
+            }
         }
     }
 }
