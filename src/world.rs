@@ -1,18 +1,67 @@
 //! The world the characters act in: named points (gaze, pointing and head-direction targets) that
-//! the host places and moves, and points that move by themselves along keyed paths. Characters
-//! stand at the origin facing +z (y up, metres). A world can be read from a JSON world file.
+//! the host places and moves, points that move by themselves along keyed paths, and where each
+//! character stands. A character stands at the origin facing +z (y up, metres) unless the world
+//! places it elsewhere; a placed character is itself a target, at its eyes, so characters can
+//! look and point at each other. Each character's engines see the world from where it stands
+//! ([`World::seen_from`]). A world can be read from a JSON world file.
 
 use std::collections::BTreeMap;
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use serde::Deserialize;
 
-/// Named points in world coordinates, some of them moving along paths.
+/// Where a character stands: a place on the ground and the way it faces.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Placement {
+    /// Where its root stands (metres, world).
+    pub position: Vec3,
+    /// Its heading: radians about +y from facing +z (π/2 faces +x).
+    pub facing: f32,
+}
+
+impl Placement {
+    /// Standing at `position`, turned `degrees` about +y from facing +z.
+    pub fn new(position: Vec3, degrees: f32) -> Placement {
+        Placement {
+            position,
+            facing: degrees.to_radians(),
+        }
+    }
+
+    /// Its turn from facing +z.
+    pub fn rotation(&self) -> Quat {
+        Quat::from_rotation_y(self.facing)
+    }
+
+    /// A point of the character's own frame (the origin facing +z) in the world.
+    pub fn to_world(&self, local: Vec3) -> Vec3 {
+        self.position + self.rotation() * local
+    }
+
+    /// A point of the world in the character's own frame.
+    pub fn to_local(&self, world: Vec3) -> Vec3 {
+        self.rotation().inverse() * (world - self.position)
+    }
+
+    /// Whether it is the origin facing +z (the character's frame is the world's).
+    pub fn is_origin(&self) -> bool {
+        *self == Placement::default()
+    }
+}
+
+/// Where a placed character is as a target: the point between the default adult's eyes, in its
+/// own frame (`gaze::eyes_at_rest` of the adult, to the centimetre).
+pub const CHARACTER_EYES: Vec3 = Vec3::new(0.0, 1.64, 0.09);
+
+/// Named points in world coordinates, some of them moving along paths, and the characters'
+/// placements.
 #[derive(Debug, Clone, PartialEq)]
 pub struct World {
     points: BTreeMap<String, Vec3>,
     /// Points that move: their keys (time in seconds, position), in time order.
     paths: BTreeMap<String, Vec<(f64, Vec3)>>,
+    /// Where characters stand (the others stand at the origin facing +z).
+    characters: BTreeMap<String, Placement>,
 }
 
 impl Default for World {
@@ -28,7 +77,8 @@ impl Default for World {
 }
 
 /// The world file: `{"points": {"user": [0, 1.6, 1.5]}, "paths": {"walker": {"keys": [[0, [1,
-/// 1.6, 2]], [4, [-1, 1.6, 2]]]}}, "obstacles": [...]}`.
+/// 1.6, 2]], [4, [-1, 1.6, 2]]]}}, "characters": {"Bob": {"position": [1, 0, 2], "facing":
+/// -150}}, "obstacles": [...]}` (`facing` in degrees about +y from facing +z).
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct WorldFile {
@@ -36,6 +86,8 @@ struct WorldFile {
     points: BTreeMap<String, [f64; 3]>,
     #[serde(default)]
     paths: BTreeMap<String, PathFile>,
+    #[serde(default)]
+    characters: BTreeMap<String, CharacterFile>,
     /// Read so that files written for locomotion load; nothing uses them yet.
     #[serde(default)]
     obstacles: Vec<serde_json::Value>,
@@ -45,6 +97,15 @@ struct WorldFile {
 #[serde(deny_unknown_fields)]
 struct PathFile {
     keys: Vec<(f64, [f64; 3])>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CharacterFile {
+    position: [f64; 3],
+    /// Degrees about +y from facing +z.
+    #[serde(default)]
+    facing: f64,
 }
 
 /// Longest list of keys a path may have.
@@ -64,6 +125,7 @@ impl World {
         World {
             points: BTreeMap::new(),
             paths: BTreeMap::new(),
+            characters: BTreeMap::new(),
         }
     }
 
@@ -84,7 +146,62 @@ impl World {
                 .collect::<Result<Vec<_>, String>>()?;
             w.set_path(&name, keys)?;
         }
+        for (name, c) in file.characters {
+            let at = vec3(&name, c.position)?;
+            w.place(&name, Placement::new(at, c.facing as f32))?;
+        }
         Ok((w, file.obstacles.len()))
+    }
+
+    /// Places character `id` (the default character is `""`). A point of the same name keeps
+    /// its place as a target; the character is a target where no point has its name.
+    pub fn place(&mut self, id: &str, at: Placement) -> Result<(), String> {
+        if !(at.position.is_finite() && at.facing.is_finite()) {
+            return Err(format!(
+                "character '{id}': its position and facing must be finite numbers"
+            ));
+        }
+        self.characters.insert(id.to_string(), at);
+        Ok(())
+    }
+
+    /// Where character `id` stands (the origin facing +z unless placed).
+    pub fn placement(&self, id: &str) -> Placement {
+        self.characters.get(id).copied().unwrap_or_default()
+    }
+
+    /// Every placed character, by id.
+    pub fn placements(&self) -> impl Iterator<Item = (&str, Placement)> {
+        self.characters.iter().map(|(k, v)| (k.as_str(), *v))
+    }
+
+    /// The world as character `id` sees it: every point, path and placement in its own frame
+    /// (where it stands is the origin, the way it faces +z).
+    pub fn seen_from(&self, id: &str) -> World {
+        let from = self.placement(id);
+        let local = |p: &Vec3| from.to_local(*p);
+        World {
+            points: (self.points.iter())
+                .map(|(k, p)| (k.clone(), local(p)))
+                .collect(),
+            paths: (self.paths.iter())
+                .map(|(k, keys)| {
+                    (
+                        k.clone(),
+                        keys.iter().map(|(t, p)| (*t, local(p))).collect(),
+                    )
+                })
+                .collect(),
+            characters: (self.characters.iter())
+                .map(|(k, c)| {
+                    let at = Placement {
+                        position: local(&c.position),
+                        facing: c.facing - from.facing,
+                    };
+                    (k.clone(), at)
+                })
+                .collect(),
+        }
     }
 
     /// Places (or moves) point `name`.
@@ -134,9 +251,11 @@ impl World {
         self.paths.remove(name);
     }
 
-    /// Where point `name` is.
+    /// Where point `name` is; a placed character without a point of its name is a target at
+    /// its eyes ([`CHARACTER_EYES`]).
     pub fn get(&self, name: &str) -> Option<Vec3> {
-        self.points.get(name).copied()
+        (self.points.get(name).copied())
+            .or_else(|| (self.characters.get(name)).map(|c| c.to_world(CHARACTER_EYES)))
     }
 
     /// Every point, by name.
@@ -151,7 +270,9 @@ impl World {
 
     /// The sentence for a target the world does not have, listing the points it has.
     pub fn unknown_target(&self, target: &str) -> String {
-        let known: Vec<&str> = self.points.keys().map(String::as_str).collect();
+        let known: Vec<&str> = (self.points.keys().chain(self.characters.keys()))
+            .map(String::as_str)
+            .collect();
         format!(
             "there is no target '{target}' in the world (it has {}; add points with --world or Realizer::world_mut)",
             known.join(", ")

@@ -172,3 +172,14 @@ fn balancing_while_gesturing() {
     assert_eq!(sync(&fb, "stand:frame:start"), sync(&fb, "stand:wave:end"));
     assert_eq!(block(&fb, "stand", "end"), (6.0, Some(BlockStatus::Done)));
 }
+
+#[test]
+fn two_characters_in_one_world() {
+    let fb = run("run --world fixtures/examples/world.json fixtures/examples/two-alice.xml fixtures/examples/two-bob.xml");
+    no_warnings(&fb);
+    assert_eq!(ms(sync(&fb, "a:g:ready")), 1.0);
+    assert_eq!(ms(sync(&fb, "b:g:ready")), 1.0);
+    assert_eq!(ms(sync(&fb, "b:p:start")), 1.0);
+    assert_eq!(block(&fb, "a", "end"), (6.0, Some(BlockStatus::Done)));
+    assert_eq!(block(&fb, "b", "end"), (6.0, Some(BlockStatus::Done)));
+}

@@ -457,6 +457,18 @@
     }
 
     /** Drag to turn around the character, wheel to come closer. */
+    /** Where the camera looks: the middle of the characters where they first stand and how far
+     *  they spread from it, or (`face`) the first character's place. */
+    stage(face) {
+      const first = this.clip.poses[0] || [];
+      if (!first.length) return { x: 0, z: 0, spread: 0 };
+      const chosen = face ? first.slice(0, 1) : first;
+      const x = chosen.reduce((a, p) => a + p[0], 0) / chosen.length;
+      const z = chosen.reduce((a, p) => a + p[2], 0) / chosen.length;
+      const spread = Math.max(...chosen.map((p) => Math.hypot(p[0] - x, p[2] - z)));
+      return { x, z, spread };
+    }
+
     orbit() {
       // the whole body, or (#face in the address, or the F key) a close look at the face
       this.body = { azimuth: 0.35, elevation: 0.08, distance: 3.5, height: 0.92 };
@@ -554,11 +566,13 @@
       }
       for (const p of this.points) if (p.keys) p.ball.position.fromArray(along(p.keys, this.t));
       const v = this.view;
-      const target = new THREE.Vector3(0, v.height, 0);
+      const stage = this.stage(v.height === this.close.height);
+      const target = new THREE.Vector3(stage.x, v.height, stage.z);
+      const distance = v.distance + 1.5 * stage.spread;
       this.camera.position.set(
-        target.x + v.distance * Math.sin(v.azimuth) * Math.cos(v.elevation),
-        target.y + v.distance * Math.sin(v.elevation),
-        target.z + v.distance * Math.cos(v.azimuth) * Math.cos(v.elevation),
+        target.x + distance * Math.sin(v.azimuth) * Math.cos(v.elevation),
+        target.y + distance * Math.sin(v.elevation),
+        target.z + distance * Math.cos(v.azimuth) * Math.cos(v.elevation),
       );
       this.camera.lookAt(target);
       this.renderer.render(this.scene, this.camera);

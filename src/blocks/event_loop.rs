@@ -168,6 +168,11 @@ impl BlockManager {
             pose.rotate(jaw, glam::Quat::from_rotation_x(open));
         }
         let clamped = self.skeleton.limits().clamp(&mut pose);
+        // from the character's own frame to where it stands in the world
+        if !self.placement.is_origin() {
+            pose.root = self.placement.to_world(pose.root);
+            pose.rotations[0] = self.placement.rotation() * pose.rotations[0];
+        }
         let (sounds, events) = self.sounds(to);
         frame.poses.push(CharacterPose {
             character: self.character.clone(),

@@ -98,7 +98,11 @@ pub struct BlockManager {
     /// The sounds that played in the last frame (ids).
     playing: Vec<String>,
     /// The world as of the last advance (shared with the realizer).
+    shared: std::sync::Arc<World>,
+    /// That world as this character sees it, from where it stands (what its engines get).
     world: std::sync::Arc<World>,
+    /// Where it stands in the world: its frames' root is placed there.
+    placement: crate::world::Placement,
     now: f64,
     seq: u64,
     out: Vec<Feedback>,
@@ -131,7 +135,9 @@ impl BlockManager {
             idle: Some(idle),
             blinks: Some(blinks),
             playing: Vec::new(),
+            shared: std::sync::Arc::new(World::default()),
             world: std::sync::Arc::new(World::default()),
+            placement: crate::world::Placement::default(),
             now: 0.0,
             seq: 0,
             out: Vec::new(),
@@ -146,11 +152,20 @@ impl BlockManager {
         self.set_idle(on);
     }
 
-    /// Uses `world` for targets from now on (the realizer shares its world this way).
+    /// Uses `world` for targets and for where the character stands from now on (the realizer
+    /// shares its world this way). The engines get it as seen from the character.
     pub fn set_world(&mut self, world: &std::sync::Arc<World>) {
-        if !std::sync::Arc::ptr_eq(&self.world, world) {
-            self.world = world.clone();
+        if std::sync::Arc::ptr_eq(&self.shared, world) {
+            return;
         }
+        self.shared = world.clone();
+        let id = self.character.as_deref().unwrap_or("");
+        self.placement = world.placement(id);
+        self.world = if self.placement.is_origin() {
+            world.clone()
+        } else {
+            std::sync::Arc::new(world.seen_from(id))
+        };
     }
 
     /// Turns the idle layer (breathing, a slow weight shift, blinks) on or off; it is on by
