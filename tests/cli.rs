@@ -535,3 +535,43 @@ fn run_gltf_writes_a_skinned_mannequin_with_the_motion() {
     assert_eq!(code, 2);
     assert!(err.contains("--gltf records on the virtual clock"), "{err}");
 }
+
+/// Characters placed in the world make one glTF scene, each a mannequin of its own where it
+/// stands: Bob's root is keyed at his place (1.2 m left, 2 m ahead of Alice).
+#[test]
+fn run_gltf_of_several_characters_is_one_scene() {
+    let path = std::env::temp_dir().join(format!("bmlr-{}-two.glb", std::process::id()));
+    let (code, _, err) = bmlr(&[
+        "run",
+        "--world",
+        "fixtures/examples/world.json",
+        "--gltf",
+        path.to_str().unwrap(),
+        "fixtures/examples/two-alice.xml",
+        "fixtures/examples/two-bob.xml",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("57 joints, 2 characters,"), "{err}");
+    let glb = std::fs::read(&path).unwrap();
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let gltf: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let n = bml_realizer::body::Skeleton::adult().len();
+    assert_eq!(gltf["skins"].as_array().unwrap().len(), 2);
+    assert_eq!(gltf["nodes"][2 * n + 1]["name"], "Bob");
+    // Bob's root translation channel, its first key
+    let channels = gltf["animations"][0]["channels"].as_array().unwrap();
+    let root = (channels.iter())
+        .find(|c| c["target"]["node"] == n + 1 && c["target"]["path"] == "translation")
+        .unwrap();
+    let sampler = &gltf["animations"][0]["samplers"][root["sampler"].as_u64().unwrap() as usize];
+    let output = &gltf["accessors"][sampler["output"].as_u64().unwrap() as usize];
+    let view = &gltf["bufferViews"][output["bufferView"].as_u64().unwrap() as usize];
+    let bin = 20 + json_len + 8 + view["byteOffset"].as_u64().unwrap() as usize;
+    let x = f32::from_le_bytes(glb[bin..bin + 4].try_into().unwrap());
+    let z = f32::from_le_bytes(glb[bin + 8..bin + 12].try_into().unwrap());
+    assert!(
+        (x - 1.2).abs() < 0.02 && (z - 2.0).abs() < 0.02,
+        "Bob's root at x {x}, z {z}"
+    );
+    std::fs::remove_file(&path).ok();
+}

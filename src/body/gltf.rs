@@ -1,8 +1,9 @@
 //! glTF 2.0 export (`bmlr run --gltf OUT.glb`): the skinned mannequin of [`mannequin`] — a box
 //! along every bone, a box head, two materials (skin for the head and hands, cloth for the
 //! rest) — and the realized motion as animation channels (every joint's rotation, the root's
-//! translation), in one binary `.glb` file for Blender, three.js or a game engine. Each vertex
-//! follows one joint (the one whose bone it belongs to), so the mannequin moves rigidly per bone.
+//! translation), in one binary `.glb` file for Blender, three.js or a game engine; several
+//! characters make one scene, each a mannequin of its own. Each vertex follows one joint (the one
+//! whose bone it belongs to), so the mannequin moves rigidly per bone.
 
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{json, Value};
@@ -118,14 +119,71 @@ impl Buffer {
 
 /// The `.glb` of the mannequin on `skeleton` playing `frames` ((time, pose) in time order).
 pub fn write(skeleton: &Skeleton, frames: &[(f64, &Pose)]) -> Vec<u8> {
-    let joints = skeleton.joints();
+    write_scene(skeleton, &[("", frames)])
+}
+
+/// The `.glb` of a scene of characters `(id, frames)`, each the mannequin on `skeleton` playing
+/// its frames (every character's at the same times, in time order) in one animation. With more
+/// than one, each character's nodes are named `ID/joint` and its mesh node `ID`.
+pub fn write_scene(skeleton: &Skeleton, characters: &[(&str, &[(f64, &Pose)])]) -> Vec<u8> {
+    let mut buf = Buffer::default();
+    let primitives = mannequin_primitives(skeleton, &mut buf);
+    // the skins: every joint, bound at its rest position
     let rest = Pose::rest(skeleton).world(skeleton).positions;
+    let inverse_bind: Vec<f32> = (rest.iter())
+        .flat_map(|&p| Mat4::from_translation(-p).to_cols_array())
+        .collect();
+    let ibm = buf.floats(&inverse_bind, "MAT4", skeleton.len(), None);
+    let (mut nodes, mut roots, mut skins) = (Vec::new(), Vec::new(), Vec::new());
+    let mut animation = Animation::default();
+    for (k, (id, frames)) in characters.iter().enumerate() {
+        let base = nodes.len();
+        let prefix = if characters.len() > 1 {
+            format!("{id}/")
+        } else {
+            String::new()
+        };
+        nodes.extend(joint_nodes(skeleton, base, &prefix));
+        let name = if prefix.is_empty() { "mannequin" } else { id };
+        nodes.push(json!({"name": name, "mesh": 0, "skin": k}));
+        roots.extend([base, base + skeleton.len()]);
+        skins.push(json!({
+            "joints": (base..base + skeleton.len()).collect::<Vec<_>>(),
+            "inverseBindMatrices": ibm,
+            "skeleton": base,
+        }));
+        animation.add(skeleton, frames, base, &mut buf);
+    }
+    let gltf = json!({
+        "asset": {"version": "2.0", "generator": concat!("bml-realizer ", env!("CARGO_PKG_VERSION"))},
+        "scene": 0,
+        "scenes": [{"nodes": roots}],
+        "nodes": nodes,
+        "meshes": [{"name": "mannequin", "primitives": primitives}],
+        "materials": [
+            {"name": "cloth", "pbrMetallicRoughness": {"baseColorFactor": [0.25, 0.33, 0.45, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.8}},
+            {"name": "skin", "pbrMetallicRoughness": {"baseColorFactor": [0.86, 0.67, 0.55, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6}},
+        ],
+        "skins": skins,
+        "animations": animation.finish().into_iter().collect::<Vec<_>>(),
+        "accessors": buf.accessors,
+        "bufferViews": buf.views,
+        "buffers": [{"byteLength": buf.bytes.len()}],
+    });
+    glb(
+        &serde_json::to_vec(&gltf).expect("glTF JSON always encodes"),
+        buf.bytes,
+    )
+}
+
+/// The mannequin's mesh (a box along every bone, each vertex following its bone's joint) into
+/// `buf`: its primitives, one per material.
+fn mannequin_primitives(skeleton: &Skeleton, buf: &mut Buffer) -> Vec<Value> {
     let mut mesh = Mesh::default();
     for part in mannequin::segments(skeleton) {
         let (a, b) = (Vec3::from(part.from), Vec3::from(part.to));
         mesh.bone(a, b, part.width, part.joint as u16, part.skin);
     }
-    let mut buf = Buffer::default();
     let position = buf.vec3s(&mesh.positions, Some(ARRAY_BUFFER), true);
     let normal = buf.vec3s(&mesh.normals, Some(ARRAY_BUFFER), false);
     let joint_data: Vec<u8> = (mesh.joints.iter())
@@ -140,7 +198,7 @@ pub fn write(skeleton: &Skeleton, frames: &[(f64, &Pose)]) -> Vec<u8> {
     );
     let weights: Vec<f32> = (0..count).flat_map(|_| [1.0, 0.0, 0.0, 0.0]).collect();
     let weight_acc = buf.floats(&weights, "VEC4", count, Some(ARRAY_BUFFER));
-    let primitives: Vec<Value> = (mesh.triangles.iter().enumerate())
+    (mesh.triangles.iter().enumerate())
         .filter(|(_, t)| !t.is_empty())
         .map(|(material, t)| {
             let data: Vec<u8> = t.iter().flat_map(|i| i.to_le_bytes()).collect();
@@ -155,84 +213,79 @@ pub fn write(skeleton: &Skeleton, frames: &[(f64, &Pose)]) -> Vec<u8> {
                 "material": material,
             })
         })
-        .collect();
-    // the skin: every joint, bound at its rest position
-    let inverse_bind: Vec<f32> = (rest.iter())
-        .flat_map(|&p| Mat4::from_translation(-p).to_cols_array())
-        .collect();
-    let ibm = buf.floats(&inverse_bind, "MAT4", joints.len(), None);
-    let animation = animation(skeleton, frames, &mut buf);
-    let nodes: Vec<Value> = joints
-        .iter()
-        .enumerate()
+        .collect()
+}
+
+/// The joint nodes of one character, numbered from `base`, named with `prefix`.
+fn joint_nodes(skeleton: &Skeleton, base: usize, prefix: &str) -> Vec<Value> {
+    let joints = skeleton.joints();
+    (joints.iter().enumerate())
         .map(|(i, j)| {
             let children: Vec<usize> = (joints.iter().enumerate())
                 .filter(|(_, c)| c.parent == Some(i))
-                .map(|(k, _)| k)
+                .map(|(k, _)| base + k)
                 .collect();
-            let mut node = json!({"name": j.name, "translation": j.offset.to_array()});
+            let name = format!("{prefix}{}", j.name);
+            let mut node = json!({"name": name, "translation": j.offset.to_array()});
             if !children.is_empty() {
                 node["children"] = json!(children);
             }
             node
         })
-        .chain([json!({"name": "mannequin", "mesh": 0, "skin": 0})])
-        .collect();
-    let gltf = json!({
-        "asset": {"version": "2.0", "generator": concat!("bml-realizer ", env!("CARGO_PKG_VERSION"))},
-        "scene": 0,
-        "scenes": [{"nodes": [0, joints.len()]}],
-        "nodes": nodes,
-        "meshes": [{"name": "mannequin", "primitives": primitives}],
-        "materials": [
-            {"name": "cloth", "pbrMetallicRoughness": {"baseColorFactor": [0.25, 0.33, 0.45, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.8}},
-            {"name": "skin", "pbrMetallicRoughness": {"baseColorFactor": [0.86, 0.67, 0.55, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6}},
-        ],
-        "skins": [{"joints": (0..joints.len()).collect::<Vec<_>>(), "inverseBindMatrices": ibm, "skeleton": 0}],
-        "animations": animation.into_iter().collect::<Vec<_>>(),
-        "accessors": buf.accessors,
-        "bufferViews": buf.views,
-        "buffers": [{"byteLength": buf.bytes.len()}],
-    });
-    glb(
-        &serde_json::to_vec(&gltf).expect("glTF JSON always encodes"),
-        buf.bytes,
-    )
+        .collect()
 }
 
-/// The animation of `frames`: one rotation channel per joint and the root's translation; `None`
-/// without frames.
-fn animation(skeleton: &Skeleton, frames: &[(f64, &Pose)], buf: &mut Buffer) -> Option<Value> {
-    let (first, last) = (frames.first()?.0, frames.last()?.0);
-    let times: Vec<f32> = frames.iter().map(|(t, _)| (*t - first) as f32).collect();
-    let input = buf.floats(&times, "SCALAR", times.len(), None);
-    buf.accessors[input]["min"] = json!([0.0]);
-    buf.accessors[input]["max"] = json!([(last - first) as f32]);
-    let mut samplers = Vec::new();
-    let mut channels = Vec::new();
-    for j in 0..skeleton.len() {
-        // the shorter way between neighbouring keys (q and -q are one rotation)
-        let mut prev = Quat::IDENTITY;
-        let rotations: Vec<f32> = (frames.iter())
-            .flat_map(|(_, p)| {
-                let q = p.rotations[j].normalize();
-                let q = if q.dot(prev) < 0.0 { -q } else { q };
-                prev = q;
-                q.to_array()
-            })
-            .collect();
-        let output = buf.floats(&rotations, "VEC4", frames.len(), None);
-        samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-        channels.push(
-            json!({"sampler": samplers.len() - 1, "target": {"node": j, "path": "rotation"}}),
+/// The one animation of a scene, built a character at a time.
+#[derive(Default)]
+struct Animation {
+    samplers: Vec<Value>,
+    channels: Vec<Value>,
+}
+
+impl Animation {
+    /// One rotation channel per joint and the root's translation of the character whose nodes
+    /// start at `base`; nothing without frames.
+    fn add(&mut self, skeleton: &Skeleton, frames: &[(f64, &Pose)], base: usize, buf: &mut Buffer) {
+        let (Some(first), Some(last)) = (frames.first(), frames.last()) else {
+            return;
+        };
+        let times: Vec<f32> = frames.iter().map(|(t, _)| (*t - first.0) as f32).collect();
+        let input = buf.floats(&times, "SCALAR", times.len(), None);
+        buf.accessors[input]["min"] = json!([0.0]);
+        buf.accessors[input]["max"] = json!([(last.0 - first.0) as f32]);
+        for j in 0..skeleton.len() {
+            // the shorter way between neighbouring keys (q and -q are one rotation)
+            let mut prev = Quat::IDENTITY;
+            let rotations: Vec<f32> = (frames.iter())
+                .flat_map(|(_, p)| {
+                    let q = p.rotations[j].normalize();
+                    let q = if q.dot(prev) < 0.0 { -q } else { q };
+                    prev = q;
+                    q.to_array()
+                })
+                .collect();
+            let output = buf.floats(&rotations, "VEC4", frames.len(), None);
+            self.channel(input, output, base + j, "rotation");
+        }
+        let root: Vec<Vec3> = frames.iter().map(|(_, p)| p.root).collect();
+        let output = buf.vec3s(&root, None, false);
+        self.channel(input, output, base, "translation");
+    }
+
+    fn channel(&mut self, input: usize, output: usize, node: usize, path: &str) {
+        self.samplers
+            .push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+        self.channels.push(
+            json!({"sampler": self.samplers.len() - 1, "target": {"node": node, "path": path}}),
         );
     }
-    let root: Vec<Vec3> = frames.iter().map(|(_, p)| p.root).collect();
-    let output = buf.vec3s(&root, None, false);
-    samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-    channels
-        .push(json!({"sampler": samplers.len() - 1, "target": {"node": 0, "path": "translation"}}));
-    Some(json!({"name": "realized", "samplers": samplers, "channels": channels}))
+
+    /// The animation, if any character had frames.
+    fn finish(self) -> Option<Value> {
+        (!self.channels.is_empty()).then(
+            || json!({"name": "realized", "samplers": self.samplers, "channels": self.channels}),
+        )
+    }
 }
 
 /// The GLB container: header, JSON chunk (padded with spaces), binary chunk (padded with zeros).
@@ -278,5 +331,27 @@ mod tests {
         let channels = gltf["animations"][0]["channels"].as_array().unwrap();
         assert_eq!(channels.len(), s.len() + 1);
         assert_eq!(gltf["materials"].as_array().unwrap().len(), 2);
+    }
+
+    #[test]
+    fn a_scene_has_each_character_s_nodes_skin_and_channels() {
+        let s = Skeleton::adult();
+        let rest = Pose::rest(&s);
+        let frames = [(0.0, &rest), (0.5, &rest)];
+        let glb = write_scene(&s, &[("Alice", &frames), ("Bob", &frames)]);
+        let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+        let gltf: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+        let n = s.len();
+        assert_eq!(gltf["nodes"].as_array().unwrap().len(), 2 * (n + 1));
+        assert_eq!(
+            gltf["nodes"][n + 1]["name"],
+            format!("Bob/{}", s.joints()[0].name)
+        );
+        assert_eq!(gltf["nodes"][2 * n + 1]["skin"], 1);
+        assert_eq!(gltf["skins"][1]["joints"][0], n + 1);
+        assert_eq!(gltf["scenes"][0]["nodes"], json!([0, n, n + 1, 2 * n + 1]));
+        let channels = gltf["animations"][0]["channels"].as_array().unwrap();
+        assert_eq!(channels.len(), 2 * (n + 1));
+        assert_eq!(channels[n + 1]["target"]["node"], n + 1);
     }
 }

@@ -118,27 +118,43 @@ impl Recording {
         Ok(())
     }
 
-    /// Writes the glTF mannequin of the character `asked` (or the one chosen as for BVH) with its
-    /// motion. An error has the exit code.
+    /// Writes the glTF mannequin of the character `asked` with its motion, or without one asked
+    /// a scene of every character that received blocks, each where it stands. An error has the
+    /// exit code.
     pub fn write_gltf(
         &self,
         realizer: &Realizer,
         path: &Path,
         asked: Option<&str>,
     ) -> Result<(), (u8, String)> {
-        let poses = self.one_character(realizer, asked, "--gltf")?;
-        let frames: Vec<(f64, &Pose)> = (self.frames.iter().zip(&poses))
-            .map(|((t, _), p)| (*t, &p.pose))
+        let everyone = received(realizer);
+        let ids: Vec<String> = match asked {
+            None if everyone.len() > 1 => everyone.into_iter().map(str::to_string).collect(),
+            _ => vec![recorded_character(realizer, asked, "--gltf")
+                .map_err(|e| (1, format!("--gltf: {e}")))?],
+        };
+        let poses: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
+        let frames: Vec<Vec<(f64, &Pose)>> = (poses.iter())
+            .map(|p| {
+                (self.frames.iter().zip(p))
+                    .map(|((t, _), p)| (*t, &p.pose))
+                    .collect()
+            })
+            .collect();
+        let scene: Vec<(&str, &[(f64, &Pose)])> = (ids.iter().zip(&frames))
+            .map(|(id, f)| (id.as_str(), f.as_slice()))
             .collect();
         let skeleton = Skeleton::adult();
-        let glb = bml_realizer::body::gltf::write(&skeleton, &frames);
+        let glb = bml_realizer::body::gltf::write_scene(&skeleton, &scene);
         write_file(path, &glb)?;
         eprintln!(
-            "wrote {} ({} frames at {} fps, {} joints, {} kB)",
+            "wrote {} ({} frames at {} fps, {} joints, {} character{}, {} kB)",
             path.display(),
-            frames.len(),
+            self.frames.len(),
             self.fps,
             skeleton.len(),
+            ids.len(),
+            if ids.len() == 1 { "" } else { "s" },
             glb.len() / 1024
         );
         Ok(())

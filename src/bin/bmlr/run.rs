@@ -57,8 +57,9 @@ pub struct RunArgs {
     /// one frame every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.bvh")]
     bvh: Option<std::path::PathBuf>,
-    /// Write a skinned mannequin with the realized motion of the character (--character, else
-    /// the default one) as binary glTF, one key every 1/--fps seconds (virtual clock only).
+    /// Write a skinned mannequin with the realized motion of the character --character names
+    /// (without it, a scene of every character that received blocks) as binary glTF, one key
+    /// every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.glb")]
     gltf: Option<std::path::PathBuf>,
     /// Write the run's sound as a WAV file: synthesized speech (--tts flite) and audiofile clips,
