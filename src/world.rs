@@ -111,11 +111,17 @@ struct CharacterFile {
 /// Longest list of keys a path may have.
 pub const MAX_PATH_KEYS: usize = 100_000;
 
+/// Largest coordinate a world file may give (metres): far beyond any scene, and far enough from
+/// `f32::MAX` that turning a point into a character's frame stays finite.
+pub const MAX_COORDINATE: f64 = 1e9;
+
 fn vec3(name: &str, v: [f64; 3]) -> Result<Vec3, String> {
-    if v.iter().all(|c| c.is_finite()) {
+    if v.iter().all(|c| c.abs() <= MAX_COORDINATE) {
         Ok(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
     } else {
-        Err(format!("'{name}': coordinates must be finite numbers"))
+        Err(format!(
+            "'{name}': coordinates must be numbers of at most {MAX_COORDINATE} m"
+        ))
     }
 }
 
@@ -338,6 +344,67 @@ mod tests {
         ] {
             let e = World::from_json(text).unwrap_err();
             assert!(e.contains(says), "{text}: {e}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod placement_props {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn point() -> impl Strategy<Value = Vec3> {
+        (-20.0f32..20.0, -1.0f32..3.0, -20.0f32..20.0).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+
+    proptest! {
+        /// Seen from a placed character, every point, path key and other character is where
+        /// its placement takes the world point into its frame; and back again.
+        #[test]
+        fn the_world_seen_from_a_character_is_the_world_in_its_frame(
+            at in point(), facing in -720.0f32..720.0, p in point(), other in point(),
+            other_facing in -180.0f32..180.0,
+        ) {
+            let mut w = World::empty();
+            w.set("p", p);
+            w.set_path("walker", vec![(0.0, p), (1.0, other)]).unwrap();
+            let me = Placement::new(Vec3::new(at.x, 0.0, at.z), facing);
+            w.place("me", me).unwrap();
+            w.place("you", Placement::new(Vec3::new(other.x, 0.0, other.z), other_facing)).unwrap();
+            let seen = w.seen_from("me");
+            for name in ["p", "walker", "you"] {
+                let (world, local) = (w.get(name).unwrap(), seen.get(name).unwrap());
+                prop_assert!(local.distance(me.to_local(world)) < 1e-4, "{}", name);
+                prop_assert!(me.to_world(local).distance(world) < 1e-4, "{}", name);
+            }
+            // the character itself is at its own frame's eyes
+            prop_assert!(seen.get("me").unwrap().distance(CHARACTER_EYES) < 1e-4);
+            // paths move in the character's frame as they do in the world
+            let (mut a, mut b) = (w.clone(), seen.clone());
+            a.move_to(0.5);
+            b.move_to(0.5);
+            prop_assert!(b.get("walker").unwrap().distance(me.to_local(a.get("walker").unwrap())) < 1e-4);
+        }
+    }
+
+    #[test]
+    fn a_world_file_places_characters_and_refuses_far_coordinates() {
+        let (w, _) =
+            World::from_json(r#"{"characters": {"Bob": {"position": [1, 0, 2], "facing": 90}}}"#)
+                .unwrap();
+        let bob = w.placement("Bob");
+        assert!(
+            bob.to_world(Vec3::Z).distance(Vec3::new(2.0, 0.0, 2.0)) < 1e-6,
+            "facing 90 faces +x"
+        );
+        assert!(w.placement("Alice").is_origin());
+        for bad in [
+            r#"{"characters": {"Bob": {"position": [1e300, 0, 2]}}}"#,
+            r#"{"points": {"far": [0, 1e10, 0]}}"#,
+            r#"{"characters": {"Bob": {"position": [0, 0, 0], "facing": 1e300}}}"#,
+        ] {
+            let e = World::from_json(bad).unwrap_err();
+            assert!(e.contains("Bob") || e.contains("far"), "{bad}: {e}");
         }
     }
 }
