@@ -513,3 +513,46 @@ fn headless_chromium_draws_the_centre_of_mass_when_asked() {
     assert!(without < 1e-4, "red without #com: {without}");
     assert!(with > 5e-4, "no centre of mass drawn: {with}");
 }
+
+/// The camera looks at the characters where the world places them: Bob alone, 2.3 m from the
+/// origin, stands in the middle of the picture; with Alice, both are drawn, apart.
+#[test]
+#[ignore = "needs Debian's chromium; .ci/run installs it and runs this with --ignored"]
+fn headless_chromium_frames_characters_where_they_stand() {
+    let world = "fixtures/examples/world.json";
+    let shot = |name: &str, files: &[&str]| {
+        let mut args = vec!["--no-idle", "--world", world];
+        args.extend_from_slice(files);
+        let (_, dir) = page(name, &args);
+        let url = format!("file://{}#t=0", dir.join("index.html").display());
+        let out = dir.join("shot.png");
+        let (_, console) = browse(&url, &format!("--screenshot={}", out.display()));
+        assert!(console.is_empty(), "{name}: {console:?}");
+        Shot::load(&out)
+    };
+    let bob = shot("view-bob", &["fixtures/examples/two-bob.xml"]);
+    let background = bob.px(880, 60);
+    let drawn = |s: &Shot, b| s.share(b, |x, y| far(s.px(x, y), background));
+    let middle = drawn(&bob, (410, 490, 60, 400));
+    assert!(
+        middle > 0.3,
+        "Bob is not in the middle: {middle:.2} of its box drawn"
+    );
+    let both = shot(
+        "view-two",
+        &[
+            "fixtures/examples/two-alice.xml",
+            "fixtures/examples/two-bob.xml",
+        ],
+    );
+    // the stage's middle lies between them; each stands to one side of it
+    let (left, right) = (
+        drawn(&both, (300, 440, 100, 330)),
+        drawn(&both, (450, 600, 100, 330)),
+    );
+    eprintln!("Bob alone: {middle:.2} drawn; two: {left:.2} left, {right:.2} right");
+    assert!(
+        left > 0.1 && right > 0.1,
+        "not both drawn: {left:.2}, {right:.2}"
+    );
+}

@@ -461,12 +461,15 @@
      *  they spread from it, or (`face`) the first character's place. */
     stage(face) {
       const first = this.clip.poses[0] || [];
-      if (!first.length) return { x: 0, z: 0, spread: 0 };
+      if (!first.length) return { x: 0, z: 0, spread: 0, yaw: 0 };
       const chosen = face ? first.slice(0, 1) : first;
       const x = chosen.reduce((a, p) => a + p[0], 0) / chosen.length;
       const z = chosen.reduce((a, p) => a + p[2], 0) / chosen.length;
       const spread = Math.max(...chosen.map((p) => Math.hypot(p[0] - x, p[2] - z)));
-      return { x, z, spread };
+      // a close look comes from in front of the character, the way it faces (its root's turn
+      // about +y)
+      const yaw = face ? 2 * Math.atan2(first[0][4], first[0][6]) : 0;
+      return { x, z, spread, yaw };
     }
 
     orbit() {
@@ -569,10 +572,11 @@
       const stage = this.stage(v.height === this.close.height);
       const target = new THREE.Vector3(stage.x, v.height, stage.z);
       const distance = v.distance + 1.5 * stage.spread;
+      const azimuth = v.azimuth + stage.yaw;
       this.camera.position.set(
-        target.x + distance * Math.sin(v.azimuth) * Math.cos(v.elevation),
+        target.x + distance * Math.sin(azimuth) * Math.cos(v.elevation),
         target.y + distance * Math.sin(v.elevation),
-        target.z + distance * Math.cos(v.azimuth) * Math.cos(v.elevation),
+        target.z + distance * Math.cos(azimuth) * Math.cos(v.elevation),
       );
       this.camera.lookAt(target);
       this.renderer.render(this.scene, this.camera);
