@@ -104,3 +104,30 @@ fn a_placement_must_be_finite() {
         .unwrap_err();
     assert!(e.contains("Bob"), "{e}");
 }
+
+/// Bob, placed and turned, points at Alice with his right hand: at the stroke his index finger
+/// points at her eyes (within 3°), in the world.
+#[test]
+fn a_placed_character_points_at_another() {
+    let mut r = realizer();
+    r.perform_bml(&format!(
+        r#"<bml {NS} id="b" characterId="Bob"><pointing id="p" target="Alice" mode="RIGHT_HAND" start="0" stroke="1" end="3"/></bml>"#
+    ))
+    .unwrap();
+    r.perform_bml(&format!(r#"<bml {NS} id="a" characterId="Alice"/>"#))
+        .unwrap();
+    for k in 0..60 {
+        r.tick(f64::from(k) / 60.0);
+    }
+    let frame = r.tick(1.0);
+    let skeleton = Skeleton::adult();
+    let w = pose_of(&frame, "Bob").world(&skeleton);
+    let (i1, i3) = (
+        skeleton.joint("r_index1").unwrap(),
+        skeleton.joint("r_index3").unwrap(),
+    );
+    let alice = eyes(&skeleton, &pose_of(&frame, "Alice")).0;
+    let finger = w.positions[i3] - w.positions[i1];
+    let off = finger.angle_between(alice - w.positions[i3]).to_degrees();
+    assert!(off < 3.0, "Bob's finger points {off:.1}° away from Alice");
+}
