@@ -514,12 +514,19 @@ fn headless_chromium_draws_the_centre_of_mass_when_asked() {
     assert!(with > 5e-4, "no centre of mass drawn: {with}");
 }
 
-/// The camera looks at the characters where the world places them: Bob alone, 2.3 m from the
+/// The camera looks at the characters where the world places them: Bob alone, 3 m from the
 /// origin, stands in the middle of the picture; with Alice, both are drawn, apart.
 #[test]
 #[ignore = "needs Debian's chromium; .ci/run installs it and runs this with --ignored"]
 fn headless_chromium_frames_characters_where_they_stand() {
-    let world = "fixtures/examples/world.json";
+    let file = scratch("view-world").join("world.json");
+    std::fs::write(
+        &file,
+        r#"{"characters": {"Alice": {"position": [0, 0, 0]},
+            "Bob": {"position": [2.4, 0, 1.8], "facing": -120}}}"#,
+    )
+    .unwrap();
+    let world = file.to_str().unwrap();
     let shot = |name: &str, files: &[&str]| {
         let mut args = vec!["--no-idle", "--world", world];
         args.extend_from_slice(files);
