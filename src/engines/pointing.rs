@@ -1,5 +1,5 @@
 //! The pointing engine: `pointing` as real arm motion toward a named point of the [`World`].
-//! The wrist goes to 85 % of the arm's reach on the line from the shoulder to the target (analytic
+//! The wrist goes to 97 % of the arm's reach on the line from the shoulder to the target (analytic
 //! two-link IK, the elbow bending down and back), and the hand turns so that the index finger
 //! points at the target. The arm moves there from `start` to `ready` (minimum jerk), holds —
 //! following a moving target — until `relax`, and returns by `end` to the pose it started from
