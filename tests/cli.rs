@@ -487,6 +487,14 @@ fn the_idle_layer_moves_the_body_and_never_the_feedback() {
     );
 }
 
+/// A `.glb`'s JSON (after checking its magic) and where its binary chunk's data starts.
+fn glb_json(glb: &[u8]) -> (serde_json::Value, usize) {
+    assert_eq!(&glb[0..4], b"glTF");
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    (json, 20 + json_len + 8)
+}
+
 #[test]
 fn run_gltf_writes_a_skinned_mannequin_with_the_motion() {
     let path = std::env::temp_dir().join(format!("bmlr-{}-welcome.glb", std::process::id()));
@@ -501,9 +509,7 @@ fn run_gltf_writes_a_skinned_mannequin_with_the_motion() {
     assert_eq!(with, without, "the glTF does not change the feedback");
     assert!(err.contains("(173 frames at 60 fps, 57 joints,"), "{err}");
     let glb = std::fs::read(&path).unwrap();
-    assert_eq!(&glb[0..4], b"glTF");
-    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
-    let gltf: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let (gltf, _) = glb_json(&glb);
     let skeleton = bml_realizer::body::Skeleton::adult();
     assert_eq!(
         gltf["skins"][0]["joints"].as_array().unwrap().len(),
@@ -553,8 +559,7 @@ fn run_gltf_of_several_characters_is_one_scene() {
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("57 joints, 2 characters,"), "{err}");
     let glb = std::fs::read(&path).unwrap();
-    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
-    let gltf: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let (gltf, bin) = glb_json(&glb);
     let n = bml_realizer::body::Skeleton::adult().len();
     assert_eq!(gltf["skins"].as_array().unwrap().len(), 2);
     assert_eq!(gltf["nodes"][2 * n + 1]["name"], "Bob");
@@ -566,7 +571,7 @@ fn run_gltf_of_several_characters_is_one_scene() {
     let sampler = &gltf["animations"][0]["samplers"][root["sampler"].as_u64().unwrap() as usize];
     let output = &gltf["accessors"][sampler["output"].as_u64().unwrap() as usize];
     let view = &gltf["bufferViews"][output["bufferView"].as_u64().unwrap() as usize];
-    let bin = 20 + json_len + 8 + view["byteOffset"].as_u64().unwrap() as usize;
+    let bin = bin + view["byteOffset"].as_u64().unwrap() as usize;
     let x = f32::from_le_bytes(glb[bin..bin + 4].try_into().unwrap());
     let z = f32::from_le_bytes(glb[bin + 8..bin + 12].try_into().unwrap());
     assert!(

@@ -17,7 +17,16 @@ const PUSH: f64 = 3.6;
 /// Realizes `bml` for `seconds` at 60 Hz, pushing the upper body sideways with `push` N s at
 /// [`PUSH`]: each frame's time and pose, and the warnings.
 fn realize(bml: &str, seconds: f64, push: f64) -> (Vec<(f64, Pose)>, Vec<String>) {
-    let mut r = Realizer::new().with_idle(false);
+    realize_with(Realizer::new().with_idle(false), bml, seconds, push)
+}
+
+/// [`realize`] on realizer `r`.
+fn realize_with(
+    mut r: Realizer,
+    bml: &str,
+    seconds: f64,
+    push: f64,
+) -> (Vec<(f64, Pose)>, Vec<String>) {
     r.perform_bml(bml).unwrap();
     let mut frames = Vec::new();
     let mut warned = Vec::new();
@@ -177,33 +186,21 @@ fn a_compound_defined_in_a_data_file_moves_the_simulated_arm() {
     .unwrap();
     let assets = Assets::from_dir(&dir).unwrap();
     assert!(assets.compounds.find("HangingLeftArm").is_some());
-    let mut r = Realizer::new()
+    let r = Realizer::new()
         .with_idle(false)
         .with_engines(move || bml_realizer::engines::registry_with(Default::default(), &assets));
-    r.perform_bml(&format!(
+    let bml = format!(
         r#"<bml {NS} id="b"><bmlt:controller id="bal" class="BalanceController" start="0" end="3"/><bmlt:controller id="reach" class="ReachForward" start="0.5" end="3"/></bml>"#
-    ))
-    .unwrap();
-    let skeleton = Skeleton::adult();
-    let mut warned = Vec::new();
-    let mut at_2_5 = None;
-    for k in 0..=(3.0 * FPS) as usize {
-        let t = k as f64 / FPS;
-        let frame = r.tick(t);
-        warned.extend(frame.feedback.iter().filter_map(|f| match f {
-            Feedback::Warning(w) => Some(w.text.clone()),
-            _ => None,
-        }));
-        if k == (2.5 * FPS) as usize {
-            at_2_5 = Some(frame.poses[0].pose.clone());
-        }
-    }
+    );
+    let (frames, warned) = realize_with(r, &bml, 3.0, 0.0);
     assert!(warned.is_empty(), "{warned:?}");
-    let pose = at_2_5.unwrap();
+    let skeleton = Skeleton::adult();
+    let (t, pose) = &frames[(2.5 * FPS) as usize];
+    assert!((t - 2.5).abs() < 1e-9);
     let rest = Pose::rest(&skeleton);
     let (shoulder, wrist) = (
-        in_trunk(&pose, &skeleton, "r_shoulder"),
-        in_trunk(&pose, &skeleton, "r_wrist"),
+        in_trunk(pose, &skeleton, "r_shoulder"),
+        in_trunk(pose, &skeleton, "r_wrist"),
     );
     let rest_wrist = in_trunk(&rest, &skeleton, "r_wrist");
     // 70° forward: the wrist ahead of the shoulder by about sin 70° of the arm's length

@@ -178,34 +178,53 @@ fn subtree_torques(links: &[Link], swings: &[Swing], t: f64) -> Vec<DVec3> {
         .collect()
 }
 
-#[test]
-fn rnea_equals_the_subtree_newton_euler_equations_on_a_random_chain() {
-    let mut rng = Rng(42);
+/// Compares the inverse dynamics (gravity as an upward base acceleration) with `want`, each
+/// joint's torque in its link's frame, on five random chains from `seed` at eight instants
+/// each (`t0`, `t0 + dt`, …): every relative difference below 1e-9. Returns the worst.
+fn worst_difference(
+    seed: u64,
+    (t0, dt): (f64, f64),
+    mut want: impl FnMut(&[Link], &[Swing], f64, &[JointMotion]) -> Vec<DVec3>,
+) -> f64 {
+    let mut rng = Rng(seed);
     let mut worst = 0.0f64;
     for _ in 0..5 {
         let (links, swings) = chain(&mut rng);
         for k in 0..8 {
-            let t = 0.1 + k as f64 * 0.23;
+            let t = t0 + k as f64 * dt;
             let joints: Vec<JointMotion> = swings.iter().map(|s| s.motion(t)).collect();
-            let d = inverse_dynamics(
+            let got = inverse_dynamics(
                 &links,
                 &joints,
                 with_gravity(BaseMotion::default(), DQuat::IDENTITY),
-            );
-            let poses = world(&links, &swings, t);
-            let want = subtree_torques(&links, &swings, t);
+            )
+            .torques;
+            let want = want(&links, &swings, t, &joints);
             for j in 0..3 {
-                let got = poses[j].1 * d.torques[j];
-                let err = (got - want[j]).length() / want[j].length().max(1.0);
+                let err = (got[j] - want[j]).length() / want[j].length().max(1.0);
                 worst = worst.max(err);
                 assert!(
                     err < 1e-9,
-                    "joint {j} at {t}: {got} vs {}: {err:e}",
+                    "joint {j} at {t}: {} vs {}: {err:e}",
+                    got[j],
                     want[j]
                 );
             }
         }
     }
+    worst
+}
+
+#[test]
+fn rnea_equals_the_subtree_newton_euler_equations_on_a_random_chain() {
+    let worst = worst_difference(42, (0.1, 0.23), |links, swings, t, _| {
+        // the subtree equations are in the world frame
+        let poses = world(links, swings, t);
+        let world_torques = subtree_torques(links, swings, t);
+        (0..3)
+            .map(|j| poses[j].1.inverse() * world_torques[j])
+            .collect()
+    });
     // the numerical differences of the kinematics limit the agreement: 4.4e-10 at worst here
     eprintln!("worst relative difference {worst:e}");
 }
@@ -329,43 +348,21 @@ impl JointSpace {
 /// §3.3). Both are exact, so they agree to rounding.
 #[test]
 fn rnea_equals_h_q_ddot_plus_c_on_a_random_chain() {
-    let mut rng = Rng(2009);
-    let mut worst = 0.0f64;
-    for _ in 0..5 {
-        let (links, swings) = chain(&mut rng);
-        for k in 0..8 {
-            let t = 0.05 + k as f64 * 0.31;
-            let joints: Vec<JointMotion> = swings.iter().map(|s| s.motion(t)).collect();
-            let poses = world(&links, &swings, t);
-            let space = JointSpace::new(&links, &poses, &joints);
-            // H is a mass matrix: symmetric, and the kinetic energy of any motion positive
-            for a in 0..3 {
-                for b in 0..3 {
-                    let asym =
-                        (space.h[a][b] - space.h[b][a].transpose()).abs_diff_eq(DMat3::ZERO, 1e-12);
-                    assert!(asym, "H not symmetric in blocks {a}, {b}");
-                }
-            }
-            let x: Vec<DVec3> = (0..3).map(|_| rng.vec(1.0)).collect();
-            assert!(space.energy(&x) > 0.0, "H not positive definite at {t}");
-            let want = space.torques(&joints);
-            let got = inverse_dynamics(
-                &links,
-                &joints,
-                with_gravity(BaseMotion::default(), DQuat::IDENTITY),
-            )
-            .torques;
-            for j in 0..3 {
-                let err = (got[j] - want[j]).length() / want[j].length().max(1.0);
-                worst = worst.max(err);
-                assert!(
-                    err < 1e-9,
-                    "joint {j} at {t}: {} vs {}: {err:e}",
-                    got[j],
-                    want[j]
-                );
+    let mut motions = Rng(7);
+    let worst = worst_difference(2009, (0.05, 0.31), |links, swings, t, joints| {
+        let poses = world(links, swings, t);
+        let space = JointSpace::new(links, &poses, joints);
+        // H is a mass matrix: symmetric, and the kinetic energy of any motion positive
+        for a in 0..3 {
+            for b in 0..3 {
+                let asym =
+                    (space.h[a][b] - space.h[b][a].transpose()).abs_diff_eq(DMat3::ZERO, 1e-12);
+                assert!(asym, "H not symmetric in blocks {a}, {b}");
             }
         }
-    }
+        let x: Vec<DVec3> = (0..3).map(|_| motions.vec(1.0)).collect();
+        assert!(space.energy(&x) > 0.0, "H not positive definite at {t}");
+        space.torques(joints)
+    });
     eprintln!("worst relative difference {worst:e}");
 }

@@ -238,6 +238,8 @@ fn joint_nodes(skeleton: &Skeleton, base: usize, prefix: &str) -> Vec<Value> {
 /// The one animation of a scene, built a character at a time.
 #[derive(Default)]
 struct Animation {
+    /// The key times' accessor, shared by every character (all are keyed at the same times).
+    input: Option<usize>,
     samplers: Vec<Value>,
     channels: Vec<Value>,
 }
@@ -249,10 +251,13 @@ impl Animation {
         let (Some(first), Some(last)) = (frames.first(), frames.last()) else {
             return;
         };
-        let times: Vec<f32> = frames.iter().map(|(t, _)| (*t - first.0) as f32).collect();
-        let input = buf.floats(&times, "SCALAR", times.len(), None);
-        buf.accessors[input]["min"] = json!([0.0]);
-        buf.accessors[input]["max"] = json!([(last.0 - first.0) as f32]);
+        let input = *self.input.get_or_insert_with(|| {
+            let times: Vec<f32> = frames.iter().map(|(t, _)| (*t - first.0) as f32).collect();
+            let input = buf.floats(&times, "SCALAR", times.len(), None);
+            buf.accessors[input]["min"] = json!([0.0]);
+            buf.accessors[input]["max"] = json!([(last.0 - first.0) as f32]);
+            input
+        });
         for j in 0..skeleton.len() {
             // the shorter way between neighbouring keys (q and -q are one rotation)
             let mut prev = Quat::IDENTITY;
@@ -353,5 +358,8 @@ mod tests {
         let channels = gltf["animations"][0]["channels"].as_array().unwrap();
         assert_eq!(channels.len(), 2 * (n + 1));
         assert_eq!(channels[n + 1]["target"]["node"], n + 1);
+        // one set of key times for both
+        let samplers = gltf["animations"][0]["samplers"].as_array().unwrap();
+        assert_eq!(samplers[0]["input"], samplers[n + 1]["input"]);
     }
 }

@@ -15,8 +15,10 @@ use super::controllers::{Controller, Drive};
 use super::humanoid::PARTS;
 use super::sim::Simulation;
 
-/// Whether a compound needs a member (see the module documentation).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Whether a compound needs a member (see the module documentation); `"required"` or
+/// `"desired"` in a definitions file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Need {
     /// The compound does not bind without it.
     Required,
@@ -142,12 +144,6 @@ impl Controller for Compound {
 /// The embedded definitions.
 const COMPOUNDS: &str = include_str!("../../fixtures/physics/compounds.json");
 
-/// The compounds the embedded data defines: an arm hanging down loosely, left and right (soft
-/// pulls toward rest on the shoulder and elbow, a damper on the wrist).
-pub fn built_in() -> Vec<CompoundSpec> {
-    CompoundLibrary::default().specs
-}
-
 /// Compound definitions by name, in the order defined (see the module documentation).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompoundLibrary {
@@ -155,7 +151,9 @@ pub struct CompoundLibrary {
 }
 
 impl Default for CompoundLibrary {
-    /// The embedded definitions (read once per process, then copied).
+    /// The embedded definitions (read once per process, then copied): an arm hanging down
+    /// loosely, left and right (soft pulls toward rest on the shoulder and elbow, a damper on
+    /// the wrist).
     fn default() -> Self {
         static LIBRARY: std::sync::LazyLock<CompoundLibrary> = std::sync::LazyLock::new(|| {
             CompoundLibrary::from_json(COMPOUNDS).expect("the embedded compounds are valid")
@@ -250,17 +248,10 @@ struct MemberFile {
     part: String,
     kp: f64,
     kd: f64,
-    need: NeedFile,
+    need: Need,
     /// z, x, y Euler degrees (ZXY); the rest pose when omitted.
     #[serde(default)]
     target: Option<[f64; 3]>,
-}
-
-#[derive(serde::Deserialize, Clone, Copy)]
-#[serde(rename_all = "lowercase")]
-enum NeedFile {
-    Required,
-    Desired,
 }
 
 impl MemberFile {
@@ -278,10 +269,7 @@ impl MemberFile {
             target,
             kp: self.kp,
             kd: self.kd,
-            need: match self.need {
-                NeedFile::Required => Need::Required,
-                NeedFile::Desired => Need::Desired,
-            },
+            need: self.need,
         }
     }
 }
@@ -296,6 +284,11 @@ mod tests {
     use super::*;
     use crate::body::{Pose, Skeleton};
     use crate::dynamics::sim::STEP;
+
+    /// The embedded definitions: `HangingLeftArm`, then `HangingRightArm`.
+    fn built_in() -> Vec<CompoundSpec> {
+        CompoundLibrary::default().specs().to_vec()
+    }
 
     /// Lower body and trunk, and the left arm without its hand.
     const WITH_LEFT_ARM: [usize; 10] = [0, 1, 3, 4, 9, 10, 11, 12, 13, 14];

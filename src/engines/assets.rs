@@ -44,8 +44,9 @@ impl Default for Assets {
 
 impl Assets {
     /// The defaults extended by each of `units.json`, `gestures.json`, `poses.json`,
-    /// `heads.json` and `compounds.json` that `dir` has (see the module documentation). The directory's bindings may
-    /// name its own units and the embedded ones. The error names the file and what is wrong.
+    /// `heads.json` and `compounds.json` that `dir` has (see the module documentation). The
+    /// directory's bindings may name its own units and the embedded ones. The error names the
+    /// file and what is wrong.
     pub fn from_dir(dir: &Path) -> Result<Assets, String> {
         if !dir.is_dir() {
             return Err(format!("{} is not a directory", dir.display()));

@@ -416,14 +416,11 @@ mod tests {
         let (y, p) = yaw_pitch(d);
         assert!((y - 0.3).abs() < 1e-5 && (p - 0.2).abs() < 1e-5);
     }
-}
 
-#[cfg(test)]
-mod placed {
     /// A placed character as a target is where the default adult's eyes are.
     #[test]
     fn a_character_target_is_at_the_adult_s_eyes() {
-        let eyes = super::eyes_at_rest(&crate::body::Skeleton::adult());
+        let eyes = eyes_at_rest(&crate::body::Skeleton::adult());
         let d = eyes.distance(crate::world::CHARACTER_EYES);
         assert!(d < 0.01, "{eyes} vs {}", crate::world::CHARACTER_EYES);
     }

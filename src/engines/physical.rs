@@ -32,7 +32,7 @@ use std::sync::Arc;
 
 use crate::bml::{Behaviour, BehaviourKind};
 use crate::body::{Pose, Skeleton};
-use crate::dynamics::compound::{self, Compound, CompoundLibrary, CompoundSpec};
+use crate::dynamics::compound::{same_name, Compound, CompoundLibrary, CompoundSpec};
 use crate::dynamics::config::{smallest_covering, Configuration};
 use crate::dynamics::controllers::{Balance, Controller, Drive, PoseController, RagDoll};
 use crate::dynamics::sim::{Simulation, STEP};
@@ -569,16 +569,10 @@ fn overshoot_capped(offset: glam::Vec3, rate: glam::Vec3, duration: f64, least: 
     }
 }
 
-/// Whether `given` names the class `name`: its name in any case, with or without the
-/// `Controller` suffix (`Balance`, `balancecontroller`).
-fn same_class(name: &str, given: &str) -> bool {
-    compound::same_name(name, given)
-}
-
 /// Whether `name` is one of the built-in controller classes (`BalanceController`, …), which a
 /// compound definition may not take.
 pub fn is_built_in_class(name: &str) -> bool {
-    CLASSES.iter().any(|(class, _)| same_class(class, name))
+    CLASSES.iter().any(|(class, _)| same_name(class, name))
 }
 
 /// `a` and `b` mixed: the root's place linearly, each rotation by slerp (`w` = 0: `a`).
@@ -617,7 +611,7 @@ impl Engine for PhysicalEngine {
             ));
         };
         let fail = |why: String| EngineError(format!("{}: {why}", unit.key));
-        let found = CLASSES.iter().find(|(name, _)| same_class(name, &c.class));
+        let found = CLASSES.iter().find(|(name, _)| same_name(name, &c.class));
         let compound = self.compounds.find(&c.class).cloned();
         let (class, defaults): (&'static str, &[(&str, f64)]) = match (found, &compound) {
             (Some((class, defaults)), _) => (class, defaults),
@@ -670,7 +664,7 @@ impl crate::engine::Motion for PhysicalEngine {
         };
         let parts: Vec<usize> = match self.compounds.find(&c.class) {
             Some(spec) => spec.parts(),
-            None if same_class("RagDoll", &c.class) => WHOLE_BODY.to_vec(),
+            None if same_name("RagDoll", &c.class) => WHOLE_BODY.to_vec(),
             None => LOWER_BODY.to_vec(),
         };
         let h = crate::dynamics::humanoid::Humanoid::new(skeleton).ok()?;
