@@ -30,6 +30,7 @@ pub mod engine;
 pub mod engines;
 pub mod face;
 pub mod feedback;
+pub mod locomotion;
 pub mod plan;
 pub mod realizer;
 pub mod schedule;

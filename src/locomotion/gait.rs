@@ -1,0 +1,358 @@
+//! A procedural human gait, driven by the distance walked. One phase runs through a gait cycle
+//! (two steps); it advances by distance / stride, so that steps are as long as human walking
+//! makes them at that speed (the walk ratio, below) and no foot slides. Each foot is either
+//! planted, fixed on the ground in world coordinates, or swinging from where it lifted off to
+//! where it will land; a planted foot rolls over its heel after heel strike and over the ball of
+//! the foot before toe-off, about points that stay fixed on the ground. The pose is made at
+//! render time: the pelvis over the feet (its height capped so that every planted foot stays
+//! within reach), rotation, list and sideways sway of the pelvis with a counter-rotation of the
+//! trunk, the arms swinging against the legs, and two-link IK from each hip to its ankle.
+//! When the walker stands, stepping goes on at a slow cadence until both feet are planted
+//! beside each other, square to the facing; then the phase stops.
+//!
+//! Cadence and step length follow the *walk ratio* (step length / cadence), which stays close
+//! to 0.0061 m per step/min across walking speeds in healthy adults (Sekiya & Nagasaki 1998,
+//! Gait & Posture 7:225–227): at speed v, cadence = √(60 v / W) steps/min and step length =
+//! W × cadence, which gives 113 steps/min and 0.69 m at 1.3 m/s. Running takes 150 + 10 v
+//! steps/min (180 at 3 m/s), with a flight phase (stance 38 % of the cycle).
+
+use glam::{Quat, Vec2, Vec3};
+
+/// The walk ratio (m per step/min).
+pub const WALK_RATIO: f32 = 0.0061;
+/// Slowest cadence of stepping (steps/min): turning on the spot, closing the feet.
+pub const MIN_CADENCE: f32 = 80.0;
+/// Half the distance between the feet (m): the hips' half width.
+pub const HALF_WIDTH: f32 = 0.09;
+/// A foot counts as placed where it belongs when within this (m) and [`SETTLED_YAW`].
+pub const SETTLED: f32 = 0.015;
+/// … and turned within this (rad).
+pub const SETTLED_YAW: f32 = 0.06;
+
+/// Cadence (steps per minute) at `speed` (m/s).
+pub fn cadence(speed: f32, running: bool) -> f32 {
+    if running {
+        150.0 + 10.0 * speed
+    } else {
+        (60.0 * speed.max(0.0) / WALK_RATIO).sqrt().max(MIN_CADENCE)
+    }
+}
+
+/// Step length (m) at `speed`: speed × 60 / cadence.
+pub fn step_length(speed: f32, running: bool) -> f32 {
+    speed.max(0.0) * 60.0 / cadence(speed, running)
+}
+
+/// A foot: planted somewhere or swinging.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Foot {
+    /// On the ground: the ankle's ground point (x, z) and the foot's heading (rad about +y).
+    Planted {
+        /// Where (x, z).
+        at: Vec2,
+        /// Its heading.
+        yaw: f32,
+    },
+    /// In the air since lifting off at `from` with heading `from_yaw`.
+    Swing {
+        /// Where it lifted off.
+        from: Vec2,
+        /// Its heading then.
+        from_yaw: f32,
+    },
+}
+
+/// The gait state of one walker: the cycle phase and both feet (left, right).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gait {
+    /// Phase through the cycle, [0, 1): the left foot strikes at 0, the right at ½.
+    pub phase: f32,
+    /// Left and right foot.
+    pub feet: [Foot; 2],
+    /// Whether running (flight phase).
+    pub running: bool,
+    /// The speed the walker goes at (for step lengths), m/s.
+    pub speed: f32,
+    /// Heading of travel (x, z), unit.
+    pub heading: Vec2,
+}
+
+/// Where the walker's body is: its ground position and facing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Body {
+    /// Root on the ground (x, z).
+    pub at: Vec2,
+    /// Facing, radians about +y from +z.
+    pub facing: f32,
+}
+
+/// The unit vector of heading `yaw` (radians about +y from +z), as (x, z).
+pub fn forward(yaw: f32) -> Vec2 {
+    Vec2::new(yaw.sin(), yaw.cos())
+}
+
+/// `a − b` wrapped into (−π, π].
+pub fn angle_diff(a: f32, b: f32) -> f32 {
+    let d = (a - b).rem_euclid(std::f32::consts::TAU);
+    if d > std::f32::consts::PI {
+        d - std::f32::consts::TAU
+    } else {
+        d
+    }
+}
+
+/// Side of each foot: +1 left (+x when facing +z), −1 right.
+const SIDE: [f32; 2] = [1.0, -1.0];
+/// Phase offset of each foot.
+const OFFSET: [f32; 2] = [0.0, 0.5];
+
+impl Gait {
+    /// Standing at `body` with both feet planted beside each other.
+    pub fn standing(body: Body) -> Gait {
+        let mut g = Gait {
+            phase: 0.05,
+            feet: [Foot::Planted {
+                at: Vec2::ZERO,
+                yaw: 0.0,
+            }; 2],
+            running: false,
+            speed: 0.0,
+            heading: forward(body.facing),
+        };
+        for k in 0..2 {
+            g.feet[k] = Foot::Planted {
+                at: standing_spot(body, k),
+                yaw: body.facing,
+            };
+        }
+        g
+    }
+
+    /// The stance fraction of the cycle.
+    pub fn stance(&self) -> f32 {
+        if self.running {
+            0.38
+        } else {
+            0.6
+        }
+    }
+
+    /// Foot `k`'s own phase: 0 at its heel strike, stance until [`stance`](Self::stance).
+    pub fn foot_phase(&self, k: usize) -> f32 {
+        (self.phase + 1.0 - OFFSET[k]).fract()
+    }
+
+    /// The length of one cycle (two steps) at the current speed, m.
+    pub fn stride(&self) -> f32 {
+        2.0 * step_length(self.speed, self.running)
+    }
+
+    /// Whether foot `k` is planted where it belongs for a body standing at `body`.
+    fn settled(&self, k: usize, body: Body) -> bool {
+        match self.feet[k] {
+            Foot::Planted { at, yaw } => {
+                at.distance(standing_spot(body, k)) < SETTLED
+                    && angle_diff(yaw, body.facing).abs() < SETTLED_YAW
+            }
+            Foot::Swing { .. } => false,
+        }
+    }
+
+    /// Whether the walker stands: both feet planted where they belong and no speed.
+    pub fn at_rest(&self, body: Body) -> bool {
+        self.speed < 0.02 && self.settled(0, body) && self.settled(1, body)
+    }
+
+    /// Where swinging foot `k` will land if it lands at its phase's end: ahead of the body by
+    /// the distance it will cover until then plus half a stance, beside the line of travel.
+    pub fn landing(&self, k: usize, body: Body) -> Vec2 {
+        let psi = self.foot_phase(k);
+        let stride = self.stride();
+        let lead = ((1.0 - psi) * stride + self.stance() * stride * 0.42).min(0.55);
+        let side = Vec2::new(body.facing.cos(), -body.facing.sin()) * (SIDE[k] * HALF_WIDTH);
+        body.at + self.heading * lead + side
+    }
+
+    /// Advances the gait by `dt` seconds for a body at `body` moving at `velocity` (x, z).
+    pub fn step(&mut self, dt: f32, body: Body, velocity: Vec2) {
+        self.speed = velocity.length();
+        if self.speed > 0.05 {
+            self.heading = velocity / self.speed;
+        } else {
+            self.heading = forward(body.facing);
+        }
+        if self.at_rest(body) {
+            return;
+        }
+        let cycles_per_s = cadence(self.speed, self.running) / 120.0;
+        let before = [self.foot_phase(0), self.foot_phase(1)];
+        self.phase = (self.phase + cycles_per_s * dt).fract();
+        for (k, &was) in before.iter().enumerate() {
+            let now = self.foot_phase(k);
+            let beta = self.stance();
+            let lifts = was < beta && now >= beta;
+            let lands = now < was; // wrapped: heel strike
+            match self.feet[k] {
+                Foot::Planted { at, yaw } if lifts => {
+                    // a foot already where it belongs stays down while the body stands
+                    if !(self.speed < 0.05 && self.settled(k, body)) {
+                        self.feet[k] = Foot::Swing {
+                            from: at,
+                            from_yaw: yaw,
+                        };
+                    }
+                }
+                Foot::Swing { .. } if lands => {
+                    self.feet[k] = Foot::Planted {
+                        at: self.landing(k, body),
+                        yaw: body.facing,
+                    };
+                }
+                _ => {}
+            }
+        }
+    }
+}
+
+/// Where foot `k` stands when the body stands at `body`.
+pub fn standing_spot(body: Body, k: usize) -> Vec2 {
+    body.at + Vec2::new(body.facing.cos(), -body.facing.sin()) * (SIDE[k] * HALF_WIDTH)
+}
+
+/// Where a foot is in one frame: its ankle (world, m) and orientation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FootPose {
+    /// The ankle joint's position.
+    pub ankle: Vec3,
+    /// The foot's orientation (heading, then pitch: positive lifts the toes).
+    pub yaw: f32,
+    /// Pitch (rad; positive: toes up).
+    pub pitch: f32,
+    /// Whether it is on the ground.
+    pub planted: bool,
+}
+
+/// Height of the ankle joint above the ground with the foot flat (m).
+pub const ANKLE_HEIGHT: f32 = 0.05;
+/// The heel's contact point behind the ankle (m).
+pub const HEEL_BACK: f32 = 0.05;
+/// The ball of the foot ahead of the ankle (m).
+pub const BALL_AHEAD: f32 = 0.12;
+
+/// The ankle when the foot, flat with its ankle over `at`, is pitched by `pitch` about a point
+/// on its sole `pivot_ahead` metres ahead of the ankle.
+fn rolled(at: Vec2, yaw: f32, pitch: f32, pivot_ahead: f32) -> Vec3 {
+    let f = forward(yaw);
+    let pivot = Vec3::new(at.x, 0.0, at.y) + Vec3::new(f.x, 0.0, f.y) * pivot_ahead;
+    let ankle_rel = Vec3::new(-f.x, 0.0, -f.y) * pivot_ahead + Vec3::Y * ANKLE_HEIGHT;
+    // toes up turns the foot about its own left axis
+    let axis = Vec3::new(f.y, 0.0, -f.x);
+    pivot + Quat::from_axis_angle(axis, -pitch) * ankle_rel
+}
+
+impl Gait {
+    /// Foot `k` in this frame for a body at `body`; `amount` (0–1) scales the heel and toe
+    /// rolls (none while stepping slowly).
+    pub fn foot_pose(&self, k: usize, body: Body, amount: f32) -> FootPose {
+        let psi = self.foot_phase(k);
+        let beta = self.stance();
+        let (strike, toe_off) = (0.25 * amount, if self.running { 0.5 } else { 0.6 } * amount);
+        match self.feet[k] {
+            Foot::Planted { at, yaw } => {
+                let heel = beta * 0.12;
+                let roll = beta * 0.7;
+                let (ankle, pitch) = if psi < heel {
+                    let p = strike * (1.0 - smooth(psi / heel));
+                    (rolled(at, yaw, p, -HEEL_BACK), p)
+                } else if psi >= roll && psi < beta {
+                    let p = -toe_off * smooth((psi - roll) / (beta - roll));
+                    (rolled(at, yaw, p, BALL_AHEAD), p)
+                } else {
+                    (Vec3::new(at.x, ANKLE_HEIGHT, at.y), 0.0)
+                };
+                FootPose {
+                    ankle,
+                    yaw,
+                    pitch,
+                    planted: true,
+                }
+            }
+            Foot::Swing { from, from_yaw } => {
+                let s = ((psi - beta) / (1.0 - beta)).clamp(0.0, 1.0);
+                let to = self.landing(k, body);
+                let e = smooth(s);
+                let yaw = from_yaw + angle_diff(body.facing, from_yaw) * e;
+                let pitch = -toe_off * (1.0 - smooth(s / 0.35).min(1.0)) + strike * smooth(s);
+                let lift = if self.running { 0.18 } else { 0.11 };
+                let clearance = lift * (std::f32::consts::PI * s).sin() * (0.3 + 0.7 * amount);
+                let start = rolled(from, from_yaw, -toe_off, BALL_AHEAD);
+                let end = rolled(to, body.facing, strike, -HEEL_BACK);
+                let flat = start.lerp(end, e);
+                FootPose {
+                    ankle: flat + Vec3::Y * clearance,
+                    yaw,
+                    pitch,
+                    planted: false,
+                }
+            }
+        }
+    }
+}
+
+/// Smoothstep on [0, 1].
+pub fn smooth(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_walk_ratio_gives_human_cadence_and_steps() {
+        // 1.3 m/s: about 115 steps/min and 0.7 m steps
+        let c = cadence(1.3, false);
+        assert!((c - 115.0).abs() < 5.0, "{c}");
+        assert!((step_length(1.3, false) - 0.7).abs() < 0.03);
+        // slower: both shrink
+        assert!(cadence(0.8, false) < c && step_length(0.8, false) < 0.6);
+        // running at 3 m/s: 180 steps/min, 1 m steps
+        assert!((cadence(3.0, true) - 180.0).abs() < 1e-3);
+        assert!((step_length(3.0, true) - 1.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn a_walking_gait_alternates_its_feet_and_plants_each_for_good() {
+        let body = Body {
+            at: Vec2::ZERO,
+            facing: 0.0,
+        };
+        let mut g = Gait::standing(body);
+        assert!(g.at_rest(body));
+        let (mut b, dt, v) = (body, 1.0 / 240.0, Vec2::new(0.0, 1.3));
+        let mut plants: Vec<(usize, Vec2)> = Vec::new();
+        for _ in 0..(240 * 5) {
+            b.at += v * dt;
+            let was = g.feet;
+            g.step(dt, b, v);
+            for k in 0..2 {
+                if let (Foot::Swing { .. }, Foot::Planted { at, .. }) = (was[k], g.feet[k]) {
+                    plants.push((k, at));
+                }
+                // a planted foot never moves
+                if let (Foot::Planted { at: a, .. }, Foot::Planted { at: c, .. }) =
+                    (was[k], g.feet[k])
+                {
+                    assert_eq!(a, c);
+                }
+            }
+        }
+        assert!(plants.len() >= 8, "{plants:?}");
+        for w in plants.windows(2).skip(2) {
+            assert_ne!(w[0].0, w[1].0, "feet alternate");
+            let step = w[1].1.y - w[0].1.y;
+            assert!((step - 0.69).abs() < 0.08, "{step}");
+        }
+    }
+}

@@ -1,0 +1,407 @@
+//! One walking character: a steered vehicle (seek along the route, arrive at its end, avoid
+//! obstacles, combined by priority), a facing that turns toward the direction of travel at a
+//! human rate (on the spot first when the goal is behind), the gait, and the moments a walk's
+//! sync points happen. It steps at its own fixed rate ([`STEP`]), so where it is at a time does
+//! not depend on how often the host asks. Obstacles are a hard limit too: after each step the
+//! body is pushed out of any obstacle it came nearer than its radius to (steering cuts corners
+//! a little; the push keeps the radius exactly).
+
+use glam::{Vec2, Vec3};
+
+use super::gait::{angle_diff, forward, Body, Gait};
+use super::obstacles::Obstacles;
+use super::path::{self, PathError};
+use super::steering::{ArriveParams, Behaviour, Combine, Context, Part, Steering, Vehicle};
+
+/// The walker's fixed step (s).
+pub const STEP: f64 = 1.0 / 240.0;
+/// How fast the body turns toward its direction of travel (rad/s).
+pub const TURN_RATE: f32 = 3.5;
+/// A goal more than this off the facing (rad) is turned to on the spot before walking.
+pub const TURN_FIRST: f32 = 1.9;
+/// Margin kept from obstacles beyond the body's radius when planning (m).
+pub const PLAN_MARGIN: f32 = 0.08;
+
+/// A walk: where to, how fast, what to face at the end.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Walk {
+    /// The goal (x, z).
+    pub goal: Vec2,
+    /// Cruising speed (m/s).
+    pub speed: f32,
+    /// Running (flight phase, other cadence).
+    pub running: bool,
+    /// A point to turn to once arrived.
+    pub face: Option<Vec2>,
+}
+
+/// When a walk's sync points happened (global times).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Moments {
+    /// First weight shift.
+    pub start: Option<f64>,
+    /// Cruising speed reached.
+    pub ready: Option<f64>,
+    /// Final deceleration began.
+    pub relax: Option<f64>,
+    /// Standing still, both feet planted.
+    pub end: Option<f64>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Active {
+    walk: Walk,
+    route: Vec<Vec2>,
+    steering: Steering,
+    moments: Moments,
+    /// Whether the vehicle has stopped (the feet may still be closing).
+    stopped: bool,
+    /// Whether it is halting where it is (interrupted).
+    halting: bool,
+}
+
+/// A walking character (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Walker {
+    /// The steered body.
+    pub vehicle: Vehicle,
+    /// Where it faces (rad about +y from +z).
+    pub facing: f32,
+    /// Its gait.
+    pub gait: Gait,
+    /// Its body radius (m).
+    pub radius: f32,
+    /// The time of its last step.
+    pub time: f64,
+    active: Option<Active>,
+}
+
+impl Walker {
+    /// Standing at `at` facing `facing`, at time `time`.
+    pub fn new(at: Vec2, facing: f32, radius: f32, time: f64) -> Walker {
+        let body = Body { at, facing };
+        Walker {
+            vehicle: Vehicle::new(Vec3::new(at.x, 0.0, at.y), 0.5, 0.6, 1.3),
+            facing,
+            gait: Gait::standing(body),
+            radius,
+            time,
+            active: None,
+        }
+    }
+
+    /// Where the body is now.
+    pub fn body(&self) -> Body {
+        Body {
+            at: Vec2::new(self.vehicle.position.x, self.vehicle.position.z),
+            facing: self.facing,
+        }
+    }
+
+    /// Velocity (x, z).
+    pub fn velocity(&self) -> Vec2 {
+        Vec2::new(self.vehicle.velocity.x, self.vehicle.velocity.z)
+    }
+
+    /// Whether a walk is under way.
+    pub fn walking(&self) -> bool {
+        self.active.is_some()
+    }
+
+    /// The moments of the walk under way.
+    pub fn moments(&self) -> Option<Moments> {
+        self.active.as_ref().map(|a| a.moments)
+    }
+
+    /// The route of the walk under way.
+    pub fn route(&self) -> &[Vec2] {
+        self.active.as_ref().map_or(&[], |a| &a.route)
+    }
+
+    /// Starts `walk` now, along a route around `obstacles`.
+    pub fn start(&mut self, walk: Walk, obstacles: &Obstacles) -> Result<(), PathError> {
+        let clearance = self.radius + PLAN_MARGIN;
+        let route = path::plan(obstacles, self.body().at, walk.goal, clearance)?;
+        let mut steering = Steering::new(Combine::Prioritised, 0x5eed);
+        let reach = 0.45;
+        let slow = (1.1 * walk.speed).max(0.7);
+        let params = ArriveParams {
+            slow_radius: slow,
+            stop_radius: 0.03,
+            floor_speed: 0.12,
+        };
+        let points = route
+            .iter()
+            .skip(1)
+            .map(|p| Vec3::new(p.x, 0.0, p.y))
+            .collect();
+        let mut avoid = Part::new(Behaviour::AvoidObstacles {
+            radius: self.radius,
+            lookahead: 0.6,
+        });
+        avoid.priority = 1;
+        steering.add(avoid);
+        steering.add(Part::new(Behaviour::FollowPoints {
+            points,
+            next: 0,
+            reach,
+            params,
+        }));
+        self.vehicle.max_speed = walk.speed;
+        // accelerate at up to about 1.2 m/s² walking, more running
+        self.vehicle.max_force = self.vehicle.mass * (0.6 + 0.5 * walk.speed);
+        self.gait.running = walk.running;
+        let moments = Moments {
+            start: Some(self.time),
+            ..Moments::default()
+        };
+        self.active = Some(Active {
+            walk,
+            route,
+            steering,
+            moments,
+            stopped: false,
+            halting: false,
+        });
+        Ok(())
+    }
+
+    /// Slows down and stands where it is (an interrupted walk).
+    pub fn halt(&mut self) {
+        if let Some(a) = self.active.as_mut() {
+            a.halting = true;
+            a.walk.face = None;
+            a.steering.clear();
+            a.steering.add(Part::new(Behaviour::Stop));
+            a.moments.relax.get_or_insert(self.time);
+            a.moments.ready.get_or_insert(self.time);
+        }
+    }
+
+    /// Moves the goal of the walk under way (a moving target), planning a new route when it
+    /// moved more than 0.3 m.
+    pub fn retarget(&mut self, goal: Vec2, face: Option<Vec2>, obstacles: &Obstacles) {
+        let Some(a) = self.active.as_ref() else {
+            return;
+        };
+        if a.halting || a.walk.goal.distance(goal) < 0.3 {
+            if let Some(a) = self.active.as_mut() {
+                a.walk.face = face.or(a.walk.face);
+            }
+            return;
+        }
+        let mut walk = a.walk.clone();
+        let moments = a.moments;
+        walk.goal = goal;
+        walk.face = face;
+        if self.start(walk, obstacles).is_ok() {
+            if let Some(a) = self.active.as_mut() {
+                a.moments = Moments {
+                    relax: None,
+                    end: None,
+                    ..moments
+                };
+            }
+        }
+    }
+
+    /// Steps until `t` (whole steps of [`STEP`]); returns the walk's moments if it ended in
+    /// that time (the walker then stands).
+    pub fn advance(&mut self, t: f64, obstacles: &Obstacles) -> Option<Moments> {
+        let mut ended = None;
+        while self.time + STEP <= t + 1e-9 {
+            self.time += STEP;
+            if let Some(m) = self.step(STEP as f32, obstacles) {
+                ended = Some(m);
+            }
+        }
+        ended
+    }
+
+    /// One step; the moments when the walk ends in it.
+    fn step(&mut self, dt: f32, obstacles: &Obstacles) -> Option<Moments> {
+        let time = self.time;
+        let mut ended = None;
+        if let Some(a) = self.active.as_mut() {
+            let to_goal = a.walk.goal - Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+            let next = a.route.get(1).copied().unwrap_or(a.walk.goal);
+            let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+            let wanted = (next - here).normalize_or_zero();
+            let behind = wanted != Vec2::ZERO
+                && angle_diff(wanted.x.atan2(wanted.y), self.facing).abs() > TURN_FIRST;
+            if !a.stopped {
+                if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
+                    // turn on the spot before setting off
+                    let brake = Behaviour::Stop.force(
+                        &mut self.vehicle,
+                        Context::default(),
+                        &mut a.steering.rng,
+                    );
+                    self.vehicle.step(brake.unwrap_or(Vec3::ZERO), dt);
+                    turn_toward(&mut self.facing, wanted.x.atan2(wanted.y), dt);
+                } else {
+                    let f = a.steering.force(
+                        &mut self.vehicle,
+                        Context {
+                            obstacles: Some(obstacles),
+                        },
+                    );
+                    self.vehicle.step(f, dt);
+                    if a.steering.parts().iter().all(|p| {
+                        !matches!(
+                            p.behaviour,
+                            Behaviour::FollowPoints { .. } | Behaviour::Stop
+                        )
+                    }) {
+                        a.stopped = true;
+                        self.vehicle.velocity = Vec3::ZERO;
+                    }
+                }
+                let speed = self.vehicle.speed();
+                if a.moments.ready.is_none() && speed >= 0.95 * a.walk.speed {
+                    a.moments.ready = Some(time);
+                }
+                let left = path::length(&a.route_from(here));
+                if a.moments.relax.is_none() && left < a.slow_radius() && speed > 0.0 {
+                    a.moments.relax = Some(time);
+                    a.moments.ready.get_or_insert(time);
+                }
+            }
+            if a.stopped {
+                a.moments.ready.get_or_insert(time);
+                a.moments.relax.get_or_insert(time);
+                if let Some(p) = a.walk.face {
+                    let d = p - here;
+                    if d.length() > 1e-3 {
+                        turn_toward(&mut self.facing, d.x.atan2(d.y), dt);
+                    }
+                }
+            }
+        }
+        self.vehicle.position.y = 0.0;
+        self.vehicle.velocity.y = 0.0;
+        // never into an obstacle
+        let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+        let out = obstacles.push_out(here, self.radius);
+        if out != here {
+            self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
+        }
+        // face the way of travel, never walk backwards
+        let v = self.velocity();
+        if v.length() > 0.05 {
+            turn_toward(&mut self.facing, v.x.atan2(v.y), dt);
+            let f = forward(self.facing);
+            if v.dot(f) < 0.0 {
+                let keep = v - f * v.dot(f);
+                self.vehicle.velocity = Vec3::new(keep.x, 0.0, keep.y);
+            }
+        }
+        let body = self.body();
+        self.gait.step(dt, body, self.velocity());
+        if let Some(a) = self.active.as_mut() {
+            let facing_done = a.walk.face.is_none_or(|p| {
+                let d = p - body.at;
+                d.length() < 1e-3 || angle_diff(d.x.atan2(d.y), self.facing).abs() < 0.03
+            });
+            if a.stopped && facing_done && self.gait.at_rest(body) {
+                a.moments.end = Some(time);
+                ended = Some(a.moments);
+                self.active = None;
+            }
+        }
+        ended
+    }
+
+    /// A copy that walks `walk` from here to its end: its moments, or why it cannot. At most
+    /// `limit` seconds are simulated.
+    pub fn rehearse(
+        &self,
+        walk: Walk,
+        obstacles: &Obstacles,
+        limit: f64,
+    ) -> Result<Moments, PathError> {
+        let mut w = self.clone();
+        w.start(walk, obstacles)?;
+        let stop = w.time + limit;
+        while w.time < stop {
+            let t = (w.time + 1.0).min(stop);
+            if let Some(m) = w.advance(t, obstacles) {
+                return Ok(m);
+            }
+        }
+        Ok(w.moments().unwrap_or_default())
+    }
+}
+
+impl Active {
+    /// The route still ahead from `here`: the points not yet sought past.
+    fn route_from(&self, here: Vec2) -> Vec<Vec2> {
+        let next = self
+            .steering
+            .parts()
+            .iter()
+            .find_map(|p| match &p.behaviour {
+                Behaviour::FollowPoints { next, .. } => Some(*next + 1),
+                _ => None,
+            })
+            .unwrap_or(self.route.len() - 1);
+        let mut v = vec![here];
+        v.extend(self.route.iter().skip(next));
+        v
+    }
+
+    fn slow_radius(&self) -> f32 {
+        (1.1 * self.walk.speed).max(0.7)
+    }
+}
+
+/// Turns `facing` toward `to` by at most [`TURN_RATE`] × `dt`.
+fn turn_toward(facing: &mut f32, to: f32, dt: f32) {
+    let d = angle_diff(to, *facing);
+    let max = TURN_RATE * dt;
+    *facing = (*facing + d.clamp(-max, max)).rem_euclid(std::f32::consts::TAU);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_walk_reaches_its_goal_and_reports_its_moments_in_order() {
+        let mut w = Walker::new(Vec2::ZERO, 0.0, 0.25, 0.0);
+        let walk = Walk {
+            goal: Vec2::new(0.0, 5.0),
+            speed: 1.3,
+            running: false,
+            face: None,
+        };
+        let o = Obstacles::default();
+        w.start(walk.clone(), &o).unwrap();
+        let mut ended = None;
+        for k in 1..2000 {
+            if let Some(m) = w.advance(k as f64 / 60.0, &o) {
+                ended = Some(m);
+                break;
+            }
+        }
+        let m = ended.expect("the walk ends");
+        let (s, r, x, e) = (
+            m.start.unwrap(),
+            m.ready.unwrap(),
+            m.relax.unwrap(),
+            m.end.unwrap(),
+        );
+        assert!(s <= r && r < x && x < e, "{m:?}");
+        assert!(
+            w.body().at.distance(Vec2::new(0.0, 5.0)) < 0.1,
+            "{:?}",
+            w.body()
+        );
+        // about 5 m at 1.3 m/s plus speeding up and slowing down
+        assert!(e > 4.0 && e < 7.5, "{e}");
+        // the rehearsal from the start predicts the same moments
+        let fresh = Walker::new(Vec2::ZERO, 0.0, 0.25, 0.0);
+        let p = fresh.rehearse(walk, &o, 60.0).unwrap();
+        assert_eq!(p.end, m.end);
+    }
+}
