@@ -485,7 +485,13 @@ impl TimingModels for DefaultTimingModels {
             | BehaviourKind::HeadDirectionShift { .. }
             | BehaviourKind::FaceShift(_) => se(1.0),
             BehaviourKind::PostureShift(_) => se(2.0),
-            BehaviourKind::Locomotion(_) => se(3.0),
+            // a walk of about 3 m (the locomotion engine predicts each walk from its path)
+            BehaviourKind::Locomotion(_) => TimingModel::stretchable(&[
+                ("start", 0.0),
+                ("ready", 1.0),
+                ("relax", 2.4),
+                ("end", 3.4),
+            ]),
             BehaviourKind::Wait(w) => se(w.max_wait.filter(|d| *d > 0.0).unwrap_or(1.0)),
             BehaviourKind::Interrupt(_) | BehaviourKind::Activate(_) => {
                 TimingModel::new(&[("start", 0.0), ("end", INSTANT)], Flexibility::Rigid)

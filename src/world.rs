@@ -58,10 +58,15 @@ pub const CHARACTER_EYES: Vec3 = Vec3::new(0.0, 1.64, 0.09);
 #[derive(Debug, Clone, PartialEq)]
 pub struct World {
     points: BTreeMap<String, Vec3>,
-    /// Points that move: their keys (time in seconds, position), in time order.
-    paths: BTreeMap<String, Vec<(f64, Vec3)>>,
+    /// Points that move: their keys (time in seconds, position), in time order (shared: a
+    /// world is copied every frame someone walks, its paths are not).
+    paths: std::sync::Arc<BTreeMap<String, Vec<(f64, Vec3)>>>,
     /// Where characters stand (the others stand at the origin facing +z).
     characters: BTreeMap<String, Placement>,
+    /// Body radius of characters the world file gives one (m).
+    radii: BTreeMap<String, f32>,
+    /// Obstacles, in world coordinates (a view from a character has none).
+    obstacles: std::sync::Arc<crate::locomotion::Obstacles>,
 }
 
 impl Default for World {
@@ -88,9 +93,8 @@ struct WorldFile {
     paths: BTreeMap<String, PathFile>,
     #[serde(default)]
     characters: BTreeMap<String, CharacterFile>,
-    /// Read so that files written for locomotion load; nothing uses them yet.
     #[serde(default)]
-    obstacles: Vec<serde_json::Value>,
+    obstacles: Vec<crate::locomotion::obstacles::ObstacleFile>,
 }
 
 #[derive(Deserialize)]
@@ -106,7 +110,13 @@ struct CharacterFile {
     /// Degrees about +y from facing +z.
     #[serde(default)]
     facing: f64,
+    /// Body radius (m).
+    #[serde(default)]
+    radius: Option<f64>,
 }
+
+/// A character's body radius unless the world file gives one (m).
+pub const DEFAULT_RADIUS: f32 = 0.25;
 
 /// Longest list of keys a path may have.
 pub const MAX_PATH_KEYS: usize = 100_000;
@@ -130,14 +140,16 @@ impl World {
     pub fn empty() -> Self {
         World {
             points: BTreeMap::new(),
-            paths: BTreeMap::new(),
+            paths: Default::default(),
             characters: BTreeMap::new(),
+            radii: BTreeMap::new(),
+            obstacles: Default::default(),
         }
     }
 
-    /// The default scene with the points and paths of a world file (its points win over the
-    /// default ones of the same name). Returns the world and how many obstacles the file lists
-    /// (they are not used yet). The error says what is wrong.
+    /// The default scene with the points, paths, characters and obstacles of a world file (its
+    /// points win over the default ones of the same name). Returns the world and how many
+    /// obstacles the file lists. The error says what is wrong.
     pub fn from_json(text: &str) -> Result<(World, usize), String> {
         let file: WorldFile = crate::data::from_json(text)?;
         let mut w = World::default();
@@ -154,9 +166,49 @@ impl World {
         }
         for (name, c) in file.characters {
             let at = vec3(&name, c.position)?;
+            if !c.facing.is_finite() || c.facing.abs() > MAX_COORDINATE {
+                return Err(format!(
+                    "character '{name}': its facing must be a finite number of degrees"
+                ));
+            }
             w.place(&name, Placement::new(at, c.facing as f32))?;
+            if let Some(r) = c.radius {
+                if !(r > 0.0 && r <= 10.0) {
+                    return Err(format!(
+                        "character '{name}': its radius must be above 0 and at most 10 m"
+                    ));
+                }
+                w.radii.insert(name.clone(), r as f32);
+            }
         }
-        Ok((w, file.obstacles.len()))
+        if file.obstacles.len() > crate::locomotion::obstacles::MAX_OBSTACLES {
+            return Err(format!(
+                "obstacles: at most {} obstacles, not {}",
+                crate::locomotion::obstacles::MAX_OBSTACLES,
+                file.obstacles.len()
+            ));
+        }
+        let list = (file.obstacles.iter().enumerate())
+            .map(|(i, o)| o.obstacle(i))
+            .collect::<Result<Vec<_>, String>>()?;
+        let n = list.len();
+        w.set_obstacles(crate::locomotion::Obstacles::new(list));
+        Ok((w, n))
+    }
+
+    /// The obstacles (world coordinates).
+    pub fn obstacles(&self) -> &crate::locomotion::Obstacles {
+        &self.obstacles
+    }
+
+    /// Sets the obstacles.
+    pub fn set_obstacles(&mut self, obstacles: crate::locomotion::Obstacles) {
+        self.obstacles = std::sync::Arc::new(obstacles);
+    }
+
+    /// Character `id`'s body radius ([`DEFAULT_RADIUS`] unless the world file gives one).
+    pub fn radius(&self, id: &str) -> f32 {
+        self.radii.get(id).copied().unwrap_or(DEFAULT_RADIUS)
     }
 
     /// Places character `id` (the default character is `""`). A point of the same name keeps
@@ -186,13 +238,19 @@ impl World {
     /// a path is where the path has it now, and it is this world that moves along them (a view
     /// is made again when it does).
     pub fn seen_from(&self, id: &str) -> World {
-        let from = self.placement(id);
+        self.seen_from_at(self.placement(id))
+    }
+
+    /// The world as seen by a character standing at `from` (see [`seen_from`](Self::seen_from)).
+    pub fn seen_from_at(&self, from: Placement) -> World {
         let local = |p: &Vec3| from.to_local(*p);
         World {
             points: (self.points.iter())
                 .map(|(k, p)| (k.clone(), local(p)))
                 .collect(),
-            paths: BTreeMap::new(),
+            paths: Default::default(),
+            radii: self.radii.clone(),
+            obstacles: Default::default(),
             characters: (self.characters.iter())
                 .map(|(k, c)| {
                     let at = Placement {
@@ -226,7 +284,7 @@ impl World {
             ));
         }
         self.points.insert(name.to_string(), keys[0].1);
-        self.paths.insert(name.to_string(), keys);
+        std::sync::Arc::make_mut(&mut self.paths).insert(name.to_string(), keys);
         Ok(())
     }
 
@@ -239,7 +297,7 @@ impl World {
 
     /// Puts every point that has a path where its path is at time `t`.
     pub fn move_to(&mut self, t: f64) {
-        for (name, keys) in &self.paths {
+        for (name, keys) in self.paths.iter() {
             if let Some(p) = self.points.get_mut(name) {
                 *p = along(keys, t);
             }
@@ -249,7 +307,9 @@ impl World {
     /// Removes point `name` (and its path).
     pub fn remove(&mut self, name: &str) {
         self.points.remove(name);
-        self.paths.remove(name);
+        if self.paths.contains_key(name) {
+            std::sync::Arc::make_mut(&mut self.paths).remove(name);
+        }
     }
 
     /// Where point `name` is; a placed character without a point of its name is a target at

@@ -85,7 +85,7 @@ fn arrive_slows_linearly_not_below_its_floor_and_stops_inside_its_radius() {
     assert!((desired(1.0).unwrap() - 0.75).abs() < 1e-5); // half way in: half speed
     assert!((desired(0.5).unwrap() - 0.375).abs() < 1e-5);
     assert!((desired(0.1).unwrap() - 0.2).abs() < 1e-5); // the floor
-    // inside the stop radius: stopped at once, and done
+                                                         // inside the stop radius: stopped at once, and done
     let mut v = Vehicle::new(Vec3::new(0.0, 0.0, 0.97), 1.0, 100.0, 1.5);
     v.velocity = Vec3::new(0.0, 0.0, 0.2);
     let mut b = Behaviour::Arrive {

@@ -105,6 +105,8 @@ impl BlockManager {
     pub fn advance(&mut self, to: f64, world: &std::sync::Arc<World>, frame: &mut Frame) {
         self.set_world(world);
         let to = to.max(self.now);
+        // a walking character moves first: its walk's sync points follow what happens
+        self.travel(to);
         // changes made from outside since the last frame (e.g. a new tempo)
         self.update_anticipators(self.now);
         let mut last_change = f64::NEG_INFINITY;

@@ -97,17 +97,14 @@ impl BlockManager {
                     }
                     Err(e) => {
                         x.phase = Phase::Removed;
-                        failed.push((x.id.clone(), e.to_string()));
+                        let kind = self.registry.engine(x.engine).refusal(&e);
+                        failed.push((x.id.clone(), e.to_string(), kind));
                     }
                 }
             }
         }
-        for (beh, reason) in failed {
-            self.warn(
-                format!("{id}:{beh}"),
-                KnownWarning::ExecutionFailure,
-                reason,
-            );
+        for (beh, reason, kind) in failed {
+            self.warn(format!("{id}:{beh}"), kind, reason);
         }
         for (beh, reason) in moves_nothing {
             self.warn(

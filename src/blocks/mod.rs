@@ -23,6 +23,7 @@ mod lifecycle;
 mod live;
 mod store;
 mod submit;
+mod travel;
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};

@@ -181,7 +181,16 @@ impl BlockManager {
     /// schedule on pegs, the anticipators' pegs at their current predictions.
     fn pegs_for(&self, live: &LiveBlock, schedule: &BlockSchedule) -> Option<Box<BlockPegs>> {
         let refs = anticipator_refs(&live.source);
-        if refs.is_empty() {
+        // behaviours whose engine revises their times while they run (a walk)
+        let own: Vec<&str> = (live.source.behaviours.iter())
+            .filter(|b| {
+                self.registry
+                    .engine_for(b)
+                    .is_some_and(|e| self.registry.engine(e).self_timed(b))
+            })
+            .map(|b| b.id.as_str())
+            .collect();
+        if refs.is_empty() && own.is_empty() {
             return None;
         }
         let (mut board, mut anticipators) = (PegBoard::new(), Anticipators::default());
@@ -196,8 +205,14 @@ impl BlockManager {
             }
         }
         let start = live.start;
-        let plan =
-            to_pegs::plan_block(&mut board, &mut anticipators, &live.source, schedule, start);
+        let plan = to_pegs::plan_block_with(
+            &mut board,
+            &mut anticipators,
+            &live.source,
+            schedule,
+            start,
+            &own,
+        );
         Some(Box::new(BlockPegs {
             board,
             anticipators,

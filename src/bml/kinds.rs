@@ -13,7 +13,7 @@ pub const GESTURE_SYNCS: &[&str] = &[
     "relax",
     "end",
 ];
-/// gaze, posture.
+/// gaze, posture, locomotion.
 pub const GAZE_SYNCS: &[&str] = &["start", "ready", "relax", "end"];
 /// face, faceLexeme, faceFacs (and BMLT facemorph).
 pub const FACE_SYNCS: &[&str] = &["start", "attackPeak", "relax", "end"];
@@ -171,7 +171,9 @@ impl BehaviourKind {
             | BehaviourKind::Pointing(_)
             | BehaviourKind::Head(_)
             | BehaviourKind::ProcAnimationGesture(_) => GESTURE_SYNCS,
-            BehaviourKind::Gaze(_) | BehaviourKind::Posture(_) => GAZE_SYNCS,
+            BehaviourKind::Gaze(_) | BehaviourKind::Posture(_) | BehaviourKind::Locomotion(_) => {
+                GAZE_SYNCS
+            }
             BehaviourKind::Face(_)
             | BehaviourKind::FaceLexeme(_)
             | BehaviourKind::FaceFacs(_)

@@ -110,6 +110,45 @@ pub trait Physics {
     fn balance(&self) -> Result<BalanceReading, String>;
 }
 
+/// An engine that moves the whole character about the world (locomotion): it steps the
+/// character's body to each frame's time before that frame's sync points pass, so that the sync
+/// points of its units can follow what really happens (a walker that arrives later than
+/// predicted moves its `end`, and what hangs on it follows).
+pub trait Travel {
+    /// Moves character `id` on to global time `now` in `world` (the shared world, world
+    /// frame), from where it stood (`at`; a host that placed it elsewhere moves it there).
+    /// Returns where it stands now.
+    fn travel(
+        &mut self,
+        now: f64,
+        world: &World,
+        id: &str,
+        at: crate::world::Placement,
+    ) -> crate::world::Placement;
+
+    /// Units whose sync times changed since last asked: the unit and the new global times of
+    /// all its syncs in sync order (passed syncs as they were). A sync that happened has its
+    /// real time; one still ahead is a prediction later than `now`.
+    fn take_revisions(&mut self) -> Vec<Revision>;
+
+    /// Whether a foot of the character is on the ground (left, right), for the frames.
+    fn contacts(&self) -> Option<[bool; 2]> {
+        None
+    }
+}
+
+/// New sync times for a unit of a [`Travel`] engine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Revision {
+    /// The unit.
+    pub unit: UnitKey,
+    /// The global times of all its syncs, in sync order.
+    pub times: Vec<f64>,
+    /// Whether behaviours tied to its syncs follow (false for an interrupted unit, whose new
+    /// times concern only itself).
+    pub others_follow: bool,
+}
+
 /// How a simulated body stands, for hosts and planners that judge balance (world frame, m).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BalanceReading {

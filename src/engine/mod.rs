@@ -17,7 +17,7 @@ use std::fmt;
 
 pub use capabilities::{
     Action, BalanceReading, Control, Expression, Motion, MotionKind, Parameters, Physics,
-    Prediction, Resources, Sound, Steering,
+    Prediction, Resources, Revision, Sound, Steering, Travel,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};
@@ -210,6 +210,23 @@ pub trait Engine {
     /// (unit, what happened); the runtime sends each as a warning feedback.
     fn take_warnings(&mut self) -> Vec<(UnitKey, String)> {
         Vec::new()
+    }
+
+    /// Its travel about the world, if it moves the whole character (locomotion).
+    fn as_travel(&mut self) -> Option<&mut dyn Travel> {
+        None
+    }
+
+    /// Whether the engine revises the sync times of `behaviour`'s units while they run (through
+    /// [`Travel::take_revisions`]): the runtime then keeps every sync of it on a peg of its own,
+    /// so that behaviours tied to one follow its revisions.
+    fn self_timed(&self, _behaviour: &Behaviour) -> bool {
+        false
+    }
+
+    /// The warning type an error of [`add`](Engine::add) is reported with.
+    fn refusal(&self, _error: &EngineError) -> crate::feedback::KnownWarning {
+        crate::feedback::KnownWarning::ExecutionFailure
     }
 
     /// Its actions on the plan, if it realizes control behaviours.

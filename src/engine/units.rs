@@ -124,6 +124,11 @@ impl<T> Units<T> {
         self.insert(held);
     }
 
+    /// Every unit with its key, in start order.
+    pub fn keyed(&self) -> impl Iterator<Item = (&SyncTimes, &T, &UnitKey)> + '_ {
+        self.units.values().map(|u| (&u.syncs, &u.data, &*u.key))
+    }
+
     /// A unit's data.
     pub fn get(&self, key: &UnitKey) -> Option<&T> {
         self.units

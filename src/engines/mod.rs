@@ -6,8 +6,9 @@
 //! - [`control`]: `wait`, `interrupt`, `activate`, `parametervaluechange`;
 //! - [`speech`]: `speech` and `bmlt:text` with the headless speech timing model, `volume` settable
 //!   while speaking;
-//! - [`timing_only`]: every other kind, timing only until its animation engine lands: it plays the
-//!   scheduled pegs and reports every sync point, but moves no body;
+//! - [`timing_only`]: BMLT audio's fallback timing: it plays the scheduled pegs and reports every
+//!   sync point;
+//! - [`locomotion`]: `locomotion` as a character walking there (steering, paths, a gait);
 //! - [`murml`]: MURML gestures and faces, timed from their keyframes (timing only as well);
 //! - [`face`]: face, faceLexeme, faceFacs, faceShift and BMLT facemorph as FACS action units and
 //!   ARKit blendshapes, mixed through a fading buffer;
@@ -32,6 +33,7 @@ pub mod gesture;
 pub mod head;
 pub mod head_direction;
 pub mod keyframe;
+pub mod locomotion;
 pub mod motion;
 pub mod murml;
 pub mod noise;
@@ -46,9 +48,6 @@ pub mod transition;
 use crate::bml::{NS_BML, NS_BMLA, NS_BMLT, NS_CORE_EXT};
 use crate::engine::{KindKey, Registry};
 use crate::timing::DefaultTimingModels;
-
-/// Kinds the timing-only motion engine realizes (namespace, element).
-pub const MOTION_KINDS: &[(&str, &str)] = &[(NS_BML, "locomotion")];
 
 /// Kinds the face engine realizes (namespace, element).
 pub const FACE_KINDS: &[(&str, &str)] = &[
@@ -85,10 +84,6 @@ pub fn registry_with(models: DefaultTimingModels, assets: &assets::Assets) -> Re
         Box::new(speech::SpeechEngine::new(models.speech)),
         &keys(&[(NS_BML, "speech"), (NS_BMLT, "text")]),
     );
-    r.register(
-        Box::new(timing_only::TimingOnlyEngine::motion(models)),
-        &keys(MOTION_KINDS),
-    );
     r.register(Box::new(face::FaceEngine::default()), &keys(FACE_KINDS));
     r.register(
         Box::new(audio::AudioEngine::default()),
@@ -109,6 +104,11 @@ pub fn registry_with(models: DefaultTimingModels, assets: &assets::Assets) -> Re
     r.register(
         Box::new(posture::PostureEngine::new(assets.poses.clone())),
         &keys(&[(NS_BML, "posture"), (NS_BML, "postureShift")]),
+    );
+    // the gait: legs, pelvis and the arms' swing, under the upper-body engines that follow
+    r.register(
+        Box::new(locomotion::LocomotionEngine::default()),
+        &keys(&[(NS_BML, "locomotion")]),
     );
     r.register(
         Box::new(gesture::GestureEngine::new(assets.gestures.clone())),

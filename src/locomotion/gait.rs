@@ -25,9 +25,9 @@ pub const MIN_CADENCE: f32 = 80.0;
 /// Half the distance between the feet (m): the hips' half width.
 pub const HALF_WIDTH: f32 = 0.09;
 /// A foot counts as placed where it belongs when within this (m) and [`SETTLED_YAW`].
-pub const SETTLED: f32 = 0.015;
+pub const SETTLED: f32 = 0.04;
 /// … and turned within this (rad).
-pub const SETTLED_YAW: f32 = 0.06;
+pub const SETTLED_YAW: f32 = 0.12;
 
 /// Cadence (steps per minute) at `speed` (m/s).
 pub fn cadence(speed: f32, running: bool) -> f32 {
@@ -75,6 +75,8 @@ pub struct Gait {
     pub speed: f32,
     /// Heading of travel (x, z), unit.
     pub heading: Vec2,
+    /// Where the body will stop, while it slows down for good: feet land no further.
+    pub stop_at: Option<Vec2>,
 }
 
 /// Where the walker's body is: its ground position and facing.
@@ -118,6 +120,7 @@ impl Gait {
             running: false,
             speed: 0.0,
             heading: forward(body.facing),
+            stop_at: None,
         };
         for k in 0..2 {
             g.feet[k] = Foot::Planted {
@@ -163,12 +166,23 @@ impl Gait {
         self.speed < 0.02 && self.settled(0, body) && self.settled(1, body)
     }
 
-    /// Where swinging foot `k` will land if it lands at its phase's end: ahead of the body by
-    /// the distance it will cover until then plus half a stance, beside the line of travel.
-    pub fn landing(&self, k: usize, body: Body) -> Vec2 {
-        let psi = self.foot_phase(k);
+    /// Where swinging foot `k` will land at its phase's end, `left` cycles from now: ahead of
+    /// the body by the distance it will cover until then and a little less than half a
+    /// stance, beside the line of travel; beside the stopping point when that is nearer.
+    pub fn landing(&self, k: usize, body: Body, left: f32) -> Vec2 {
         let stride = self.stride();
-        let lead = ((1.0 - psi) * stride + self.stance() * stride * 0.42).min(0.55);
+        let lead = (left.max(0.0) * stride + self.stance() * stride * 0.42).min(0.55);
+        if let Some(stop) = self.stop_at {
+            if stop.distance(body.at) < lead + 0.05 {
+                return standing_spot(
+                    Body {
+                        at: stop,
+                        facing: body.facing,
+                    },
+                    k,
+                );
+            }
+        }
         let side = Vec2::new(body.facing.cos(), -body.facing.sin()) * (SIDE[k] * HALF_WIDTH);
         body.at + self.heading * lead + side
     }
@@ -204,7 +218,7 @@ impl Gait {
                 }
                 Foot::Swing { .. } if lands => {
                     self.feet[k] = Foot::Planted {
-                        at: self.landing(k, body),
+                        at: self.landing(k, body, 0.0),
                         yaw: body.facing,
                     };
                 }
@@ -279,7 +293,7 @@ impl Gait {
             }
             Foot::Swing { from, from_yaw } => {
                 let s = ((psi - beta) / (1.0 - beta)).clamp(0.0, 1.0);
-                let to = self.landing(k, body);
+                let to = self.landing(k, body, 1.0 - psi);
                 let e = smooth(s);
                 let yaw = from_yaw + angle_diff(body.facing, from_yaw) * e;
                 let pitch = -toe_off * (1.0 - smooth(s / 0.35).min(1.0)) + strike * smooth(s);

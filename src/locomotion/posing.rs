@@ -129,11 +129,12 @@ pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, p
     }
 }
 
-/// Lowers the root so that each planted foot is within the leg's reach (less 2 mm).
+/// Lowers the root so that each foot is within the leg's reach (less 2 mm); over both feet, so
+/// that the height changes smoothly as they lift and land.
 fn lower_to_reach(skeleton: &Skeleton, j: &GaitJoints, feet: &[FootPose; 2], pose: &mut Pose) {
     let reach = j.reach - 0.002;
     let mut drop = 0.0f32;
-    for (k, foot) in feet.iter().enumerate().filter(|(_, f)| f.planted) {
+    for (k, foot) in feet.iter().enumerate() {
         let hip = pose.joint_world(skeleton, j.legs[k][0]).0;
         let d = hip - foot.ankle;
         let h = Vec2::new(d.x, d.z).length().min(reach);

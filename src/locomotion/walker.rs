@@ -124,11 +124,10 @@ impl Walker {
         let route = path::plan(obstacles, self.body().at, walk.goal, clearance)?;
         let mut steering = Steering::new(Combine::Prioritised, 0x5eed);
         let reach = 0.45;
-        let slow = (1.1 * walk.speed).max(0.7);
         let params = ArriveParams {
-            slow_radius: slow,
+            slow_radius: slow_radius(walk.speed),
             stop_radius: 0.03,
-            floor_speed: 0.12,
+            floor_speed: 0.25,
         };
         let points = route
             .iter()
@@ -148,8 +147,8 @@ impl Walker {
             params,
         }));
         self.vehicle.max_speed = walk.speed;
-        // accelerate at up to about 1.2 m/s² walking, more running
-        self.vehicle.max_force = self.vehicle.mass * (0.6 + 0.5 * walk.speed);
+        // accelerate and brake at up to about 2 m/s² walking, more running
+        self.vehicle.max_force = self.vehicle.mass * (1.0 + 0.8 * walk.speed);
         self.gait.running = walk.running;
         let moments = Moments {
             start: Some(self.time),
@@ -176,6 +175,14 @@ impl Walker {
             a.moments.relax.get_or_insert(self.time);
             a.moments.ready.get_or_insert(self.time);
         }
+    }
+
+    /// Gives up the walk under way at once: the body stands where it is (its feet may still
+    /// close).
+    pub fn stand(&mut self) {
+        self.active = None;
+        self.gait.stop_at = None;
+        self.vehicle.velocity = Vec3::ZERO;
     }
 
     /// Moves the goal of the walk under way (a moving target), planning a new route when it
@@ -266,8 +273,13 @@ impl Walker {
                     a.moments.relax = Some(time);
                     a.moments.ready.get_or_insert(time);
                 }
+                if a.moments.relax.is_some() {
+                    self.gait.stop_at = Some(a.walk.goal);
+                }
             }
             if a.stopped {
+                // the feet close where the body stopped
+                self.gait.stop_at = None;
                 a.moments.ready.get_or_insert(time);
                 a.moments.relax.get_or_insert(time);
                 if let Some(p) = a.walk.face {
@@ -307,6 +319,7 @@ impl Walker {
                 a.moments.end = Some(time);
                 ended = Some(a.moments);
                 self.active = None;
+                self.gait.stop_at = None;
             }
         }
         ended
@@ -351,8 +364,13 @@ impl Active {
     }
 
     fn slow_radius(&self) -> f32 {
-        (1.1 * self.walk.speed).max(0.7)
+        slow_radius(self.walk.speed)
     }
+}
+
+/// Where the final deceleration at `speed` begins, from the goal (m): about two steps at a walk.
+fn slow_radius(speed: f32) -> f32 {
+    (0.9 * speed).max(0.5)
 }
 
 /// Turns `facing` toward `to` by at most [`TURN_RATE`] × `dt`.

@@ -146,10 +146,34 @@ pub fn plan_block(
     schedule: &BlockSchedule,
     start: f64,
 ) -> PlannedBlock {
+    plan_block_with(board, anticipators, block, schedule, start, &[])
+}
+
+/// [`plan_block`], with every sync of the behaviours `own_pegs` on a peg of its own (joined
+/// only by `at` constraints): behaviours whose engine revises their times while they run.
+pub fn plan_block_with(
+    board: &mut PegBoard,
+    anticipators: &mut Anticipators,
+    block: &Block,
+    schedule: &BlockSchedule,
+    start: f64,
+    own_pegs: &[&str],
+) -> PlannedBlock {
     let block_peg = board.add_block(&block.id, start);
     let mut p = Planner::new(board, anticipators, schedule, block_peg, start);
     let constraints = extract(block);
     let orders = p.read_constraints(&constraints);
+    for b in schedule
+        .behaviours
+        .iter()
+        .filter(|b| own_pegs.contains(&b.id.as_str()))
+    {
+        for (sync, _) in &b.syncs {
+            if let Some(&v) = p.node.get(&(b.id.as_str(), sync.as_ref())) {
+                p.named[v] = true;
+            }
+        }
+    }
     p.join_rigid();
     p.cluster_pegs();
     let behaviours = (schedule.behaviours.iter())

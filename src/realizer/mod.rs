@@ -400,9 +400,14 @@ impl Realizer {
             ..Frame::default()
         };
         let from = self.unframed.len();
-        for m in self.characters.values_mut() {
+        for (id, m) in self.characters.iter_mut() {
             m.advance(now, &self.world, &mut frame);
             m.move_feedback(&mut self.unframed);
+            // a character that walked stands elsewhere: the others see it there
+            let at = m.placement();
+            if at != self.world.placement(id) {
+                let _ = std::sync::Arc::make_mut(&mut self.world).place(id, at);
+            }
         }
         if let Some(due) = due {
             self.unframed.push(Feedback::Warning(WarningFeedback {

@@ -216,14 +216,8 @@ pub fn with_world(mut realizer: Realizer, path: Option<&Path>) -> Result<Realize
         return Ok(realizer);
     };
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let (world, obstacles) = bml_realizer::world::World::from_json(&text)
+    let (world, _obstacles) = bml_realizer::world::World::from_json(&text)
         .map_err(|e| format!("{}: {e}", path.display()))?;
-    if obstacles > 0 {
-        eprintln!(
-            "{}: {obstacles} obstacle(s) read but not used: locomotion is timing only",
-            path.display()
-        );
-    }
     *realizer.world_mut() = world;
     Ok(realizer)
 }

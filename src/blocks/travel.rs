@@ -1,0 +1,85 @@
+//! Characters that move about the world: before a frame's sync points pass, the engines that
+//! move the whole character (locomotion) step it to the frame's time. Where it then stands is
+//! its placement (its engines see the world from there), and the sync times those engines
+//! revise are taken into the plan: through the block's pegs, so that what is tied to them
+//! follows, or, for an interrupted unit, for that unit alone.
+
+use super::live::Phase;
+use super::BlockManager;
+use crate::engine::{Revision, UnitKey};
+use crate::plan::pegs::SyncAddr;
+
+impl BlockManager {
+    /// Where the character stands now (world frame).
+    pub fn placement(&self) -> crate::world::Placement {
+        self.placement
+    }
+
+    /// Steps the engines that move the character to `to`, and takes their revisions.
+    pub(super) fn travel(&mut self, to: f64) {
+        let id = self.character.clone().unwrap_or_default();
+        let (mut at, mut revisions) = (self.placement, Vec::new());
+        for e in self.registry.engines_mut() {
+            if let Some(t) = e.as_travel() {
+                at = t.travel(to, &self.shared, &id, at);
+                revisions.extend(t.take_revisions());
+            }
+        }
+        if at != self.placement {
+            self.placement = at;
+            self.world = std::sync::Arc::new(self.shared.seen_from_at(at));
+        }
+        for r in revisions {
+            self.revise(r);
+        }
+    }
+
+    /// Whether each foot is on the ground, if an engine moves the character's feet.
+    pub fn contacts(&mut self) -> Option<[bool; 2]> {
+        (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.contacts()))
+    }
+
+    /// Takes new times of a unit into the plan (see the module documentation).
+    fn revise(&mut self, r: Revision) {
+        let Some(i) = self.blocks.find(&r.unit.block) else {
+            return;
+        };
+        let Some(xi) = (self.blocks[i].behaviours.iter()).position(|x| x.id == r.unit.behaviour)
+        else {
+            return;
+        };
+        let x = &self.blocks[i].behaviours[xi];
+        if !matches!(x.phase, Phase::Planned | Phase::Added | Phase::Running) {
+            return;
+        }
+        let now = self.now;
+        let on_pegs = r.others_follow && self.blocks[i].pegs.is_some();
+        if on_pegs {
+            let block = self.blocks[i].id.to_string();
+            let (next, names): (usize, Vec<String>) =
+                (x.next, x.syncs.iter().map(|s| s.0.to_string()).collect());
+            if let Some(p) = self.blocks[i].pegs.as_mut() {
+                for (k, name) in names.iter().enumerate().skip(next) {
+                    let addr = SyncAddr::new(&block, &r.unit.behaviour, name);
+                    if let (Some(peg), Some(&t)) = (p.board.peg_of(&addr), r.times.get(k)) {
+                        if (p.board.global(peg) - t).abs() > 1e-9 {
+                            let _ = p.board.move_to(peg, t);
+                        }
+                    }
+                }
+            }
+            self.follow_pegs(i, now);
+        } else {
+            let start = self.blocks[i].start;
+            let x = &mut self.blocks[i].behaviours[xi];
+            x.retime(&r.times, start, now);
+            let global = x.global(start);
+            let (engine, key) = (x.engine, UnitKey::new(r.unit.block.clone(), x.id.clone()));
+            self.registry.engine_mut(engine).retime(&key, &global);
+        }
+        self.touch();
+        if self.blocks.get(i).is_some() && self.blocks[i].started() {
+            self.predict(i, true);
+        }
+    }
+}

@@ -1,0 +1,596 @@
+//! The locomotion engine: BML `<locomotion target manner>` as a character that walks there.
+//!
+//! - The target is a point of the world, a point moving along a path (followed as it moves), a
+//!   placed character (the walker stops 1.2 m from them, turned to face them) or `x,z` in world
+//!   metres. `manner` is WALK (1.3 m/s), STROLL (0.8 m/s) or RUN (3.0 m/s, with a flight
+//!   phase); `bmlt:speed` (m/s) overrides the speed.
+//! - Timing: when the block is scheduled the engine rehearses the walk from where the character
+//!   stands (the same fixed-step simulation it will run), which gives the preferred times of
+//!   `start` (first weight shift), `ready` (cruising speed), `relax` (final deceleration begins)
+//!   and `end` (standing, both feet planted). While walking it revises them ([`Travel`]): a sync
+//!   point passes when it really happens, and what is tied to it follows.
+//! - Each frame the character's body is stepped to the frame's time before the frame's sync
+//!   points pass; where it stands becomes the character's placement in the world (its other
+//!   engines see the world from there); the gait poses the legs, pelvis and arms
+//!   (`locomotion::posing`) under whatever upper-body engines play after it.
+//! - An interrupted walk slows down and stands within a step or two. A target inside an
+//!   obstacle or walled in gives EXECUTION_FAILURE and the walk ends where it stands; an
+//!   unknown one NO_SUCH_TARGET.
+
+use std::cell::RefCell;
+
+use glam::{Vec2, Vec3};
+
+use crate::bml::{Behaviour, BehaviourKind, NS_BMLT};
+use crate::body::{Pose, Skeleton};
+use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitKey, Units};
+use crate::feedback::KnownWarning;
+use crate::locomotion::posing::{pose_gait, GaitJoints};
+use crate::locomotion::{Moments, Walk, Walker};
+use crate::timing::{Flexibility, SyncKey, SyncName, TimingModel, TimingModels};
+use crate::world::{Placement, World};
+
+/// How far from another character a walk to them stops (m).
+pub const SOCIAL_DISTANCE: f32 = 1.2;
+/// Fastest `bmlt:speed` taken (m/s).
+pub const MAX_SPEED: f32 = 10.0;
+/// Longest walk rehearsed when scheduling (s); a longer one is predicted from its length.
+pub const REHEARSAL_LIMIT: f64 = 120.0;
+
+/// The sentence an unknown target's refusal starts with.
+const NO_TARGET: &str = "there is no target";
+
+/// A walk as written: where to and how.
+#[derive(Debug, Clone, PartialEq)]
+struct Order {
+    target: String,
+    speed: f32,
+    running: bool,
+    /// Why the speed or manner written was not taken.
+    note: Option<String>,
+}
+
+/// What a unit is doing.
+#[derive(Debug, Clone, PartialEq)]
+struct WalkUnit {
+    order: Order,
+    started: bool,
+    /// The moments that happened (global times), once started.
+    moments: Moments,
+    done: bool,
+    /// Interrupted: slowing down to stand where it is.
+    halted: bool,
+    /// A walk still going then has failed (global time).
+    deadline: f64,
+}
+
+/// The locomotion engine (see the module documentation).
+#[derive(Debug, Default)]
+pub struct LocomotionEngine {
+    units: Units<WalkUnit>,
+    walker: Option<Walker>,
+    /// The unit being walked.
+    current: Option<UnitKey>,
+    /// The shared world and where the character stood, as of the last travel.
+    world: Option<std::sync::Arc<World>>,
+    at: Placement,
+    id: String,
+    joints: Option<Option<GaitJoints>>,
+    /// Whether the character has walked (until then the gait leaves the pose alone).
+    walked: bool,
+    revisions: Vec<Revision>,
+    warnings: Vec<(UnitKey, String)>,
+    /// The last rehearsal: (walker state, walk) → moments relative to its start.
+    rehearsed: RefCell<Option<(Walker, Walk, Moments)>>,
+}
+
+/// Reads a locomotion behaviour's order.
+fn order(b: &Behaviour) -> Option<Order> {
+    let BehaviourKind::Locomotion(l) = &b.kind else {
+        return None;
+    };
+    let mut note = None;
+    let (mut speed, running) = match l.manner.as_deref().map(str::to_ascii_uppercase).as_deref() {
+        None | Some("WALK") => (1.3, false),
+        Some("STROLL") => (0.8, false),
+        Some("RUN") => (3.0, true),
+        Some(other) => {
+            note = Some(format!(
+                "manner '{other}' is not one of WALK, STROLL, RUN: it walks"
+            ));
+            (1.3, false)
+        }
+    };
+    let written = b
+        .foreign_attrs
+        .iter()
+        .find(|a| a.ns == NS_BMLT && a.name == "speed");
+    if let Some(a) = written {
+        match a.value.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() && v > 0.05 && v <= MAX_SPEED => speed = v,
+            _ => {
+                note = Some(format!(
+                    "bmlt:speed '{}' is not a speed above 0.05 and at most {MAX_SPEED} m/s: it goes at {speed} m/s",
+                    a.value
+                ))
+            }
+        }
+    }
+    Some(Order {
+        target: l.target.clone(),
+        speed,
+        running,
+        note,
+    })
+}
+
+/// `x,z` in metres, if `target` is written so.
+fn coordinates(target: &str) -> Option<Vec2> {
+    let (x, z) = target.split_once(',')?;
+    let (x, z) = (x.trim().parse::<f32>().ok()?, z.trim().parse::<f32>().ok()?);
+    let limit = crate::world::MAX_COORDINATE as f32;
+    (x.is_finite() && z.is_finite() && x.abs() <= limit && z.abs() <= limit)
+        .then(|| Vec2::new(x, z))
+}
+
+/// Where a walk to `target` goes in `world` for a walker at `from`, and what it faces there.
+fn resolve(world: &World, me: &str, target: &str, from: Vec2) -> Option<(Vec2, Option<Vec2>)> {
+    if let Some(p) = coordinates(target) {
+        return Some((p, None));
+    }
+    let is_character = target != me
+        && world.placements().any(|(id, _)| id == target)
+        && world.points().all(|(n, _)| n != target);
+    if is_character {
+        let p = world.placement(target).position;
+        let them = Vec2::new(p.x, p.z);
+        let away = (from - them).normalize_or(Vec2::Y);
+        return Some((them + away * SOCIAL_DISTANCE, Some(them)));
+    }
+    let p = world.get(target)?;
+    Some((Vec2::new(p.x, p.z), None))
+}
+
+fn to_times(syncs: &[(SyncName, f64)]) -> Vec<f64> {
+    syncs.iter().map(|s| s.1).collect()
+}
+
+impl LocomotionEngine {
+    /// The walker, standing where the character stands if it has none yet.
+    fn walker(&mut self, at: Placement, world: &World, now: f64) -> &mut Walker {
+        let here = Vec2::new(at.position.x, at.position.z);
+        let moved_by_host = self.walker.as_ref().is_some_and(|w| {
+            let b = w.body();
+            b.at.distance(here) > 1e-3
+                || crate::locomotion::gait::angle_diff(b.facing, at.facing).abs() > 1e-3
+        });
+        if self.walker.is_none() || moved_by_host {
+            let radius = world.radius(&self.id);
+            self.walker = Some(Walker::new(here, at.facing, radius, now));
+        }
+        self.walker.as_mut().expect("just made")
+    }
+
+    /// The moments of `walk` from the walker's state, relative to its start.
+    fn rehearse(
+        &self,
+        walker: &Walker,
+        walk: &Walk,
+        obstacles: &crate::locomotion::Obstacles,
+    ) -> Result<Moments, String> {
+        if let Some((w, k, m)) = self.rehearsed.borrow().as_ref() {
+            if w == walker && k == walk {
+                return Ok(*m);
+            }
+        }
+        let m = walker
+            .rehearse(walk.clone(), obstacles, REHEARSAL_LIMIT)
+            .map_err(|e| e.to_string())?;
+        let rel = |t: Option<f64>| t.map(|t| t - walker.time);
+        let rel = Moments {
+            start: Some(0.0),
+            ready: rel(m.ready),
+            relax: rel(m.relax),
+            end: rel(m.end),
+        };
+        *self.rehearsed.borrow_mut() = Some((walker.clone(), walk.clone(), rel));
+        Ok(rel)
+    }
+
+    /// Starts the walk of unit `key` now; a walk under way stops where it is.
+    fn start_walk(&mut self, key: UnitKey, world: &World) {
+        let Some(u) = self.units.get(&key).cloned() else {
+            return;
+        };
+        let here = self.walker.as_ref().map_or(Vec2::ZERO, |w| w.body().at);
+        let walk = match resolve(world, &self.id, &u.order.target, here) {
+            Some((goal, face)) => Walk {
+                goal,
+                speed: u.order.speed,
+                running: u.order.running,
+                face,
+            },
+            None => {
+                self.fail(&key, world.unknown_target(&u.order.target));
+                return;
+            }
+        };
+        if let Some(old) = self.current.take() {
+            self.end_now(&old);
+        }
+        let obstacles = world.obstacles().clone();
+        let Some(walker) = self.walker.clone() else {
+            return;
+        };
+        let planned = self.rehearse(&walker, &walk, &obstacles);
+        let w = self.walker.as_mut().expect("a walker");
+        match w.start(walk, &obstacles) {
+            Ok(()) => {
+                self.walked = true;
+                self.current = Some(key.clone());
+                let t0 = w.time;
+                if let (Ok(m), Some((syncs, unit))) = (planned, self.units.get_mut(&key)) {
+                    unit.started = true;
+                    unit.moments.start = Some(t0);
+                    unit.deadline = t0 + 2.0 * m.end.unwrap_or(REHEARSAL_LIMIT) + 10.0;
+                    // the rehearsal from here is what will happen: the plan follows it
+                    let at = |o: Option<f64>| o.map_or(f64::INFINITY, |o| t0 + o);
+                    let new: Vec<f64> = syncs
+                        .iter()
+                        .map(|(n, t)| match n.as_ref() {
+                            "ready" => at(m.ready),
+                            "relax" => at(m.relax),
+                            "end" => at(m.end),
+                            _ => *t,
+                        })
+                        .collect();
+                    if new.iter().all(|t| t.is_finite()) {
+                        self.revise(&key, new, true);
+                    }
+                }
+            }
+            Err(e) => self.fail(&key, format!("{key}: {e}")),
+        }
+    }
+
+    /// A walk that cannot go: a warning, and it ends at once where the character stands.
+    fn fail(&mut self, key: &UnitKey, why: String) {
+        self.warnings.push((key.clone(), why));
+        self.end_now(key);
+    }
+
+    /// Unit `key` ends now: its syncs still ahead move to the walker's time.
+    fn end_now(&mut self, key: &UnitKey) {
+        let now = self.walker.as_ref().map_or(0.0, |w| w.time);
+        if let Some((syncs, u)) = self.units.get_mut(key) {
+            u.done = true;
+            u.started = true;
+            let new: Vec<f64> = syncs.iter().map(|s| s.1.min(now)).collect();
+            self.revise(key, new, false);
+        }
+    }
+
+    /// Records new times for `key` (and in the engine's own copy).
+    fn revise(&mut self, key: &UnitKey, times: Vec<f64>, others_follow: bool) {
+        self.units.retime(key, &times);
+        self.revisions.retain(|r| r.unit != *key);
+        self.revisions.push(Revision {
+            unit: key.clone(),
+            times,
+            others_follow,
+        });
+    }
+
+    /// After stepping to `now`: moments that happened become the sync times; syncs still
+    /// ahead whose planned time has come are put off a little.
+    fn follow_moments(&mut self, now: f64, ended: Option<Moments>) {
+        let Some(key) = self.current.clone() else {
+            return;
+        };
+        let Some(w) = self.walker.as_ref() else {
+            return;
+        };
+        let m = ended.or_else(|| w.moments()).unwrap_or_default();
+        let Some((syncs, u)) = self.units.get_mut(&key) else {
+            return;
+        };
+        if ended.is_none() && now > u.deadline {
+            let why = format!(
+                "{key}: the walk to '{}' has not arrived {:.1} s after it set off; it stops where it is",
+                u.order.target,
+                now - syncs[0].1
+            );
+            if let Some(w) = self.walker.as_mut() {
+                w.halt();
+                w.stand();
+            }
+            self.current = None;
+            self.fail(&key, why);
+            return;
+        }
+        let (mut new, mut changed) = (to_times(syncs), false);
+        for (k, (name, t)) in syncs.iter().enumerate() {
+            let happened = match name.as_ref() {
+                "ready" => m.ready,
+                "relax" => m.relax,
+                "end" => m.end,
+                _ => continue,
+            };
+            let want = match happened {
+                Some(h) => h,
+                None if *t <= now => now + 0.05,
+                None => *t,
+            };
+            if (want - t).abs() > 1e-9 {
+                new[k] = want;
+                changed = true;
+            }
+        }
+        // keep the order
+        for k in 1..new.len() {
+            new[k] = new[k].max(new[k - 1]);
+        }
+        if ended.is_some() {
+            if let Some((_, u)) = self.units.get_mut(&key) {
+                u.done = true;
+                u.moments = m;
+            }
+            self.current = None;
+        }
+        if changed {
+            let follow = !self.units.get(&key).is_some_and(|u| u.halted);
+            self.revise(&key, new, follow);
+        }
+    }
+}
+
+impl Engine for LocomotionEngine {
+    crate::units_retime_len!();
+    crate::units_play!("locomotion");
+
+    fn name(&self) -> &'static str {
+        "locomotion"
+    }
+
+    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
+        let o = order(behaviour)?;
+        let fallback = crate::timing::DefaultTimingModels::default().model(behaviour);
+        let (Some(world), Some(walker)) = (self.world.as_deref(), self.walker.as_ref()) else {
+            return fallback;
+        };
+        let Some((goal, face)) = resolve(world, &self.id, &o.target, walker.body().at) else {
+            return fallback;
+        };
+        let walk = Walk {
+            goal,
+            speed: o.speed,
+            running: o.running,
+            face,
+        };
+        let m = match self.rehearse(walker, &walk, world.obstacles()) {
+            Ok(m) => m,
+            Err(_) => return fallback,
+        };
+        // a walk longer than the rehearsal: its length at its speed
+        let long = f64::from(goal.distance(walker.body().at) / o.speed) + 2.0;
+        let end = m.end.unwrap_or(long.max(REHEARSAL_LIMIT));
+        let relax = m.relax.unwrap_or(end - 1.0).clamp(0.0, end);
+        let ready = m.ready.unwrap_or(relax.min(1.0)).clamp(0.0, relax);
+        let key = |n: &'static str, at: f64| SyncKey::new(crate::bml::Id::new_static(n), at);
+        Some(TimingModel {
+            keys: vec![
+                key("start", 0.0),
+                key("ready", ready),
+                key("relax", relax),
+                key("end", end),
+            ],
+            flexibility: Flexibility::Stretchable {
+                min_duration: crate::timing::MIN_DURATION,
+                max_duration: f64::INFINITY,
+            },
+            persistent: false,
+        })
+    }
+
+    fn check_timing(&self, _b: &Behaviour, _syncs: &[(SyncName, f64)]) -> Result<(), String> {
+        // the walk decides its own times and revises them
+        Ok(())
+    }
+
+    fn self_timed(&self, behaviour: &Behaviour) -> bool {
+        matches!(behaviour.kind, BehaviourKind::Locomotion(_))
+    }
+
+    fn interprets(&self, ns: &str, name: &str) -> bool {
+        ns == NS_BMLT && name == "speed"
+    }
+
+    fn refusal(&self, error: &EngineError) -> KnownWarning {
+        if error.0.contains(NO_TARGET) {
+            KnownWarning::NoSuchTarget
+        } else {
+            KnownWarning::ExecutionFailure
+        }
+    }
+
+    fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
+        let o = order(unit.behaviour)
+            .ok_or_else(|| EngineError("the locomotion engine realizes locomotion".into()))?;
+        if let Some(world) = self.world.as_deref() {
+            let here = self.walker.as_ref().map_or(Vec2::ZERO, |w| w.body().at);
+            if resolve(world, &self.id, &o.target, here).is_none() {
+                return Err(EngineError(format!(
+                    "{}: {}",
+                    unit.key,
+                    world.unknown_target(&o.target)
+                )));
+            }
+        }
+        if let Some(note) = &o.note {
+            self.warnings.push((unit.key.clone(), note.clone()));
+        }
+        self.units.add(
+            unit,
+            WalkUnit {
+                order: o,
+                started: false,
+                moments: Moments::default(),
+                done: false,
+                halted: false,
+                deadline: f64::INFINITY,
+            },
+        );
+        Ok(())
+    }
+
+    fn remove(&mut self, key: &UnitKey) {
+        if self.current.as_ref() == Some(key) {
+            if let Some(w) = self.walker.as_mut() {
+                w.halt();
+            }
+            self.current = None;
+        }
+        self.units.remove(key);
+    }
+
+    fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
+        let walking = self.current.as_ref() == Some(key);
+        if !walking {
+            let times = crate::engine::stop_now(now, syncs);
+            self.units.retime(key, &times);
+            if let Some((_, u)) = self.units.get_mut(key) {
+                u.done = true;
+                u.started = true;
+            }
+            return times;
+        }
+        if let Some(w) = self.walker.as_mut() {
+            w.halt();
+        }
+        let speed = self.walker.as_ref().map_or(0.0, |w| w.vehicle.speed());
+        let stop = now + f64::from(speed / 1.2) + 0.6;
+        let times: Vec<f64> = syncs
+            .iter()
+            .map(|(n, t)| match n.as_ref() {
+                _ if *t <= now => *t,
+                "end" => stop,
+                _ => now,
+            })
+            .collect();
+        self.units.retime(key, &times);
+        if let Some((_, u)) = self.units.get_mut(key) {
+            u.halted = true;
+        }
+        times
+    }
+
+    fn take_warnings(&mut self) -> Vec<(UnitKey, String)> {
+        std::mem::take(&mut self.warnings)
+    }
+
+    fn as_travel(&mut self) -> Option<&mut dyn Travel> {
+        Some(self)
+    }
+
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+        Some(self)
+    }
+}
+
+impl Travel for LocomotionEngine {
+    fn travel(&mut self, now: f64, world: &World, id: &str, at: Placement) -> Placement {
+        self.id = id.to_string();
+        if !self
+            .world
+            .as_deref()
+            .is_some_and(|w| std::ptr::eq(w, world))
+        {
+            self.world = Some(std::sync::Arc::new(world.clone()));
+        }
+        self.walker(at, world, now);
+        let obstacles = world.obstacles().clone();
+        loop {
+            // the next walk to start by now
+            let next = (self.units.all())
+                .filter(|(syncs, u)| !u.started && syncs.first().is_some_and(|s| s.1 <= now))
+                .map(|(syncs, _)| syncs[0].1)
+                .reduce(f64::min);
+            let until = next.unwrap_or(now).min(now);
+            let ended = self
+                .walker
+                .as_mut()
+                .and_then(|w| w.advance(until, &obstacles));
+            self.follow_moments(until, ended);
+            let Some(start) = next else { break };
+            match self.unit_starting_at(start) {
+                Some(k) => self.start_walk(k, world),
+                None => break,
+            }
+        }
+        // a moving target: follow it
+        if let (Some(key), Some(w)) = (self.current.clone(), self.walker.as_ref()) {
+            if let Some(u) = self.units.get(&key) {
+                if let Some((goal, face)) = resolve(world, id, &u.order.target, w.body().at) {
+                    if let Some(w) = self.walker.as_mut() {
+                        w.retarget(goal, face, &obstacles);
+                    }
+                }
+            }
+        }
+        let body = self.walker.as_ref().map(|w| w.body());
+        self.at = match body {
+            Some(b) => Placement {
+                position: Vec3::new(b.at.x, at.position.y, b.at.y),
+                facing: b.facing,
+            },
+            None => at,
+        };
+        self.at
+    }
+
+    fn take_revisions(&mut self) -> Vec<Revision> {
+        std::mem::take(&mut self.revisions)
+    }
+
+    fn contacts(&self) -> Option<[bool; 2]> {
+        let w = self.walker.as_ref().filter(|_| self.walked)?;
+        Some(
+            w.gait
+                .feet
+                .map(|f| matches!(f, crate::locomotion::gait::Foot::Planted { .. })),
+        )
+    }
+}
+
+impl LocomotionEngine {
+    /// The key of the unstarted unit starting at `start` (the first added of several).
+    fn unit_starting_at(&self, start: f64) -> Option<UnitKey> {
+        (self.units.keyed())
+            .find(|(syncs, u, _)| !u.started && syncs.first().is_some_and(|s| s.1 == start))
+            .map(|(_, _, k)| k.clone())
+    }
+}
+
+impl crate::engine::Motion for LocomotionEngine {
+    fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
+        order(behaviour)?;
+        Some(Steering::kinematic(
+            skeleton,
+            GaitJoints::names(skeleton),
+            false,
+        ))
+    }
+
+    fn animate(&mut self, _now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) {
+        if !self.walked {
+            return;
+        }
+        let Some(w) = self.walker.as_ref() else {
+            return;
+        };
+        let joints = self.joints.get_or_insert_with(|| GaitJoints::of(skeleton));
+        if let Some(j) = joints {
+            pose_gait(skeleton, j, &w.gait, w.body(), pose);
+        }
+    }
+}
