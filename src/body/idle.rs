@@ -1,6 +1,7 @@
 //! The idle layer: what a standing person does while nothing else moves them — breathing (the
 //! chest and the shoulders rise and fall) and a slow shift of weight from foot to foot (the pelvis
-//! sways sideways, the spine leans back against it). It is the pose every frame starts from, so
+//! sways sideways, the spine leans back against it, the feet stay where they stand: the legs
+//! follow by inverse kinematics). It is the pose every frame starts from, so
 //! behaviours play on top of it and inverse kinematics and gaze aim from where it put the body.
 //! It is not a behaviour: it has no timing and never shows in the feedback. Deterministic: the
 //! same character (by id) at the same time gets the same pose.
@@ -31,6 +32,8 @@ pub struct Idle {
     /// The joints it turns, found once: chest (vt6), collarbones (left, right), pelvis
     /// (sacroiliac) and lower spine (vl5).
     joints: [Option<usize>; 5],
+    /// Hip, knee and ankle of each leg, with the ankle's place at rest (world).
+    legs: [Option<([usize; 3], Vec3)>; 2],
 }
 
 impl Idle {
@@ -50,6 +53,11 @@ impl Idle {
                 "vl5",
             ]
             .map(|j| skeleton.joint(j)),
+            legs: ["l", "r"].map(|side| {
+                let j = |n: &str| skeleton.joint(&format!("{side}_{n}"));
+                let leg = [j("hip")?, j("knee")?, j("talocrural")?];
+                Some((leg, Pose::rest(skeleton).joint_world(skeleton, leg[2]).0))
+            }),
         }
     }
 
@@ -77,7 +85,41 @@ impl Idle {
         let roll = (WEIGHT_SHIFT_ROLL_DEG * shift).to_radians();
         turn(pelvis, Quat::from_rotation_z(roll), &mut pose);
         turn(spine, Quat::from_rotation_z(-roll), &mut pose);
+        self.plant_feet(skeleton, &mut pose);
         pose
+    }
+
+    /// Keeps both feet flat where they stand at rest: the pelvis a little lower where a leg
+    /// would not reach, hips and knees by two-link IK.
+    fn plant_feet(&self, skeleton: &Skeleton, pose: &mut Pose) {
+        let joints = skeleton.joints();
+        let mut drop = 0.0f32;
+        for (leg, ankle) in self.legs.iter().flatten() {
+            let reach = 0.995 * (joints[leg[1]].offset.length() + joints[leg[2]].offset.length());
+            let d = pose.joint_world(skeleton, leg[0]).0 - *ankle;
+            let h = glam::Vec2::new(d.x, d.z).length().min(reach);
+            drop = drop.max(d.y - (reach * reach - h * h).sqrt());
+        }
+        pose.root.y -= drop;
+        for (leg, ankle) in self.legs.iter().flatten() {
+            let Some(frame) = super::ik::LimbRoot::chain(skeleton, pose, leg[0]) else {
+                continue;
+            };
+            let placed = super::ik::place_limb(
+                skeleton,
+                frame,
+                *leg,
+                *ankle,
+                super::ik::LEG_POLE,
+                super::ik::LEG_HINGE,
+            );
+            if let Some((hip, knee)) = placed {
+                pose.rotations[leg[0]] = hip;
+                pose.rotations[leg[1]] = knee;
+                let shin = pose.joint_world(skeleton, leg[1]).1;
+                pose.rotations[leg[2]] = shin.inverse().normalize();
+            }
+        }
     }
 }
 
@@ -104,6 +146,11 @@ mod tests {
         let xs: Vec<f32> = (0..140).map(|i| root(f64::from(i) * 0.05)).collect();
         let max = xs.iter().fold(0f32, |a, &b| a.max(b.abs()));
         assert!((max - WEIGHT_SHIFT_M).abs() < 1e-3, "{max}");
+        // the feet stay put while the pelvis sways (no more than a tenth of a millimetre)
+        let ankle = |t: f64| idle.pose(&s, t).world(&s).positions[s.joint("l_talocrural").unwrap()];
+        let moved = (0..140).map(|i| ankle(f64::from(i) * 0.05).distance(ankle(0.0)));
+        let most = moved.fold(0f32, f32::max);
+        assert!(most < 1e-4, "{most}");
         // deterministic, and another character is out of step
         assert_eq!(idle.pose(&s, 2.0), Idle::new("", &s).pose(&s, 2.0));
         assert_ne!(idle.pose(&s, 2.0), Idle::new("anna", &s).pose(&s, 2.0));

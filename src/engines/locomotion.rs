@@ -318,7 +318,8 @@ impl LocomotionEngine {
             };
             let want = match happened {
                 Some(h) => h,
-                None if *t <= now => now + 0.05,
+                // late: put off by half a second at a time (a prediction a frame, no more)
+                None if *t <= now => now + 0.5,
                 None => *t,
             };
             if (want - t).abs() > 1e-9 {

@@ -77,6 +77,10 @@ pub struct Gait {
     pub heading: Vec2,
     /// Where the body will stop, while it slows down for good: feet land no further.
     pub stop_at: Option<Vec2>,
+    /// How much the body walks (0 standing, 1 walking from 0.6 m/s): the size of the pelvis
+    /// motion, the arm swing and the feet's rolls, following the speed within about 0.25 s
+    /// so that it never jumps.
+    pub amount: f32,
 }
 
 /// Where the walker's body is: its ground position and facing.
@@ -121,6 +125,7 @@ impl Gait {
             speed: 0.0,
             heading: forward(body.facing),
             stop_at: None,
+            amount: 0.0,
         };
         for k in 0..2 {
             g.feet[k] = Foot::Planted {
@@ -190,6 +195,8 @@ impl Gait {
     /// Advances the gait by `dt` seconds for a body at `body` moving at `velocity` (x, z).
     pub fn step(&mut self, dt: f32, body: Body, velocity: Vec2) {
         self.speed = velocity.length();
+        let target = smooth(self.speed / 0.6);
+        self.amount += (target - self.amount) * (1.0 - (-dt / 0.25).exp());
         if self.speed > 0.05 {
             self.heading = velocity / self.speed;
         } else {

@@ -6,7 +6,7 @@
 
 use glam::{Quat, Vec2, Vec3};
 
-use super::gait::{forward, Body, FootPose, Gait};
+use super::gait::{forward, Body, FootPose, Gait, ANKLE_HEIGHT, BALL_AHEAD};
 use crate::body::ik::{place_limb, LimbRoot, LEG_HINGE};
 use crate::body::{Pose, Skeleton};
 
@@ -74,16 +74,10 @@ fn to_local(f: FootPose, body: Body) -> FootPose {
     }
 }
 
-/// How much the body walks (0 standing, 1 from 0.6 m/s): the size of the pelvis motion, the
-/// arm swing and the feet's rolls.
-pub fn walk_amount(speed: f32) -> f32 {
-    super::gait::smooth(speed / 0.6)
-}
-
 /// Poses the gait of a body standing at `body` on `pose` (the character's own frame): the
 /// pelvis, trunk and arms on top of what is there, the legs set.
 pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, pose: &mut Pose) {
-    let amount = walk_amount(gait.speed);
+    let amount = gait.amount;
     let tau = std::f32::consts::TAU;
     let beta = gait.stance();
     let (psi_l, psi_r) = (gait.foot_phase(0), gait.foot_phase(1));
@@ -129,10 +123,11 @@ pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, p
     }
 }
 
-/// Lowers the root so that each foot is within the leg's reach (less 2 mm); over both feet, so
+/// Lowers the root so that each foot is within 98.5 % of the leg's reach (a straight knee
+/// turns fast for little change of length); over both feet, so
 /// that the height changes smoothly as they lift and land.
 fn lower_to_reach(skeleton: &Skeleton, j: &GaitJoints, feet: &[FootPose; 2], pose: &mut Pose) {
-    let reach = j.reach - 0.002;
+    let reach = j.reach * 0.985;
     let mut drop = 0.0f32;
     for (k, foot) in feet.iter().enumerate() {
         let hip = pose.joint_world(skeleton, j.legs[k][0]).0;
@@ -144,26 +139,49 @@ fn lower_to_reach(skeleton: &Skeleton, j: &GaitJoints, feet: &[FootPose; 2], pos
     pose.root.y -= drop;
 }
 
+/// The most the ankle is bent toes-up against the shin (rad; its limit is 20°).
+const MAX_DORSIFLEXION: f32 = 0.28;
+
 /// Puts a leg's ankle at `foot` (hip and knee by IK, knee toward the foot's heading) and turns
-/// the foot to its heading and pitch.
-fn place_leg(skeleton: &Skeleton, [hip, knee, ankle]: [usize; 3], foot: FootPose, pose: &mut Pose) {
+/// the foot to its heading and pitch. Where the shin leans so far over the foot that the ankle
+/// would bend past [`MAX_DORSIFLEXION`], the heel rises instead: a planted foot rolls about the
+/// ball of the foot (which stays on the ground), a swinging one about its ankle.
+fn place_leg(skeleton: &Skeleton, leg: [usize; 3], foot: FootPose, pose: &mut Pose) {
+    let mut foot = foot;
+    for _ in 0..4 {
+        let dorsiflexion = set_leg(skeleton, leg, foot, pose);
+        let excess = dorsiflexion - MAX_DORSIFLEXION;
+        if excess < 1e-3 {
+            return;
+        }
+        let f = forward(foot.yaw);
+        let axis = Vec3::new(f.y, 0.0, -f.x);
+        let turn = Quat::from_axis_angle(axis, excess);
+        if foot.planted {
+            let orientation = Quat::from_rotation_y(foot.yaw) * Quat::from_rotation_x(-foot.pitch);
+            let ball = foot.ankle + orientation * Vec3::new(0.0, -ANKLE_HEIGHT, BALL_AHEAD);
+            foot.ankle = ball + turn * (foot.ankle - ball);
+        }
+        foot.pitch -= excess;
+    }
+}
+
+/// Sets one leg to `foot`; returns how far the ankle is bent toes-up against the shin (rad).
+fn set_leg(skeleton: &Skeleton, [hip, knee, ankle]: [usize; 3], foot: FootPose, pose: &mut Pose) -> f32 {
     let Some(frame) = LimbRoot::chain(skeleton, pose, hip) else {
-        return;
+        return 0.0;
     };
     let f = forward(foot.yaw);
     let pole = Vec3::new(f.x, 0.0, f.y);
-    if let Some((h, k)) = place_limb(
-        skeleton,
-        frame,
-        [hip, knee, ankle],
-        foot.ankle,
-        pole,
-        LEG_HINGE,
-    ) {
+    if let Some((h, k)) = place_limb(skeleton, frame, [hip, knee, ankle], foot.ankle, pole, LEG_HINGE)
+    {
         pose.rotations[hip] = h;
         pose.rotations[knee] = k;
     }
     let shin = pose.joint_world(skeleton, knee).1;
     let wanted = Quat::from_rotation_y(foot.yaw) * Quat::from_rotation_x(-foot.pitch);
-    pose.rotations[ankle] = (shin.inverse() * wanted).normalize();
+    let local = (shin.inverse() * wanted).normalize();
+    pose.rotations[ankle] = local;
+    // toes-up is a turn about −x
+    -local.to_euler(glam::EulerRot::XYZ).0
 }

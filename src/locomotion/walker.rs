@@ -81,7 +81,7 @@ impl Walker {
     pub fn new(at: Vec2, facing: f32, radius: f32, time: f64) -> Walker {
         let body = Body { at, facing };
         Walker {
-            vehicle: Vehicle::new(Vec3::new(at.x, 0.0, at.y), 0.5, 0.6, 1.3),
+            vehicle: Vehicle::new(Vec3::new(at.x, 0.0, at.y), 0.2, 0.5, 1.3),
             facing,
             gait: Gait::standing(body),
             radius,
@@ -126,8 +126,8 @@ impl Walker {
         let reach = 0.45;
         let params = ArriveParams {
             slow_radius: slow_radius(walk.speed),
-            stop_radius: 0.03,
-            floor_speed: 0.25,
+            stop_radius: 0.04,
+            floor_speed: 0.12,
         };
         let points = route
             .iter()
@@ -147,8 +147,9 @@ impl Walker {
             params,
         }));
         self.vehicle.max_speed = walk.speed;
-        // accelerate and brake at up to about 2 m/s² walking, more running
-        self.vehicle.max_force = self.vehicle.mass * (1.0 + 0.8 * walk.speed);
+        // the velocity follows the steering within about 0.2 s, speeding up and braking at up
+        // to about 2.3 m/s² walking, more running
+        self.vehicle.max_force = self.vehicle.mass * (1.6 + 0.6 * walk.speed);
         self.gait.running = walk.running;
         let moments = Moments {
             start: Some(self.time),
@@ -165,16 +166,37 @@ impl Walker {
         Ok(())
     }
 
-    /// Slows down and stands where it is (an interrupted walk).
+    /// Slows down and stands within a step or two (an interrupted walk): it arrives at the
+    /// point its stopping distance ahead.
     pub fn halt(&mut self) {
-        if let Some(a) = self.active.as_mut() {
-            a.halting = true;
-            a.walk.face = None;
-            a.steering.clear();
-            a.steering.add(Part::new(Behaviour::Stop));
-            a.moments.relax.get_or_insert(self.time);
-            a.moments.ready.get_or_insert(self.time);
+        let (here, v) = (self.body().at, self.velocity());
+        let speed = v.length();
+        let Some(a) = self.active.as_mut() else {
+            return;
+        };
+        a.halting = true;
+        a.walk.face = None;
+        a.moments.relax.get_or_insert(self.time);
+        a.moments.ready.get_or_insert(self.time);
+        if a.stopped {
+            return;
         }
+        let ahead = if speed > 1e-3 { v / speed } else { forward(self.facing) };
+        let stop = here + ahead * (speed * speed / 2.0 + 0.2 * speed);
+        a.walk.goal = stop;
+        a.route = vec![here, stop];
+        a.steering.clear();
+        a.steering.add(Part::new(Behaviour::FollowPoints {
+            points: vec![Vec3::new(stop.x, 0.0, stop.y)],
+            next: 0,
+            reach: 0.45,
+            params: ArriveParams {
+                slow_radius: (1.2 * (stop - here).length()).max(0.3),
+                stop_radius: 0.04,
+                floor_speed: 0.12,
+            },
+        }));
+        self.gait.stop_at = Some(stop);
     }
 
     /// Gives up the walk under way at once: the body stands where it is (its feet may still
@@ -186,12 +208,12 @@ impl Walker {
     }
 
     /// Moves the goal of the walk under way (a moving target), planning a new route when it
-    /// moved more than 0.3 m.
+    /// moved more than 0.1 m.
     pub fn retarget(&mut self, goal: Vec2, face: Option<Vec2>, obstacles: &Obstacles) {
         let Some(a) = self.active.as_ref() else {
             return;
         };
-        if a.halting || a.walk.goal.distance(goal) < 0.3 {
+        if a.halting || a.stopped || a.walk.goal.distance(goal) < 0.1 {
             if let Some(a) = self.active.as_mut() {
                 a.walk.face = face.or(a.walk.face);
             }
@@ -370,7 +392,7 @@ impl Active {
 
 /// Where the final deceleration at `speed` begins, from the goal (m): about two steps at a walk.
 fn slow_radius(speed: f32) -> f32 {
-    (0.9 * speed).max(0.5)
+    (0.75 * speed).max(0.5)
 }
 
 /// Turns `facing` toward `to` by at most [`TURN_RATE`] × `dt`.

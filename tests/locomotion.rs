@@ -1,0 +1,383 @@
+//! Does the character walk like a person? Each test realizes BML with `<locomotion>` on the
+//! virtual clock and judges the frames through forward kinematics: where the root goes and how
+//! fast, whether planted feet stay put, how long the steps are and how often they come, whether
+//! the body keeps clear of obstacles, and when the sync points are reported.
+
+use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::feedback::Feedback;
+use bml_realizer::realizer::Realizer;
+use bml_realizer::world::World;
+use glam::{Vec2, Vec3};
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+const BMLT: &str = r#"xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
+
+/// What a run produced: every frame's time and pose of the default character, and the feedback.
+struct Run {
+    dt: f64,
+    frames: Vec<(f64, Pose)>,
+    feedback: Vec<Feedback>,
+}
+
+fn run_in(world: Option<World>, bml: &[&str], seconds: f64, fps: f64) -> Run {
+    let mut r = Realizer::new();
+    if let Some(w) = world {
+        *r.world_mut() = w;
+    }
+    let mut feedback = Vec::new();
+    let mut frames = Vec::new();
+    for b in bml {
+        let _ = r.perform_bml(b);
+    }
+    for i in 0..=(seconds * fps).ceil() as u32 {
+        let t = f64::from(i) / fps;
+        let f = r.tick(t);
+        feedback.extend(f.feedback);
+        frames.push((t, f.poses[0].pose.clone()));
+    }
+    Run {
+        dt: 1.0 / fps,
+        frames,
+        feedback,
+    }
+}
+
+fn run(bml: &[&str], seconds: f64) -> Run {
+    run_in(None, bml, seconds, 60.0)
+}
+
+fn walk(attrs: &str, then: &str) -> String {
+    format!(r#"<bml {NS} {BMLT} id="b1"><locomotion id="w" {attrs}/>{then}</bml>"#)
+}
+
+impl Run {
+    /// The global time of sync `id` (`b1:w:end`).
+    fn sync(&self, id: &str) -> f64 {
+        self.feedback
+            .iter()
+            .find_map(|f| match f {
+                Feedback::SyncPointProgress(p)
+                    if format!("{}:{}:{}", p.block, p.behaviour, p.sync) == id =>
+                {
+                    Some(p.global_time)
+                }
+                _ => None,
+            })
+            .unwrap_or_else(|| panic!("no {id} in {:#?}", self.feedback))
+    }
+
+    fn warnings(&self) -> Vec<(String, String)> {
+        (self.feedback.iter())
+            .filter_map(|f| match f {
+                Feedback::Warning(w) => Some((w.kind.as_str().to_string(), w.text.clone())),
+                _ => None,
+            })
+            .collect()
+    }
+
+    fn block_ended(&self) -> bool {
+        (self.feedback.iter()).any(|f| matches!(f, Feedback::BlockProgress(p) if p.block == "b1" && p.sync == "end"))
+    }
+
+    fn root(&self, k: usize) -> Vec2 {
+        let r = self.frames[k].1.root;
+        Vec2::new(r.x, r.z)
+    }
+
+    /// Horizontal root speed between frames k−1 and k.
+    fn speed(&self, k: usize) -> f32 {
+        if k == 0 {
+            return 0.0;
+        }
+        self.root(k).distance(self.root(k - 1)) / self.dt as f32
+    }
+
+    fn frame_at(&self, t: f64) -> usize {
+        self.frames.partition_point(|f| f.0 < t - 1e-9).min(self.frames.len() - 1)
+    }
+}
+
+/// The points of each foot that touch the ground: heel and ball (world), by forward kinematics.
+fn soles(s: &Skeleton, pose: &Pose) -> [[Vec3; 2]; 2] {
+    let w = pose.world(s);
+    ["l", "r"].map(|side| {
+        let a = s.joint(&format!("{side}_talocrural")).unwrap();
+        let ball = w.positions[s.joint(&format!("{side}_metatarsal")).unwrap()];
+        let heel = w.positions[a] + w.orientations[a] * Vec3::new(0.0, -0.05, -0.05);
+        [heel, ball]
+    })
+}
+
+/// For each foot, each stretch of frames with a sole point on the ground (within 4 mm): how far
+/// the points on the ground moved over it (summed frame to frame), and when it began.
+fn stances(run: &Run) -> [Vec<(f64, f32, Vec2)>; 2] {
+    let s = Skeleton::adult();
+    let mut out: [Vec<(f64, f32, Vec2)>; 2] = [Vec::new(), Vec::new()];
+    let mut prev: Option<[[Vec3; 2]; 2]> = None;
+    let mut open = [false; 2];
+    for (t, pose) in &run.frames {
+        let now = soles(&s, pose);
+        for k in 0..2 {
+            let down = now[k].iter().any(|p| p.y < 0.004);
+            if down && !open[k] {
+                let at = (now[k][0] + now[k][1]) / 2.0;
+                out[k].push((*t, 0.0, Vec2::new(at.x, at.z)));
+            }
+            if let (true, true, Some(p)) = (down, open[k], prev) {
+                let slide: f32 = (0..2)
+                    .filter(|&i| now[k][i].y < 0.004 && p[k][i].y < 0.004)
+                    .map(|i| Vec2::new(now[k][i].x - p[k][i].x, now[k][i].z - p[k][i].z).length())
+                    .fold(0.0, f32::max);
+                out[k].last_mut().unwrap().1 += slide;
+            }
+            open[k] = down;
+        }
+        prev = Some(now);
+    }
+    out
+}
+
+#[test]
+fn a_walk_arrives_stops_and_reports_its_end_when_it_stands() {
+    let r = run(&[&walk(r#"target="1,5""#, "")], 9.0);
+    let end = r.sync("b1:w:end");
+    let k = r.frame_at(end);
+    let last = r.frames.len() - 1;
+    assert!(r.root(last).distance(Vec2::new(1.0, 5.0)) < 0.15, "{}", r.root(last));
+    assert!(r.speed(k) < 0.05, "{}", r.speed(k));
+    // the real stop: nothing moves after `end`, and something did a frame before it
+    let s = Skeleton::adult();
+    let feet_moved = |a: usize, b: usize| {
+        let (p, q) = (soles(&s, &r.frames[a].1), soles(&s, &r.frames[b].1));
+        let feet = (0..2).flat_map(|f| (0..2).map(move |i| (f, i)));
+        feet.map(|(f, i)| p[f][i].distance(q[f][i])).fold(0.0, f32::max)
+    };
+    assert!(feet_moved(k, last) < 0.003, "{}", feet_moved(k, last));
+    // (the root sways with the weight shift while standing, slowly)
+    assert!((k..=last).all(|i| r.speed(i) < 0.05));
+    assert!(feet_moved(k - 2, k) > 1e-4, "the end came late: nothing moved before it");
+    // sync order and the block's end
+    let (s0, rd, rx) = (r.sync("b1:w:start"), r.sync("b1:w:ready"), r.sync("b1:w:relax"));
+    assert!(s0 <= rd && rd <= rx && rx < end);
+    assert!(r.block_ended());
+}
+
+#[test]
+fn cruising_speed_is_the_manner_s() {
+    for (attrs, speed) in [
+        (r#"target="0,8""#, 1.3),
+        (r#"target="0,8" manner="STROLL""#, 0.8),
+        (r#"target="0,12" manner="RUN""#, 3.0),
+        (r#"target="0,8" bmlt:speed="1.0""#, 1.0),
+    ] {
+        let r = run(&[&walk(attrs, "")], 14.0);
+        let (rd, rx) = (r.sync("b1:w:ready"), r.sync("b1:w:relax"));
+        let ks = r.frame_at(rd)..r.frame_at(rx);
+        let mean = ks.clone().map(|k| r.speed(k)).sum::<f32>() / ks.len() as f32;
+        assert!((mean - speed).abs() < 0.1 * speed, "{attrs}: {mean}");
+    }
+}
+
+#[test]
+fn planted_feet_do_not_slide_and_stay_above_the_floor() {
+    let r = run(&[&walk(r#"target="2,6""#, "")], 10.0);
+    let st = stances(&r);
+    for (k, foot) in st.iter().enumerate() {
+        assert!(foot.len() >= 4, "{k}: {foot:?}");
+        for (t, slide, _) in foot {
+            assert!(*slide < 0.01, "foot {k} slid {slide} m in the stance from {t}");
+        }
+    }
+    let s = Skeleton::adult();
+    for (t, p) in &r.frames {
+        let w = p.world(&s);
+        let low = w.positions.iter().map(|q| q.y).fold(f32::INFINITY, f32::min);
+        assert!(low > -0.01, "at {t} a joint is {low} m under the floor");
+    }
+}
+
+#[test]
+fn steps_are_as_long_and_as_frequent_as_a_person_s() {
+    // the walk ratio: cadence √(60 v / 0.0061) steps/min, step length 0.0061 × cadence
+    for (attrs, v) in [
+        (r#"target="0,12" manner="STROLL""#, 0.8f32),
+        (r#"target="0,12" bmlt:speed="1.0""#, 1.0),
+        (r#"target="0,14""#, 1.3),
+    ] {
+        let r = run(&[&walk(attrs, "")], 20.0);
+        let (rd, rx) = (r.sync("b1:w:ready"), r.sync("b1:w:relax"));
+        // heel strikes of both feet while cruising, in time order
+        let mut strikes: Vec<(f64, Vec2)> = stances(&r)
+            .into_iter()
+            .flatten()
+            .filter(|s| s.0 > rd && s.0 < rx)
+            .map(|s| (s.0, s.2))
+            .collect();
+        strikes.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert!(strikes.len() >= 4, "{attrs}: {strikes:?}");
+        let n = (strikes.len() - 1) as f32;
+        let span = (strikes.last().unwrap().0 - strikes[0].0) as f32;
+        let cadence = 60.0 * n / span;
+        let step = (strikes.last().unwrap().1.y - strikes[0].1.y) / n;
+        let want_c = (60.0 * v / 0.0061).sqrt();
+        let want_s = 0.0061 * want_c;
+        assert!((cadence - want_c).abs() < 0.15 * want_c, "{attrs}: {cadence} vs {want_c}");
+        assert!((step - want_s).abs() < 0.15 * want_s, "{attrs}: {step} vs {want_s}");
+    }
+}
+
+#[test]
+fn knees_bend_in_swing_and_no_joint_turns_too_fast() {
+    let r = run(&[&walk(r#"target="0,6""#, "")], 8.0);
+    let s = Skeleton::adult();
+    let knee = s.joint("l_knee").unwrap();
+    let most = (r.frames.iter())
+        .map(|(_, p)| p.rotations[knee].angle_between(glam::Quat::IDENTITY))
+        .fold(0.0, f32::max);
+    assert!(most > 0.7, "the knee bends at most {most} rad");
+    for w in r.frames.windows(2) {
+        for (i, j) in s.joints().iter().enumerate() {
+            if j.name.contains("eyeball") {
+                continue;
+            }
+            let rate = w[0].1.rotations[i].angle_between(w[1].1.rotations[i]) / r.dt as f32;
+            assert!(rate < 15.0, "{} turns at {rate} rad/s at {}", j.name, w[1].0);
+        }
+    }
+}
+
+#[test]
+fn the_same_walk_at_20_and_90_frames_a_second_ends_alike() {
+    let mut world = World::default();
+    world.set("door", Vec3::new(-2.0, 1.0, 5.0));
+    let bml = walk(r#"target="door""#, "");
+    let a = run_in(Some(world.clone()), &[&bml], 10.0, 20.0);
+    let b = run_in(Some(world), &[&bml], 10.0, 90.0);
+    let (ea, eb) = (a.sync("b1:w:end"), b.sync("b1:w:end"));
+    assert!((ea - eb).abs() < 0.1, "{ea} {eb}");
+    let (pa, pb) = (a.root(a.frames.len() - 1), b.root(b.frames.len() - 1));
+    assert!(pa.distance(pb) < 0.05, "{pa} {pb}");
+}
+
+fn obstacle_world(json: &str) -> World {
+    World::from_json(json).expect("a world").0
+}
+
+#[test]
+fn the_body_keeps_its_radius_from_obstacles_and_leaves_a_u_shaped_trap() {
+    let world = obstacle_world(
+        r#"{"obstacles": [{"segment": [-1.5, 2, 1.5, 2]}, {"segment": [-1.5, 2, -1.5, -0.5]},
+            {"segment": [1.5, 2, 1.5, -0.5]}, {"circle": [0.5, 4, 0.4]}, {"box": [-3, 5.5, -1, 6]}]}"#,
+    );
+    let r = run_in(Some(world.clone()), &[&walk(r#"target="0,7""#, "")], 20.0, 60.0);
+    assert!(r.root(r.frames.len() - 1).distance(Vec2::new(0.0, 7.0)) < 0.15);
+    for (k, (t, _)) in r.frames.iter().enumerate() {
+        let d = world.obstacles().clearance(r.root(k), 1.0);
+        assert!(d >= 0.25 - 1e-3, "at {t} the root is {d} m from an obstacle");
+    }
+}
+
+#[test]
+fn speech_tied_to_the_walk_s_end_starts_when_it_really_arrives() {
+    let mut world = World::default();
+    // a target that walks away while the character comes: the walk takes longer than planned
+    world
+        .set_path("walker", vec![(0.0, Vec3::new(0.0, 1.0, 3.0)), (3.0, Vec3::new(0.0, 1.0, 6.0))])
+        .unwrap();
+    let speech = r#"<speech id="s" start="w:end"><text>Here I am.</text></speech>"#;
+    let r = run_in(Some(world), &[&walk(r#"target="walker""#, speech)], 14.0, 60.0);
+    let (end, said) = (r.sync("b1:w:end"), r.sync("b1:s:start"));
+    assert_eq!(end, said);
+    // it arrived at the target's end point, and stood still when it spoke
+    let k = r.frame_at(said);
+    assert!(r.root(k).distance(Vec2::new(0.0, 6.0)) < 0.15, "{}", r.root(k));
+    assert!(r.speed(k) < 0.05);
+    // the first plan had it arrive earlier: the end was revised
+    let planned = r.feedback.iter().find_map(|f| match f {
+        Feedback::Prediction(p) => p.behaviours.iter().find(|b| b.behaviour == "w").map(|b| b.syncs.last().unwrap().1),
+        _ => None,
+    });
+    assert!(planned.unwrap() < end - 0.5, "{planned:?} {end}");
+}
+
+#[test]
+fn an_interrupted_walk_stands_within_two_steps() {
+    let interrupt = format!(
+        r#"<bml {NS} xmlns:bmla="http://www.asap-project.org/bmla" id="b2"><bmla:interrupt id="i" target="b1" start="2"/></bml>"#
+    );
+    let r = run(&[&walk(r#"target="0,10""#, ""), &interrupt], 8.0);
+    let k2 = r.frame_at(2.0);
+    let end = r.sync("b1:w:end");
+    let ke = r.frame_at(end);
+    assert!(end - 2.0 < 2.0, "{end}");
+    assert!(r.root(ke).distance(r.root(k2)) < 1.5, "{} {}", r.root(k2), r.root(ke));
+    assert!(r.speed(ke) < 0.05);
+    let s = Skeleton::adult();
+    let last = r.frames.len() - 1;
+    // standing on both feet, not frozen mid-stride
+    for foot in soles(&s, &r.frames[last].1) {
+        assert!(foot.iter().all(|p| p.y < 0.004), "{foot:?}");
+    }
+    assert!(r.block_ended());
+}
+
+#[test]
+fn bad_targets_and_speeds_are_warned_about_and_the_block_ends() {
+    let r = run(&[&walk(r#"target="nowhere""#, "")], 2.0);
+    let w = r.warnings();
+    assert!(w.iter().any(|(k, t)| k == "NO_SUCH_TARGET" && t.contains("nowhere") && t.contains("user")), "{w:?}");
+    assert!(r.block_ended());
+    for bad in [r#"target="NaN,1""#, r#"target="1e30,1""#] {
+        let r = run(&[&walk(bad, "")], 2.0);
+        assert!(r.warnings().iter().any(|(k, _)| k == "NO_SUCH_TARGET"), "{bad}");
+        assert!(r.block_ended());
+    }
+    for speed in ["0", "-1", "1e9", "fast"] {
+        let r = run(&[&walk(&format!(r#"target="0,2" bmlt:speed="{speed}""#), "")], 8.0);
+        let w = r.warnings();
+        assert!(w.iter().any(|(_, t)| t.contains("bmlt:speed")), "{speed}: {w:?}");
+        assert!(r.block_ended(), "{speed}");
+    }
+    // a goal inside an obstacle, and one walled in
+    let world = obstacle_world(
+        r#"{"obstacles": [{"circle": [0, 3, 1]}, {"segment": [4, 4, 6, 4]}, {"segment": [6, 4, 6, 6]},
+            {"segment": [6, 6, 4, 6]}, {"segment": [4, 6, 4, 4]}]}"#,
+    );
+    for goal in ["0,3", "5,5"] {
+        let r = run_in(Some(world.clone()), &[&walk(&format!(r#"target="{goal}""#), "")], 3.0, 60.0);
+        assert!(r.warnings().iter().any(|(k, _)| k == "EXECUTION_FAILURE"), "{goal}");
+        assert!(r.block_ended(), "{goal}");
+    }
+}
+
+#[test]
+fn a_thousand_obstacles_and_a_long_path_do_not_stall() {
+    let obstacles: Vec<String> = (0..1000)
+        .map(|i| format!(r#"{{"circle": [{}, {}, 0.2]}}"#, 3.0 + (i % 40) as f32 * 1.5, 3.0 + (i / 40) as f32 * 1.5))
+        .collect();
+    let keys: Vec<String> = (0..100_000).map(|i| format!("[{}, [{}, 1, -3]]", i as f64 * 0.01, (i % 7) as f64)).collect();
+    let json = format!(r#"{{"obstacles": [{}], "paths": {{"far": {{"keys": [{}]}}}}}}"#, obstacles.join(","), keys.join(","));
+    let world = obstacle_world(&json);
+    let r = run_in(Some(world.clone()), &[&walk(r#"target="30,30""#, "")], 60.0, 30.0);
+    assert!(r.block_ended());
+    let r = run_in(Some(world), &[&walk(r#"target="far""#, "")], 15.0, 30.0);
+    assert!(r.block_ended());
+}
+
+#[test]
+fn zz_debug_clamps() {
+    let mut r = Realizer::new();
+    r.perform_bml(&walk(r#"target="2,6""#, "")).unwrap();
+    let s = Skeleton::adult();
+    for i in 0..70 {
+        let f = r.tick(i as f64 / 60.0);
+        let c = &f.poses[0].clamped;
+        if !c.is_empty() {
+            let names: Vec<&str> = c.iter().map(|&j| s.joints()[j].name.as_str()).collect();
+            let j = s.joint("l_talocrural").unwrap();
+            let k = s.joint("r_talocrural").unwrap();
+            let e = |q: glam::Quat| { let (a, b, c) = q.to_euler(glam::EulerRot::XYZ); (a.to_degrees() as i32, b.to_degrees() as i32, c.to_degrees() as i32) };
+            println!("{:.2} {:?} L{:?} R{:?}", i as f64 / 60.0, names, e(f.poses[0].pose.rotations[j]), e(f.poses[0].pose.rotations[k]));
+        }
+    }
+}
