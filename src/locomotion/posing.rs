@@ -167,14 +167,25 @@ fn place_leg(skeleton: &Skeleton, leg: [usize; 3], foot: FootPose, pose: &mut Po
 }
 
 /// Sets one leg to `foot`; returns how far the ankle is bent toes-up against the shin (rad).
-fn set_leg(skeleton: &Skeleton, [hip, knee, ankle]: [usize; 3], foot: FootPose, pose: &mut Pose) -> f32 {
+fn set_leg(
+    skeleton: &Skeleton,
+    [hip, knee, ankle]: [usize; 3],
+    foot: FootPose,
+    pose: &mut Pose,
+) -> f32 {
     let Some(frame) = LimbRoot::chain(skeleton, pose, hip) else {
         return 0.0;
     };
     let f = forward(foot.yaw);
     let pole = Vec3::new(f.x, 0.0, f.y);
-    if let Some((h, k)) = place_limb(skeleton, frame, [hip, knee, ankle], foot.ankle, pole, LEG_HINGE)
-    {
+    if let Some((h, k)) = place_limb(
+        skeleton,
+        frame,
+        [hip, knee, ankle],
+        foot.ankle,
+        pole,
+        LEG_HINGE,
+    ) {
         pose.rotations[hip] = h;
         pose.rotations[knee] = k;
     }

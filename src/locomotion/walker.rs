@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use super::gait::{angle_diff, forward, Body, Gait};
 use super::obstacles::Obstacles;
 use super::path::{self, PathError};
-use super::steering::{ArriveParams, Behaviour, Combine, Context, Part, Steering, Vehicle};
+use super::steering::{flat, ArriveParams, Behaviour, Combine, Context, Part, Steering, Vehicle};
 
 /// The walker's fixed step (s).
 pub const STEP: f64 = 1.0 / 240.0;
@@ -19,6 +19,8 @@ pub const STEP: f64 = 1.0 / 240.0;
 pub const TURN_RATE: f32 = 3.5;
 /// A goal more than this off the facing (rad) is turned to on the spot before walking.
 pub const TURN_FIRST: f32 = 1.9;
+/// How hard a halted walk brakes (m/s²).
+pub const HALT_DECELERATION: f32 = 1.6;
 /// Margin kept from obstacles beyond the body's radius when planning (m).
 pub const PLAN_MARGIN: f32 = 0.08;
 
@@ -166,37 +168,17 @@ impl Walker {
         Ok(())
     }
 
-    /// Slows down and stands within a step or two (an interrupted walk): it arrives at the
-    /// point its stopping distance ahead.
+    /// Slows down and stands within a step or two (an interrupted walk): it brakes along its
+    /// way at [`HALT_DECELERATION`] (not the arrive law, whose linear slowing ends in a long
+    /// creep).
     pub fn halt(&mut self) {
-        let (here, v) = (self.body().at, self.velocity());
-        let speed = v.length();
-        let Some(a) = self.active.as_mut() else {
-            return;
-        };
-        a.halting = true;
-        a.walk.face = None;
-        a.moments.relax.get_or_insert(self.time);
-        a.moments.ready.get_or_insert(self.time);
-        if a.stopped {
-            return;
+        if let Some(a) = self.active.as_mut() {
+            a.halting = true;
+            a.walk.face = None;
+            a.moments.relax.get_or_insert(self.time);
+            a.moments.ready.get_or_insert(self.time);
+            a.steering.clear();
         }
-        let ahead = if speed > 1e-3 { v / speed } else { forward(self.facing) };
-        let stop = here + ahead * (speed * speed / 2.0 + 0.2 * speed);
-        a.walk.goal = stop;
-        a.route = vec![here, stop];
-        a.steering.clear();
-        a.steering.add(Part::new(Behaviour::FollowPoints {
-            points: vec![Vec3::new(stop.x, 0.0, stop.y)],
-            next: 0,
-            reach: 0.45,
-            params: ArriveParams {
-                slow_radius: (1.2 * (stop - here).length()).max(0.3),
-                stop_radius: 0.04,
-                floor_speed: 0.12,
-            },
-        }));
-        self.gait.stop_at = Some(stop);
     }
 
     /// Gives up the walk under way at once: the body stands where it is (its feet may still
@@ -258,7 +240,17 @@ impl Walker {
             let wanted = (next - here).normalize_or_zero();
             let behind = wanted != Vec2::ZERO
                 && angle_diff(wanted.x.atan2(wanted.y), self.facing).abs() > TURN_FIRST;
-            if !a.stopped {
+            if a.halting && !a.stopped {
+                let v = self.vehicle.velocity;
+                let speed = flat(v).length();
+                let slower = (speed - HALT_DECELERATION * dt).max(0.0);
+                self.vehicle.velocity = if speed > 0.0 { v * (slower / speed) } else { v };
+                self.vehicle.position += self.vehicle.velocity * dt;
+                if slower == 0.0 {
+                    a.stopped = true;
+                }
+                self.gait.stop_at = None;
+            } else if !a.stopped {
                 if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
                     // turn on the spot before setting off
                     let brake = Behaviour::Stop.force(
