@@ -467,3 +467,105 @@ fn a_thousand_obstacles_and_a_long_path_do_not_stall() {
     let r = run_in(Some(world), &[&walk(r#"target="far""#, "")], 15.0, 30.0);
     assert!(r.block_ended());
 }
+
+/// Distance from `p` to the torso's axis, a segment from the pelvis to the neck base.
+fn from_torso_axis(s: &Skeleton, pose: &Pose, p: Vec3) -> f32 {
+    let w = pose.world(s);
+    let (a, b) = (
+        w.positions[s.joint("sacroiliac").unwrap()],
+        w.positions[s.joint("vc7").unwrap()],
+    );
+    let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+    p.distance(a + t * (b - a))
+}
+
+#[test]
+fn gestures_play_over_the_gait_and_keep_the_hands_out_of_the_torso() {
+    let gestures = r#"<gesture id="g1" lexeme="BEAT" start="1"/><gesture id="g2" lexeme="WAVE" mode="LEFT_HAND" start="2.5"/><gesture id="g3" lexeme="SHRUG" start="4.5"/>"#;
+    let r = run(&[&walk(r#"target="0,8""#, gestures)], 9.0);
+    let s = Skeleton::adult();
+    let (g1, w) = (r.sync("b1:g1:stroke"), r.frame_at(r.sync("b1:g1:stroke")));
+    // the beat's stroke happens while walking, with the gesture's arm in front of the body
+    assert!(r.speed(w) > 1.0, "walking at {g1}");
+    for (t, pose) in &r.frames {
+        for joint in ["l_wrist", "r_wrist", "l_elbow", "r_elbow"] {
+            let at = pose.world(&s).positions[s.joint(joint).unwrap()];
+            let d = from_torso_axis(&s, pose, at);
+            assert!(d > 0.12, "{joint} {d} m from the torso axis at {t}");
+        }
+    }
+    // the wave is up beside the head while the legs walk
+    let k = r.frame_at(r.sync("b1:g2:stroke"));
+    let pw = r.frames[k].1.world(&s);
+    let (wrist, head) = (
+        pw.positions[s.joint("l_wrist").unwrap()],
+        pw.positions[s.joint("skullbase").unwrap()],
+    );
+    assert!(wrist.y > head.y - 0.25, "{wrist} {head}");
+    assert!(r.speed(k) > 1.0);
+}
+
+#[test]
+fn standing_still_for_half_a_minute_the_feet_stay_put() {
+    let wait = format!(r#"<bml {NS} id="b1"><wait id="w" max-wait="0.5"/></bml>"#);
+    for bml in [wait, walk(r#"target="1,1""#, "")] {
+        let r = run(&[&bml], 36.0);
+        let s = Skeleton::adult();
+        let from = r.frame_at(6.0);
+        let start = soles(&s, &r.frames[from].1);
+        for (t, pose) in &r.frames[from..] {
+            let now = soles(&s, pose);
+            for k in 0..2 {
+                for i in 0..2 {
+                    let d = now[k][i].distance(start[k][i]);
+                    assert!(d < 0.003, "{bml:?}: a foot moved {d} m by {t}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_target_behind_is_turned_to_on_the_spot_then_walked_to() {
+    let r = run(&[&walk(r#"target="0,-3""#, "")], 9.0);
+    // facing +z at first: it turns round before it walks, without stepping backwards
+    let s = Skeleton::adult();
+    let facing = |k: usize| {
+        let q = r.frames[k].1.rotations[0];
+        let f = q * Vec3::Z;
+        f.x.atan2(f.z)
+    };
+    let k = r.frame_at(0.5);
+    assert!(
+        r.root(k).length() < 0.1,
+        "it set off before turning: {}",
+        r.root(k)
+    );
+    assert!(
+        facing(k).abs() > 0.45,
+        "half a second in, it faces {}",
+        facing(k)
+    );
+    let last = r.frames.len() - 1;
+    assert!(r.root(last).distance(Vec2::new(0.0, -3.0)) < 0.15);
+    assert!(facing(last).abs() > 2.8, "{}", facing(last));
+    for (k, foot) in stances(&r).iter().enumerate() {
+        for (t, slide, _) in foot {
+            assert!(*slide < 0.01, "foot {k} slid {slide} m from {t}");
+        }
+    }
+    let _ = s;
+}
+
+#[test]
+fn a_walk_to_another_character_stops_at_social_distance_facing_them() {
+    let world =
+        obstacle_world(r#"{"characters": {"Bob": {"position": [1, 0, 5], "facing": 180}}}"#);
+    let r = run_in(Some(world), &[&walk(r#"target="Bob""#, "")], 10.0, 60.0);
+    let last = r.frames.len() - 1;
+    let d = r.root(last).distance(Vec2::new(1.0, 5.0));
+    assert!((d - 1.2).abs() < 0.15, "{d}");
+    let f = r.frames[last].1.rotations[0] * Vec3::Z;
+    let to_bob = (Vec2::new(1.0, 5.0) - r.root(last)).normalize();
+    assert!(Vec2::new(f.x, f.z).normalize().dot(to_bob) > 0.97, "{f}");
+}

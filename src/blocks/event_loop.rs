@@ -176,6 +176,7 @@ impl BlockManager {
             pose.rotations[0] = self.placement.rotation() * pose.rotations[0];
         }
         let (sounds, events) = self.sounds(to);
+        let contacts = self.contacts();
         frame.poses.push(CharacterPose {
             character: self.character.clone(),
             pose,
@@ -183,6 +184,7 @@ impl BlockManager {
             face,
             sounds,
             events,
+            contacts,
         });
         for (engine, key) in std::mem::take(&mut self.retiring) {
             self.registry.engine_mut(engine).remove(&key);

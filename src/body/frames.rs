@@ -16,14 +16,23 @@ use crate::face::{Face, FaceModel, ARKIT, VISEMES};
 use crate::sound::SoundEvent;
 
 /// One character in a frame: its id (`""` the default one), pose, the joints clamped into their
-/// limits, its face (if it has one) and the sounds that started or stopped since the last frame.
+/// limits, its face (if it has one), the sounds that started or stopped since the last frame
+/// and, once it has walked, which feet are on the ground (left, right).
 pub type Character<'a> = (
     &'a str,
     &'a Pose,
     &'a [usize],
     Option<&'a Face>,
     &'a [SoundEvent],
+    Option<[bool; 2]>,
 );
+
+/// Feet on the ground, as a frame writes them.
+#[derive(Serialize)]
+struct Contacts {
+    l: bool,
+    r: bool,
+}
 
 #[derive(Serialize)]
 struct EventLine<'a> {
@@ -76,6 +85,8 @@ struct CharacterLine<'a> {
     viseme: Option<&'static str>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     events: Vec<EventLine<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    contacts: Option<Contacts>,
 }
 
 /// The action units of `face` that are not 0, one entry for both sides where they are equal.
@@ -138,7 +149,7 @@ pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
 /// joints that were clamped into their limits and the face.
 pub fn line(skeleton: &Skeleton, time: f64, poses: &[Character<'_>]) -> String {
     let characters = (poses.iter())
-        .map(|&(id, pose, clamped, face, events)| {
+        .map(|&(id, pose, clamped, face, events, contacts)| {
             let world = pose.world(skeleton);
             let joints = (skeleton.joints().iter().zip(&pose.rotations))
                 .map(|(j, &q)| (j.name.as_str(), quat(q)))
@@ -163,6 +174,7 @@ pub fn line(skeleton: &Skeleton, time: f64, poses: &[Character<'_>]) -> String {
                         offset: (e.offset * 1e6).round() / 1e6,
                     })
                     .collect(),
+                contacts: contacts.map(|[l, r]| Contacts { l, r }),
             };
             (id, character)
         })
@@ -192,7 +204,7 @@ mod tests {
             glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         );
         let f: serde_json::Value =
-            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[], None, &[])])).unwrap();
+            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[], None, &[], None)])).unwrap();
         assert_eq!(f["time"], 0.5);
         let c = &f["characters"][""];
         assert_eq!(c["root"], serde_json::json!([0.0, 0.95, 0.0]));
@@ -204,11 +216,23 @@ mod tests {
             (q[0].as_f64().unwrap() + h).abs() < 1e-6 && (q[3].as_f64().unwrap() - h).abs() < 1e-6
         );
         assert!(c.get("clamped").is_none(), "only when a joint was clamped");
-        let f: serde_json::Value =
-            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[elbow], None, &[])])).unwrap();
+        let f: serde_json::Value = serde_json::from_str(&line(
+            &s,
+            0.5,
+            &[("", &pose, &[elbow], None, &[], Some([true, false]))],
+        ))
+        .unwrap();
         assert_eq!(
             f["characters"][""]["clamped"],
             serde_json::json!(["l_elbow"])
+        );
+        assert_eq!(
+            f["characters"][""]["contacts"],
+            serde_json::json!({"l": true, "r": false})
+        );
+        assert!(
+            c.get("contacts").is_none(),
+            "only for characters that walked"
         );
     }
 }

@@ -36,6 +36,8 @@ pub struct CharacterPose {
     pub sounds: Vec<crate::sound::Playing>,
     /// Sounds that started or stopped since the previous frame.
     pub events: Vec<crate::sound::SoundEvent>,
+    /// Whether each foot (left, right) is on the ground, once the character has walked.
+    pub contacts: Option<[bool; 2]>,
 }
 
 /// Everything the realizer produced for one moment: engine output, each character's pose, and the

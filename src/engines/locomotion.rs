@@ -26,7 +26,7 @@ use crate::body::{Pose, Skeleton};
 use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitKey, Units};
 use crate::feedback::KnownWarning;
 use crate::locomotion::posing::{pose_gait, GaitJoints};
-use crate::locomotion::{Moments, Walk, Walker};
+use crate::locomotion::{walker, Moments, Walk, Walker};
 use crate::timing::{Flexibility, SyncKey, SyncName, TimingModel, TimingModels};
 use crate::world::{Placement, World};
 

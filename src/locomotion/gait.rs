@@ -22,6 +22,8 @@ use glam::{Quat, Vec2, Vec3};
 pub const WALK_RATIO: f32 = 0.0061;
 /// Slowest cadence of stepping (steps/min): turning on the spot, closing the feet.
 pub const MIN_CADENCE: f32 = 80.0;
+/// Cadence of stepping on the spot (steps/min): turning, closing the feet.
+pub const SPOT_CADENCE: f32 = 110.0;
 /// Half the distance between the feet (m): the hips' half width.
 pub const HALF_WIDTH: f32 = 0.09;
 /// A foot counts as placed where it belongs when within this (m) and [`SETTLED_YAW`].
@@ -81,6 +83,9 @@ pub struct Gait {
     /// motion, the arm swing and the feet's rolls, following the speed within about 0.25 s
     /// so that it never jumps.
     pub amount: f32,
+    /// How fast the body turns (rad/s, positive to the left): a foot lands turned ahead by
+    /// half its stance's turn, so that the leg twists as little one way as the other.
+    pub turn_rate: f32,
 }
 
 /// Where the walker's body is: its ground position and facing.
@@ -126,6 +131,7 @@ impl Gait {
             heading: forward(body.facing),
             stop_at: None,
             amount: 0.0,
+            turn_rate: 0.0,
         };
         for k in 0..2 {
             g.feet[k] = Foot::Planted {
@@ -152,7 +158,8 @@ impl Gait {
 
     /// The length of one cycle (two steps) at the current speed, m.
     pub fn stride(&self) -> f32 {
-        2.0 * step_length(self.speed, self.running)
+        let spot = SPOT_CADENCE - (SPOT_CADENCE - MIN_CADENCE) * (self.speed / 0.3).min(1.0);
+        2.0 * self.speed * 60.0 / cadence(self.speed, self.running).max(spot)
     }
 
     /// Whether foot `k` is planted where it belongs for a body standing at `body`.
@@ -192,6 +199,13 @@ impl Gait {
         body.at + self.heading * lead + side
     }
 
+    /// The heading a foot lands with: the body's, turned ahead by half a stance of turning.
+    pub fn landing_yaw(&self, body: Body) -> f32 {
+        let stance_time =
+            self.stance() * 120.0 / cadence(self.speed, self.running).max(SPOT_CADENCE);
+        body.facing + self.turn_rate * stance_time * 0.5
+    }
+
     /// Advances the gait by `dt` seconds for a body at `body` moving at `velocity` (x, z).
     pub fn step(&mut self, dt: f32, body: Body, velocity: Vec2) {
         self.speed = velocity.length();
@@ -205,7 +219,9 @@ impl Gait {
         if self.at_rest(body) {
             return;
         }
-        let cycles_per_s = cadence(self.speed, self.running) / 120.0;
+        // on the spot (turning, closing the feet) quicker steps than the slowest walk
+        let spot = SPOT_CADENCE - (SPOT_CADENCE - MIN_CADENCE) * (self.speed / 0.3).min(1.0);
+        let cycles_per_s = cadence(self.speed, self.running).max(spot) / 120.0;
         let before = [self.foot_phase(0), self.foot_phase(1)];
         self.phase = (self.phase + cycles_per_s * dt).fract();
         for (k, &was) in before.iter().enumerate() {
@@ -226,7 +242,7 @@ impl Gait {
                 Foot::Swing { .. } if lands => {
                     self.feet[k] = Foot::Planted {
                         at: self.landing(k, body, 0.0),
-                        yaw: body.facing,
+                        yaw: self.landing_yaw(body),
                     };
                 }
                 _ => {}
@@ -302,12 +318,12 @@ impl Gait {
                 let s = ((psi - beta) / (1.0 - beta)).clamp(0.0, 1.0);
                 let to = self.landing(k, body, 1.0 - psi);
                 let e = smooth(s);
-                let yaw = from_yaw + angle_diff(body.facing, from_yaw) * e;
+                let yaw = from_yaw + angle_diff(self.landing_yaw(body), from_yaw) * e;
                 let pitch = -toe_off * (1.0 - smooth(s / 0.35).min(1.0)) + strike * smooth(s);
                 let lift = if self.running { 0.18 } else { 0.11 };
                 let clearance = lift * (std::f32::consts::PI * s).sin() * (0.3 + 0.7 * amount);
                 let start = rolled(from, from_yaw, -toe_off, BALL_AHEAD);
-                let end = rolled(to, body.facing, strike, -HEEL_BACK);
+                let end = rolled(to, self.landing_yaw(body), strike, -HEEL_BACK);
                 let flat = start.lerp(end, e);
                 FootPose {
                     ankle: flat + Vec3::Y * clearance,

@@ -16,9 +16,12 @@ use super::steering::{flat, ArriveParams, Behaviour, Combine, Context, Part, Ste
 /// The walker's fixed step (s).
 pub const STEP: f64 = 1.0 / 240.0;
 /// How fast the body turns toward its direction of travel (rad/s).
-pub const TURN_RATE: f32 = 3.5;
+pub const TURN_RATE: f32 = 2.0;
+/// How fast the body turns on the spot (rad/s): about 45° a step, the most a planted foot lets
+/// the leg twist.
+pub const TURN_ON_THE_SPOT: f32 = 1.0;
 /// A goal more than this off the facing (rad) is turned to on the spot before walking.
-pub const TURN_FIRST: f32 = 1.9;
+pub const TURN_FIRST: f32 = 0.8;
 /// How hard a halted walk brakes (m/s²).
 pub const HALT_DECELERATION: f32 = 1.6;
 /// Margin kept from obstacles beyond the body's radius when planning (m).
@@ -218,9 +221,16 @@ impl Walker {
 
     /// Steps until `t` (whole steps of [`STEP`]); returns the walk's moments if it ended in
     /// that time (the walker then stands).
+    /// A walker that stands with its feet together has nothing to step: its clock jumps.
     pub fn advance(&mut self, t: f64, obstacles: &Obstacles) -> Option<Moments> {
         let mut ended = None;
         while self.time + STEP <= t + 1e-9 {
+            if self.active.is_none() && self.gait.at_rest(self.body()) && self.gait.amount < 1e-3 {
+                let steps = ((t + 1e-9 - self.time) / STEP).floor();
+                self.time += steps * STEP;
+                self.gait.amount = 0.0;
+                break;
+            }
             self.time += STEP;
             if let Some(m) = self.step(STEP as f32, obstacles) {
                 ended = Some(m);
@@ -232,6 +242,7 @@ impl Walker {
     /// One step; the moments when the walk ends in it.
     fn step(&mut self, dt: f32, obstacles: &Obstacles) -> Option<Moments> {
         let time = self.time;
+        let facing_before = self.facing;
         let mut ended = None;
         if let Some(a) = self.active.as_mut() {
             let to_goal = a.walk.goal - Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
@@ -259,7 +270,11 @@ impl Walker {
                         &mut a.steering.rng,
                     );
                     self.vehicle.step(brake.unwrap_or(Vec3::ZERO), dt);
-                    turn_toward(&mut self.facing, wanted.x.atan2(wanted.y), dt);
+                    turn_toward(
+                        &mut self.facing,
+                        wanted.x.atan2(wanted.y),
+                        TURN_ON_THE_SPOT * dt,
+                    );
                 } else {
                     let f = a.steering.force(
                         &mut self.vehicle,
@@ -299,7 +314,7 @@ impl Walker {
                 if let Some(p) = a.walk.face {
                     let d = p - here;
                     if d.length() > 1e-3 {
-                        turn_toward(&mut self.facing, d.x.atan2(d.y), dt);
+                        turn_toward(&mut self.facing, d.x.atan2(d.y), TURN_ON_THE_SPOT * dt);
                     }
                 }
             }
@@ -315,7 +330,7 @@ impl Walker {
         // face the way of travel, never walk backwards
         let v = self.velocity();
         if v.length() > 0.05 {
-            turn_toward(&mut self.facing, v.x.atan2(v.y), dt);
+            turn_toward(&mut self.facing, v.x.atan2(v.y), TURN_RATE * dt);
             let f = forward(self.facing);
             if v.dot(f) < 0.0 {
                 let keep = v - f * v.dot(f);
@@ -323,6 +338,7 @@ impl Walker {
             }
         }
         let body = self.body();
+        self.gait.turn_rate = angle_diff(self.facing, facing_before) / dt;
         self.gait.step(dt, body, self.velocity());
         if let Some(a) = self.active.as_mut() {
             let facing_done = a.walk.face.is_none_or(|p| {
@@ -387,10 +403,9 @@ fn slow_radius(speed: f32) -> f32 {
     (0.75 * speed).max(0.5)
 }
 
-/// Turns `facing` toward `to` by at most [`TURN_RATE`] × `dt`.
-fn turn_toward(facing: &mut f32, to: f32, dt: f32) {
+/// Turns `facing` toward `to` by at most `max` radians.
+fn turn_toward(facing: &mut f32, to: f32, max: f32) {
     let d = angle_diff(to, *facing);
-    let max = TURN_RATE * dt;
     *facing = (*facing + d.clamp(-max, max)).rem_euclid(std::f32::consts::TAU);
 }
 

@@ -87,6 +87,7 @@ impl LiveView {
                     p.clamped.as_slice(),
                     Some(&p.face),
                     p.events.as_slice(),
+                    p.contacts,
                 )
             })
             .collect();

@@ -212,6 +212,7 @@ impl Recording {
                             p.clamped.as_slice(),
                             Some(&p.face),
                             p.events.as_slice(),
+                            p.contacts,
                         )
                     })
                     .collect();
@@ -270,6 +271,7 @@ impl Recording {
             face: bml_realizer::face::Face::neutral(bml_realizer::face::FaceModel::default_model()),
             sounds: Vec::new(),
             events: Vec::new(),
+            contacts: None,
         };
         self.frames
             .iter()
