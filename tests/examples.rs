@@ -183,3 +183,16 @@ fn two_characters_in_one_world() {
     assert_eq!(block(&fb, "a", "end"), (6.0, Some(BlockStatus::Done)));
     assert_eq!(block(&fb, "b", "end"), (6.0, Some(BlockStatus::Done)));
 }
+
+#[test]
+fn walking_to_the_door_then_speaking() {
+    let fb = run("run --world fixtures/examples/room.json fixtures/examples/walk-to-door.xml");
+    no_warnings(&fb);
+    assert_eq!(ms(sync(&fb, "door:w:start")), 0.0);
+    assert_eq!(ms(sync(&fb, "door:w:ready")), 2.263);
+    assert_eq!(ms(sync(&fb, "door:w:relax")), 4.446);
+    assert_eq!(sync(&fb, "door:look:start"), sync(&fb, "door:w:relax"));
+    assert_eq!(ms(sync(&fb, "door:w:end")), 6.387);
+    assert_eq!(sync(&fb, "door:s:start"), sync(&fb, "door:w:end"));
+    assert_eq!(block(&fb, "door", "end").1, Some(BlockStatus::Done));
+}

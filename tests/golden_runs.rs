@@ -52,6 +52,20 @@ fn xml_files(dir: &str) -> Vec<String> {
     files
 }
 
+/// The world an example is written for: the one its comment names ("with room.json"), else the
+/// example world.
+fn example_world(path: &str) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let named = text.split("with ").nth(1).and_then(|rest| {
+        let word = rest.split(|c: char| c.is_whitespace() || c == ':').next()?;
+        word.ends_with(".json").then(|| word.to_string())
+    });
+    format!(
+        "fixtures/examples/{}",
+        named.as_deref().unwrap_or("world.json")
+    )
+}
+
 fn stem(path: &str) -> &str {
     let name = path.rsplit('/').next().unwrap_or(path);
     name.strip_suffix(".xml").unwrap_or(name)
@@ -61,7 +75,8 @@ fn stem(path: &str) -> &str {
 fn the_examples_realize_as_logged() {
     let mut failures = Vec::new();
     for f in xml_files("fixtures/examples") {
-        let args = ["run", f.as_str(), "--world", "fixtures/examples/world.json"];
+        let world = example_world(&f);
+        let args = ["run", f.as_str(), "--world", world.as_str()];
         check(
             &format!("examples/{}.xml.log", stem(&f)),
             &args,

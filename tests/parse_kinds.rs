@@ -257,7 +257,7 @@ fn locomotion_and_wait() {
             manner: Some("RUN".into())
         })
     );
-    assert_eq!(b.sync_points(), START_END);
+    assert_eq!(b.sync_points(), GAZE_SYNCS);
     let b = one(r#"<wait id="w" max-wait="2.5" start="1"/>"#);
     assert_eq!(
         b.kind,

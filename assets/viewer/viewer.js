@@ -407,6 +407,27 @@
         this.scene.add(ball);
         this.points.push({ ball, keys: (world.paths || {})[name] });
       }
+      // obstacles: grey blocks to their height
+      const grey = new THREE.MeshStandardMaterial({ color: 0x8a8f98, transparent: true, opacity: 0.6 });
+      for (const o of world.obstacles || []) {
+        const h = o.height;
+        let mesh = null;
+        if (o.circle) {
+          const [x, z, r] = o.circle;
+          mesh = new THREE.Mesh(new THREE.CylinderGeometry(r, r, h, 32), grey);
+          mesh.position.set(x, h / 2, z);
+        } else if (o.box) {
+          const [x0, z0, x1, z1] = o.box;
+          mesh = new THREE.Mesh(new THREE.BoxGeometry(x1 - x0, h, z1 - z0), grey);
+          mesh.position.set((x0 + x1) / 2, h / 2, (z0 + z1) / 2);
+        } else if (o.segment) {
+          const [x0, z0, x1, z1] = o.segment;
+          mesh = new THREE.Mesh(new THREE.BoxGeometry(Math.hypot(x1 - x0, z1 - z0), h, 0.04), grey);
+          mesh.position.set((x0 + x1) / 2, h / 2, (z0 + z1) / 2);
+          mesh.rotation.y = -Math.atan2(z1 - z0, x1 - x0);
+        }
+        if (mesh) this.scene.add(mesh);
+      }
       for (const keys of Object.values(world.paths || {})) {
         const line = new THREE.Line(
           new THREE.BufferGeometry().setFromPoints(keys.map((k) => new THREE.Vector3().fromArray(k[1]))),
@@ -457,19 +478,33 @@
     }
 
     /** Drag to turn around the character, wheel to come closer. */
-    /** Where the camera looks: the middle of the characters where they first stand and how far
-     *  they spread from it, or (`face`) the first character's place. */
+    /** Where the camera looks: the middle of everywhere the characters stand during the clip and
+     *  how far that spreads (walkers stay in view), or (`face`) the first character's place now. */
     stage(face) {
       const first = this.clip.poses[0] || [];
       if (!first.length) return { x: 0, z: 0, spread: 0, yaw: 0 };
-      const chosen = face ? first.slice(0, 1) : first;
-      const x = chosen.reduce((a, p) => a + p[0], 0) / chosen.length;
-      const z = chosen.reduce((a, p) => a + p[2], 0) / chosen.length;
-      const spread = Math.max(...chosen.map((p) => Math.hypot(p[0] - x, p[2] - z)));
-      // a close look comes from in front of the character, the way it faces (its root's turn
-      // about +y)
-      const yaw = face ? 2 * Math.atan2(first[0][4], first[0][6]) : 0;
-      return { x, z, spread, yaw };
+      if (face) {
+        const now = this.clip.sample(this.THREE, this.t, 0, new Float32Array(first[0].length));
+        // a close look comes from in front of the character, the way it faces (its root's
+        // turn about +y)
+        return { x: now[0], z: now[2], spread: 0, yaw: 2 * Math.atan2(now[4], now[6]) };
+      }
+      if (!this.bounds || this.boundsFrames !== this.clip.poses.length) {
+        this.boundsFrames = this.clip.poses.length;
+        let [x0, z0, x1, z1] = [Infinity, Infinity, -Infinity, -Infinity];
+        for (const frame of this.clip.poses) {
+          for (const p of frame) {
+            if (!p) continue;
+            [x0, z0] = [Math.min(x0, p[0]), Math.min(z0, p[2])];
+            [x1, z1] = [Math.max(x1, p[0]), Math.max(z1, p[2])];
+          }
+        }
+        this.bounds = { x0, z0, x1, z1 };
+      }
+      const b = this.bounds;
+      const x = (b.x0 + b.x1) / 2;
+      const z = (b.z0 + b.z1) / 2;
+      return { x, z, spread: Math.hypot(b.x1 - b.x0, b.z1 - b.z0) / 2, yaw: 0 };
     }
 
     orbit() {

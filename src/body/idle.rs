@@ -95,7 +95,7 @@ impl Idle {
         let joints = skeleton.joints();
         let mut drop = 0.0f32;
         for (leg, ankle) in self.legs.iter().flatten() {
-            let reach = 0.995 * (joints[leg[1]].offset.length() + joints[leg[2]].offset.length());
+            let reach = joints[leg[1]].offset.length() + joints[leg[2]].offset.length() - 1.5e-4;
             let d = pose.joint_world(skeleton, leg[0]).0 - *ankle;
             let h = glam::Vec2::new(d.x, d.z).length().min(reach);
             drop = drop.max(d.y - (reach * reach - h * h).sqrt());

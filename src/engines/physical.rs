@@ -111,8 +111,9 @@ impl Catalogue {
 }
 
 /// How far (rad) the kinematic engines may turn a simulated joint from rest before the engine
-/// warns that the simulation hides it (the idle layer's weight shift stays below).
-const HIDDEN: f32 = 0.1;
+/// warns that the simulation hides it (the idle layer's weight shift stays below: it bends the
+/// knee of the leg it unloads by up to about 8°, 0.14 rad, to keep both feet on the floor).
+const HIDDEN: f32 = 0.2;
 
 /// The shortest hand-back to the kinematic pose when the last controller ends (s); a body far
 /// from that pose takes longer, so that the way back keeps under [`RELEASE_SPEED`].

@@ -206,8 +206,26 @@ fn metres(p: glam::Vec3) -> [f64; 3] {
     p.to_array().map(|v| (f64::from(v) * 1e6).round() / 1e6)
 }
 
-/// The world's points and paths.
+/// The world's points, paths and obstacles.
 fn world_data(w: &World) -> Value {
+    use bml_realizer::locomotion::Shape;
+    let obstacles: Vec<Value> = (w.obstacles().all().iter())
+        .map(|o| {
+            let m = |v: f32| (f64::from(v) * 1e6).round() / 1e6;
+            let h = m(o.height);
+            match o.shape {
+                Shape::Circle { centre, radius } => {
+                    json!({"circle": [m(centre.x), m(centre.y), m(radius)], "height": h})
+                }
+                Shape::Box { min, max } => {
+                    json!({"box": [m(min.x), m(min.y), m(max.x), m(max.y)], "height": h})
+                }
+                Shape::Segment { a, b } => {
+                    json!({"segment": [m(a.x), m(a.y), m(b.x), m(b.y)], "height": h})
+                }
+            }
+        })
+        .collect();
     let points: serde_json::Map<String, Value> = (w.points())
         .map(|(name, at)| (name.to_string(), json!(metres(at))))
         .collect();
@@ -217,7 +235,7 @@ fn world_data(w: &World) -> Value {
             (name.to_string(), Value::Array(keys))
         })
         .collect();
-    json!({"points": points, "paths": paths})
+    json!({"points": points, "paths": paths, "obstacles": obstacles})
 }
 
 /// Writes DIR/index.html and DIR/three-LICENSE.txt.
