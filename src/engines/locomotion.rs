@@ -517,11 +517,20 @@ impl Travel for LocomotionEngine {
                 .map(|(syncs, _)| syncs[0].1)
                 .reduce(f64::min);
             let until = next.unwrap_or(now).min(now);
+            // a walk is stepped no further than its deadline at a time: a huge jump of the
+            // clock ends it there instead of simulating all of it
+            let deadline = (self.current.as_ref())
+                .and_then(|k| self.units.get(k))
+                .map_or(f64::INFINITY, |u| u.deadline);
+            let stop = until.min(deadline + walker::STEP);
             let ended = self
                 .walker
                 .as_mut()
-                .and_then(|w| w.advance(until, &obstacles));
-            self.follow_moments(until, ended);
+                .and_then(|w| w.advance(stop, &obstacles));
+            self.follow_moments(stop, ended);
+            if stop < until {
+                continue;
+            }
             let Some(start) = next else { break };
             match self.unit_starting_at(start) {
                 Some(k) => self.start_walk(k, world),

@@ -230,14 +230,14 @@ impl Gait {
             let lifts = was < beta && now >= beta;
             let lands = now < was; // wrapped: heel strike
             match self.feet[k] {
-                Foot::Planted { at, yaw } if lifts => {
-                    // a foot already where it belongs stays down while the body stands
-                    if !(self.speed < 0.05 && self.settled(k, body)) {
-                        self.feet[k] = Foot::Swing {
-                            from: at,
-                            from_yaw: yaw,
-                        };
-                    }
+                // a foot already where it belongs stays down while the body stands
+                Foot::Planted { at, yaw }
+                    if lifts && !(self.speed < 0.05 && self.settled(k, body)) =>
+                {
+                    self.feet[k] = Foot::Swing {
+                        from: at,
+                        from_yaw: yaw,
+                    };
                 }
                 Foot::Swing { .. } if lands => {
                     self.feet[k] = Foot::Planted {
@@ -373,13 +373,12 @@ mod tests {
             b.at += v * dt;
             let was = g.feet;
             g.step(dt, b, v);
-            for k in 0..2 {
-                if let (Foot::Swing { .. }, Foot::Planted { at, .. }) = (was[k], g.feet[k]) {
+            for (k, (before, after)) in was.into_iter().zip(g.feet).enumerate() {
+                if let (Foot::Swing { .. }, Foot::Planted { at, .. }) = (before, after) {
                     plants.push((k, at));
                 }
                 // a planted foot never moves
-                if let (Foot::Planted { at: a, .. }, Foot::Planted { at: c, .. }) =
-                    (was[k], g.feet[k])
+                if let (Foot::Planted { at: a, .. }, Foot::Planted { at: c, .. }) = (before, after)
                 {
                     assert_eq!(a, c);
                 }

@@ -108,15 +108,15 @@ pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, p
     }
     let arm = if run { 0.55 } else { 0.3 } * amount;
     let swing = [(tau * psi_r).cos(), (tau * psi_l).cos()];
-    for k in 0..2 {
-        if let Some(s) = j.shoulders[k] {
-            pose.rotate(s, Quat::from_rotation_x(-(arm * swing[k] + 0.05 * amount)));
+    for ((shoulder, elbow), swing) in j.shoulders.iter().zip(&j.elbows).zip(swing) {
+        if let Some(s) = *shoulder {
+            pose.rotate(s, Quat::from_rotation_x(-(arm * swing + 0.05 * amount)));
         }
-        if let Some(e) = j.elbows[k] {
+        if let Some(e) = *elbow {
             let bend = if run {
                 1.4
             } else {
-                0.25 + 0.15 * swing[k].max(0.0)
+                0.25 + 0.15 * swing.max(0.0)
             } * amount;
             pose.rotate(e, Quat::from_axis_angle(Vec3::NEG_X, bend));
         }
