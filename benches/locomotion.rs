@@ -84,7 +84,12 @@ fn steering(c: &mut Criterion) {
     c.bench_function("steering: one step among 1000 posts", |b| {
         b.iter(|| {
             let mut v = v;
-            let f = s.force(&mut v, Context { obstacles: Some(&o) });
+            let f = s.force(
+                &mut v,
+                Context {
+                    obstacles: Some(&o),
+                },
+            );
             v.step(f, 1.0 / 240.0);
             black_box(v)
         })

@@ -27,7 +27,7 @@ use glam::{Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
 use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
+use crate::engine::{Engine, EngineError, Steering, Unit, UnitKey, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
 use crate::timing::SyncName;
 use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
@@ -127,7 +127,16 @@ pub struct GazeEngine {
     rest: Option<(String, Influence)>,
     /// The point between the eyes in the rest pose (the skeleton does not change).
     eyes_at_rest: Option<Vec3>,
+    /// The body aim of the last frame (joint, yaw, pitch) and the gazes that made it.
+    last: (Vec<(usize, f32, f32)>, Vec<UnitKey>),
+    /// A gaze removed while it turned the body (its block replaced, say): the aim it left, held
+    /// under the gazes that follow until one has turned fully, then faded out over [`HAND_OVER`]
+    /// s (since when, once fading).
+    ghost: Option<(Vec<(usize, f32, f32)>, Option<f64>)>,
 }
+
+/// How long the aim a removed gaze left takes to fade once nothing turns over it (s).
+pub const HAND_OVER: f64 = 0.4;
 
 fn gaze(b: &Behaviour) -> Option<(&str, Influence, bool, (f32, f32))> {
     let (g, shift) = match &b.kind {
@@ -250,30 +259,36 @@ impl crate::engine::Motion for GazeEngine {
             self.rest = Some((u.target.clone(), u.influence));
         }
         let Some(aim) = self.aim(now, skeleton, world) else {
+            self.last = (Vec::new(), Vec::new());
             return;
         };
-        aim.turn_body(skeleton, pose);
+        let applied = aim.turn_body(skeleton, pose);
         aim.turn_eyes(skeleton, pose);
+        self.last.0 = applied;
     }
 }
 
 /// Where the gaze points in one frame: the rest aim (a gaze shift's target, if one ended) and the
-/// target of the gaze that wins now, with its weights.
+/// running gazes over it, each blending from what is under it toward its own target with its
+/// weights. They are layered in start order, so the one that started last wins once it has
+/// turned, and one that takes over mid-turn turns on from where the head is.
 struct Aim {
     /// Where the eyes are with the body at rest.
     eyes: Vec3,
     /// The rest target and influence.
     rest: Option<(Vec3, Influence)>,
-    /// The winning gaze's target.
-    target: Option<Target>,
+    /// The running gazes, the winner last.
+    layers: Vec<Target>,
+    /// The aim a removed gaze left (joint, yaw, pitch) and how much of it holds (0–1).
+    ghost: (Vec<(usize, f32, f32)>, f32),
 }
 
-/// The target of the gaze that wins in a frame.
+/// The target of one running gaze in a frame.
 #[derive(Clone, Copy)]
 struct Target {
     point: Vec3,
     influence: Influence,
-    /// How far the body and the eyes have turned from the rest aim to the target (0–1).
+    /// How far the body and the eyes have turned from what is under it to the target (0–1).
     body_weight: f32,
     eye_weight: f32,
     /// (yaw, pitch) offset from the target, radians.
@@ -291,73 +306,127 @@ impl GazeEngine {
             (world.get(target)).map_or(0.0, |p| f64::from(from.angle_between(p - eyes)))
         };
         // the gaze that started last wins; ties go to the one that ends first
-        let active = (self.units.all())
+        let keys: Vec<UnitKey> = self.units.keyed().map(|(_, _, k)| k.clone()).collect();
+        if self.last.1.iter().any(|k| !keys.contains(k)) && !self.last.0.is_empty() {
+            self.ghost = Some((self.last.0.clone(), None));
+        }
+        self.last.1 = keys;
+        let mut active: Vec<(f64, f64, Target)> = (self.units.all())
             .filter_map(|(syncs, u)| {
-                let w = weights(u, syncs, now, amplitude(&u.target))?;
-                Some((at(syncs, "start")?, at(syncs, "end")?, u, w))
+                let (wb, we) = weights(u, syncs, now, amplitude(&u.target))?;
+                let target = Target {
+                    point: world.get(&u.target)?,
+                    influence: u.influence,
+                    body_weight: wb as f32,
+                    eye_weight: we as f32,
+                    offset: u.offset,
+                };
+                Some((at(syncs, "start")?, at(syncs, "end")?, target))
             })
-            .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
-        let target = active.and_then(|(_, _, u, (wb, we))| {
-            Some(Target {
-                point: world.get(&u.target)?,
-                influence: u.influence,
-                body_weight: wb as f32,
-                eye_weight: we as f32,
-                offset: u.offset,
-            })
-        });
-        (target.is_some() || rest.is_some()).then_some(Aim { eyes, rest, target })
+            .filter(|a| a.2.body_weight > 0.0 || a.2.eye_weight > 0.0)
+            .collect();
+        active.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
+        let layers: Vec<Target> = active.into_iter().map(|a| a.2).collect();
+        // the aim a removed gaze left holds until a gaze over it has turned fully, then fades
+        let turned = layers.last().is_none_or(|t| t.body_weight >= 0.999);
+        let ghost = match self.ghost.as_mut() {
+            Some((joints, since)) => {
+                if turned && since.is_none() {
+                    *since = Some(now);
+                }
+                let held = since.map_or(1.0, |s| 1.0 - ((now - s) / HAND_OVER).min(1.0));
+                (joints.clone(), held as f32)
+            }
+            None => (Vec::new(), 0.0),
+        };
+        if ghost.1 <= 0.0 {
+            self.ghost = None;
+        }
+        let some = !layers.is_empty() || rest.is_some() || ghost.1 > 0.0;
+        some.then_some(Aim {
+            eyes,
+            rest,
+            layers,
+            ghost,
+        })
     }
 }
 
+/// The yaw and pitch share of `influence` at joint `j`.
+fn share(influence: Influence, j: &str) -> (f32, f32) {
+    (shares(influence).iter().find(|s| s.0 == j)).map_or((0.0, 0.0), |s| (s.1, s.2))
+}
+
+/// `a` turned by whole turns to lie within half a turn of `near`.
+fn unwrap_near(a: f32, near: f32) -> f32 {
+    let tau = std::f32::consts::TAU;
+    a - ((a - near) / tau).round() * tau
+}
+
 impl Aim {
-    /// The spine, neck and head: the rest aim's shares blended with the target's.
-    fn turn_body(&self, skeleton: &Skeleton, pose: &mut Pose) {
-        let aim_of = |p: Vec3| yaw_pitch(p - self.eyes);
+    /// The target's (yaw, pitch) from the eyes at rest, with its offset.
+    fn aim_of(&self, t: &Target) -> (f32, f32) {
+        let (y, p) = yaw_pitch(t.point - self.eyes);
+        (y + t.offset.0, p + t.offset.1)
+    }
+
+    /// The spine, neck and head: the rest aim's shares, the aim a removed gaze left over them,
+    /// each layer blended over that. Returns what it applied (joint, yaw, pitch).
+    fn turn_body(&self, skeleton: &Skeleton, pose: &mut Pose) -> Vec<(usize, f32, f32)> {
         let (rest_yaw, rest_pitch, rest_influence) = match self.rest {
             Some((p, i)) => {
-                let (y, pi) = aim_of(p);
+                let (y, pi) = yaw_pitch(p - self.eyes);
                 (y, pi, i)
             }
             None => (0.0, 0.0, Influence::Eyes),
         };
-        let wb = self.target.map_or(0.0, |t| t.body_weight);
-        let (t_yaw, t_pitch, t_influence) = match self.target {
-            Some(t) => {
-                let (y, pi) = aim_of(t.point);
-                (y + t.offset.0, pi + t.offset.1, t.influence)
-            }
-            None => (rest_yaw, rest_pitch, rest_influence),
-        };
+        let aims: Vec<(f32, f32)> = self.layers.iter().map(|t| self.aim_of(t)).collect();
         let mut joints: Vec<&str> = Vec::new();
-        for s in shares(rest_influence).iter().chain(shares(t_influence)) {
+        let influences =
+            std::iter::once(rest_influence).chain(self.layers.iter().map(|t| t.influence));
+        for s in influences.flat_map(shares) {
             if !joints.contains(&s.0) {
                 joints.push(s.0);
             }
         }
-        let share = |inf: Influence, j: &str| {
-            (shares(inf).iter().find(|s| s.0 == j)).map_or((0.0, 0.0), |s| (s.1, s.2))
-        };
-        for j in joints {
-            let Some(i) = skeleton.joint(j) else { continue };
-            let (ry, rp) = share(rest_influence, j);
-            let (ty, tp) = share(t_influence, j);
-            let yaw = (1.0 - wb) * ry * rest_yaw + wb * ty * t_yaw;
-            let pitch = (1.0 - wb) * rp * rest_pitch + wb * tp * t_pitch;
-            pose.rotate(i, donders(yaw, pitch));
+        let mut indices: Vec<(usize, &str)> = joints
+            .into_iter()
+            .filter_map(|j| Some((skeleton.joint(j)?, j)))
+            .collect();
+        for &(i, _, _) in &self.ghost.0 {
+            if !indices.iter().any(|x| x.0 == i) {
+                indices.push((i, ""));
+            }
         }
+        let mut applied = Vec::with_capacity(indices.len());
+        for (i, j) in indices {
+            let (ry, rp) = share(rest_influence, j);
+            let (mut yaw, mut pitch) = (ry * rest_yaw, rp * rest_pitch);
+            if let Some(&(_, gy, gp)) = self.ghost.0.iter().find(|g| g.0 == i) {
+                let g = self.ghost.1;
+                yaw = (1.0 - g) * yaw + g * gy;
+                pitch = (1.0 - g) * pitch + g * gp;
+            }
+            for (t, &(ty, tp)) in self.layers.iter().zip(&aims) {
+                let (sy, sp) = share(t.influence, j);
+                let w = t.body_weight;
+                yaw = (1.0 - w) * yaw + w * sy * ty;
+                pitch = (1.0 - w) * pitch + w * sp * tp;
+            }
+            pose.rotate(i, donders(yaw, pitch));
+            applied.push((i, yaw, pitch));
+        }
+        applied
     }
 
-    /// The eyes: aimed exactly from where they are now (after the body turned), blended from the
-    /// rest aim, within their limits.
+    /// The eyes: aimed exactly from where they are now (after the body turned), each layer
+    /// blended over the rest aim, within their limits. A target straight behind is seen on the
+    /// side the body turned toward (the eyes take what the body left of the same turn).
     fn turn_eyes(&self, skeleton: &Skeleton, pose: &mut Pose) {
         let (yaw_max, pitch_max) = (EYE_YAW_LIMIT.to_radians(), EYE_PITCH_LIMIT.to_radians());
         let limit =
             |(y, p): (f32, f32)| (y.clamp(-yaw_max, yaw_max), p.clamp(-pitch_max, pitch_max));
         let rest_point = self.rest.map(|r| r.0);
-        let (we, off) = self
-            .target
-            .map_or((0.0, (0.0, 0.0)), |t| (t.eye_weight, t.offset));
         for eye in ["l_eyeball_joint", "r_eyeball_joint"] {
             let Some(e) = skeleton.joint(eye) else {
                 continue;
@@ -366,18 +435,20 @@ impl Aim {
             // along the eye's ancestors only
             let (at_eye, eye_orientation) = pose.joint_world(skeleton, e);
             let inv = (eye_orientation * pose.rotations[e].inverse()).inverse();
-            let eye_aim =
-                |p: Option<Vec3>| p.map_or((0.0, 0.0), |p| limit(yaw_pitch(inv * (p - at_eye))));
-            let (ry, rp) = eye_aim(rest_point);
-            let (ty, tp) = match self.target {
-                Some(t) => {
-                    let (y, pi) = eye_aim(Some(t.point));
-                    limit((y + off.0, pi + off.1))
-                }
-                None => (ry, rp),
-            };
-            let yaw = ry + we * (ty - ry);
-            let pitch = rp + we * (tp - rp);
+            let eye_aim = |p: Vec3| yaw_pitch(inv * (p - at_eye));
+            let (mut yaw, mut pitch) = rest_point.map_or((0.0, 0.0), |p| limit(eye_aim(p)));
+            for t in &self.layers {
+                let (ty, _) = self.aim_of(t);
+                // what the body left of the turn to this target
+                let body: f32 = shares(t.influence).iter().map(|s| s.1).sum();
+                let (y, p) = eye_aim(t.point);
+                let (y, p) = limit((
+                    unwrap_near(y + t.offset.0, ty * (1.0 - body)),
+                    p + t.offset.1,
+                ));
+                yaw += t.eye_weight * (y - yaw);
+                pitch += t.eye_weight * (p - pitch);
+            }
             pose.rotate(e, donders(yaw, pitch));
             // the eye's anatomical range (a swing ellipse and a little twist, which the yaw and
             // pitch box only approximates: its corners lie outside): an aim beyond it holds the
