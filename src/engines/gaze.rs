@@ -128,12 +128,15 @@ pub struct GazeEngine {
     /// The point between the eyes in the rest pose (the skeleton does not change).
     eyes_at_rest: Option<Vec3>,
     /// The body aim of the last frame (joint, yaw, pitch) and the gazes that made it.
-    last: (Vec<(usize, f32, f32)>, Vec<UnitKey>),
+    last: (BodyAim, Vec<UnitKey>),
     /// A gaze removed while it turned the body (its block replaced, say): the aim it left, held
     /// under the gazes that follow until one has turned fully, then faded out over [`HAND_OVER`]
     /// s (since when, once fading).
-    ghost: Option<(Vec<(usize, f32, f32)>, Option<f64>)>,
+    ghost: Option<(BodyAim, Option<f64>)>,
 }
+
+/// A body aim: (joint, yaw, pitch) per joint the gaze turns.
+type BodyAim = Vec<(usize, f32, f32)>;
 
 /// How long the aim a removed gaze left takes to fade once nothing turns over it (s).
 pub const HAND_OVER: f64 = 0.4;
@@ -280,7 +283,7 @@ struct Aim {
     /// The running gazes, the winner last.
     layers: Vec<Target>,
     /// The aim a removed gaze left (joint, yaw, pitch) and how much of it holds (0–1).
-    ghost: (Vec<(usize, f32, f32)>, f32),
+    ghost: (BodyAim, f32),
 }
 
 /// The target of one running gaze in a frame.
@@ -372,7 +375,7 @@ impl Aim {
 
     /// The spine, neck and head: the rest aim's shares, the aim a removed gaze left over them,
     /// each layer blended over that. Returns what it applied (joint, yaw, pitch).
-    fn turn_body(&self, skeleton: &Skeleton, pose: &mut Pose) -> Vec<(usize, f32, f32)> {
+    fn turn_body(&self, skeleton: &Skeleton, pose: &mut Pose) -> BodyAim {
         let (rest_yaw, rest_pitch, rest_influence) = match self.rest {
             Some((p, i)) => {
                 let (y, pi) = yaw_pitch(p - self.eyes);
