@@ -34,8 +34,9 @@ use crate::world::{Placement, World};
 pub const SOCIAL_DISTANCE: f32 = 1.2;
 /// Fastest `bmlt:speed` taken (m/s).
 pub const MAX_SPEED: f32 = 10.0;
-/// Longest walk rehearsed when scheduling (s); a longer one is predicted from its length.
-pub const REHEARSAL_LIMIT: f64 = 120.0;
+/// Longest walk rehearsed when scheduling (s of walking, about 7 ms of work); a longer one is
+/// predicted from its length.
+pub const REHEARSAL_LIMIT: f64 = 30.0;
 
 /// The sentence an unknown target's refusal starts with.
 const NO_TARGET: &str = "there is no target";
@@ -232,7 +233,8 @@ impl LocomotionEngine {
                 if let (Ok(m), Some((syncs, unit))) = (planned, self.units.get_mut(&key)) {
                     unit.started = true;
                     unit.moments.start = Some(t0);
-                    unit.deadline = t0 + 2.0 * m.end.unwrap_or(REHEARSAL_LIMIT) + 10.0;
+                    let planned = m.end.or(m.relax).unwrap_or(REHEARSAL_LIMIT);
+                    unit.deadline = t0 + 2.0 * planned + 10.0;
                     // the rehearsal from here is what will happen: the plan follows it
                     let at = |o: Option<f64>| o.map_or(f64::INFINITY, |o| t0 + o);
                     let new: Vec<f64> = syncs
@@ -240,7 +242,7 @@ impl LocomotionEngine {
                         .map(|(n, t)| match n.as_ref() {
                             "ready" => at(m.ready),
                             "relax" => at(m.relax),
-                            "end" => at(m.end),
+                            "end" => at(m.end.or(m.relax.map(|r| r + 2.0))),
                             _ => *t,
                         })
                         .collect();
@@ -372,9 +374,8 @@ impl Engine for LocomotionEngine {
             Ok(m) => m,
             Err(_) => return fallback,
         };
-        // a walk longer than the rehearsal: its length at its speed
-        let long = f64::from(goal.distance(walker.body().at) / o.speed) + 2.0;
-        let end = m.end.unwrap_or(long.max(REHEARSAL_LIMIT));
+        // a walk longer than the rehearsal: its slowing down after `relax` as a walk's
+        let end = m.end.unwrap_or(m.relax.unwrap_or(REHEARSAL_LIMIT) + 2.0);
         let relax = m.relax.unwrap_or(end - 1.0).clamp(0.0, end);
         let ready = m.ready.unwrap_or(relax.min(1.0)).clamp(0.0, relax);
         let key = |n: &'static str, at: f64| SyncKey::new(crate::bml::Id::new_static(n), at);

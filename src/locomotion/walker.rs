@@ -118,6 +118,13 @@ impl Walker {
         self.active.as_ref().map(|a| a.moments)
     }
 
+    /// How far the walk under way has still to go along its route (m).
+    pub fn remaining(&self) -> f32 {
+        self.active
+            .as_ref()
+            .map_or(0.0, |a| path::length(&a.route_from(self.body().at)))
+    }
+
     /// The route of the walk under way.
     pub fn route(&self) -> &[Vec2] {
         self.active.as_ref().map_or(&[], |a| &a.route)
@@ -356,7 +363,8 @@ impl Walker {
     }
 
     /// A copy that walks `walk` from here to its end: its moments, or why it cannot. At most
-    /// `limit` seconds are simulated.
+    /// `limit` seconds are simulated; a longer walk has no `end`, and its `relax` is predicted
+    /// from the rest of its route at cruising speed.
     pub fn rehearse(
         &self,
         walk: Walk,
@@ -366,13 +374,22 @@ impl Walker {
         let mut w = self.clone();
         w.start(walk, obstacles)?;
         let stop = w.time + limit;
-        while w.time < stop {
+        // (whole steps only: a remainder shorter than a step would never be stepped)
+        while w.time + STEP <= stop + 1e-9 {
             let t = (w.time + 1.0).min(stop);
             if let Some(m) = w.advance(t, obstacles) {
                 return Ok(m);
             }
         }
-        Ok(w.moments().unwrap_or_default())
+        // longer than the rehearsal: the rest at cruising speed, then the usual slowing down
+        let mut m = w.moments().unwrap_or_default();
+        let speed = f64::from(w.vehicle.max_speed.max(0.05));
+        let slow = f64::from(slow_radius(w.vehicle.max_speed));
+        let relax = w.time + (f64::from(w.remaining()) - slow).max(0.0) / speed;
+        m.relax.get_or_insert(relax);
+        m.end = None;
+        m.ready.get_or_insert(relax);
+        Ok(m)
     }
 }
 
@@ -448,7 +465,16 @@ mod tests {
         assert!(e > 4.0 && e < 7.5, "{e}");
         // the rehearsal from the start predicts the same moments
         let fresh = Walker::new(Vec2::ZERO, 0.0, 0.25, 0.0);
-        let p = fresh.rehearse(walk, &o, 60.0).unwrap();
+        let p = fresh.rehearse(walk.clone(), &o, 60.0).unwrap();
         assert_eq!(p.end, m.end);
+        // a walk longer than the rehearsal: it stops at the limit, with no end
+        let far = Walk {
+            goal: Vec2::new(0.0, 1e4),
+            ..walk
+        };
+        let p = fresh.rehearse(far, &o, 10.0).unwrap();
+        assert_eq!((p.ready.is_some(), p.end), (true, None));
+        let relax = p.relax.unwrap();
+        assert!((relax - 1e4 / 1.3).abs() < 5.0, "{relax}");
     }
 }
