@@ -563,3 +563,56 @@ fn headless_chromium_frames_characters_where_they_stand() {
         "not both drawn: {left:.2}, {right:.2}"
     );
 }
+
+/// A walker stays in view and moves across it; the obstacles are drawn. The example walks round
+/// a table to a door on the right: the figure's dark suit is far to the right at the door.
+#[test]
+#[ignore = "needs Debian's chromium; .ci/run installs it and runs this with --ignored"]
+fn headless_chromium_follows_a_walker_and_draws_the_obstacles() {
+    let (_, dir) = page(
+        "view-walk",
+        &[
+            "--world",
+            "fixtures/examples/room.json",
+            "fixtures/examples/walk-to-door.xml",
+        ],
+    );
+    let shot = |t: &str| {
+        let url = format!("file://{}#t={t}", dir.join("index.html").display());
+        let out = dir.join(format!("walk{t}.png"));
+        let (_, console) = browse(&url, &format!("--screenshot={}", out.display()));
+        assert!(console.is_empty(), "{t}: {console:?}");
+        Shot::load(&out)
+    };
+    // the mean x of the suit's dark blue pixels in the 3D view
+    let suit = |s: &Shot| {
+        let (mut sum, mut n) = (0usize, 0usize);
+        for y in 0..430 {
+            for x in 0..895 {
+                let [r, g, b] = s.px(x, y);
+                if u16::from(b) > u16::from(r) + 15
+                    && u16::from(r) + u16::from(g) + u16::from(b) < 330
+                {
+                    sum += x;
+                    n += 1;
+                }
+            }
+        }
+        assert!(n > 500, "no figure drawn ({n} pixels)");
+        sum as f64 / n as f64
+    };
+    let (start, door) = (shot("0.5"), shot("6.5"));
+    let (a, b) = (suit(&start), suit(&door));
+    eprintln!("the walker's suit at x = {a:.0} px, then {b:.0} px");
+    assert!(
+        b - a > 150.0,
+        "the walker did not cross the view: {a} → {b}"
+    );
+    // the table: grey, between the two places
+    let grey = start.share((380, 520, 250, 380), |x, y| {
+        let [r, g, b] = start.px(x, y);
+        let (lo, hi) = (r.min(g).min(b), r.max(g).max(b));
+        hi - lo < 25 && (100..200).contains(&lo)
+    });
+    assert!(grey > 0.3, "no table drawn: {grey:.2}");
+}
