@@ -569,3 +569,58 @@ fn a_walk_to_another_character_stops_at_social_distance_facing_them() {
     let to_bob = (Vec2::new(1.0, 5.0) - r.root(last)).normalize();
     assert!(Vec2::new(f.x, f.z).normalize().dot(to_bob) > 0.97, "{f}");
 }
+
+mod routes {
+    use bml_realizer::locomotion::path::{self, PathError};
+    use bml_realizer::locomotion::{Obstacle, Obstacles, Shape};
+    use glam::Vec2;
+    use proptest::prelude::*;
+
+    fn shape() -> impl Strategy<Value = Shape> {
+        let p = || (-5.0f32..5.0, -5.0f32..5.0);
+        prop_oneof![
+            (p(), 0.1f32..1.0).prop_map(|((x, z), r)| Shape::Circle {
+                centre: Vec2::new(x, z),
+                radius: r
+            }),
+            (p(), 0.1f32..2.0, 0.1f32..2.0).prop_map(|((x, z), w, d)| Shape::Box {
+                min: Vec2::new(x, z),
+                max: Vec2::new(x + w, z + d)
+            }),
+            (p(), p()).prop_map(|((x0, z0), (x1, z1))| Shape::Segment {
+                a: Vec2::new(x0, z0),
+                b: Vec2::new(x1, z1)
+            }),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// A route starts where asked, ends at the goal and keeps the clearance all along; no
+        /// route means the goal is too near an obstacle or walled in (then no straight line
+        /// reaches it either).
+        #[test]
+        fn routes_keep_their_clearance(
+            shapes in proptest::collection::vec(shape(), 0..12),
+            goal in (-6.0f32..6.0, -6.0f32..6.0),
+        ) {
+            let o = Obstacles::new(shapes.into_iter().map(|shape| Obstacle { shape, height: 2.0 }).collect());
+            let (start, goal, c) = (Vec2::new(0.0, -6.5), Vec2::new(goal.0, goal.1), 0.33);
+            prop_assume!(o.clearance(start, 1.0) > c);
+            match path::plan(&o, start, goal, c) {
+                Ok(route) => {
+                    prop_assert_eq!(route[0], start);
+                    prop_assert_eq!(*route.last().unwrap(), goal);
+                    for w in route.windows(2) {
+                        prop_assert!(o.segment_clear(w[0], w[1], c - 1e-3), "{:?}", w);
+                    }
+                }
+                Err(PathError::GoalBlocked { .. }) => prop_assert!(o.clearance(goal, 1.0) < c),
+                Err(PathError::Enclosed { .. }) => {
+                    prop_assert!(!o.segment_clear(start, goal, c));
+                }
+                Err(e) => prop_assert!(false, "{e}"),
+            }
+        }
+    }
+}
