@@ -624,3 +624,37 @@ mod routes {
         }
     }
 }
+
+#[test]
+fn running_has_a_flight_phase_and_speed_never_jumps() {
+    let s = Skeleton::adult();
+    let r = run(&[&walk(r#"target="0,15" manner="RUN""#, "")], 10.0);
+    let (rd, rx) = (
+        r.frame_at(r.sync("b1:w:ready")),
+        r.frame_at(r.sync("b1:w:relax")),
+    );
+    let flying = (rd..rx)
+        .filter(|&k| {
+            soles(&s, &r.frames[k].1)
+                .iter()
+                .flatten()
+                .all(|p| p.y > 0.01)
+        })
+        .count();
+    assert!(
+        flying * 10 > rx - rd,
+        "both feet off the ground in {flying} of {} frames",
+        rx - rd
+    );
+    // walking and running: the speed changes by less than 0.2 m/s from one frame to the next
+    for r in [r, run(&[&walk(r#"target="3,4""#, "")], 8.0)] {
+        for k in 2..r.frames.len() {
+            let dv = (r.speed(k) - r.speed(k - 1)).abs();
+            assert!(
+                dv < 0.2,
+                "the speed jumped by {dv} m/s at {}",
+                r.frames[k].0
+            );
+        }
+    }
+}
