@@ -121,7 +121,7 @@ pub trait Travel {
     fn travel(
         &mut self,
         now: f64,
-        world: &World,
+        world: &std::sync::Arc<World>,
         id: &str,
         at: crate::world::Placement,
     ) -> crate::world::Placement;

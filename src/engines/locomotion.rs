@@ -500,15 +500,18 @@ impl Engine for LocomotionEngine {
 }
 
 impl Travel for LocomotionEngine {
-    fn travel(&mut self, now: f64, world: &World, id: &str, at: Placement) -> Placement {
-        self.id = id.to_string();
-        if !self
-            .world
-            .as_deref()
-            .is_some_and(|w| std::ptr::eq(w, world))
-        {
-            self.world = Some(std::sync::Arc::new(world.clone()));
+    fn travel(
+        &mut self,
+        now: f64,
+        world: &std::sync::Arc<World>,
+        id: &str,
+        at: Placement,
+    ) -> Placement {
+        if self.id != id {
+            self.id = id.to_string();
         }
+        // (shared, not copied: the world changes every frame someone walks)
+        self.world = Some(world.clone());
         self.walker(at, world, now);
         let obstacles = world.obstacles().clone();
         loop {

@@ -400,13 +400,20 @@ impl Realizer {
             ..Frame::default()
         };
         let from = self.unframed.len();
-        for (id, m) in self.characters.iter_mut() {
+        for m in self.characters.values_mut() {
             m.advance(now, &self.world, &mut frame);
             m.move_feedback(&mut self.unframed);
-            // a character that walked stands elsewhere: the others see it there
-            let at = m.placement();
-            if at != self.world.placement(id) {
-                let _ = std::sync::Arc::make_mut(&mut self.world).place(id, at);
+        }
+        // characters that walked stand elsewhere: from the next frame on, the others see them
+        // there (all at once: no character sees another's move of this frame)
+        let moved: Vec<(&str, crate::world::Placement)> = (self.characters.iter())
+            .map(|(id, m)| (id.as_str(), m.placement()))
+            .filter(|(id, at)| *at != self.world.placement(id))
+            .collect();
+        if !moved.is_empty() {
+            let world = std::sync::Arc::make_mut(&mut self.world);
+            for (id, at) in moved {
+                let _ = world.place(id, at);
             }
         }
         if let Some(due) = due {
