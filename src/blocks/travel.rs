@@ -17,11 +17,11 @@ impl BlockManager {
 
     /// Steps the engines that move the character to `to`, and takes their revisions.
     pub(super) fn travel(&mut self, to: f64) {
-        let id = self.character.clone().unwrap_or_default();
+        let id = self.character.as_deref().unwrap_or("");
         let (mut at, mut revisions) = (self.placement, Vec::new());
         for e in self.registry.engines_mut() {
             if let Some(t) = e.as_travel() {
-                at = t.travel(to, &self.shared, &id, at);
+                at = t.travel(to, &self.shared, id, at);
                 revisions.extend(t.take_revisions());
             }
         }

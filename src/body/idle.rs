@@ -34,7 +34,16 @@ pub struct Idle {
     joints: [Option<usize>; 5],
     /// Hip, knee and ankle of each leg, with the ankle's place at rest (world).
     legs: [Option<([usize; 3], Vec3)>; 2],
+    /// The legs solved once for [`LEG_TABLE`] amounts of the weight shift from −1 to 1: how far
+    /// the pelvis sinks and the six leg rotations (left hip, knee, ankle, then right). A frame
+    /// interpolates between the two nearest (measured: solving both legs every frame cost more
+    /// than all the rest of a standing character's frame).
+    table: [(f32, [Quat; 6]); LEG_TABLE],
 }
+
+/// Entries of the legs' table (the solutions differ by well under a millimetre at the feet
+/// between neighbours).
+const LEG_TABLE: usize = 33;
 
 impl Idle {
     /// The idle motion of character `id` ("" the default one) on `skeleton`.
@@ -43,7 +52,7 @@ impl Idle {
         let hash = id.bytes().fold(0x811c_9dc5u32, |h, b| {
             (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
         });
-        Idle {
+        let mut idle = Idle {
             phase: (hash % 10_000) as f32 / 10_000.0 * WEIGHT_SHIFT_PERIOD,
             joints: [
                 "vt6",
@@ -58,6 +67,33 @@ impl Idle {
                 let leg = [j("hip")?, j("knee")?, j("talocrural")?];
                 Some((leg, Pose::rest(skeleton).joint_world(skeleton, leg[2]).0))
             }),
+            table: [(0.0, [Quat::IDENTITY; 6]); LEG_TABLE],
+        };
+        for k in 0..LEG_TABLE {
+            let shift = -1.0 + 2.0 * k as f32 / (LEG_TABLE - 1) as f32;
+            let mut pose = Pose::rest(skeleton);
+            idle.shift_pelvis(shift, &mut pose);
+            let rest_y = pose.root.y;
+            idle.plant_feet(skeleton, &mut pose);
+            let mut legs = [Quat::IDENTITY; 6];
+            for (s, leg) in idle.legs.iter().enumerate() {
+                for (i, &joint) in leg.iter().flat_map(|l| l.0.iter()).enumerate() {
+                    legs[3 * s + i] = pose.rotations[joint];
+                }
+            }
+            idle.table[k] = (rest_y - pose.root.y, legs);
+        }
+        idle
+    }
+
+    /// The weight shift's pelvis: `shift` (−1 to 1) of the sway sideways and the roll.
+    fn shift_pelvis(&self, shift: f32, pose: &mut Pose) {
+        pose.root += Vec3::X * (WEIGHT_SHIFT_M * shift);
+        if let Some(j) = self.joints[3] {
+            pose.rotate(
+                j,
+                Quat::from_rotation_z((WEIGHT_SHIFT_ROLL_DEG * shift).to_radians()),
+            );
         }
     }
 
@@ -68,7 +104,7 @@ impl Idle {
         let tau = std::f32::consts::TAU;
         // breathing: in for the first part of the cycle, out after (a raised cosine, 0 at rest)
         let breath = 0.5 - 0.5 * (tau * BREATHING_HZ * t).cos();
-        let [chest, l_clavicle, r_clavicle, pelvis, spine] = self.joints;
+        let [chest, l_clavicle, r_clavicle, _pelvis, spine] = self.joints;
         let turn = |joint: Option<usize>, q: Quat, pose: &mut Pose| {
             if let Some(j) = joint {
                 pose.rotate(j, q);
@@ -81,11 +117,20 @@ impl Idle {
         turn(r_clavicle, Quat::from_rotation_z(-shoulder), &mut pose);
         // weight shift: the pelvis sways sideways and rolls, the lower spine rolls it back
         let shift = (tau * t / WEIGHT_SHIFT_PERIOD).sin();
-        pose.root += Vec3::X * (WEIGHT_SHIFT_M * shift);
+        self.shift_pelvis(shift, &mut pose);
         let roll = (WEIGHT_SHIFT_ROLL_DEG * shift).to_radians();
-        turn(pelvis, Quat::from_rotation_z(roll), &mut pose);
         turn(spine, Quat::from_rotation_z(-roll), &mut pose);
-        self.plant_feet(skeleton, &mut pose);
+        // the legs, from the table
+        let u = (shift + 1.0) / 2.0 * (LEG_TABLE - 1) as f32;
+        let k = (u.floor() as usize).min(LEG_TABLE - 2);
+        let f = u - k as f32;
+        let ((d0, a), (d1, b)) = (&self.table[k], &self.table[k + 1]);
+        pose.root.y -= d0 + (d1 - d0) * f;
+        for (s, leg) in self.legs.iter().enumerate() {
+            for (i, &joint) in leg.iter().flat_map(|l| l.0.iter()).enumerate() {
+                pose.rotations[joint] = a[3 * s + i].slerp(b[3 * s + i], f);
+            }
+        }
         pose
     }
 

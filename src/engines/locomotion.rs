@@ -167,7 +167,10 @@ impl LocomotionEngine {
         });
         if self.walker.is_none() || moved_by_host {
             let radius = world.radius(&self.id);
-            self.walker = Some(Walker::new(here, at.facing, radius, now));
+            // on the walker's grid of steps, so that where it is at a time does not depend on
+            // when the host's frames come
+            let time = (now / walker::STEP).floor() * walker::STEP;
+            self.walker = Some(Walker::new(here, at.facing, radius, time));
         }
         self.walker.as_mut().expect("just made")
     }
@@ -358,8 +361,18 @@ impl Engine for LocomotionEngine {
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         let o = order(behaviour)?;
         let fallback = crate::timing::DefaultTimingModels::default().model(behaviour);
-        let (Some(world), Some(walker)) = (self.world.as_deref(), self.walker.as_ref()) else {
+        let Some(world) = self.world.as_deref() else {
             return fallback;
+        };
+        // a character that has not walked yet stands where it is placed
+        let standing;
+        let walker = match self.walker.as_ref() {
+            Some(w) => w,
+            None => {
+                let here = Vec2::new(self.at.position.x, self.at.position.z);
+                standing = Walker::new(here, self.at.facing, world.radius(&self.id), 0.0);
+                &standing
+            }
         };
         let Some((goal, face)) = resolve(world, &self.id, &o.target, walker.body().at) else {
             return fallback;
@@ -512,7 +525,17 @@ impl Travel for LocomotionEngine {
         }
         // (shared, not copied: the world changes every frame someone walks)
         self.world = Some(world.clone());
-        self.walker(at, world, now);
+        // a character that never walked and has no walk to start stands where it is placed
+        if !self.walked && self.units.is_empty() {
+            self.walker = None;
+            self.at = at;
+            return at;
+        }
+        // a new walker starts no later than the first walk
+        let first = (self.units.all())
+            .filter_map(|(syncs, u)| (!u.started).then(|| syncs.first().map(|s| s.1)).flatten())
+            .fold(now, f64::min);
+        self.walker(at, world, first);
         let obstacles = world.obstacles().clone();
         loop {
             // the next walk to start by now
