@@ -181,3 +181,47 @@ fn the_combiners_follow_their_definitions() {
         assert_eq!(d.force(&mut at_rest(), ctx), Vec3::new(0.0, 0.0, 4.0));
     }
 }
+
+#[test]
+fn pursuit_heads_for_where_the_target_will_be_and_catches_it_sooner_than_seek() {
+    // a target crossing at 1 m/s, 5 m ahead; pursuer and seeker at 2 m/s
+    let chase = |pursue: bool| {
+        let mut rng = Rng(3);
+        let mut v = Vehicle::new(Vec3::ZERO, 1.0, 8.0, 2.0);
+        let (mut target, vel) = (Vec3::new(-3.0, 0.0, 5.0), Vec3::new(1.0, 0.0, 0.0));
+        for step in 0..2000 {
+            let mut b = if pursue {
+                Behaviour::Pursue {
+                    position: target,
+                    velocity: vel,
+                }
+            } else {
+                Behaviour::Seek(target)
+            };
+            let f = b.force(&mut v, Context::default(), &mut rng).unwrap();
+            v.step(f, 0.01);
+            target += vel * 0.01;
+            if v.position.distance(target) < 0.2 {
+                return step;
+            }
+        }
+        2000
+    };
+    let (p, s) = (chase(true), chase(false));
+    assert!(p < s, "pursuit {p} steps, seek {s}");
+    // and the first force of pursuit points ahead of the target (toward +x of it)
+    let mut v = Vehicle::new(Vec3::ZERO, 1.0, 100.0, 2.0);
+    let mut b = Behaviour::Pursue {
+        position: Vec3::new(0.0, 0.0, 5.0),
+        velocity: Vec3::new(1.0, 0.0, 0.0),
+    };
+    let f = b.force(&mut v, Context::default(), &mut Rng(1)).unwrap();
+    assert!(f.x > 0.5, "{f}");
+    // evade runs from where the target will be
+    let mut e = Behaviour::Evade {
+        position: Vec3::new(0.0, 0.0, 5.0),
+        velocity: Vec3::new(1.0, 0.0, 0.0),
+    };
+    let f = e.force(&mut v, Context::default(), &mut Rng(1)).unwrap();
+    assert!(f.x < -0.3 && f.z < 0.0, "{f}");
+}
