@@ -228,6 +228,16 @@ impl World {
         self.characters.get(id).copied().unwrap_or_default()
     }
 
+    /// Whether character `id` is placed.
+    pub fn is_placed(&self, id: &str) -> bool {
+        self.characters.contains_key(id)
+    }
+
+    /// Whether there is a point named `name` (a character's place is not one).
+    pub fn has_point(&self, name: &str) -> bool {
+        self.points.contains_key(name)
+    }
+
     /// Every placed character, by id.
     pub fn placements(&self) -> impl Iterator<Item = (&str, Placement)> {
         self.characters.iter().map(|(k, v)| (k.as_str(), *v))

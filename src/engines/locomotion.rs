@@ -26,12 +26,11 @@ use crate::body::{Pose, Skeleton};
 use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitKey, Units};
 use crate::feedback::KnownWarning;
 use crate::locomotion::posing::{pose_gait, GaitJoints};
+use crate::locomotion::targets::resolve;
 use crate::locomotion::{walker, Moments, Walk, Walker};
 use crate::timing::{Flexibility, SyncKey, SyncName, TimingModel, TimingModels};
 use crate::world::{Placement, World};
 
-/// How far from another character a walk to them stops (m).
-pub const SOCIAL_DISTANCE: f32 = 1.2;
 /// Fastest `bmlt:speed` taken (m/s).
 pub const MAX_SPEED: f32 = 10.0;
 /// Longest walk rehearsed when scheduling (s of walking, about 7 ms of work); a longer one is
@@ -123,33 +122,6 @@ fn order(b: &Behaviour) -> Option<Order> {
         running,
         note,
     })
-}
-
-/// `x,z` in metres, if `target` is written so.
-fn coordinates(target: &str) -> Option<Vec2> {
-    let (x, z) = target.split_once(',')?;
-    let (x, z) = (x.trim().parse::<f32>().ok()?, z.trim().parse::<f32>().ok()?);
-    let limit = crate::world::MAX_COORDINATE as f32;
-    (x.is_finite() && z.is_finite() && x.abs() <= limit && z.abs() <= limit)
-        .then(|| Vec2::new(x, z))
-}
-
-/// Where a walk to `target` goes in `world` for a walker at `from`, and what it faces there.
-fn resolve(world: &World, me: &str, target: &str, from: Vec2) -> Option<(Vec2, Option<Vec2>)> {
-    if let Some(p) = coordinates(target) {
-        return Some((p, None));
-    }
-    let is_character = target != me
-        && world.placements().any(|(id, _)| id == target)
-        && world.points().all(|(n, _)| n != target);
-    if is_character {
-        let p = world.placement(target).position;
-        let them = Vec2::new(p.x, p.z);
-        let away = (from - them).normalize_or(Vec2::Y);
-        return Some((them + away * SOCIAL_DISTANCE, Some(them)));
-    }
-    let p = world.get(target)?;
-    Some((Vec2::new(p.x, p.z), None))
 }
 
 fn to_times(syncs: &[(SyncName, f64)]) -> Vec<f64> {

@@ -2,7 +2,8 @@
 //! model with the steering behaviours and combiners of the IViHumans platform (usable on its
 //! own); [`obstacles`] the world's circles, boxes and walls; [`path`] routes around them (A* on
 //! a grid, pulled tight); [`gait`] a procedural human gait driven by the distance walked, with
-//! planted feet; [`posing`] that gait as a pose of the skeleton; [`walker`] one walking
+//! planted feet; [`posing`] that gait as a pose of the skeleton; [`targets`] where a walk goes;
+//! [`walker`] one walking
 //! character that puts them together at a fixed step. The locomotion engine
 //! (`engines::locomotion`) realizes BML `<locomotion>` with them; `docs/locomotion.md` explains
 //! the whole.
@@ -12,6 +13,7 @@ pub mod obstacles;
 pub mod path;
 pub mod posing;
 pub mod steering;
+pub mod targets;
 pub mod walker;
 
 pub use obstacles::{Obstacle, Obstacles, Shape};
