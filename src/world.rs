@@ -65,6 +65,8 @@ pub struct World {
     characters: BTreeMap<String, Placement>,
     /// Body radius of characters the world file gives one (m).
     radii: BTreeMap<String, f32>,
+    /// How the steering of characters the world file gives a combiner combines.
+    combiners: BTreeMap<String, crate::locomotion::steering::Combine>,
     /// Obstacles, in world coordinates (a view from a character has none).
     obstacles: std::sync::Arc<crate::locomotion::Obstacles>,
 }
@@ -113,6 +115,9 @@ struct CharacterFile {
     /// Body radius (m).
     #[serde(default)]
     radius: Option<f64>,
+    /// How its steering behaviours combine: `prioritised` (default), `weighted`, `dithering`.
+    #[serde(default)]
+    steering: Option<String>,
 }
 
 /// A character's body radius unless the world file gives one (m).
@@ -143,6 +148,7 @@ impl World {
             paths: Default::default(),
             characters: BTreeMap::new(),
             radii: BTreeMap::new(),
+            combiners: BTreeMap::new(),
             obstacles: Default::default(),
         }
     }
@@ -180,6 +186,20 @@ impl World {
                 }
                 w.radii.insert(name.clone(), r as f32);
             }
+            if let Some(c) = c.steering.as_deref() {
+                use crate::locomotion::steering::Combine;
+                let combine = match c {
+                    "prioritised" => Combine::Prioritised,
+                    "weighted" => Combine::WeightedSum,
+                    "dithering" => Combine::Dithering,
+                    other => {
+                        return Err(format!(
+                            "character '{name}': steering '{other}' is not one of prioritised, weighted, dithering"
+                        ))
+                    }
+                };
+                w.combiners.insert(name.clone(), combine);
+            }
         }
         if file.obstacles.len() > crate::locomotion::obstacles::MAX_OBSTACLES {
             return Err(format!(
@@ -209,6 +229,13 @@ impl World {
     /// Character `id`'s body radius ([`DEFAULT_RADIUS`] unless the world file gives one).
     pub fn radius(&self, id: &str) -> f32 {
         self.radii.get(id).copied().unwrap_or(DEFAULT_RADIUS)
+    }
+
+    /// How character `id`'s steering behaviours combine (prioritised unless the world file
+    /// says otherwise).
+    pub fn combiner(&self, id: &str) -> crate::locomotion::steering::Combine {
+        (self.combiners.get(id).copied())
+            .unwrap_or(crate::locomotion::steering::Combine::Prioritised)
     }
 
     /// Places character `id` (the default character is `""`). A point of the same name keeps
@@ -260,6 +287,7 @@ impl World {
                 .collect(),
             paths: Default::default(),
             radii: self.radii.clone(),
+            combiners: self.combiners.clone(),
             obstacles: Default::default(),
             characters: (self.characters.iter())
                 .map(|(k, c)| {

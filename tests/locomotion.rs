@@ -658,3 +658,38 @@ fn running_has_a_flight_phase_and_speed_never_jumps() {
         }
     }
 }
+
+#[test]
+fn each_character_s_steering_combiner_comes_from_the_world_file() {
+    use bml_realizer::locomotion::steering::Combine;
+    let json = r#"{"characters": {"A": {"position": [0, 0, 0], "steering": "weighted"},
+        "B": {"position": [3, 0, 0], "steering": "dithering"}, "C": {"position": [6, 0, 0]}},
+        "obstacles": [{"box": [-0.5, 2, 0.3, 2.5]}, {"box": [2.5, 2, 3.3, 2.5]}, {"box": [5.5, 2, 6.3, 2.5]}]}"#;
+    let world = obstacle_world(json);
+    assert_eq!(world.combiner("A"), Combine::WeightedSum);
+    assert_eq!(world.combiner("B"), Combine::Dithering);
+    assert_eq!(world.combiner("C"), Combine::Prioritised);
+    let e =
+        World::from_json(r#"{"characters": {"A": {"position": [0, 0, 0], "steering": "fast"}}}"#);
+    assert!(e.unwrap_err().contains("'A': steering 'fast'"));
+    // each walks past its box to a point behind it, keeping its radius
+    for (id, x) in [("A", 0.0f32), ("B", 3.0), ("C", 6.0)] {
+        let bml = format!(
+            r#"<bml {NS} id="b1" characterId="{id}"><locomotion id="w" target="{x},5"/></bml>"#
+        );
+        let r = run_in(Some(world.clone()), &[&bml], 12.0, 60.0);
+        assert!(r.block_ended(), "{id}");
+        let last = r.frames.len() - 1;
+        assert!(
+            r.root(last).distance(Vec2::new(x, 5.0)) < 0.15,
+            "{id}: {}",
+            r.root(last)
+        );
+        for k in 0..r.frames.len() {
+            assert!(
+                world.obstacles().clearance(r.root(k), 1.0) >= 0.25 - 1e-3,
+                "{id}"
+            );
+        }
+    }
+}

@@ -142,7 +142,9 @@ impl LocomotionEngine {
             // on the walker's grid of steps, so that where it is at a time does not depend on
             // when the host's frames come
             let time = (now / walker::STEP).floor() * walker::STEP;
-            self.walker = Some(Walker::new(here, at.facing, radius, time));
+            let mut w = Walker::new(here, at.facing, radius, time);
+            w.combine = world.combiner(&self.id);
+            self.walker = Some(w);
         }
         self.walker.as_mut().expect("just made")
     }
@@ -337,12 +339,13 @@ impl Engine for LocomotionEngine {
             return fallback;
         };
         // a character that has not walked yet stands where it is placed
-        let standing;
+        let mut standing;
         let walker = match self.walker.as_ref() {
             Some(w) => w,
             None => {
                 let here = Vec2::new(self.at.position.x, self.at.position.z);
                 standing = Walker::new(here, self.at.facing, world.radius(&self.id), 0.0);
+                standing.combine = world.combiner(&self.id);
                 &standing
             }
         };

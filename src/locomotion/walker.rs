@@ -78,6 +78,8 @@ pub struct Walker {
     pub radius: f32,
     /// The time of its last step.
     pub time: f64,
+    /// How its steering behaviours combine (prioritised by default).
+    pub combine: Combine,
     active: Option<Active>,
 }
 
@@ -91,6 +93,7 @@ impl Walker {
             gait: Gait::standing(body),
             radius,
             time,
+            combine: Combine::Prioritised,
             active: None,
         }
     }
@@ -134,7 +137,7 @@ impl Walker {
     pub fn start(&mut self, walk: Walk, obstacles: &Obstacles) -> Result<(), PathError> {
         let clearance = self.radius + PLAN_MARGIN;
         let route = path::plan(obstacles, self.body().at, walk.goal, clearance)?;
-        let mut steering = Steering::new(Combine::Prioritised, 0x5eed);
+        let mut steering = Steering::new(self.combine, 0x5eed);
         let reach = 0.45;
         let params = ArriveParams {
             slow_radius: slow_radius(walk.speed),
