@@ -693,3 +693,38 @@ fn each_character_s_steering_combiner_comes_from_the_world_file() {
         }
     }
 }
+
+#[test]
+fn the_head_leads_the_turn_round_an_obstacle() {
+    // round the table of the example room: while the body turns, the head is already turned
+    // further the same way
+    let world = obstacle_world(include_str!("../fixtures/examples/room.json"));
+    let r = run_in(Some(world), &[&walk(r#"target="door""#, "")], 8.0, 60.0);
+    let s = Skeleton::adult();
+    let (skull, root) = (s.joint("skullbase").unwrap(), 0);
+    let yaw = |k: usize, j: usize| {
+        let f = r.frames[k].1.world(&s).orientations[j] * Vec3::Z;
+        f.x.atan2(f.z)
+    };
+    let (mut agree, mut turning) = (0, 0);
+    let (ready, relax) = (
+        r.frame_at(r.sync("b1:w:ready")),
+        r.frame_at(r.sync("b1:w:relax")),
+    );
+    for k in ready.max(1)..relax {
+        let rate = (yaw(k, root) - yaw(k - 1, root)) / r.dt as f32;
+        if rate.abs() < 0.3 {
+            continue;
+        }
+        turning += 1;
+        let lead = yaw(k, skull) - yaw(k, root);
+        if lead * rate > 0.0 && lead.abs() > 0.05 {
+            agree += 1;
+        }
+    }
+    assert!(turning > 10, "{turning} turning frames");
+    assert!(
+        agree * 10 >= turning * 8,
+        "the head led {agree} of {turning} turning frames"
+    );
+}

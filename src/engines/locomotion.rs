@@ -25,7 +25,7 @@ use crate::bml::{Behaviour, BehaviourKind, NS_BMLT};
 use crate::body::{Pose, Skeleton};
 use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitKey, Units};
 use crate::feedback::KnownWarning;
-use crate::locomotion::posing::{pose_gait, GaitJoints};
+use crate::locomotion::posing::{lead_the_turn, pose_gait, GaitJoints};
 use crate::locomotion::targets::resolve;
 use crate::locomotion::{walker, Moments, Walk, Walker};
 use crate::timing::{Flexibility, SyncKey, SyncName, TimingModel, TimingModels};
@@ -603,6 +603,7 @@ impl crate::engine::Motion for LocomotionEngine {
         let joints = self.joints.get_or_insert_with(|| GaitJoints::of(skeleton));
         if let Some(j) = joints {
             pose_gait(skeleton, j, &w.gait, w.body(), pose);
+            lead_the_turn(j, w.look_ahead(), w.gait.amount, pose);
         }
     }
 }

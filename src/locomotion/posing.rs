@@ -17,6 +17,8 @@ pub struct GaitJoints {
     spine: [Option<usize>; 2],
     shoulders: [Option<usize>; 2],
     elbows: [Option<usize>; 2],
+    /// Neck and skull base (the head turns into a bend ahead).
+    neck: [Option<usize>; 2],
     /// The legs' full length (hip to ankle), m.
     reach: f32,
 }
@@ -40,6 +42,7 @@ impl GaitJoints {
             spine: [j("vl5"), j("vt6")],
             shoulders: [j("l_shoulder"), j("r_shoulder")],
             elbows: [j("l_elbow"), j("r_elbow")],
+            neck: [j("vc4"), j("skullbase")],
             reach,
         })
     }
@@ -58,7 +61,7 @@ impl GaitJoints {
                 }
             }
         }
-        v.extend(["vl5", "vt6"]);
+        v.extend(["vl5", "vt6", "vc4", "skullbase"]);
         v
     }
 }
@@ -119,6 +122,18 @@ pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, p
                 0.25 + 0.15 * swing.max(0.0)
             } * amount;
             pose.rotate(e, Quat::from_axis_angle(Vec3::NEG_X, bend));
+        }
+    }
+}
+
+/// The head leads a turn: turned toward where the way goes `ahead` radians off the facing
+/// (the route a little way ahead), by up to 35°, 40 % at the neck and 60 % at the skull base,
+/// as much as the body walks (`amount`). Gaze behaviours turn the head on top of it.
+pub fn lead_the_turn(j: &GaitJoints, ahead: f32, amount: f32, pose: &mut Pose) {
+    let turn = ahead.clamp(-0.6, 0.6) * amount;
+    for (joint, share) in j.neck.iter().zip([0.4, 0.6]) {
+        if let Some(i) = *joint {
+            pose.rotate(i, Quat::from_rotation_y(turn * share));
         }
     }
 }

@@ -128,6 +128,30 @@ impl Walker {
             .map_or(0.0, |a| path::length(&a.route_from(self.body().at)))
     }
 
+    /// How far off its facing the way goes 1.5 m ahead along the route (rad, positive to the
+    /// left); 0 when not walking.
+    pub fn look_ahead(&self) -> f32 {
+        let Some(a) = self.active.as_ref().filter(|a| !a.stopped) else {
+            return 0.0;
+        };
+        let here = self.body().at;
+        let (mut left, mut at) = (1.5f32, here);
+        for p in a.route_from(here).into_iter().skip(1) {
+            let d = at.distance(p);
+            if d >= left {
+                at += (p - at) * (left / d);
+                break;
+            }
+            left -= d;
+            at = p;
+        }
+        let to = at - here;
+        if to.length() < 0.2 {
+            return 0.0;
+        }
+        angle_diff(to.x.atan2(to.y), self.facing)
+    }
+
     /// The route of the walk under way.
     pub fn route(&self) -> &[Vec2] {
         self.active.as_ref().map_or(&[], |a| &a.route)
