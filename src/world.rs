@@ -123,6 +123,10 @@ struct CharacterFile {
 /// A character's body radius unless the world file gives one (m).
 pub const DEFAULT_RADIUS: f32 = 0.25;
 
+/// How [`World::unknown_target`]'s sentence begins (engines that refuse a unit for an unknown
+/// target report NO_SUCH_TARGET by it).
+pub const UNKNOWN_TARGET: &str = "there is no target";
+
 /// Longest list of keys a path may have.
 pub const MAX_PATH_KEYS: usize = 100_000;
 
@@ -368,12 +372,13 @@ impl World {
     }
 
     /// The sentence for a target the world does not have, listing the points it has.
+    /// It starts with [`UNKNOWN_TARGET`].
     pub fn unknown_target(&self, target: &str) -> String {
         let known: Vec<&str> = (self.points.keys().chain(self.characters.keys()))
             .map(String::as_str)
             .collect();
         format!(
-            "there is no target '{target}' in the world (it has {}; add points with --world or Realizer::world_mut)",
+            "{UNKNOWN_TARGET} '{target}' in the world (it has {}; add points with --world or Realizer::world_mut)",
             known.join(", ")
         )
     }

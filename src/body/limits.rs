@@ -242,7 +242,7 @@ fn ellipse(comps: &[(usize, f32, f32, f32); 2]) -> f32 {
 }
 
 /// An angle in (-π, π].
-fn wrap(a: f32) -> f32 {
+pub fn wrap(a: f32) -> f32 {
     let tau = std::f32::consts::TAU;
     let a = a.rem_euclid(tau);
     if a > std::f32::consts::PI {

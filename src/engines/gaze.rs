@@ -362,8 +362,7 @@ fn share(influence: Influence, j: &str) -> (f32, f32) {
 
 /// `a` turned by whole turns to lie within half a turn of `near`.
 fn unwrap_near(a: f32, near: f32) -> f32 {
-    let tau = std::f32::consts::TAU;
-    a - ((a - near) / tau).round() * tau
+    near + crate::body::limits::wrap(a - near)
 }
 
 impl Aim {

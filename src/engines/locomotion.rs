@@ -28,7 +28,7 @@ use crate::feedback::KnownWarning;
 use crate::locomotion::posing::{lead_the_turn, pose_gait, GaitJoints};
 use crate::locomotion::targets::resolve;
 use crate::locomotion::{walker, Moments, Walk, Walker};
-use crate::timing::{Flexibility, SyncKey, SyncName, TimingModel, TimingModels};
+use crate::timing::{SyncName, TimingModel, TimingModels};
 use crate::world::{Placement, World};
 
 /// Fastest `bmlt:speed` taken (m/s).
@@ -36,9 +36,6 @@ pub const MAX_SPEED: f32 = 10.0;
 /// Longest walk rehearsed when scheduling (s of walking, about 7 ms of work); a longer one is
 /// predicted from its length.
 pub const REHEARSAL_LIMIT: f64 = 30.0;
-
-/// The sentence an unknown target's refusal starts with.
-const NO_TARGET: &str = "there is no target";
 
 /// A walk as written: where to and how.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,9 +52,6 @@ struct Order {
 struct WalkUnit {
     order: Order,
     started: bool,
-    /// The moments that happened (global times), once started.
-    moments: Moments,
-    done: bool,
     /// Interrupted: slowing down to stand where it is.
     halted: bool,
     /// A walk still going then has failed (global time).
@@ -138,15 +132,20 @@ impl LocomotionEngine {
                 || crate::locomotion::gait::angle_diff(b.facing, at.facing).abs() > 1e-3
         });
         if self.walker.is_none() || moved_by_host {
-            let radius = world.radius(&self.id);
             // on the walker's grid of steps, so that where it is at a time does not depend on
             // when the host's frames come
             let time = (now / walker::STEP).floor() * walker::STEP;
-            let mut w = Walker::new(here, at.facing, radius, time);
-            w.combine = world.combiner(&self.id);
-            self.walker = Some(w);
+            self.walker = Some(self.standing(at, world, time));
         }
         self.walker.as_mut().expect("just made")
+    }
+
+    /// A walker of this character standing at `at` at time `time`.
+    fn standing(&self, at: Placement, world: &World, time: f64) -> Walker {
+        let here = Vec2::new(at.position.x, at.position.z);
+        let mut w = Walker::new(here, at.facing, world.radius(&self.id), time);
+        w.combine = world.combiner(&self.id);
+        w
     }
 
     /// The moments of `walk` from the walker's state, relative to its start.
@@ -209,7 +208,6 @@ impl LocomotionEngine {
                 let t0 = w.time;
                 if let (Ok(m), Some((syncs, unit))) = (planned, self.units.get_mut(&key)) {
                     unit.started = true;
-                    unit.moments.start = Some(t0);
                     let planned = m.end.or(m.relax).unwrap_or(REHEARSAL_LIMIT);
                     unit.deadline = t0 + 2.0 * planned + 10.0;
                     // the rehearsal from here is what will happen: the plan follows it
@@ -242,7 +240,6 @@ impl LocomotionEngine {
     fn end_now(&mut self, key: &UnitKey) {
         let now = self.walker.as_ref().map_or(0.0, |w| w.time);
         if let Some((syncs, u)) = self.units.get_mut(key) {
-            u.done = true;
             u.started = true;
             let new: Vec<f64> = syncs.iter().map(|s| s.1.min(now)).collect();
             self.revise(key, new, false);
@@ -311,10 +308,6 @@ impl LocomotionEngine {
             new[k] = new[k].max(new[k - 1]);
         }
         if ended.is_some() {
-            if let Some((_, u)) = self.units.get_mut(&key) {
-                u.done = true;
-                u.moments = m;
-            }
             self.current = None;
         }
         if changed {
@@ -339,13 +332,11 @@ impl Engine for LocomotionEngine {
             return fallback;
         };
         // a character that has not walked yet stands where it is placed
-        let mut standing;
+        let standing;
         let walker = match self.walker.as_ref() {
             Some(w) => w,
             None => {
-                let here = Vec2::new(self.at.position.x, self.at.position.z);
-                standing = Walker::new(here, self.at.facing, world.radius(&self.id), 0.0);
-                standing.combine = world.combiner(&self.id);
+                standing = self.standing(self.at, world, 0.0);
                 &standing
             }
         };
@@ -366,20 +357,12 @@ impl Engine for LocomotionEngine {
         let end = m.end.unwrap_or(m.relax.unwrap_or(REHEARSAL_LIMIT) + 2.0);
         let relax = m.relax.unwrap_or(end - 1.0).clamp(0.0, end);
         let ready = m.ready.unwrap_or(relax.min(1.0)).clamp(0.0, relax);
-        let key = |n: &'static str, at: f64| SyncKey::new(crate::bml::Id::new_static(n), at);
-        Some(TimingModel {
-            keys: vec![
-                key("start", 0.0),
-                key("ready", ready),
-                key("relax", relax),
-                key("end", end),
-            ],
-            flexibility: Flexibility::Stretchable {
-                min_duration: crate::timing::MIN_DURATION,
-                max_duration: f64::INFINITY,
-            },
-            persistent: false,
-        })
+        Some(TimingModel::stretchable(&[
+            ("start", 0.0),
+            ("ready", ready),
+            ("relax", relax),
+            ("end", end),
+        ]))
     }
 
     fn check_timing(&self, _b: &Behaviour, _syncs: &[(SyncName, f64)]) -> Result<(), String> {
@@ -396,7 +379,7 @@ impl Engine for LocomotionEngine {
     }
 
     fn refusal(&self, error: &EngineError) -> KnownWarning {
-        if error.0.contains(NO_TARGET) {
+        if error.0.contains(crate::world::UNKNOWN_TARGET) {
             KnownWarning::NoSuchTarget
         } else {
             KnownWarning::ExecutionFailure
@@ -424,8 +407,6 @@ impl Engine for LocomotionEngine {
             WalkUnit {
                 order: o,
                 started: false,
-                moments: Moments::default(),
-                done: false,
                 halted: false,
                 deadline: f64::INFINITY,
             },
@@ -449,7 +430,6 @@ impl Engine for LocomotionEngine {
             let times = crate::engine::stop_now(now, syncs);
             self.units.retime(key, &times);
             if let Some((_, u)) = self.units.get_mut(key) {
-                u.done = true;
                 u.started = true;
             }
             return times;

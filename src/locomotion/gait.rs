@@ -104,12 +104,7 @@ pub fn forward(yaw: f32) -> Vec2 {
 
 /// `a − b` wrapped into (−π, π].
 pub fn angle_diff(a: f32, b: f32) -> f32 {
-    let d = (a - b).rem_euclid(std::f32::consts::TAU);
-    if d > std::f32::consts::PI {
-        d - std::f32::consts::TAU
-    } else {
-        d
-    }
+    crate::body::limits::wrap(a - b)
 }
 
 /// Side of each foot: +1 left (+x when facing +z), −1 right.

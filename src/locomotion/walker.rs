@@ -111,11 +111,6 @@ impl Walker {
         Vec2::new(self.vehicle.velocity.x, self.vehicle.velocity.z)
     }
 
-    /// Whether a walk is under way.
-    pub fn walking(&self) -> bool {
-        self.active.is_some()
-    }
-
     /// The moments of the walk under way.
     pub fn moments(&self) -> Option<Moments> {
         self.active.as_ref().map(|a| a.moments)
@@ -150,11 +145,6 @@ impl Walker {
             return 0.0;
         }
         angle_diff(to.x.atan2(to.y), self.facing)
-    }
-
-    /// The route of the walk under way.
-    pub fn route(&self) -> &[Vec2] {
-        self.active.as_ref().map_or(&[], |a| &a.route)
     }
 
     /// Starts `walk` now, along a route around `obstacles`.
