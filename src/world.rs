@@ -6,6 +6,7 @@
 //! ([`World::seen_from`]). A world can be read from a JSON world file.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use serde::Deserialize;
@@ -55,20 +56,28 @@ pub const CHARACTER_EYES: Vec3 = Vec3::new(0.0, 1.64, 0.09);
 
 /// Named points in world coordinates, some of them moving along paths, and the characters'
 /// placements.
+///
+/// Cloning is cheap (the maps are shared until one is changed), and so is a character's view of
+/// it ([`seen_from_at`](Self::seen_from_at)): the view shares the maps and turns what is read
+/// into its frame, so that a crowd's views cost nothing per frame beyond their reads.
 #[derive(Debug, Clone, PartialEq)]
 pub struct World {
-    points: BTreeMap<String, Vec3>,
+    /// Points, in world coordinates.
+    points: Arc<BTreeMap<String, Vec3>>,
     /// Points that move: their keys (time in seconds, position), in time order (shared: a
     /// world is copied every frame someone walks, its paths are not).
-    paths: std::sync::Arc<BTreeMap<String, Vec<(f64, Vec3)>>>,
-    /// Where characters stand (the others stand at the origin facing +z).
-    characters: BTreeMap<String, Placement>,
+    paths: Arc<BTreeMap<String, Vec<(f64, Vec3)>>>,
+    /// Where characters stand, in world coordinates (the others stand at the origin facing +z).
+    characters: Arc<BTreeMap<String, Placement>>,
     /// Body radius of characters the world file gives one (m).
-    radii: BTreeMap<String, f32>,
+    radii: Arc<BTreeMap<String, f32>>,
     /// How the steering of characters the world file gives a combiner combines.
-    combiners: BTreeMap<String, crate::locomotion::steering::Combine>,
+    combiners: Arc<BTreeMap<String, crate::locomotion::steering::Combine>>,
     /// Obstacles, in world coordinates (a view from a character has none).
-    obstacles: std::sync::Arc<crate::locomotion::Obstacles>,
+    obstacles: Arc<crate::locomotion::Obstacles>,
+    /// The frame things are read and written in: the origin for the world itself, where a
+    /// character stands for its view.
+    frame: Placement,
 }
 
 impl Default for World {
@@ -148,12 +157,13 @@ impl World {
     /// A world without points.
     pub fn empty() -> Self {
         World {
-            points: BTreeMap::new(),
+            points: Default::default(),
             paths: Default::default(),
-            characters: BTreeMap::new(),
-            radii: BTreeMap::new(),
-            combiners: BTreeMap::new(),
+            characters: Default::default(),
+            radii: Default::default(),
+            combiners: Default::default(),
             obstacles: Default::default(),
+            frame: Placement::default(),
         }
     }
 
@@ -188,7 +198,7 @@ impl World {
                         "character '{name}': its radius must be above 0 and at most 10 m"
                     ));
                 }
-                w.radii.insert(name.clone(), r as f32);
+                Arc::make_mut(&mut w.radii).insert(name.clone(), r as f32);
             }
             if let Some(c) = c.steering.as_deref() {
                 use crate::locomotion::steering::Combine;
@@ -202,7 +212,7 @@ impl World {
                         ))
                     }
                 };
-                w.combiners.insert(name.clone(), combine);
+                Arc::make_mut(&mut w.combiners).insert(name.clone(), combine);
             }
         }
         if file.obstacles.len() > crate::locomotion::obstacles::MAX_OBSTACLES {
@@ -227,7 +237,7 @@ impl World {
 
     /// Sets the obstacles.
     pub fn set_obstacles(&mut self, obstacles: crate::locomotion::Obstacles) {
-        self.obstacles = std::sync::Arc::new(obstacles);
+        self.obstacles = Arc::new(obstacles);
     }
 
     /// Character `id`'s body radius ([`DEFAULT_RADIUS`] unless the world file gives one).
@@ -250,13 +260,29 @@ impl World {
                 "character '{id}': its position and facing must be finite numbers"
             ));
         }
-        self.characters.insert(id.to_string(), at);
+        let at = Placement {
+            position: self.frame.to_world(at.position),
+            facing: at.facing + self.frame.facing,
+        };
+        Arc::make_mut(&mut self.characters).insert(id.to_string(), at);
         Ok(())
     }
 
     /// Where character `id` stands (the origin facing +z unless placed).
     pub fn placement(&self, id: &str) -> Placement {
-        self.characters.get(id).copied().unwrap_or_default()
+        let at = self.characters.get(id).copied().unwrap_or_default();
+        self.local(at)
+    }
+
+    /// A placement in world coordinates, in this world's frame.
+    fn local(&self, at: Placement) -> Placement {
+        if self.frame.is_origin() {
+            return at;
+        }
+        Placement {
+            position: self.frame.to_local(at.position),
+            facing: at.facing - self.frame.facing,
+        }
     }
 
     /// Whether character `id` is placed.
@@ -271,7 +297,9 @@ impl World {
 
     /// Every placed character, by id.
     pub fn placements(&self) -> impl Iterator<Item = (&str, Placement)> {
-        self.characters.iter().map(|(k, v)| (k.as_str(), *v))
+        self.characters
+            .iter()
+            .map(|(k, v)| (k.as_str(), self.local(*v)))
     }
 
     /// The world as character `id` sees it now: every point and placement in its own frame
@@ -284,30 +312,25 @@ impl World {
 
     /// The world as seen by a character standing at `from` (see [`seen_from`](Self::seen_from)).
     pub fn seen_from_at(&self, from: Placement) -> World {
-        let local = |p: &Vec3| from.to_local(*p);
         World {
-            points: (self.points.iter())
-                .map(|(k, p)| (k.clone(), local(p)))
-                .collect(),
+            points: self.points.clone(),
             paths: Default::default(),
             radii: self.radii.clone(),
             combiners: self.combiners.clone(),
             obstacles: Default::default(),
-            characters: (self.characters.iter())
-                .map(|(k, c)| {
-                    let at = Placement {
-                        position: local(&c.position),
-                        facing: c.facing - from.facing,
-                    };
-                    (k.clone(), at)
-                })
-                .collect(),
+            characters: self.characters.clone(),
+            // `from` is given in this world's frame
+            frame: Placement {
+                position: self.frame.to_world(from.position),
+                facing: self.frame.facing + from.facing,
+            },
         }
     }
 
     /// Places (or moves) point `name`.
     pub fn set(&mut self, name: &str, at: Vec3) {
-        self.points.insert(name.to_string(), at);
+        let at = self.frame.to_world(at);
+        Arc::make_mut(&mut self.points).insert(name.to_string(), at);
     }
 
     /// Makes `name` a point that moves along `keys` (time in seconds, position): linearly
@@ -325,8 +348,11 @@ impl World {
                 "path '{name}': key times must be finite and in increasing order"
             ));
         }
-        self.points.insert(name.to_string(), keys[0].1);
-        std::sync::Arc::make_mut(&mut self.paths).insert(name.to_string(), keys);
+        let keys: Vec<(f64, Vec3)> = (keys.into_iter())
+            .map(|(t, p)| (t, self.frame.to_world(p)))
+            .collect();
+        Arc::make_mut(&mut self.points).insert(name.to_string(), keys[0].1);
+        Arc::make_mut(&mut self.paths).insert(name.to_string(), keys);
         Ok(())
     }
 
@@ -339,8 +365,9 @@ impl World {
 
     /// Puts every point that has a path where its path is at time `t`.
     pub fn move_to(&mut self, t: f64) {
+        let points = Arc::make_mut(&mut self.points);
         for (name, keys) in self.paths.iter() {
-            if let Some(p) = self.points.get_mut(name) {
+            if let Some(p) = points.get_mut(name) {
                 *p = along(keys, t);
             }
         }
@@ -348,9 +375,11 @@ impl World {
 
     /// Removes point `name` (and its path).
     pub fn remove(&mut self, name: &str) {
-        self.points.remove(name);
+        if self.points.contains_key(name) {
+            Arc::make_mut(&mut self.points).remove(name);
+        }
         if self.paths.contains_key(name) {
-            std::sync::Arc::make_mut(&mut self.paths).remove(name);
+            Arc::make_mut(&mut self.paths).remove(name);
         }
     }
 
@@ -359,11 +388,12 @@ impl World {
     pub fn get(&self, name: &str) -> Option<Vec3> {
         (self.points.get(name).copied())
             .or_else(|| (self.characters.get(name)).map(|c| c.to_world(CHARACTER_EYES)))
+            .map(|p| self.frame.to_local(p))
     }
 
     /// Every point, by name.
     pub fn points(&self) -> impl Iterator<Item = (&str, Vec3)> {
-        self.points.iter().map(|(k, v)| (k.as_str(), *v))
+        (self.points.iter()).map(|(k, v)| (k.as_str(), self.frame.to_local(*v)))
     }
 
     /// Every point that moves along a path, with its keys (time, position) in time order.
@@ -477,6 +507,19 @@ mod tests {
             w.move_to(0.5);
             let moved = w.seen_from("me").get("walker").unwrap();
             prop_assert!(moved.distance(me.to_local(p.lerp(other, 0.5))) < 1e-4);
+            // a view of a view is the view from the placement they compose to, and what is
+            // placed in a view is placed in its frame
+            let you = seen.placement("you");
+            let twice = seen.seen_from_at(you);
+            let direct = w.seen_from("you");
+            prop_assert!(twice.get("p").unwrap().distance(direct.get("p").unwrap()) < 1e-3);
+            let mut view = w.seen_from("me");
+            view.set("q", Vec3::Z);
+            view.place("them", Placement::new(Vec3::X, 30.0)).unwrap();
+            let them = view.placement("them");
+            prop_assert!(view.get("q").unwrap().distance(Vec3::Z) < 1e-4);
+            prop_assert!(them.position.distance(Vec3::X) < 1e-4);
+            prop_assert!((them.facing - 30f32.to_radians()).abs() < 1e-4);
         }
     }
 

@@ -192,7 +192,7 @@ fn walking_to_the_door_then_speaking() {
     assert_eq!(ms(sync(&fb, "door:w:ready")), 2.263);
     assert_eq!(ms(sync(&fb, "door:w:relax")), 4.446);
     assert_eq!(sync(&fb, "door:look:start"), sync(&fb, "door:w:relax"));
-    assert_eq!(ms(sync(&fb, "door:w:end")), 6.387);
+    assert_eq!(ms(sync(&fb, "door:w:end")), 6.025);
     assert_eq!(sync(&fb, "door:s:start"), sync(&fb, "door:w:end"));
     assert_eq!(block(&fb, "door", "end").1, Some(BlockStatus::Done));
 }

@@ -164,6 +164,11 @@ fn a_walk_arrives_stops_and_reports_its_end_when_it_stands() {
     assert!(feet_moved(k, last) < 0.003, "{}", feet_moved(k, last));
     // (the root sways with the weight shift while standing, slowly)
     assert!((k..=last).all(|i| r.speed(i) < 0.05));
+    // the body slows to its stop, it does not stop dead from the arrival's floor speed
+    let dropped = (r.frame_at(end - 1.0)..=k)
+        .map(|i| r.speed(i - 1) - r.speed(i))
+        .fold(0.0, f32::max);
+    assert!(dropped < 0.05, "speed fell {dropped} m/s in one frame");
     assert!(
         feet_moved(k - 2, k) > 1e-4,
         "the end came late: nothing moved before it"
@@ -359,6 +364,45 @@ fn speech_tied_to_the_walk_s_end_starts_when_it_really_arrives() {
         _ => None,
     });
     assert!(planned.unwrap() < end - 0.5, "{planned:?} {end}");
+}
+
+#[test]
+fn a_target_crossing_ahead_is_pursued_where_it_will_be_and_caught() {
+    let mut world = World::default();
+    // a point crossing 6 m ahead, left to right at 1 m/s, then resting at x = 4
+    world
+        .set_path(
+            "cat",
+            vec![
+                (0.0, Vec3::new(-4.0, 0.0, 6.0)),
+                (8.0, Vec3::new(4.0, 0.0, 6.0)),
+            ],
+        )
+        .unwrap();
+    let r = run_in(Some(world), &[&walk(r#"target="cat""#, "")], 14.0, 30.0);
+    // it meets the line ahead of the target (a follower aiming at where the target is comes
+    // from behind it: about 1.1 m behind here)
+    let k = (0..r.frames.len()).find(|&k| r.root(k).y > 5.5).unwrap();
+    let target_x = -4.0 + r.frames[k].0 as f32;
+    assert!(
+        r.root(k).x > target_x,
+        "{} at {}: target at {target_x}",
+        r.root(k),
+        r.frames[k].0
+    );
+    // and it stands where the target rests, with one end reported
+    let end = r.sync("b1:w:end");
+    let k = r.frame_at(end);
+    assert!(
+        r.root(k).distance(Vec2::new(4.0, 6.0)) < 0.15,
+        "{}",
+        r.root(k)
+    );
+    // relax is reported once, not re-planned every frame
+    let predictions = (r.feedback.iter())
+        .filter(|f| matches!(f, Feedback::Prediction(_)))
+        .count();
+    assert!(predictions < 30, "{predictions} predictions");
 }
 
 #[test]

@@ -26,7 +26,7 @@ use crate::body::{Pose, Skeleton};
 use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitKey, Units};
 use crate::feedback::KnownWarning;
 use crate::locomotion::posing::{lead_the_turn, pose_gait, GaitJoints};
-use crate::locomotion::targets::resolve;
+use crate::locomotion::targets::{resolve, Pursuit};
 use crate::locomotion::{walker, Moments, Walk, Walker};
 use crate::timing::{SyncName, TimingModel, TimingModels};
 use crate::world::{Placement, World};
@@ -76,6 +76,8 @@ pub struct LocomotionEngine {
     warnings: Vec<(UnitKey, String)>,
     /// The last rehearsal: (walker state, walk) → moments relative to its start.
     rehearsed: RefCell<Option<(Walker, Walk, Moments)>>,
+    /// The pursuit of the current walk's target (which may move).
+    pursuit: Pursuit,
 }
 
 /// Reads a locomotion behaviour's order.
@@ -205,6 +207,7 @@ impl LocomotionEngine {
             Ok(()) => {
                 self.walked = true;
                 self.current = Some(key.clone());
+                self.pursuit = Pursuit::default();
                 let t0 = w.time;
                 if let (Ok(m), Some((syncs, unit))) = (planned, self.units.get_mut(&key)) {
                     unit.started = true;
@@ -519,14 +522,15 @@ impl Travel for LocomotionEngine {
                 None => break,
             }
         }
-        // a moving target: follow it
-        if let (Some(key), Some(w)) = (self.current.clone(), self.walker.as_ref()) {
-            if let Some(u) = self.units.get(&key) {
-                if let Some((goal, face)) = resolve(world, id, &u.order.target, w.body().at) {
-                    if let Some(w) = self.walker.as_mut() {
-                        w.retarget(goal, face, &obstacles);
-                    }
-                }
+        // a moving target: pursue it
+        let order =
+            (self.current.as_ref()).and_then(|k| self.units.get(k).map(|u| u.order.clone()));
+        if let (Some(o), Some(w)) = (order, self.walker.as_mut()) {
+            let from = w.body().at;
+            if let Some((goal, face)) = resolve(world, id, &o.target, from) {
+                self.pursuit.observe(now, face.unwrap_or(goal));
+                let aim = self.pursuit.aim(goal, from, o.speed);
+                w.retarget(aim, face, &obstacles);
             }
         }
         let body = self.walker.as_ref().map(|w| w.body());

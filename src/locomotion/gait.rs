@@ -168,6 +168,17 @@ impl Gait {
         }
     }
 
+    /// Whether planted foot `k` stays down rather than take its next step: it is where it
+    /// belongs and the body stands, or the body is about to stop (within 0.1 m) where the
+    /// foot already belongs.
+    fn stays(&self, k: usize, body: Body) -> bool {
+        let standing = self.speed < 0.05 && self.settled(k, body);
+        let stopping = self
+            .stop_at
+            .is_some_and(|at| at.distance(body.at) < 0.1 && self.settled(k, Body { at, ..body }));
+        standing || stopping
+    }
+
     /// Whether the walker stands: both feet planted where they belong and no speed.
     pub fn at_rest(&self, body: Body) -> bool {
         self.speed < 0.02 && self.settled(0, body) && self.settled(1, body)
@@ -225,10 +236,9 @@ impl Gait {
             let lifts = was < beta && now >= beta;
             let lands = now < was; // wrapped: heel strike
             match self.feet[k] {
-                // a foot already where it belongs stays down while the body stands
-                Foot::Planted { at, yaw }
-                    if lifts && !(self.speed < 0.05 && self.settled(k, body)) =>
-                {
+                // a foot already where it belongs stays down while the body stands, or
+                // where it will belong when the body, nearly there, stops
+                Foot::Planted { at, yaw } if lifts && !self.stays(k, body) => {
                     self.feet[k] = Foot::Swing {
                         from: at,
                         from_yaw: yaw,

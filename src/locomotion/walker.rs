@@ -24,6 +24,8 @@ pub const TURN_ON_THE_SPOT: f32 = 1.0;
 pub const TURN_FIRST: f32 = 0.8;
 /// How hard a halted walk brakes (m/s²).
 pub const HALT_DECELERATION: f32 = 1.6;
+/// Within this distance of its goal (m) a walk has arrived: it brakes to a stop there.
+pub const STOP_RADIUS: f32 = 0.04;
 /// Margin kept from obstacles beyond the body's radius when planning (m).
 pub const PLAN_MARGIN: f32 = 0.08;
 
@@ -61,7 +63,7 @@ struct Active {
     moments: Moments,
     /// Whether the vehicle has stopped (the feet may still be closing).
     stopped: bool,
-    /// Whether it is halting where it is (interrupted).
+    /// Whether it is halting where it is (interrupted, or braking at its goal).
     halting: bool,
 }
 
@@ -155,7 +157,7 @@ impl Walker {
         let reach = 0.45;
         let params = ArriveParams {
             slow_radius: slow_radius(walk.speed),
-            stop_radius: 0.04,
+            stop_radius: STOP_RADIUS,
             floor_speed: 0.12,
         };
         let points = route
@@ -202,6 +204,7 @@ impl Walker {
         if let Some(a) = self.active.as_mut() {
             a.halting = true;
             a.walk.face = None;
+            self.gait.stop_at = None;
             a.moments.relax.get_or_insert(self.time);
             a.moments.ready.get_or_insert(self.time);
             a.steering.clear();
@@ -217,7 +220,7 @@ impl Walker {
     }
 
     /// Moves the goal of the walk under way (a moving target), planning a new route when it
-    /// moved more than 0.1 m.
+    /// moved more than 0.1 m. Moments that happened stay.
     pub fn retarget(&mut self, goal: Vec2, face: Option<Vec2>, obstacles: &Obstacles) {
         let Some(a) = self.active.as_ref() else {
             return;
@@ -234,8 +237,8 @@ impl Walker {
         walk.face = face;
         if self.start(walk, obstacles).is_ok() {
             if let Some(a) = self.active.as_mut() {
+                // (a relax that happened stays: it has been reported)
                 a.moments = Moments {
-                    relax: None,
                     end: None,
                     ..moments
                 };
@@ -275,6 +278,13 @@ impl Walker {
             let wanted = (next - here).normalize_or_zero();
             let behind = wanted != Vec2::ZERO
                 && angle_diff(wanted.x.atan2(wanted.y), self.facing).abs() > TURN_FIRST;
+            // arriving, the floor speed is braked away where the arrival would stop dead (a
+            // person does not stop from 0.12 m/s in a step; this takes about 0.1 s and 5 mm)
+            let speed = self.vehicle.speed();
+            let braking = speed * speed / (2.0 * HALT_DECELERATION);
+            if !a.halting && speed < 0.3 && to_goal.length() <= STOP_RADIUS + braking {
+                a.halting = a.route_from(here).len() <= 2;
+            }
             if a.halting && !a.stopped {
                 let v = self.vehicle.velocity;
                 let speed = flat(v).length();
@@ -284,7 +294,6 @@ impl Walker {
                 if slower == 0.0 {
                     a.stopped = true;
                 }
-                self.gait.stop_at = None;
             } else if !a.stopped {
                 if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
                     // turn on the spot before setting off
@@ -327,7 +336,9 @@ impl Walker {
                     a.moments.ready.get_or_insert(time);
                 }
                 if a.moments.relax.is_some() {
-                    self.gait.stop_at = Some(a.walk.goal);
+                    // where the body will stand: arrived, STOP_RADIUS short of the goal
+                    let back = (a.walk.goal - here).normalize_or_zero() * STOP_RADIUS;
+                    self.gait.stop_at = Some(a.walk.goal - back);
                 }
             }
             if a.stopped {
