@@ -24,6 +24,7 @@ pub mod body;
 pub mod clock;
 #[cfg(feature = "conformance")]
 pub mod conformance;
+pub mod crowd;
 mod data;
 pub mod dynamics;
 pub mod engine;

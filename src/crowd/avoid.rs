@@ -1,0 +1,253 @@
+//! The choice of a velocity among others (the thesis' three stages of path following): the
+//! contacts a walker would have if everyone kept their course, the speeds and headings it
+//! considers given how soon the first contact comes, and the cheapest sampled candidate.
+//!
+//! The cost of a candidate v (the thesis gives its terms, not its formula; this is the
+//! realizer's normalised form, with u the preferred speed):
+//! α‖v − v_prev‖/2u + β·| |v| − |v_prev| |/u + γ·(angle(v, v_des)/π + ½·max(0, |v_des| − |v|)/u)
+//! + δ·(1 − min(tc(v), tcMax)/tcMax) + keepSide (when it turns to the other side than the one
+//! chosen) + a small cost on the left (people keep right), and a prohibitive cost for a contact
+//! of the bodies themselves within half a second. Candidates are visited desired first, then
+//! to the right from the centre out, then to the left; a later one must be strictly cheaper.
+
+use glam::Vec2;
+
+use super::contact::time_to_contact;
+use super::profile::Profile;
+use super::snapshot::Agent;
+
+/// Spacing of the headings sampled (rad): the 4.5° of Karamouzas and Overmars.
+pub const HEADING_STEP: f32 = 0.078;
+/// Speeds sampled between the range's ends (besides standing).
+pub const SPEED_SAMPLES: usize = 7;
+/// Most contacts weighed (the soonest; the thesis keeps at least 5).
+pub const MAX_CONTACTS: usize = 10;
+/// A candidate that brings the bodies themselves into contact sooner than this (s) is all but
+/// refused.
+pub const BODY_HORIZON: f32 = 0.5;
+/// Cost on candidates to the left of the desired heading: ties go right.
+pub const RIGHT_BIAS: f32 = 0.02;
+
+/// One walker's avoidance state: the side it chose, its last velocity, its random jitter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Avoider {
+    /// −1 passing to the right, +1 to the left, 0 not avoiding.
+    side: i8,
+    /// Whether the last choice had contacts.
+    pub avoiding: bool,
+    rng: u64,
+    contacts: Vec<(f32, Agent)>,
+}
+
+impl Avoider {
+    /// A walker's state, its jitter seeded by `seed` (the same seed, the same choices).
+    pub fn new(seed: u64) -> Avoider {
+        Avoider {
+            side: 0,
+            avoiding: false,
+            rng: seed | 1,
+            contacts: Vec::new(),
+        }
+    }
+
+    fn jitter(&mut self) -> f32 {
+        let mut x = self.rng;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        self.rng = x;
+        (x >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+    }
+
+    /// The velocity `me` takes among `others`, wanting `desired` at preferred speed `pref`
+    /// (m/s), having last moved at `previous`; `heading` is where it looks (rad about +y from
+    /// +z), for its field of view.
+    pub fn choose(
+        &mut self,
+        me: Agent,
+        desired: Vec2,
+        previous: Vec2,
+        heading: f32,
+        pref: f32,
+        others: impl Iterator<Item = Agent>,
+        p: &Profile,
+    ) -> Vec2 {
+        let pref = pref.max(0.1);
+        self.collect_contacts(me, desired, heading, others, p);
+        self.avoiding = !self.contacts.is_empty();
+        if !self.avoiding {
+            self.side = 0;
+            return desired;
+        }
+        let first = self.contacts[0].0;
+        let (span, lo, hi) = if first < p.tc_min {
+            (p.delta_max.to_radians(), 0.0, 1.0)
+        } else if first < p.tc_mid {
+            (p.delta_mid.to_radians(), 0.5, 1.0)
+        } else {
+            (0.5 * p.delta_mid.to_radians(), 0.8, 1.0)
+        };
+        let base = if desired.length() > 1e-3 {
+            desired.x.atan2(desired.y)
+        } else {
+            heading
+        };
+        let n = (span / HEADING_STEP).floor() as i32;
+        // desired first, then right (clockwise seen from above: decreasing angle), then left
+        let offsets = std::iter::once(0).chain((1..=n).map(|k| -k)).chain(1..=n);
+        let mut best = (f32::INFINITY, desired);
+        let wanted_speed = desired.length();
+        for k in offsets {
+            let side = k.signum() as i8;
+            for s in 0..=SPEED_SAMPLES {
+                let f = 1.0 - s as f32 / SPEED_SAMPLES as f32;
+                let speed = if k == 0 && s == 0 {
+                    wanted_speed
+                } else {
+                    let u = (lo + (hi - lo) * f) * pref;
+                    (u + self.jitter() * p.distortion * pref / SPEED_SAMPLES as f32).max(0.0)
+                };
+                let angle = if k == 0 {
+                    base
+                } else {
+                    base + k as f32 * HEADING_STEP * (1.0 + self.jitter() * p.distortion)
+                };
+                let v = Vec2::new(angle.sin(), angle.cos()) * speed;
+                let mut cost = self.cost(me, v, desired, previous, pref, p);
+                if side != 0 && self.side != 0 && side != self.side {
+                    cost += p.keep_side;
+                }
+                if side > 0 {
+                    cost += RIGHT_BIAS;
+                }
+                if cost < best.0 {
+                    best = (cost, v);
+                }
+            }
+        }
+        let dev = crate::body::limits::wrap(best.1.x.atan2(best.1.y) - base);
+        if best.1.length() > 0.05 && dev.abs() > HEADING_STEP * 0.5 {
+            self.side = if dev < 0.0 { -1 } else { 1 };
+        }
+        best.1
+    }
+
+    /// The contacts with `desired`, soonest first, at most [`MAX_CONTACTS`].
+    fn collect_contacts(
+        &mut self,
+        me: Agent,
+        desired: Vec2,
+        heading: f32,
+        others: impl Iterator<Item = Agent>,
+        p: &Profile,
+    ) {
+        self.contacts.clear();
+        let look = Vec2::new(heading.sin(), heading.cos());
+        let half_fov = (0.5 * p.field_of_view).to_radians().cos();
+        for o in others {
+            let dx = o.at - me.at;
+            let d = dx.length();
+            let seen = d < 1.0 || dx.dot(look) >= half_fov * d;
+            if !seen {
+                continue;
+            }
+            let reach = (me.radius + o.radius) * p.incr;
+            if let Some(t) = time_to_contact(dx, o.velocity - desired, reach) {
+                if t < p.tc_max {
+                    self.contacts.push((t, o));
+                }
+            }
+        }
+        self.contacts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        self.contacts.truncate(MAX_CONTACTS);
+    }
+
+    fn cost(&self, me: Agent, v: Vec2, desired: Vec2, previous: Vec2, u: f32, p: &Profile) -> f32 {
+        let effort = p.alpha * (v - previous).length() / (2.0 * u)
+            + p.beta * (v.length() - previous.length()).abs() / u;
+        let angle = if v.length() > 1e-3 && desired.length() > 1e-3 {
+            v.angle_to(desired).abs()
+        } else {
+            0.0
+        };
+        let slower = (desired.length() - v.length()).max(0.0) / u;
+        let deviation = p.gamma * (angle / std::f32::consts::PI + 0.5 * slower);
+        let (mut soonest, mut touch) = (p.tc_max, f32::INFINITY);
+        for &(_, o) in &self.contacts {
+            let dx = o.at - me.at;
+            let dv = o.velocity - v;
+            let reach = (me.radius + o.radius) * p.incr;
+            if let Some(t) = time_to_contact(dx, dv, reach) {
+                soonest = soonest.min(t);
+            }
+            if let Some(t) = time_to_contact(dx, dv, me.radius + o.radius + 0.02) {
+                touch = touch.min(t);
+            }
+        }
+        let risk = p.delta * (1.0 - soonest / p.tc_max);
+        let bodies = if touch < BODY_HORIZON {
+            10.0 * (1.0 - touch / BODY_HORIZON) + 1.0
+        } else {
+            0.0
+        };
+        effort + deviation + risk + bodies
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn agent(x: f32, z: f32, vx: f32, vz: f32) -> Agent {
+        Agent {
+            at: Vec2::new(x, z),
+            velocity: Vec2::new(vx, vz),
+            radius: 0.25,
+        }
+    }
+
+    #[test]
+    fn nobody_near_keeps_the_desired_velocity() {
+        let mut a = Avoider::new(1);
+        let me = agent(0.0, 0.0, 0.0, 1.3);
+        let far = [agent(0.0, 30.0, 0.0, -1.3), agent(5.0, 0.0, 0.0, 1.3)];
+        let d = Vec2::new(0.0, 1.3);
+        let v = a.choose(me, d, d, 0.0, 1.3, far.into_iter(), &Profile::default());
+        assert_eq!(v, d);
+        assert!(!a.avoiding);
+    }
+
+    #[test]
+    fn head_on_each_turns_to_its_right_and_keeps_that_side() {
+        let p = Profile::default();
+        let d = Vec2::new(0.0, 1.3);
+        let mut a = Avoider::new(7);
+        let me = agent(0.0, 0.0, 0.0, 1.3);
+        let them = agent(0.0, 6.0, 0.0, -1.3);
+        let v = a.choose(me, d, d, 0.0, 1.3, [them].into_iter(), &p);
+        // facing +z, the right hand is −x
+        assert!(v.x < -0.05, "{v}");
+        assert!(a.avoiding);
+        // the other, facing −z, also turns to its right: +x
+        let mut b = Avoider::new(9);
+        let v = b.choose(them, -d, -d, std::f32::consts::PI, 1.3, [me].into_iter(), &p);
+        assert!(v.x > 0.05, "{v}");
+        // having chosen, a small nudge the other way does not flip it
+        let nudged = agent(-0.1, 6.0, 0.0, -1.3);
+        let v = a.choose(me, d, v, 0.0, 1.3, [nudged].into_iter(), &p);
+        assert!(v.x < 0.0, "{v}");
+    }
+
+    #[test]
+    fn a_body_about_to_be_touched_is_never_walked_into() {
+        let p = Profile::default();
+        let d = Vec2::new(0.0, 1.3);
+        let mut a = Avoider::new(3);
+        let me = agent(0.0, 0.0, 0.0, 1.3);
+        // someone standing just ahead, slightly to the right
+        let there = agent(-0.1, 0.7, 0.0, 0.0);
+        let v = a.choose(me, d, d, 0.0, 1.3, [there].into_iter(), &p);
+        let t = time_to_contact(there.at - me.at, -v, 0.5);
+        assert!(t.is_none_or(|t| t > BODY_HORIZON), "{v} {t:?}");
+    }
+}

@@ -1,0 +1,19 @@
+//! Crowds: walkers that share space. After the social path following of Karamouzas and
+//! Overmars as extended in the "Social Path Following" thesis (Ch. 5): each walker, several
+//! times a second, lists the people it would touch within a few seconds if everyone kept their
+//! course (time to contact, with radii widened to a personal space), widens the speeds and
+//! headings it considers the sooner the first contact comes, samples them in a fixed order
+//! (the desired velocity, then to the right, then to the left, each sample jittered) and takes
+//! the cheapest by a cost of effort, deviation and collision risk; once it has chosen a side it
+//! keeps it. [`profile`] holds the per-character parameters, [`contact`] the time to contact,
+//! [`snapshot`] the crowd as every walker sees it in a frame (with a uniform grid to find
+//! neighbours), [`avoid`] the choice itself. `docs/crowds.md` explains the whole.
+
+pub mod avoid;
+pub mod contact;
+pub mod profile;
+pub mod snapshot;
+
+pub use avoid::Avoider;
+pub use profile::Profile;
+pub use snapshot::{Agent, Crowd};

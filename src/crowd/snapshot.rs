@@ -1,0 +1,175 @@
+//! The crowd as the walkers see it in one frame: every placed character's place, velocity and
+//! radius as of the end of the previous frame (so that no walker sees another's move of this
+//! frame, and the order in which characters step does not matter), and a uniform grid over them
+//! to find who is near. Built once a frame for the whole world, shared by every walker.
+//!
+//! The grid is written here rather than taken from a k-d tree crate: the query is "everyone
+//! within r", rebuilt every frame for every agent, where a sorted list of cell keys is built in
+//! one sort, visited in a fixed order (the same neighbours in the same order on every run) and
+//! needs no allocation per query beyond the caller's buffer.
+
+use glam::Vec2;
+
+/// Side of a grid cell (m).
+pub const CELL: f32 = 2.0;
+/// Most characters a crowd holds (beyond, the rest are not seen by walkers, with a warning
+/// from whoever builds it).
+pub const MAX_AGENTS: usize = 20_000;
+
+/// One character as the others see it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Agent {
+    /// Where it stands (x, z).
+    pub at: Vec2,
+    /// How it moves (m/s, x and z).
+    pub velocity: Vec2,
+    /// Its body radius (m).
+    pub radius: f32,
+}
+
+/// Every character of a world at one time, with a grid to find neighbours.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Crowd {
+    /// When the places were taken (s).
+    pub time: f64,
+    ids: Vec<String>,
+    agents: Vec<Agent>,
+    /// (cell key, agent index), sorted.
+    cells: Vec<(u64, u32)>,
+}
+
+fn cell_of(p: Vec2) -> (i32, i32) {
+    let c = |v: f32| (v / CELL).floor().clamp(-1e9, 1e9) as i32;
+    (c(p.x), c(p.y))
+}
+
+fn key(c: (i32, i32)) -> u64 {
+    ((c.0 as u32 as u64) << 32) | c.1 as u32 as u64
+}
+
+impl Crowd {
+    /// The crowd of `agents` (by id; kept in id order, one per id) at `time`; at most
+    /// [`MAX_AGENTS`] are kept.
+    pub fn new(time: f64, agents: impl IntoIterator<Item = (String, Agent)>) -> Crowd {
+        let mut all: Vec<(String, Agent)> = agents
+            .into_iter()
+            .filter(|(_, a)| a.at.is_finite() && a.velocity.is_finite())
+            .take(MAX_AGENTS)
+            .collect();
+        all.sort_by(|a, b| a.0.cmp(&b.0));
+        all.dedup_by(|a, b| a.0 == b.0);
+        let (ids, agents): (Vec<String>, Vec<Agent>) = all.into_iter().unzip();
+        let mut cells: Vec<(u64, u32)> = (agents.iter().enumerate())
+            .map(|(i, a)| (key(cell_of(a.at)), i as u32))
+            .collect();
+        cells.sort_unstable();
+        Crowd {
+            time,
+            ids,
+            agents,
+            cells,
+        }
+    }
+
+    /// How many characters it holds.
+    pub fn len(&self) -> usize {
+        self.agents.len()
+    }
+
+    /// Whether it holds nobody.
+    pub fn is_empty(&self) -> bool {
+        self.agents.is_empty()
+    }
+
+    /// The index of character `id`.
+    pub fn index(&self, id: &str) -> Option<usize> {
+        self.ids.binary_search_by(|i| i.as_str().cmp(id)).ok()
+    }
+
+    /// Character `i`.
+    pub fn agent(&self, i: usize) -> Agent {
+        self.agents[i]
+    }
+
+    /// The id of character `i`.
+    pub fn id(&self, i: usize) -> &str {
+        &self.ids[i]
+    }
+
+    /// Every character, in id order.
+    pub fn agents(&self) -> &[Agent] {
+        &self.agents
+    }
+
+    /// The indices of the characters within `r` of `p` (by their place in the snapshot), into
+    /// `out` (cleared first), in a fixed order.
+    pub fn near(&self, p: Vec2, r: f32, out: &mut Vec<usize>) {
+        out.clear();
+        if !p.is_finite() || !r.is_finite() {
+            return;
+        }
+        let (lo, hi) = (cell_of(p - Vec2::splat(r)), cell_of(p + Vec2::splat(r)));
+        for cx in lo.0..=hi.0 {
+            let (from, to) = (key((cx, lo.1)), key((cx, hi.1)));
+            // (cells of one column are contiguous keys unless z crosses zero; then two runs)
+            let runs: [(u64, u64); 2] = if from <= to {
+                [(from, to), (1, 0)]
+            } else {
+                [(from, key((cx, -1))), (key((cx, 0)), to)]
+            };
+            for (a, b) in runs {
+                if a > b {
+                    continue;
+                }
+                let start = self.cells.partition_point(|c| c.0 < a);
+                for &(k, i) in &self.cells[start..] {
+                    if k > b {
+                        break;
+                    }
+                    if self.agents[i as usize].at.distance_squared(p) <= r * r {
+                        out.push(i as usize);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn near_finds_exactly_those_within_reach_across_cell_and_sign_boundaries() {
+        let mut agents = Vec::new();
+        let mut k = 0u32;
+        for x in -10..10 {
+            for z in -10..10 {
+                let at = Vec2::new(x as f32 * 0.7 + 0.05, z as f32 * 0.9 - 0.03);
+                let a = Agent {
+                    at,
+                    velocity: Vec2::ZERO,
+                    radius: 0.25,
+                };
+                agents.push((format!("a{k:04}"), a));
+                k += 1;
+            }
+        }
+        let crowd = Crowd::new(0.0, agents);
+        let mut out = Vec::new();
+        for (p, r) in [
+            (Vec2::ZERO, 1.5),
+            (Vec2::new(-3.1, 2.2), 2.7),
+            (Vec2::new(5.0, -5.0), 0.1),
+        ] {
+            crowd.near(p, r, &mut out);
+            let mut got = out.clone();
+            got.sort();
+            let want: Vec<usize> = (0..crowd.len())
+                .filter(|&i| crowd.agent(i).at.distance(p) <= r)
+                .collect();
+            assert_eq!(got, want, "{p} {r}");
+        }
+        assert_eq!(crowd.index("a0021"), Some(21));
+    }
+}
