@@ -4,11 +4,16 @@
 //!
 //! The cost of a candidate v (the thesis gives its terms, not its formula; this is the
 //! realizer's normalised form, with u the preferred speed):
-//! α‖v − v_prev‖/2u + β·| |v| − |v_prev| |/u + γ·(angle(v, v_des)/π + ½·max(0, |v_des| − |v|)/u)
-//! + δ·(1 − min(tc(v), tcMax)/tcMax) + keepSide (when it turns to the other side than the one
-//! chosen) + a small cost on the left (people keep right), and a prohibitive cost for a contact
-//! of the bodies themselves within half a second. Candidates are visited desired first, then
-//! to the right from the centre out, then to the left; a later one must be strictly cheaper.
+//!
+//! ```text
+//! α‖v − v_prev‖/2u  +  β·| |v| − |v_prev| |/u  +  γ·(angle(v, v_des)/π + ½·max(0, |v_des| − |v|)/u)
+//!   +  δ·(1 − min(tc(v), tcMax)/tcMax)  +  keepSide (turning to the side not chosen)
+//!   +  a small cost on the left (people keep right)  +  a prohibitive cost for bodies touching
+//!      within half a second
+//! ```
+//!
+//! Candidates are visited desired first, then to the right from the centre out, then to the
+//! left; a later one must be strictly cheaper.
 
 use glam::Vec2;
 
@@ -62,6 +67,7 @@ impl Avoider {
     /// The velocity `me` takes among `others`, wanting `desired` at preferred speed `pref`
     /// (m/s), having last moved at `previous`; `heading` is where it looks (rad about +y from
     /// +z), for its field of view.
+    #[allow(clippy::too_many_arguments)] // the thesis' inputs, each a number or a vector
     pub fn choose(
         &mut self,
         me: Agent,
@@ -230,7 +236,15 @@ mod tests {
         assert!(a.avoiding);
         // the other, facing −z, also turns to its right: +x
         let mut b = Avoider::new(9);
-        let v = b.choose(them, -d, -d, std::f32::consts::PI, 1.3, [me].into_iter(), &p);
+        let v = b.choose(
+            them,
+            -d,
+            -d,
+            std::f32::consts::PI,
+            1.3,
+            [me].into_iter(),
+            &p,
+        );
         assert!(v.x > 0.05, "{v}");
         // having chosen, a small nudge the other way does not flip it
         let nudged = agent(-0.1, 6.0, 0.0, -1.3);

@@ -39,13 +39,25 @@ mod tests {
         let t = time_to_contact(Vec2::new(0.0, 10.0), Vec2::new(0.0, -2.0), 1.0).unwrap();
         assert!((t - 4.5).abs() < 1e-5, "{t}");
         // passing 2 m to the side never comes within 1 m
-        assert_eq!(time_to_contact(Vec2::new(2.0, 10.0), Vec2::new(0.0, -2.0), 1.0), None);
+        assert_eq!(
+            time_to_contact(Vec2::new(2.0, 10.0), Vec2::new(0.0, -2.0), 1.0),
+            None
+        );
         // moving apart, or side by side at one velocity
-        assert_eq!(time_to_contact(Vec2::new(0.0, 3.0), Vec2::new(0.0, 1.0), 1.0), None);
+        assert_eq!(
+            time_to_contact(Vec2::new(0.0, 3.0), Vec2::new(0.0, 1.0), 1.0),
+            None
+        );
         assert_eq!(time_to_contact(Vec2::new(0.5, 3.0), Vec2::ZERO, 1.0), None);
         // within reach: now if closing, never if parting
-        assert_eq!(time_to_contact(Vec2::new(0.0, 0.5), Vec2::new(0.0, -1.0), 1.0), Some(0.0));
-        assert_eq!(time_to_contact(Vec2::new(0.0, 0.5), Vec2::new(0.0, 1.0), 1.0), None);
+        assert_eq!(
+            time_to_contact(Vec2::new(0.0, 0.5), Vec2::new(0.0, -1.0), 1.0),
+            Some(0.0)
+        );
+        assert_eq!(
+            time_to_contact(Vec2::new(0.0, 0.5), Vec2::new(0.0, 1.0), 1.0),
+            None
+        );
         // paths that cross, but at different times: no contact (line crossing would say yes)
         // (me at 1 m/s along +z; the other from 5 m left, 2 m ahead at 5 m/s along +x: it
         // crosses (0, 2) at 1 s when I am at (0, 1), never nearer than 0.98 m)

@@ -85,7 +85,9 @@ impl Profile {
         ];
         for (name, v, lo, hi) in fields {
             if !(v.is_finite() && (lo..=hi).contains(&v)) {
-                return Err(format!("'{name}' is {v}: it must be a number from {lo} to {hi}"));
+                return Err(format!(
+                    "'{name}' is {v}: it must be a number from {lo} to {hi}"
+                ));
             }
         }
         if !(self.tc_min <= self.tc_mid && self.tc_mid <= self.tc_max) {
