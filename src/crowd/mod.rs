@@ -7,7 +7,8 @@
 //! the cheapest by a cost of effort, deviation and collision risk; once it has chosen a side it
 //! keeps it. [`profile`] holds the per-character parameters, [`contact`] the time to contact,
 //! [`snapshot`] the crowd as every walker sees it in a frame (with a uniform grid to find
-//! neighbours), [`avoid`] the choice itself. `docs/crowds.md` explains the whole.
+//! neighbours), [`avoid`] the choice itself. Walkers do not use it yet (the realizer still
+//! lets them walk through each other).
 
 pub mod avoid;
 pub mod contact;

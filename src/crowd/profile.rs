@@ -2,7 +2,7 @@
 //! δ, η, the time-to-contact thresholds, the angle spans, `incr` and the distortion), plus a
 //! deviation weight the thesis' list leaves out, a field of view and the side-keeping cost. The
 //! thesis gives its cost and range formulas only as figures; the values and the cost here are
-//! this realizer's reconstruction, documented in `docs/crowds.md`.
+//! this realizer's reconstruction (see `avoid` for the cost).
 
 use serde::Deserialize;
 
