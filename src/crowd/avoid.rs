@@ -230,9 +230,9 @@ mod tests {
         let mut a = Avoider::new(7);
         let me = agent(0.0, 0.0, 0.0, 1.3);
         let them = agent(0.0, 6.0, 0.0, -1.3);
-        let v = a.choose(me, d, d, 0.0, 1.3, [them].into_iter(), &p);
+        let mine = a.choose(me, d, d, 0.0, 1.3, [them].into_iter(), &p);
         // facing +z, the right hand is −x
-        assert!(v.x < -0.05, "{v}");
+        assert!(mine.x < -0.05, "{mine}");
         assert!(a.avoiding);
         // the other, facing −z, also turns to its right: +x
         let mut b = Avoider::new(9);
@@ -246,9 +246,10 @@ mod tests {
             &p,
         );
         assert!(v.x > 0.05, "{v}");
-        // having chosen, a small nudge the other way does not flip it
+        // having chosen, the other drifting onto its side does not flip it (a fresh walker also
+        // stays right here: the right-hand order alone holds; keepSide is not yet shown to matter)
         let nudged = agent(-0.1, 6.0, 0.0, -1.3);
-        let v = a.choose(me, d, v, 0.0, 1.3, [nudged].into_iter(), &p);
+        let v = a.choose(me, d, mine, 0.0, 1.3, [nudged].into_iter(), &p);
         assert!(v.x < 0.0, "{v}");
     }
 
