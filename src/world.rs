@@ -75,6 +75,10 @@ pub struct World {
     combiners: Arc<BTreeMap<String, crate::locomotion::steering::Combine>>,
     /// Obstacles, in world coordinates (a view from a character has none).
     obstacles: Arc<crate::locomotion::Obstacles>,
+    /// The avoidance profile of characters the world file gives one.
+    profiles: Arc<BTreeMap<String, crate::crowd::Profile>>,
+    /// Every character as walkers see it this frame, in world coordinates (a view has none).
+    crowd: Arc<crate::crowd::Crowd>,
     /// The frame things are read and written in: the origin for the world itself, where a
     /// character stands for its view.
     frame: Placement,
@@ -106,6 +110,8 @@ struct WorldFile {
     characters: BTreeMap<String, CharacterFile>,
     #[serde(default)]
     obstacles: Vec<crate::locomotion::obstacles::ObstacleFile>,
+    #[serde(default)]
+    profiles: BTreeMap<String, crate::crowd::Profile>,
 }
 
 #[derive(Deserialize)]
@@ -127,6 +133,9 @@ struct CharacterFile {
     /// How its steering behaviours combine: `prioritised` (default), `weighted`, `dithering`.
     #[serde(default)]
     steering: Option<String>,
+    /// The name of its avoidance profile (in `profiles`).
+    #[serde(default)]
+    profile: Option<String>,
 }
 
 /// A character's body radius unless the world file gives one (m).
@@ -135,6 +144,9 @@ pub const DEFAULT_RADIUS: f32 = 0.25;
 /// How [`World::unknown_target`]'s sentence begins (engines that refuse a unit for an unknown
 /// target report NO_SUCH_TARGET by it).
 pub const UNKNOWN_TARGET: &str = "there is no target";
+
+/// Most characters a world file may place (the most a crowd holds).
+pub const MAX_CHARACTERS: usize = crate::crowd::snapshot::MAX_AGENTS;
 
 /// Longest list of keys a path may have.
 pub const MAX_PATH_KEYS: usize = 100_000;
@@ -163,6 +175,8 @@ impl World {
             radii: Default::default(),
             combiners: Default::default(),
             obstacles: Default::default(),
+            profiles: Default::default(),
+            crowd: Default::default(),
             frame: Placement::default(),
         }
     }
@@ -184,8 +198,27 @@ impl World {
                 .collect::<Result<Vec<_>, String>>()?;
             w.set_path(&name, keys)?;
         }
+        if file.characters.len() > MAX_CHARACTERS {
+            return Err(format!(
+                "characters: at most {MAX_CHARACTERS} characters, not {}",
+                file.characters.len()
+            ));
+        }
+        for (name, p) in &file.profiles {
+            p.check().map_err(|e| format!("profiles.{name}: {e}"))?;
+        }
         for (name, c) in file.characters {
             let at = vec3(&name, c.position)?;
+            if let Some(p) = c.profile.as_deref() {
+                let Some(profile) = file.profiles.get(p) else {
+                    let known: Vec<&str> = file.profiles.keys().map(String::as_str).collect();
+                    return Err(format!(
+                        "character '{name}': profile '{p}' is not among the world's profiles ({})",
+                        known.join(", ")
+                    ));
+                };
+                Arc::make_mut(&mut w.profiles).insert(name.clone(), *profile);
+            }
             if !c.facing.is_finite() || c.facing.abs() > MAX_COORDINATE {
                 return Err(format!(
                     "character '{name}': its facing must be a finite number of degrees"
@@ -228,6 +261,21 @@ impl World {
         let n = list.len();
         w.set_obstacles(crate::locomotion::Obstacles::new(list));
         Ok((w, n))
+    }
+
+    /// Character `id`'s avoidance profile (the defaults unless the world file names one).
+    pub fn profile(&self, id: &str) -> crate::crowd::Profile {
+        self.profiles.get(id).copied().unwrap_or_default()
+    }
+
+    /// Every character as walkers see it this frame (world coordinates; empty in a view).
+    pub fn crowd(&self) -> &Arc<crate::crowd::Crowd> {
+        &self.crowd
+    }
+
+    /// Sets the crowd walkers see.
+    pub fn set_crowd(&mut self, crowd: crate::crowd::Crowd) {
+        self.crowd = Arc::new(crowd);
     }
 
     /// The obstacles (world coordinates).
@@ -318,6 +366,8 @@ impl World {
             radii: self.radii.clone(),
             combiners: self.combiners.clone(),
             obstacles: Default::default(),
+            profiles: self.profiles.clone(),
+            crowd: Default::default(),
             characters: self.characters.clone(),
             // `from` is given in this world's frame
             frame: Placement {

@@ -34,6 +34,11 @@ impl BlockManager {
         }
     }
 
+    /// Whether an engine moves the character about now.
+    pub fn moving(&mut self) -> bool {
+        (self.registry.engines_mut()).any(|e| e.as_travel().is_some_and(|t| t.moving()))
+    }
+
     /// Whether each foot is on the ground, if an engine moves the character's feet.
     pub fn contacts(&mut self) -> Option<[bool; 2]> {
         (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.contacts()))

@@ -135,6 +135,11 @@ pub trait Travel {
     fn contacts(&self) -> Option<[bool; 2]> {
         None
     }
+
+    /// Whether the character is on the move (others then see it on the crowd's grid of times).
+    fn moving(&self) -> bool {
+        false
+    }
 }
 
 /// New sync times for a unit of a [`Travel`] engine.

@@ -147,6 +147,7 @@ impl LocomotionEngine {
         let here = Vec2::new(at.position.x, at.position.z);
         let mut w = Walker::new(here, at.facing, world.radius(&self.id), time);
         w.combine = world.combiner(&self.id);
+        w.profile = world.profile(&self.id);
         w
     }
 
@@ -508,10 +509,14 @@ impl Travel for LocomotionEngine {
                 .and_then(|k| self.units.get(k))
                 .map_or(f64::INFINITY, |u| u.deadline);
             let stop = until.min(deadline + walker::STEP);
+            let others = walker::Others {
+                crowd: world.crowd(),
+                me: world.crowd().index(id),
+            };
             let ended = self
                 .walker
                 .as_mut()
-                .and_then(|w| w.advance(stop, &obstacles));
+                .and_then(|w| w.advance_among(stop, &obstacles, Some(others)));
             self.follow_moments(stop, ended);
             if stop < until {
                 continue;
@@ -546,6 +551,11 @@ impl Travel for LocomotionEngine {
 
     fn take_revisions(&mut self) -> Vec<Revision> {
         std::mem::take(&mut self.revisions)
+    }
+
+    fn moving(&self) -> bool {
+        self.current.is_some()
+            || (self.walker.as_ref()).is_some_and(|w| !w.gait.at_rest(w.body()))
     }
 
     fn contacts(&self) -> Option<[bool; 2]> {

@@ -12,6 +12,7 @@ use super::gait::{angle_diff, forward, Body, Gait};
 use super::obstacles::Obstacles;
 use super::path::{self, PathError};
 use super::steering::{flat, ArriveParams, Behaviour, Combine, Context, Part, Steering, Vehicle};
+use crate::crowd::{Agent, Avoider, Crowd, Profile};
 
 /// The walker's fixed step (s).
 pub const STEP: f64 = 1.0 / 240.0;
@@ -82,7 +83,22 @@ pub struct Walker {
     pub time: f64,
     /// How its steering behaviours combine (prioritised by default).
     pub combine: Combine,
+    /// How it avoids other people.
+    pub profile: Profile,
+    /// Its avoidance state, and the velocity it chose among others (none when nobody is in
+    /// its way).
+    avoider: Avoider,
+    chosen: Option<Vec2>,
     active: Option<Active>,
+}
+
+/// The others a walker shares the ground with: the frame's crowd and its own place in it.
+#[derive(Debug, Clone, Copy)]
+pub struct Others<'a> {
+    /// The crowd (places as of its time, moved on by their velocities).
+    pub crowd: &'a Crowd,
+    /// The walker's own index in it.
+    pub me: Option<usize>,
 }
 
 impl Walker {
@@ -96,6 +112,9 @@ impl Walker {
             radius,
             time,
             combine: Combine::Prioritised,
+            profile: Profile::default(),
+            avoider: Avoider::new(0x5eed ^ (at.x.to_bits() as u64) << 20 ^ at.y.to_bits() as u64),
+            chosen: None,
             active: None,
         }
     }
@@ -250,6 +269,16 @@ impl Walker {
     /// that time (the walker then stands).
     /// A walker that stands with its feet together has nothing to step: its clock jumps.
     pub fn advance(&mut self, t: f64, obstacles: &Obstacles) -> Option<Moments> {
+        self.advance_among(t, obstacles, None)
+    }
+
+    /// [`advance`](Self::advance) among `others`, avoiding them.
+    pub fn advance_among(
+        &mut self,
+        t: f64,
+        obstacles: &Obstacles,
+        others: Option<Others<'_>>,
+    ) -> Option<Moments> {
         let mut ended = None;
         while self.time + STEP <= t + 1e-9 {
             if self.active.is_none() && self.gait.at_rest(self.body()) && self.gait.amount < 1e-3 {
@@ -259,7 +288,7 @@ impl Walker {
                 break;
             }
             self.time += STEP;
-            if let Some(m) = self.step(STEP as f32, obstacles) {
+            if let Some(m) = self.step(STEP as f32, obstacles, others) {
                 ended = Some(m);
             }
         }
@@ -267,7 +296,7 @@ impl Walker {
     }
 
     /// One step; the moments when the walk ends in it.
-    fn step(&mut self, dt: f32, obstacles: &Obstacles) -> Option<Moments> {
+    fn step(&mut self, dt: f32, obstacles: &Obstacles, others: Option<Others<'_>>) -> Option<Moments> {
         let time = self.time;
         let facing_before = self.facing;
         let mut ended = None;
@@ -315,6 +344,33 @@ impl Walker {
                             obstacles: Some(obstacles),
                         },
                     );
+                    let f = match others {
+                        Some(o) if o.crowd.len() > 1 => {
+                            let route = a.route_from(here);
+                            let left = path::length(&route);
+                            let toward = (route.get(1).copied().unwrap_or(a.walk.goal) - here)
+                                .normalize_or_zero();
+                            let slowing = (left / a.slow_radius()).clamp(0.1, 1.0);
+                            let near = Near {
+                                others: o,
+                                time,
+                                radius: self.radius,
+                                profile: &self.profile,
+                                obstacles,
+                            };
+                            let desired = toward * a.walk.speed * slowing;
+                            near.steer(
+                                &mut self.avoider,
+                                &mut self.chosen,
+                                &self.vehicle,
+                                self.facing,
+                                desired,
+                                a.walk.speed,
+                            )
+                            .unwrap_or(f)
+                        }
+                        _ => f,
+                    };
                     self.vehicle.step(f, dt);
                     if a.steering.parts().iter().all(|p| {
                         !matches!(
@@ -356,7 +412,12 @@ impl Walker {
         }
         self.vehicle.position.y = 0.0;
         self.vehicle.velocity.y = 0.0;
-        // never into an obstacle
+        // never into another body, nor into an obstacle
+        if let Some(o) = others {
+            let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+            let out = push_out_of_people(o, time, here, self.radius);
+            self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
+        }
         let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
         let out = obstacles.push_out(here, self.radius);
         if out != here {
@@ -419,6 +480,94 @@ impl Walker {
         m.ready.get_or_insert(relax);
         Ok(m)
     }
+}
+
+/// How often a walker among others chooses its velocity again (steps): 10 times a second.
+pub const DECIDE_EVERY: i64 = 24;
+/// Kept between two bodies beyond their radii (m): the pelvis sways about 2 cm to each side
+/// of the walker's track, and others' places are a frame old, moved on by their velocity.
+pub const PEOPLE_MARGIN: f32 = 0.04;
+/// How far a walker looks for others (m).
+pub const NEIGHBOUR_RADIUS: f32 = 8.0;
+
+/// What a walker among others needs to steer round them.
+struct Near<'a, 'b> {
+    others: Others<'b>,
+    time: f64,
+    radius: f32,
+    profile: &'a Profile,
+    obstacles: &'a Obstacles,
+}
+
+impl Near<'_, '_> {
+    /// The force toward the velocity chosen among the others ([`DECIDE_EVERY`] steps), or
+    /// `None` when nobody is in the way (or the choice would lead into an obstacle).
+    fn steer(
+        &self,
+        avoider: &mut Avoider,
+        chosen: &mut Option<Vec2>,
+        vehicle: &Vehicle,
+        facing: f32,
+        desired: Vec2,
+        pref: f32,
+    ) -> Option<Vec3> {
+        let here = Vec2::new(vehicle.position.x, vehicle.position.z);
+        let velocity = Vec2::new(vehicle.velocity.x, vehicle.velocity.z);
+        let tick = (self.time / STEP).round() as i64;
+        if tick % DECIDE_EVERY == 0 {
+            let me = Agent {
+                at: here,
+                velocity,
+                radius: self.radius,
+            };
+            let v = avoider.choose(
+                me,
+                desired,
+                velocity,
+                facing,
+                pref,
+                neighbours(self.others, self.time, here, NEIGHBOUR_RADIUS).into_iter(),
+                self.profile,
+            );
+            let clear = self
+                .obstacles
+                .segment_clear(here, here + v * 0.6, self.radius);
+            *chosen = (avoider.avoiding && clear).then_some(v);
+        }
+        chosen.map(|v| Vec3::new(v.x, 0.0, v.y) - flat(vehicle.velocity))
+    }
+}
+
+/// The others within `r` of `here` at `time` (their places moved on by their velocities).
+fn neighbours(o: Others<'_>, time: f64, here: Vec2, r: f32) -> Vec<Agent> {
+    let mut found = Vec::new();
+    o.crowd.near(here, r, &mut found);
+    let ahead = (time - o.crowd.time) as f32;
+    (found.into_iter())
+        .filter(|&i| Some(i) != o.me)
+        .map(|i| {
+            let a = o.crowd.agent(i);
+            Agent {
+                at: a.at + a.velocity * ahead,
+                ..a
+            }
+        })
+        .collect()
+}
+
+/// `here` moved out of every other body it overlaps (a hard limit, like obstacles).
+fn push_out_of_people(o: Others<'_>, time: f64, here: Vec2, radius: f32) -> Vec2 {
+    let mut at = here;
+    for other in neighbours(o, time, here, radius + 1.0) {
+        let d = at - other.at;
+        let reach = radius + other.radius + PEOPLE_MARGIN;
+        let l = d.length();
+        if l < reach {
+            let away = if l > 1e-6 { d / l } else { Vec2::X };
+            at = other.at + away * reach;
+        }
+    }
+    at
 }
 
 impl Active {

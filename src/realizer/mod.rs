@@ -400,21 +400,20 @@ impl Realizer {
             ..Frame::default()
         };
         let from = self.unframed.len();
-        for m in self.characters.values_mut() {
-            m.advance(now, &self.world, &mut frame);
-            m.move_feedback(&mut self.unframed);
-        }
-        // characters that walked stand elsewhere: from the next frame on, the others see them
-        // there (all at once: no character sees another's move of this frame)
-        let moved: Vec<(&str, crate::world::Placement)> = (self.characters.iter())
-            .map(|(id, m)| (id.as_str(), m.placement()))
-            .filter(|(id, at)| *at != self.world.placement(id))
-            .collect();
-        if !moved.is_empty() {
-            let world = std::sync::Arc::make_mut(&mut self.world);
-            for (id, at) in moved {
-                let _ = world.place(id, at);
+        // walkers among others see the crowd on a fixed grid of times, whatever the frames:
+        // the characters are stepped to each grid time passed since the last frame
+        while self.among_others_moving() {
+            let next = crowd_grid(self.world.crowd().time) + CROWD_PERIOD;
+            if next >= now - 1e-9 {
+                break;
             }
+            self.step_characters(next, &mut Frame::default());
+            self.update_crowd(next);
+        }
+        self.step_characters(now, &mut frame);
+        let on_grid = (now - crowd_grid(now + 1e-9)).abs() < 1e-9;
+        if on_grid || !self.among_others_moving() {
+            self.update_crowd(crowd_grid(now + 1e-9));
         }
         if let Some(due) = due {
             self.unframed.push(Feedback::Warning(WarningFeedback {
@@ -430,6 +429,83 @@ impl Realizer {
         self.deliver(from);
         frame.feedback = std::mem::take(&mut self.unframed);
         frame
+    }
+}
+
+/// How often walkers among others see where the others are (s): every 0.1 s of global time,
+/// on a grid of its multiples, so that no result depends on the host's frames.
+pub const CROWD_PERIOD: f64 = 0.1;
+
+/// The crowd grid time at or before `t`.
+fn crowd_grid(t: f64) -> f64 {
+    (t / CROWD_PERIOD).floor() * CROWD_PERIOD
+}
+
+impl Realizer {
+    /// Every character passes its sync points up to `now` (in id order) and plays into
+    /// `frame`; where the ones that walked now stand is written to the world (all at once: no
+    /// character sees another's move of this step).
+    fn step_characters(&mut self, now: f64, frame: &mut Frame) {
+        for m in self.characters.values_mut() {
+            m.advance(now, &self.world, frame);
+            m.move_feedback(&mut self.unframed);
+        }
+        let moved: Vec<(&str, crate::world::Placement)> = (self.characters.iter())
+            .map(|(id, m)| (id.as_str(), m.placement()))
+            .filter(|(id, at)| *at != self.world.placement(id))
+            .collect();
+        if !moved.is_empty() {
+            let world = std::sync::Arc::make_mut(&mut self.world);
+            for (id, at) in moved {
+                let _ = world.place(id, at);
+            }
+        }
+    }
+
+    /// Whether someone walks among others (the crowd is then kept on its grid).
+    fn among_others_moving(&mut self) -> bool {
+        self.world.crowd().len() > 1 && self.characters.values_mut().any(|m| m.moving())
+    }
+
+    /// The crowd walkers see from `now` on: every character placed in the world or realized
+    /// here, where it now stands, with its velocity since the last crowd. Kept empty while
+    /// there is no one to avoid.
+    fn update_crowd(&mut self, now: f64) {
+        let placed = self.world.placements().count();
+        let unplaced = (self.characters.keys())
+            .filter(|id| !self.world.is_placed(id))
+            .count();
+        if placed + unplaced < 2 {
+            if !self.world.crowd().is_empty() {
+                std::sync::Arc::make_mut(&mut self.world).set_crowd(Default::default());
+            }
+            return;
+        }
+        // velocities over the time since the last crowd
+        let last = self.world.crowd().clone();
+        let dt = (now - last.time) as f32;
+        let agent = |id: &str, at: crate::world::Placement| {
+            let here = glam::Vec2::new(at.position.x, at.position.z);
+            let velocity = (last.index(id))
+                .filter(|_| dt > 1e-6)
+                .map_or(glam::Vec2::ZERO, |i| (here - last.agent(i).at) / dt);
+            let agent = crate::crowd::Agent {
+                at: here,
+                velocity,
+                radius: self.world.radius(id),
+            };
+            (id.to_string(), agent)
+        };
+        let mut agents: Vec<(String, crate::crowd::Agent)> = (self.world.placements())
+            .map(|(id, at)| agent(id, at))
+            .collect();
+        agents.extend(
+            (self.characters.keys())
+                .filter(|id| !self.world.is_placed(id))
+                .map(|id| agent(id, crate::world::Placement::default())),
+        );
+        let crowd = crate::crowd::Crowd::new(now, agents);
+        std::sync::Arc::make_mut(&mut self.world).set_crowd(crowd);
     }
 }
 
