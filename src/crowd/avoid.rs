@@ -30,8 +30,12 @@ pub const MAX_CONTACTS: usize = 10;
 /// A candidate that brings the bodies themselves into contact sooner than this (s) is all but
 /// refused.
 pub const BODY_HORIZON: f32 = 0.5;
+/// Kept between bodies beyond their radii when judging whether they touch (m).
+pub const BODY_MARGIN: f32 = 0.05;
 /// Cost on candidates to the left of the desired heading: ties go right.
-pub const RIGHT_BIAS: f32 = 0.02;
+pub const RIGHT_BIAS: f32 = 0.05;
+/// How long a walker held below half its preferred speed waits before it is fully impatient (s).
+pub const PATIENCE: f32 = 3.0;
 
 /// One walker's avoidance state: the side it chose, its last velocity, its random jitter.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,6 +44,8 @@ pub struct Avoider {
     side: i8,
     /// Whether the last choice had contacts.
     pub avoiding: bool,
+    /// How long it has been held back (s), up to [`PATIENCE`].
+    waited: f32,
     rng: u64,
     contacts: Vec<(f32, Agent)>,
 }
@@ -50,9 +56,27 @@ impl Avoider {
         Avoider {
             side: 0,
             avoiding: false,
+            waited: 0.0,
             rng: seed | 1,
             contacts: Vec::new(),
         }
+    }
+
+    /// Counts `dt` seconds of being held back (moving at under half the preferred speed while
+    /// avoiding) or of walking freely (which calms it twice as fast).
+    pub fn wait(&mut self, dt: f32, held: bool) {
+        self.waited = if held && self.avoiding {
+            (self.waited + dt).min(PATIENCE)
+        } else {
+            (self.waited - 2.0 * dt).max(0.0)
+        };
+    }
+
+    /// How impatient it is, from 0 to 1: a walker kept waiting weighs the risk of contacts
+    /// beyond its body less and its own progress more, so that walkers who all stopped for each
+    /// other do not wait for ever (people in a jam edge on through the gaps).
+    pub fn impatience(&self) -> f32 {
+        self.waited / PATIENCE
     }
 
     fn jitter(&mut self) -> f32 {
@@ -98,6 +122,8 @@ impl Avoider {
         } else {
             heading
         };
+        // a walker kept waiting looks wider, up to turning about, to find a way round
+        let span = span + self.impatience() * (std::f32::consts::PI - span);
         let n = (span / HEADING_STEP).floor() as i32;
         // desired first, then right (clockwise seen from above: decreasing angle), then left
         let offsets = std::iter::once(0).chain((1..=n).map(|k| -k)).chain(1..=n);
@@ -177,7 +203,9 @@ impl Avoider {
             0.0
         };
         let slower = (desired.length() - v.length()).max(0.0) / u;
-        let deviation = p.gamma * (angle / std::f32::consts::PI + 0.5 * slower);
+        let hurry = self.impatience();
+        let deviation =
+            p.gamma * (angle / std::f32::consts::PI + 0.5 * (1.0 + 2.0 * hurry) * slower);
         let (mut soonest, mut touch) = (p.tc_max, f32::INFINITY);
         for &(_, o) in &self.contacts {
             let dx = o.at - me.at;
@@ -186,11 +214,11 @@ impl Avoider {
             if let Some(t) = time_to_contact(dx, dv, reach) {
                 soonest = soonest.min(t);
             }
-            if let Some(t) = time_to_contact(dx, dv, me.radius + o.radius + 0.02) {
+            if let Some(t) = time_to_contact(dx, dv, me.radius + o.radius + BODY_MARGIN) {
                 touch = touch.min(t);
             }
         }
-        let risk = p.delta * (1.0 - soonest / p.tc_max);
+        let risk = p.delta * (1.0 - 0.75 * hurry) * (1.0 - soonest / p.tc_max);
         let bodies = if touch < BODY_HORIZON {
             10.0 * (1.0 - touch / BODY_HORIZON) + 1.0
         } else {

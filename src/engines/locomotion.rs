@@ -554,8 +554,7 @@ impl Travel for LocomotionEngine {
     }
 
     fn moving(&self) -> bool {
-        self.current.is_some()
-            || (self.walker.as_ref()).is_some_and(|w| !w.gait.at_rest(w.body()))
+        self.current.is_some() || (self.walker.as_ref()).is_some_and(|w| !w.gait.at_rest(w.body()))
     }
 
     fn contacts(&self) -> Option<[bool; 2]> {

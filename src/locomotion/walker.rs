@@ -296,7 +296,12 @@ impl Walker {
     }
 
     /// One step; the moments when the walk ends in it.
-    fn step(&mut self, dt: f32, obstacles: &Obstacles, others: Option<Others<'_>>) -> Option<Moments> {
+    fn step(
+        &mut self,
+        dt: f32,
+        obstacles: &Obstacles,
+        others: Option<Others<'_>>,
+    ) -> Option<Moments> {
         let time = self.time;
         let facing_before = self.facing;
         let mut ended = None;
@@ -415,7 +420,7 @@ impl Walker {
         // never into another body, nor into an obstacle
         if let Some(o) = others {
             let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
-            let out = push_out_of_people(o, time, here, self.radius);
+            let out = push_out_of_people(o, time, here, self.radius, dt);
             self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
         }
         let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
@@ -487,6 +492,13 @@ pub const DECIDE_EVERY: i64 = 24;
 /// Kept between two bodies beyond their radii (m): the pelvis sways about 2 cm to each side
 /// of the walker's track, and others' places are a frame old, moved on by their velocity.
 pub const PEOPLE_MARGIN: f32 = 0.04;
+/// How often a walker checks that its course does not touch someone within
+/// [`URGENT_HORIZON`] (steps: 40 times a second).
+pub const WATCH_EVERY: i64 = 6;
+/// A course that touches someone sooner than this (s) is chosen again at once.
+pub const URGENT_HORIZON: f32 = 0.4;
+/// Fastest a walker is pushed out of others it overlaps (m/s).
+pub const PUSH_SPEED: f32 = 1.0;
 /// How far a walker looks for others (m).
 pub const NEIGHBOUR_RADIUS: f32 = 8.0;
 
@@ -514,7 +526,22 @@ impl Near<'_, '_> {
         let here = Vec2::new(vehicle.position.x, vehicle.position.z);
         let velocity = Vec2::new(vehicle.velocity.x, vehicle.velocity.z);
         let tick = (self.time / STEP).round() as i64;
-        if tick % DECIDE_EVERY == 0 {
+        let regular = tick % DECIDE_EVERY == 0;
+        if regular {
+            avoider.wait(
+                DECIDE_EVERY as f32 * STEP as f32,
+                velocity.length() < 0.5 * pref,
+            );
+        }
+        // between the regular choices, a course about to touch someone is chosen again at once
+        let urgent = !regular
+            && tick % WATCH_EVERY == 0
+            && (neighbours(self.others, self.time, here, 2.0).iter()).any(|o| {
+                let reach = self.radius + o.radius + crate::crowd::avoid::BODY_MARGIN;
+                crate::crowd::contact::time_to_contact(o.at - here, o.velocity - velocity, reach)
+                    .is_some_and(|t| t < URGENT_HORIZON)
+            });
+        if regular || urgent {
             let me = Agent {
                 at: here,
                 velocity,
@@ -555,19 +582,21 @@ fn neighbours(o: Others<'_>, time: f64, here: Vec2, r: f32) -> Vec<Agent> {
         .collect()
 }
 
-/// `here` moved out of every other body it overlaps (a hard limit, like obstacles).
-fn push_out_of_people(o: Others<'_>, time: f64, here: Vec2, radius: f32) -> Vec2 {
-    let mut at = here;
+/// `here` moved out of the other bodies it overlaps, by the sum of the overlaps but at most
+/// [`PUSH_SPEED`] × `dt`: bodies part over a few steps rather than jump (in a press of people
+/// moving out of one body at once may lead into the next, and they shove back).
+fn push_out_of_people(o: Others<'_>, time: f64, here: Vec2, radius: f32, dt: f32) -> Vec2 {
+    let mut push = Vec2::ZERO;
     for other in neighbours(o, time, here, radius + 1.0) {
-        let d = at - other.at;
+        let d = here - other.at;
         let reach = radius + other.radius + PEOPLE_MARGIN;
         let l = d.length();
         if l < reach {
             let away = if l > 1e-6 { d / l } else { Vec2::X };
-            at = other.at + away * reach;
+            push += away * (reach - l);
         }
     }
-    at
+    here + push.clamp_length_max(PUSH_SPEED * dt)
 }
 
 impl Active {

@@ -403,7 +403,7 @@ impl Realizer {
         // walkers among others see the crowd on a fixed grid of times, whatever the frames:
         // the characters are stepped to each grid time passed since the last frame
         while self.among_others_moving() {
-            let next = crowd_grid(self.world.crowd().time) + CROWD_PERIOD;
+            let next = grid_time(grid_index(self.world.crowd().time) + 1);
             if next >= now - 1e-9 {
                 break;
             }
@@ -411,9 +411,9 @@ impl Realizer {
             self.update_crowd(next);
         }
         self.step_characters(now, &mut frame);
-        let on_grid = (now - crowd_grid(now + 1e-9)).abs() < 1e-9;
-        if on_grid || !self.among_others_moving() {
-            self.update_crowd(crowd_grid(now + 1e-9));
+        let at = grid_time(grid_index(now));
+        if (now - at).abs() < 1e-9 || !self.among_others_moving() {
+            self.update_crowd(at);
         }
         if let Some(due) = due {
             self.unframed.push(Feedback::Warning(WarningFeedback {
@@ -436,9 +436,15 @@ impl Realizer {
 /// on a grid of its multiples, so that no result depends on the host's frames.
 pub const CROWD_PERIOD: f64 = 0.1;
 
-/// The crowd grid time at or before `t`.
-fn crowd_grid(t: f64) -> f64 {
-    (t / CROWD_PERIOD).floor() * CROWD_PERIOD
+/// The index of the crowd grid time at or before `t` (a time within a millionth of a period
+/// of a grid time counts as on it: `k * 0.1 / 0.1` may fall just short of `k`).
+fn grid_index(t: f64) -> i64 {
+    (t / CROWD_PERIOD + 1e-6).floor() as i64
+}
+
+/// The `k`th crowd grid time.
+fn grid_time(k: i64) -> f64 {
+    k as f64 * CROWD_PERIOD
 }
 
 impl Realizer {

@@ -1,0 +1,306 @@
+//! Do walkers share the ground the way people do? Each test places several characters in a
+//! world, sends each a `<locomotion>`, ticks the realizer on the virtual clock and judges where
+//! the bodies stood (the world's placements, the ground under each body): whether everyone
+//! arrives, how close any two came, on which side they passed, how long their paths were, and
+//! whether the answer depends on the host's frame rate.
+
+use std::collections::BTreeMap;
+
+use bml_realizer::feedback::Feedback;
+use bml_realizer::realizer::Realizer;
+use bml_realizer::world::World;
+use glam::Vec2;
+use proptest::prelude::*;
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// Sum of two default radii, less the centimetre the acceptance allows.
+const CLOSEST: f32 = 2.0 * 0.25 - 0.01;
+
+/// A walker: where it stands, which way it faces (degrees), where it goes.
+#[derive(Debug, Clone, Copy)]
+struct Walker {
+    from: Vec2,
+    facing: f32,
+    to: Vec2,
+}
+
+fn walker(from: (f32, f32), to: (f32, f32)) -> Walker {
+    let (from, to) = (Vec2::from(from), Vec2::from(to));
+    let d = to - from;
+    Walker {
+        from,
+        facing: d.x.atan2(d.y).to_degrees(),
+        to,
+    }
+}
+
+fn id(k: usize) -> String {
+    format!("w{k:03}")
+}
+
+/// What a scene produced: each walker's ground track (one point a frame) and the feedback.
+struct Crowd {
+    tracks: BTreeMap<String, Vec<Vec2>>,
+    feedback: Vec<Feedback>,
+}
+
+fn world_json(walkers: &[Walker]) -> String {
+    let chars: Vec<String> = (walkers.iter().enumerate())
+        .map(|(k, w)| {
+            format!(
+                r#""{}": {{"position": [{}, 0, {}], "facing": {}}}"#,
+                id(k),
+                w.from.x,
+                w.from.y,
+                w.facing
+            )
+        })
+        .collect();
+    format!(r#"{{"characters": {{{}}}}}"#, chars.join(", "))
+}
+
+fn realize(walkers: &[Walker], seconds: f64, fps: f64) -> Crowd {
+    let mut r = Realizer::new();
+    *r.world_mut() = World::from_json(&world_json(walkers)).expect("a world").0;
+    for (k, w) in walkers.iter().enumerate() {
+        let bml = format!(
+            r#"<bml {NS} id="b{k}" characterId="{}"><locomotion id="w" target="{},{}"/></bml>"#,
+            id(k),
+            w.to.x,
+            w.to.y
+        );
+        let _ = r.perform_bml(&bml);
+    }
+    let mut crowd = Crowd {
+        tracks: BTreeMap::new(),
+        feedback: Vec::new(),
+    };
+    for i in 0..=(seconds * fps).ceil() as u32 {
+        let f = r.tick(f64::from(i) / fps);
+        crowd.feedback.extend(f.feedback);
+        for k in 0..walkers.len() {
+            let at = r.world().placement(&id(k)).position;
+            (crowd.tracks.entry(id(k)).or_default()).push(Vec2::new(at.x, at.z));
+        }
+    }
+    crowd
+}
+
+impl Crowd {
+    /// The closest two walkers came (m), and who and when (frame).
+    fn closest(&self) -> (f32, String, String, usize) {
+        let ids: Vec<&String> = self.tracks.keys().collect();
+        let mut best = (f32::INFINITY, String::new(), String::new(), 0);
+        for (i, a) in ids.iter().enumerate() {
+            for b in &ids[i + 1..] {
+                let (ta, tb) = (&self.tracks[*a], &self.tracks[*b]);
+                for (k, (p, q)) in ta.iter().zip(tb).enumerate() {
+                    let d = p.distance(*q);
+                    if d < best.0 {
+                        best = (d, a.to_string(), b.to_string(), k);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    fn path_length(&self, id: &str) -> f32 {
+        self.tracks[id]
+            .windows(2)
+            .map(|w| w[0].distance(w[1]))
+            .sum()
+    }
+
+    fn last(&self, id: &str) -> Vec2 {
+        *self.tracks[id].last().unwrap()
+    }
+
+    /// The time block `b` ended.
+    fn end(&self, block: &str) -> Option<f64> {
+        self.feedback.iter().find_map(|f| match f {
+            Feedback::BlockProgress(p) if p.block.as_str() == block && p.sync.as_str() == "end" => {
+                Some(p.global_time)
+            }
+            _ => None,
+        })
+    }
+
+    fn warnings(&self) -> Vec<String> {
+        (self.feedback.iter())
+            .filter_map(|f| match f {
+                Feedback::Warning(w) => Some(format!("{}: {}", w.id, w.text)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Asserts that every walker arrived and nobody came too close.
+    fn all_arrive_apart(&self, walkers: &[Walker]) {
+        assert!(self.warnings().is_empty(), "{:?}", self.warnings());
+        for (k, w) in walkers.iter().enumerate() {
+            let d = self.last(&id(k)).distance(w.to);
+            assert!(d < 0.1, "{} ends {d} m from its goal", id(k));
+            assert!(self.end(&format!("b{k}")).is_some(), "b{k} did not end");
+        }
+        let (d, a, b, k) = self.closest();
+        assert!(d >= CLOSEST, "{a} and {b} came {d} m apart at frame {k}");
+    }
+}
+
+#[test]
+fn a_head_on_pair_on_one_line_passes_each_on_its_right() {
+    let walkers = [
+        walker((0.0, -5.0), (0.0, 5.0)),
+        walker((0.0, 5.0), (0.0, -5.0)),
+    ];
+    let c = realize(&walkers, 14.0, 30.0);
+    c.all_arrive_apart(&walkers);
+    // where they pass (z equal), w000 (heading +z, its right is −x) is on −x of w001
+    let (a, b) = (&c.tracks["w000"], &c.tracks["w001"]);
+    let k = (0..a.len()).find(|&k| a[k].y >= b[k].y).unwrap();
+    assert!(a[k].x < b[k].x - 0.3, "{} vs {}", a[k], b[k]);
+    for id in ["w000", "w001"] {
+        let l = c.path_length(id);
+        assert!(l <= 1.15 * 10.0, "{id} walked {l} m for 10");
+    }
+}
+
+#[test]
+fn head_on_encounters_nearly_on_one_line_pass_on_the_right() {
+    // twenty encounters, offset sideways by up to 12 cm (either way), meeting at different
+    // places (the other starts up to a metre further off)
+    let mut right = 0;
+    for k in 0..20 {
+        let off = (k as f32 - 9.5) * 0.0125;
+        let further = (k * 7 % 20) as f32 * 0.05;
+        let a = walker((off, -5.0), (off, 5.0));
+        let b = walker((0.0, 5.0 + further), (0.0, -5.0));
+        let run = realize(&[a, b], 14.0, 20.0);
+        run.all_arrive_apart(&[a, b]);
+        let (ta, tb) = (&run.tracks["w000"], &run.tracks["w001"]);
+        let i = (0..ta.len()).find(|&i| ta[i].y >= tb[i].y).unwrap();
+        if ta[i].x < tb[i].x {
+            right += 1;
+        } else {
+            eprintln!("left: offset {off}, {further} m further");
+        }
+    }
+    assert!(right >= 19, "{right} of 20 passed on the right");
+}
+
+#[test]
+fn walkers_crossing_at_right_angles_keep_apart_and_keep_their_line() {
+    let walkers = [
+        walker((-5.0, 0.0), (5.0, 0.0)),
+        walker((0.0, -5.0), (0.0, 5.0)),
+    ];
+    let c = realize(&walkers, 14.0, 30.0);
+    c.all_arrive_apart(&walkers);
+    for id in ["w000", "w001"] {
+        let l = c.path_length(id);
+        assert!(l <= 1.15 * 10.0, "{id} walked {l} m for 10");
+    }
+}
+
+fn circle(n: usize, r: f32) -> Vec<Walker> {
+    (0..n)
+        .map(|k| {
+            let a = std::f32::consts::TAU * k as f32 / n as f32;
+            let p = (r * a.sin(), r * a.cos());
+            walker(p, (-p.0, -p.1))
+        })
+        .collect()
+}
+
+#[test]
+fn twenty_four_on_a_circle_swap_places_without_touching() {
+    let walkers = circle(24, 6.0);
+    let c = realize(&walkers, 40.0, 10.0);
+    c.all_arrive_apart(&walkers);
+    let last = (0..24)
+        .filter_map(|k| c.end(&format!("b{k}")))
+        .fold(0.0, f64::max);
+    // 12 m at 1.4 m/s alone takes about 9 s; the press in the middle may slow them to thrice
+    assert!(last < 30.0, "the last arrived at {last} s");
+}
+
+#[test]
+fn the_crowd_is_the_same_whatever_the_frame_rate() {
+    let walkers = circle(8, 4.0);
+    // what happened, and when: progress and warnings (predictions are made at frames)
+    let key = |c: &Crowd| {
+        let mut lines: Vec<String> = (c.feedback.iter())
+            .filter(|f| !matches!(f, Feedback::Prediction(_)))
+            .map(|f| format!("{f:?}"))
+            .collect();
+        lines.sort();
+        lines
+    };
+    let (a, b) = (realize(&walkers, 20.0, 60.0), realize(&walkers, 20.0, 7.0));
+    assert_eq!(key(&a), key(&b));
+    for (id, t) in &a.tracks {
+        assert_eq!(t.last(), b.tracks[id].last(), "{id}");
+    }
+}
+
+#[test]
+fn profiles_come_from_the_world_file_and_bad_ones_are_refused() {
+    let ok = r#"{"profiles": {"shy": {"tcMax": 12}},
+                 "characters": {"A": {"position": [0, 0, 0], "profile": "shy"}}}"#;
+    let w = World::from_json(ok).expect("a world").0;
+    assert_eq!(w.profile("A").tc_max, 12.0);
+    assert_eq!(w.profile("B").tc_max, 8.0);
+    let unknown = r#"{"characters": {"A": {"position": [0, 0, 0], "profile": "shy"}}}"#;
+    let e = World::from_json(unknown).unwrap_err();
+    assert!(e.contains("character 'A': profile 'shy'"), "{e}");
+    let negative = r#"{"profiles": {"shy": {"alpha": -1}}, "characters": {}}"#;
+    let e = World::from_json(negative).unwrap_err();
+    assert!(e.contains("profiles.shy") && e.contains("alpha"), "{e}");
+    let typo = r#"{"profiles": {"shy": {"tc_max": 3}}, "characters": {}}"#;
+    assert!(World::from_json(typo).is_err());
+}
+
+#[test]
+fn a_world_of_too_many_characters_is_refused() {
+    let chars: Vec<String> = (0..bml_realizer::world::MAX_CHARACTERS + 1)
+        .map(|k| format!(r#""c{k}": {{"position": [{}, 0, 0]}}"#, k % 1000))
+        .collect();
+    let json = format!(r#"{{"characters": {{{}}}}}"#, chars.join(","));
+    let e = World::from_json(&json).unwrap_err();
+    assert!(e.contains("at most"), "{e}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+    /// Random scenes: nobody's place becomes NaN, no two bodies come closer than the
+    /// tolerance, and every walk either arrives or says it could not.
+    #[test]
+    fn random_scenes_never_overlap_and_every_walk_arrives_or_says_why(
+        ends in proptest::collection::vec(((-5.0f32..5.0, -5.0f32..5.0), (-5.0f32..5.0, -5.0f32..5.0)), 2..10),
+    ) {
+        // starts and goals at least a body and a margin apart
+        let spaced = |ps: Vec<Vec2>| ps.iter().enumerate().all(|(i, p)| ps[..i].iter().all(|q| p.distance(*q) > 0.7));
+        let walkers: Vec<Walker> = ends.iter().map(|&(a, b)| walker(a, b)).collect();
+        prop_assume!(spaced(walkers.iter().map(|w| w.from).collect()));
+        prop_assume!(spaced(walkers.iter().map(|w| w.to).collect()));
+        let c = realize(&walkers, 40.0, 10.0);
+        for t in c.tracks.values() {
+            prop_assert!(t.iter().all(|p| p.is_finite()));
+        }
+        let (d, a, b, k) = c.closest();
+        prop_assert!(d >= CLOSEST, "{} and {} came {} m apart at frame {}", a, b, d, k);
+        let warned = c.warnings();
+        for (k, w) in walkers.iter().enumerate() {
+            // one that stands at its goal may be shouldered aside by someone passing
+            let arrived = c.last(&id(k)).distance(w.to) < 0.25;
+            let said = warned.iter().any(|s| s.contains(&format!("b{k}:w")));
+            prop_assert!(
+                arrived || said,
+                "{} ended at {} (goal {}) at {:?} and did not say why: {:?}",
+                id(k), c.last(&id(k)), w.to, c.end(&format!("b{k}")), warned
+            );
+        }
+    }
+}
