@@ -7,8 +7,10 @@
 //! the cheapest by a cost of effort, deviation and collision risk; once it has chosen a side it
 //! keeps it. [`profile`] holds the per-character parameters, [`contact`] the time to contact,
 //! [`snapshot`] the crowd as every walker sees it in a frame (with a uniform grid to find
-//! neighbours), [`avoid`] the choice itself. Walkers do not use it yet (the realizer still
-//! lets them walk through each other).
+//! neighbours), [`avoid`] the choice itself. The realizer keeps the crowd on a fixed grid of
+//! times (every 0.1 s of global time, whatever the host's frames) and each walker
+//! (`locomotion::walker`) chooses among the others between its route and its gait
+//! (`docs/crowds.md`).
 
 pub mod avoid;
 pub mod contact;
