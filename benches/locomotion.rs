@@ -151,5 +151,49 @@ fn crowd(c: &mut Criterion) {
     });
 }
 
+/// 1 000 walkers in counter-flowing rows 1.5 m apart (each row against its neighbours), full
+/// bodies without gestures: one 60 Hz tick on all cores and on one thread.
+fn thousand(c: &mut Criterion) {
+    for parallel in [true, false] {
+        let mut world = World::default();
+        let (cols, rows) = (40, 25);
+        for i in 0..cols * rows {
+            let (x, z) = ((i % cols) as f32 * 2.0, (i / cols) as f32 * 1.5);
+            let facing = if (i / cols) % 2 == 0 { 90.0 } else { -90.0 };
+            let at = Placement::new(Vec3::new(x, 0.0, z), facing);
+            world.place(&format!("c{i}"), at).unwrap();
+        }
+        let mut r = Realizer::new();
+        r.set_parallel(parallel);
+        *r.world_mut() = world;
+        for i in 0..cols * rows {
+            let z = (i / cols) as f32 * 1.5;
+            let x = if (i / cols) % 2 == 0 { 100_000.0 } else { -100_000.0 };
+            r.perform_bml(&format!(
+                r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b" characterId="c{i}"><locomotion id="w" target="{x},{z}"/></bml>"#
+            ))
+            .unwrap();
+        }
+        let mut t = 0.0;
+        for _ in 0..120 {
+            t += 1.0 / 60.0;
+            r.tick(t);
+        }
+        let name = if parallel { "all cores" } else { "one thread" };
+        c.bench_function(&format!("tick: 1000 characters walking (60 Hz), {name}"), |b| {
+            b.iter(|| {
+                t += 1.0 / 60.0;
+                black_box(r.tick(t))
+            })
+        });
+    }
+}
+
 criterion_group!(benches, paths, steering, gait, crowd);
+criterion_group! {
+    name = big;
+    config = Criterion::default().sample_size(10);
+    targets = thousand
+}
+criterion_main!(benches, big);
 criterion_main!(benches);

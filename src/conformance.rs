@@ -2,8 +2,7 @@
 //! clock, so the conformance suite runs fast and deterministically inside `cargo test` and
 //! `bmlr conformance`. Feedback goes through the XML codec, as it would through a real port.
 
-use std::cell::RefCell;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex};
 
 use realizer_tests::{Fixture, TestPort};
 
@@ -16,7 +15,7 @@ use crate::timing::{DefaultTimingModels, SpeechTiming, Voice};
 /// retimable speech.
 pub struct InProcess {
     realizer: Realizer,
-    lines: Rc<RefCell<Vec<String>>>,
+    lines: Arc<Mutex<Vec<String>>>,
     end_delay: f64,
     voice: Voice,
 }
@@ -30,7 +29,7 @@ impl Default for InProcess {
 impl InProcess {
     /// A port to a new realizer.
     pub fn new() -> Self {
-        let lines = Rc::new(RefCell::new(Vec::new()));
+        let lines = Arc::new(Mutex::new(Vec::new()));
         InProcess {
             realizer: Self::realizer(&lines, 0.0, Fixture::Standard, Voice::Builtin),
             lines,
@@ -55,7 +54,7 @@ impl InProcess {
     }
 
     fn realizer(
-        lines: &Rc<RefCell<Vec<String>>>,
+        lines: &Arc<Mutex<Vec<String>>>,
         end_delay: f64,
         fixture: Fixture,
         voice: Voice,
@@ -75,13 +74,13 @@ impl InProcess {
                     p.global_time += end_delay;
                 }
             }
-            sink.borrow_mut().push(Format::Xml.encode(&fb));
+            sink.lock().unwrap_or_else(|e| e.into_inner()).push(Format::Xml.encode(&fb));
         }));
         r
     }
 
     fn take(&mut self) -> Vec<String> {
-        std::mem::take(&mut *self.lines.borrow_mut())
+        std::mem::take(&mut *self.lines.lock().unwrap_or_else(|e| e.into_inner()))
     }
 }
 
@@ -109,7 +108,7 @@ impl TestPort for InProcess {
 
     fn reset(&mut self, fixture: Fixture) -> Result<(), String> {
         self.realizer = Self::realizer(&self.lines, self.end_delay, fixture, self.voice);
-        self.lines.borrow_mut().clear();
+        self.lines.lock().unwrap_or_else(|e| e.into_inner()).clear();
         Ok(())
     }
 }

@@ -256,14 +256,14 @@ fn a_moving_target_is_tracked_after_ready() {
 #[test]
 fn a_gaze_at_a_target_the_world_lacks_is_refused_with_a_warning() {
     let mut r = still();
-    let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let log = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
     let sink = log.clone();
     r.add_listener(Box::new(move |f: &Feedback| {
-        sink.borrow_mut().push(f.clone())
+        sink.lock().unwrap().push(f.clone())
     }));
     r.perform_bml(&gaze_block("b", "nowhere", "")).unwrap();
     let warnings: Vec<String> = log
-        .borrow()
+        .lock().unwrap()
         .iter()
         .filter_map(|f| match f {
             Feedback::Warning(w) => Some(format!("{} {} {}", w.id, w.kind.as_str(), w.text)),
@@ -306,10 +306,10 @@ fn pointing_aims_the_index_finger_at_the_target_at_the_stroke_and_returns() {
     ] {
         let mut r = still();
         r.world_mut().set("thing", target);
-        let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let log = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = log.clone();
         r.add_listener(Box::new(move |f: &Feedback| {
-            sink.borrow_mut().push(f.clone())
+            sink.lock().unwrap().push(f.clone())
         }));
         r.perform_bml(&format!(
             r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><pointing id="p" target="thing" mode="{mode}" start="0.2" end="2.4"/></bml>"#
@@ -324,7 +324,7 @@ fn pointing_aims_the_index_finger_at_the_target_at_the_stroke_and_returns() {
             let t = f64::from(i) / FPS;
             let frame = r.tick(t);
             if stroke.is_none() {
-                stroke = log.borrow().iter().find_map(|f| match f {
+                stroke = log.lock().unwrap().iter().find_map(|f| match f {
                     Feedback::SyncPointProgress(p) if p.sync == "stroke" => Some(p.global_time),
                     _ => None,
                 });
@@ -425,10 +425,10 @@ fn a_beat_hits_its_bound_keys_at_its_syncs_and_the_left_hand_mirrors_them() {
     let beat = lexicon.keys("BEAT").unwrap();
     for mode in ["RIGHT_HAND", "LEFT_HAND"] {
         let mut r = still();
-        let log = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let log = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = log.clone();
         r.add_listener(Box::new(move |f: &Feedback| {
-            sink.borrow_mut().push(f.clone())
+            sink.lock().unwrap().push(f.clone())
         }));
         r.perform_bml(&format!(
             r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gesture id="g" lexeme="BEAT" mode="{mode}" start="0.5" end="2"/></bml>"#
@@ -436,7 +436,7 @@ fn a_beat_hits_its_bound_keys_at_its_syncs_and_the_left_hand_mirrors_them() {
         .unwrap();
         // the scheduled sync times, from the PENDING prediction
         let predicted: Vec<(String, f64)> = log
-            .borrow()
+            .lock().unwrap()
             .iter()
             .find_map(|f| match f {
                 Feedback::Prediction(p) if !p.behaviours.is_empty() => Some(

@@ -61,7 +61,15 @@ fn world_json(walkers: &[Walker]) -> String {
 }
 
 fn realize(walkers: &[Walker], seconds: f64, fps: f64) -> Crowd {
+    realize_with(walkers, seconds, fps, true).0
+}
+
+/// Realizes the scene with characters stepped in parallel or not; also gives every frame
+/// (poses and feedback) as text.
+fn realize_with(walkers: &[Walker], seconds: f64, fps: f64, parallel: bool) -> (Crowd, String) {
     let mut r = Realizer::new();
+    r.set_parallel(parallel);
+    let mut text = String::new();
     *r.world_mut() = World::from_json(&world_json(walkers)).expect("a world").0;
     for (k, w) in walkers.iter().enumerate() {
         let bml = format!(
@@ -78,13 +86,15 @@ fn realize(walkers: &[Walker], seconds: f64, fps: f64) -> Crowd {
     };
     for i in 0..=(seconds * fps).ceil() as u32 {
         let f = r.tick(f64::from(i) / fps);
+        text += &format!("{:?}\n", f.poses);
         crowd.feedback.extend(f.feedback);
         for k in 0..walkers.len() {
             let at = r.world().placement(&id(k)).position;
             (crowd.tracks.entry(id(k)).or_default()).push(Vec2::new(at.x, at.z));
         }
     }
-    crowd
+    text += &format!("{:?}", crowd.feedback);
+    (crowd, text)
 }
 
 impl Crowd {
@@ -243,6 +253,20 @@ fn the_crowd_is_the_same_whatever_the_frame_rate() {
     for (id, t) in &a.tracks {
         assert_eq!(t.last(), b.tracks[id].last(), "{id}");
     }
+}
+
+#[test]
+fn characters_stepped_in_parallel_give_exactly_what_one_thread_gives() {
+    let walkers = circle(8, 4.0);
+    let (_, sequential) = realize_with(&walkers, 12.0, 30.0, false);
+    let (_, parallel) = realize_with(&walkers, 12.0, 30.0, true);
+    assert!(sequential == parallel, "the parallel run differs");
+}
+
+#[test]
+fn a_realizer_may_be_owned_by_any_thread() {
+    fn send<T: Send>() {}
+    send::<Realizer>();
 }
 
 #[test]

@@ -3,8 +3,7 @@
 //! against bad input, determinism, bounded memory, characters and engines registered from outside
 //! the core.
 
-use std::cell::RefCell;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex};
 
 use bml_realizer::bml::{Behaviour, BehaviourKind, NS_BML};
 use bml_realizer::engine::{Engine, EngineError, KindKey, Unit, UnitKey};
@@ -41,7 +40,7 @@ fn metronome() -> Realizer {
 
 struct Session {
     r: Realizer,
-    log: Rc<RefCell<Vec<Feedback>>>,
+    log: Arc<Mutex<Vec<Feedback>>>,
 }
 
 impl Session {
@@ -52,10 +51,10 @@ impl Session {
     }
 
     fn with(mut r: Realizer) -> Self {
-        let log = Rc::new(RefCell::new(Vec::new()));
+        let log = Arc::new(Mutex::new(Vec::new()));
         let sink = log.clone();
         r.add_listener(Box::new(move |f: &Feedback| {
-            sink.borrow_mut().push(f.clone())
+            sink.lock().unwrap().push(f.clone())
         }));
         Session { r, log }
     }
@@ -72,7 +71,7 @@ impl Session {
     }
 
     fn fb(&self) -> Vec<Feedback> {
-        self.log.borrow().clone()
+        self.log.lock().unwrap().clone()
     }
 
     /// Global time of `block:behaviour:sync`.
@@ -507,7 +506,7 @@ fn scenario15_append_waits_forever_for_a_persistent_block_append_after_does_not(
 fn an_appended_block_reports_in_the_order_of_design_section_4() {
     let mut s = Session::new();
     s.send(0.0, &block("bml1", "", &speech("s", 2, None, "")));
-    s.log.borrow_mut().clear();
+    s.log.lock().unwrap().clear();
     s.send(
         0.0,
         &block("bml2", r#"composition="APPEND""#, &speech("t", 1, None, "")),

@@ -112,7 +112,7 @@ pub fn stop_now(now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
 /// [`add`](Engine::add), [`remove`](Engine::remove) and [`len`](Engine::len) have no default.
 /// An engine that does more returns itself from the matching `as_…` method (for example
 /// `fn as_motion(&mut self) -> Option<&mut dyn Motion> { Some(self) }`).
-pub trait Engine {
+pub trait Engine: Send {
     /// A short name (frame output, logs).
     fn name(&self) -> &'static str;
 

@@ -265,7 +265,7 @@ pub fn from_line(line: &str) -> Result<Feedback, FeedbackError> {
 pub struct FeedbackError(pub String);
 
 /// Receives feedback messages as the realizer produces them.
-pub trait FeedbackListener {
+pub trait FeedbackListener: Send {
     /// Called once per message, in order.
     fn feedback(&mut self, fb: &Feedback);
 }
@@ -276,7 +276,7 @@ impl FeedbackListener for Vec<Feedback> {
     }
 }
 
-impl<F: FnMut(&Feedback)> FeedbackListener for F {
+impl<F: FnMut(&Feedback) + Send> FeedbackListener for F {
     fn feedback(&mut self, fb: &Feedback) {
         self(fb)
     }

@@ -8,7 +8,7 @@
 use std::sync::{Arc, Mutex, PoisonError};
 
 /// A source of predicted event times.
-pub trait Anticipator {
+pub trait Anticipator: Send {
     /// The id BML uses (`anticipators:ID:SYNC`).
     fn id(&self) -> &str;
 

@@ -32,8 +32,8 @@ pub trait RealizerPort {
     fn add_listener(&mut self, listener: Box<dyn FeedbackListener>);
 }
 
-type RegistryFactory = Box<dyn Fn() -> Registry>;
-type StrategyFactory = Box<dyn Fn() -> Box<dyn SchedulingStrategy>>;
+type RegistryFactory = Box<dyn Fn() -> Registry + Send>;
+type StrategyFactory = Box<dyn Fn() -> Box<dyn SchedulingStrategy> + Send>;
 
 /// A BML realizer for one or more characters.
 pub struct Realizer {
@@ -51,6 +51,8 @@ pub struct Realizer {
     world: std::sync::Arc<World>,
     now: f64,
     unframed: Vec<Feedback>,
+    /// Whether characters are stepped on several threads.
+    parallel: bool,
 }
 
 impl Default for Realizer {
@@ -73,6 +75,7 @@ impl Realizer {
             skeleton: Skeleton::adult(),
             idle: true,
             world: std::sync::Arc::new(World::default()),
+            parallel: true,
             now: 0.0,
             unframed: Vec::new(),
         }
@@ -80,7 +83,7 @@ impl Realizer {
 
     /// Uses `factory` to make the engines of each character (register extra kinds and engines
     /// here).
-    pub fn with_engines(mut self, factory: impl Fn() -> Registry + 'static) -> Self {
+    pub fn with_engines(mut self, factory: impl Fn() -> Registry + Send + 'static) -> Self {
         self.engines = Box::new(factory);
         self
     }
@@ -96,7 +99,7 @@ impl Realizer {
     /// Uses another scheduling strategy.
     pub fn with_strategy(
         mut self,
-        factory: impl Fn() -> Box<dyn SchedulingStrategy> + 'static,
+        factory: impl Fn() -> Box<dyn SchedulingStrategy> + Send + 'static,
     ) -> Self {
         self.strategy = Box::new(factory);
         self
@@ -432,6 +435,9 @@ impl Realizer {
     }
 }
 
+/// Fewest characters stepped in parallel (below it, threads cost more than they save).
+pub const PARALLEL_CHARACTERS: usize = 4;
+
 /// How often walkers among others see where the others are (s): every 0.1 s of global time,
 /// on a grid of its multiples, so that no result depends on the host's frames.
 pub const CROWD_PERIOD: f64 = 0.1;
@@ -452,9 +458,32 @@ impl Realizer {
     /// `frame`; where the ones that walked now stand is written to the world (all at once: no
     /// character sees another's move of this step).
     fn step_characters(&mut self, now: f64, frame: &mut Frame) {
-        for m in self.characters.values_mut() {
-            m.advance(now, &self.world, frame);
-            m.move_feedback(&mut self.unframed);
+        let world = &self.world;
+        let step = |m: &mut BlockManager| {
+            let mut own = Frame {
+                time: frame.time,
+                ..Frame::default()
+            };
+            let mut feedback = Vec::new();
+            m.advance(now, world, &mut own);
+            m.move_feedback(&mut feedback);
+            (own, feedback)
+        };
+        let mut managers: Vec<&mut BlockManager> = self.characters.values_mut().collect();
+        // each character reads only the shared world: they are stepped on all cores and their
+        // output is merged in id order, exactly as one thread would produce it
+        let parts: Vec<(Frame, Vec<Feedback>)> =
+            if self.parallel && managers.len() >= PARALLEL_CHARACTERS {
+                use rayon::prelude::*;
+                managers.par_iter_mut().map(|m| step(m)).collect()
+            } else {
+                managers.iter_mut().map(|m| step(m)).collect()
+            };
+        for (own, feedback) in parts {
+            frame.outputs.extend(own.outputs);
+            frame.poses.extend(own.poses);
+            frame.feedback.extend(own.feedback);
+            self.unframed.extend(feedback);
         }
         let moved: Vec<(&str, crate::world::Placement)> = (self.characters.iter())
             .map(|(id, m)| (id.as_str(), m.placement()))
@@ -466,6 +495,12 @@ impl Realizer {
                 let _ = world.place(id, at);
             }
         }
+    }
+
+    /// Whether characters are stepped on several threads when there are at least
+    /// [`PARALLEL_CHARACTERS`] of them (the default; the output is the same either way).
+    pub fn set_parallel(&mut self, on: bool) {
+        self.parallel = on;
     }
 
     /// Whether someone walks among others (the crowd is then kept on its grid).

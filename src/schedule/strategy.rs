@@ -7,7 +7,7 @@ use crate::feedback::KnownWarning;
 use crate::timing::TimingModels;
 
 /// A way of turning a block into sync times; strategies plug in from outside the core.
-pub trait SchedulingStrategy {
+pub trait SchedulingStrategy: Send {
     /// A short name for logs and benches.
     fn name(&self) -> &'static str;
 
