@@ -196,4 +196,3 @@ criterion_group! {
     targets = thousand
 }
 criterion_main!(benches, big);
-criterion_main!(benches);
