@@ -168,7 +168,11 @@ fn thousand(c: &mut Criterion) {
         *r.world_mut() = world;
         for i in 0..cols * rows {
             let z = (i / cols) as f32 * 1.5;
-            let x = if (i / cols) % 2 == 0 { 100_000.0 } else { -100_000.0 };
+            let x = if (i / cols) % 2 == 0 {
+                100_000.0
+            } else {
+                -100_000.0
+            };
             r.perform_bml(&format!(
                 r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b" characterId="c{i}"><locomotion id="w" target="{x},{z}"/></bml>"#
             ))
@@ -180,12 +184,15 @@ fn thousand(c: &mut Criterion) {
             r.tick(t);
         }
         let name = if parallel { "all cores" } else { "one thread" };
-        c.bench_function(&format!("tick: 1000 characters walking (60 Hz), {name}"), |b| {
-            b.iter(|| {
-                t += 1.0 / 60.0;
-                black_box(r.tick(t))
-            })
-        });
+        c.bench_function(
+            &format!("tick: 1000 characters walking (60 Hz), {name}"),
+            |b| {
+                b.iter(|| {
+                    t += 1.0 / 60.0;
+                    black_box(r.tick(t))
+                })
+            },
+        );
     }
 }
 

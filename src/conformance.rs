@@ -74,7 +74,9 @@ impl InProcess {
                     p.global_time += end_delay;
                 }
             }
-            sink.lock().unwrap_or_else(|e| e.into_inner()).push(Format::Xml.encode(&fb));
+            sink.lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(Format::Xml.encode(&fb));
         }));
         r
     }

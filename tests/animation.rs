@@ -263,7 +263,8 @@ fn a_gaze_at_a_target_the_world_lacks_is_refused_with_a_warning() {
     }));
     r.perform_bml(&gaze_block("b", "nowhere", "")).unwrap();
     let warnings: Vec<String> = log
-        .lock().unwrap()
+        .lock()
+        .unwrap()
         .iter()
         .filter_map(|f| match f {
             Feedback::Warning(w) => Some(format!("{} {} {}", w.id, w.kind.as_str(), w.text)),
@@ -436,7 +437,8 @@ fn a_beat_hits_its_bound_keys_at_its_syncs_and_the_left_hand_mirrors_them() {
         .unwrap();
         // the scheduled sync times, from the PENDING prediction
         let predicted: Vec<(String, f64)> = log
-            .lock().unwrap()
+            .lock()
+            .unwrap()
             .iter()
             .find_map(|f| match f {
                 Feedback::Prediction(p) if !p.behaviours.is_empty() => Some(

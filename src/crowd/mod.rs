@@ -15,6 +15,7 @@
 pub mod avoid;
 pub mod contact;
 pub mod profile;
+pub mod sim;
 pub mod snapshot;
 
 pub use avoid::Avoider;

@@ -71,6 +71,29 @@ impl Crowd {
         }
     }
 
+    /// The crowd of `agents` without names (agent `i` is index `i`; [`Crowd::index`] finds
+    /// none), for simulations of roots only.
+    pub fn unnamed(time: f64, mut agents: Vec<Agent>) -> Crowd {
+        agents.truncate(MAX_AGENTS);
+        for a in &mut agents {
+            if !(a.at.is_finite() && a.velocity.is_finite()) {
+                // kept in place so that indices stay the agents' own; far away, still
+                a.at = Vec2::splat(1e9);
+                a.velocity = Vec2::ZERO;
+            }
+        }
+        let mut cells: Vec<(u64, u32)> = (agents.iter().enumerate())
+            .map(|(i, a)| (key(cell_of(a.at)), i as u32))
+            .collect();
+        cells.sort_unstable();
+        Crowd {
+            time,
+            ids: Vec::new(),
+            agents,
+            cells,
+        }
+    }
+
     /// How many characters it holds.
     pub fn len(&self) -> usize {
         self.agents.len()
@@ -93,7 +116,7 @@ impl Crowd {
 
     /// The id of character `i`.
     pub fn id(&self, i: usize) -> &str {
-        &self.ids[i]
+        self.ids.get(i).map_or("", String::as_str)
     }
 
     /// Every character, in id order.

@@ -1,0 +1,239 @@
+//! A crowd of roots only: discs that walk to their goals choosing their velocities among each
+//! other exactly as the realizer's walkers do ([`Avoider`], the same push-out), without bodies,
+//! routes or obstacles. It serves where whole bodies would cost too much (ten thousand people
+//! at 30 Hz) and as the avoidance layer measured on its own, beside other algorithms, in
+//! `benches/crowd.rs` and `examples/crowd_quality.rs`. A step reads one snapshot of everyone
+//! and moves everyone from it, on all cores, in a fixed order: the result is the same on any
+//! number of threads.
+
+use glam::Vec2;
+use rayon::prelude::*;
+
+use super::{Agent, Avoider, Crowd, Profile};
+
+/// How often each mover chooses its velocity (s), staggered over the movers.
+pub const DECIDE_PERIOD: f64 = 0.1;
+/// Most a mover's velocity changes in a second (m/s²), as a walker's steering allows.
+pub const MAX_ACCELERATION: f32 = 2.0;
+/// Within this of its goal a mover slows linearly (m).
+pub const SLOW_RADIUS: f32 = 1.0;
+/// Within this of its goal a mover has arrived (m).
+pub const ARRIVED: f32 = 0.05;
+/// Kept between bodies beyond their radii by the push-out (m), as for walkers.
+pub const MARGIN: f32 = 0.04;
+/// Fastest a mover is pushed out of another (m/s).
+pub const PUSH_SPEED: f32 = 1.0;
+/// How far a mover looks for others (m).
+pub const NEIGHBOUR_RADIUS: f32 = 8.0;
+/// Fewest movers stepped on several threads.
+const PARALLEL_MOVERS: usize = 64;
+
+/// One disc walking to its goal.
+#[derive(Debug, Clone)]
+pub struct Mover {
+    /// Where it is (x, z).
+    pub at: Vec2,
+    /// Its velocity.
+    pub velocity: Vec2,
+    /// Where it goes.
+    pub goal: Vec2,
+    /// Its radius (m).
+    pub radius: f32,
+    /// Its preferred speed (m/s).
+    pub speed: f32,
+    /// When it arrived.
+    pub arrived: Option<f64>,
+    avoider: Avoider,
+    chosen: Option<Vec2>,
+}
+
+impl Mover {
+    /// A mover standing at `at`, going to `goal`.
+    pub fn new(at: Vec2, goal: Vec2, radius: f32, speed: f32) -> Mover {
+        let seed = 0x5eed ^ (u64::from(at.x.to_bits()) << 20) ^ u64::from(at.y.to_bits());
+        Mover {
+            at,
+            velocity: Vec2::ZERO,
+            goal,
+            radius,
+            speed,
+            arrived: None,
+            avoider: Avoider::new(seed),
+            chosen: None,
+        }
+    }
+
+    /// The velocity it wants: toward its goal, slowing in the last [`SLOW_RADIUS`].
+    pub fn desired(&self) -> Vec2 {
+        if self.arrived.is_some() {
+            return Vec2::ZERO;
+        }
+        let d = self.goal - self.at;
+        let l = d.length();
+        if l < 1e-6 {
+            return Vec2::ZERO;
+        }
+        d / l * self.speed * (l / SLOW_RADIUS).min(1.0)
+    }
+
+    fn agent(&self) -> Agent {
+        Agent {
+            at: self.at,
+            velocity: self.velocity,
+            radius: self.radius,
+        }
+    }
+}
+
+/// Many movers stepped together.
+#[derive(Debug, Clone)]
+pub struct Sim {
+    /// The time (s).
+    pub time: f64,
+    /// Everyone, in a fixed order.
+    pub movers: Vec<Mover>,
+    /// How everyone avoids others.
+    pub profile: Profile,
+    steps: u64,
+}
+
+impl Sim {
+    /// The movers at time 0, with the default profile.
+    pub fn new(movers: Vec<Mover>) -> Sim {
+        Sim {
+            time: 0.0,
+            movers,
+            profile: Profile::default(),
+            steps: 0,
+        }
+    }
+
+    /// Whether everyone has arrived.
+    pub fn all_arrived(&self) -> bool {
+        self.movers.iter().all(|m| m.arrived.is_some())
+    }
+
+    /// Moves everyone on by `dt` seconds, each choosing from where all were before the step.
+    pub fn step(&mut self, dt: f32) {
+        let crowd = Crowd::unnamed(self.time, self.movers.iter().map(Mover::agent).collect());
+        let every = ((DECIDE_PERIOD / f64::from(dt)).round() as u64).max(1);
+        let (steps, profile, time) = (self.steps, self.profile, self.time);
+        let one = |(i, m): (usize, &mut Mover)| {
+            let decide = (steps + i as u64).is_multiple_of(every);
+            step_one(m, i, &crowd, &profile, decide, every as f32 * dt, dt, time);
+        };
+        if self.movers.len() >= PARALLEL_MOVERS {
+            self.movers.par_iter_mut().enumerate().for_each(one);
+        } else {
+            self.movers.iter_mut().enumerate().for_each(one);
+        }
+        self.steps += 1;
+        self.time += f64::from(dt);
+    }
+}
+
+/// One mover's step from the snapshot `crowd` (where it is index `me`).
+#[allow(clippy::too_many_arguments)] // the step's inputs, each a number or a shared snapshot
+fn step_one(
+    m: &mut Mover,
+    me: usize,
+    crowd: &Crowd,
+    profile: &Profile,
+    decide: bool,
+    period: f32,
+    dt: f32,
+    time: f64,
+) {
+    let desired = m.desired();
+    let mut near = Vec::new();
+    crowd.near(m.at, NEIGHBOUR_RADIUS, &mut near);
+    let others = near.iter().filter(|&&i| i != me).map(|&i| crowd.agent(i));
+    if decide && m.arrived.is_none() {
+        let held = m.velocity.length() < 0.5 * m.speed;
+        m.avoider.wait(period, held);
+        let heading = if m.velocity.length() > 0.05 {
+            m.velocity.x.atan2(m.velocity.y)
+        } else {
+            let d = m.goal - m.at;
+            d.x.atan2(d.y)
+        };
+        let v = (m.avoider).choose(
+            m.agent(),
+            desired,
+            m.velocity,
+            heading,
+            m.speed,
+            others.clone(),
+            profile,
+        );
+        m.chosen = m.avoider.avoiding.then_some(v);
+    }
+    let target = m.chosen.filter(|_| m.arrived.is_none()).unwrap_or(desired);
+    m.velocity += (target - m.velocity).clamp_length_max(MAX_ACCELERATION * dt);
+    let mut at = m.at + m.velocity * dt;
+    let mut push = Vec2::ZERO;
+    for o in others {
+        let d = at - o.at;
+        let reach = m.radius + o.radius + MARGIN;
+        let l = d.length();
+        if l < reach && l < NEIGHBOUR_RADIUS {
+            push += if l > 1e-6 { d / l } else { Vec2::X } * (reach - l);
+        }
+    }
+    at += push.clamp_length_max(PUSH_SPEED * dt);
+    m.at = at;
+    if m.arrived.is_none() && m.at.distance(m.goal) < ARRIVED {
+        m.arrived = Some(time + f64::from(dt));
+        m.velocity = Vec2::ZERO;
+        m.chosen = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pair_head_on_passes_and_arrives_and_threads_change_nothing() {
+        let pair = || {
+            Sim::new(vec![
+                Mover::new(Vec2::new(0.0, -5.0), Vec2::new(0.0, 5.0), 0.25, 1.3),
+                Mover::new(Vec2::new(0.0, 5.0), Vec2::new(0.0, -5.0), 0.25, 1.3),
+            ])
+        };
+        let mut s = pair();
+        let mut closest = f32::INFINITY;
+        while !s.all_arrived() && s.time < 30.0 {
+            s.step(1.0 / 30.0);
+            closest = closest.min(s.movers[0].at.distance(s.movers[1].at));
+        }
+        assert!(s.all_arrived(), "{:?}", s.movers);
+        assert!(closest > 0.5, "{closest}");
+        // a crowd big enough for threads gives what one thread gives
+        let many = |n: usize| {
+            let mut movers = Vec::new();
+            for k in 0..n {
+                let a = std::f32::consts::TAU * k as f32 / n as f32;
+                let p = Vec2::new(a.sin(), a.cos()) * 12.0;
+                movers.push(Mover::new(p, -p, 0.25, 1.3));
+            }
+            Sim::new(movers)
+        };
+        let (mut a, mut b) = (many(80), many(80));
+        for _ in 0..60 {
+            a.step(1.0 / 30.0);
+        }
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            for _ in 0..60 {
+                b.step(1.0 / 30.0);
+            }
+        });
+        for (x, y) in a.movers.iter().zip(&b.movers) {
+            assert_eq!(x.at, y.at);
+        }
+    }
+}
