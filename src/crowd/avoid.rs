@@ -127,7 +127,29 @@ impl Avoider {
         let n = (span / HEADING_STEP).floor() as i32;
         // desired first, then right (clockwise seen from above: decreasing angle), then left
         let offsets = std::iter::once(0).chain((1..=n).map(|k| -k)).chain(1..=n);
+        let side_of = |v: Vec2| {
+            let dev = crate::body::limits::wrap(v.x.atan2(v.y) - base);
+            if v.length() > 0.05 && dev.abs() > HEADING_STEP * 0.5 {
+                dev.signum() as i8
+            } else {
+                0
+            }
+        };
+        let extra = |side: i8, chosen: i8| {
+            let flip = if side != 0 && chosen != 0 && side != chosen {
+                p.keep_side
+            } else {
+                0.0
+            };
+            flip + if side > 0 { RIGHT_BIAS } else { 0.0 }
+        };
+        // going on as it goes is a candidate too, visited first: the samples are jittered, and
+        // without it a walker would wobble from one near-equal sample to the next
         let mut best = (f32::INFINITY, desired);
+        if previous.length() > 0.05 {
+            let cost = self.cost(me, previous, desired, previous, pref, p);
+            best = (cost + extra(side_of(previous), self.side), previous);
+        }
         let wanted_speed = desired.length();
         for k in offsets {
             let side = k.signum() as i8;
@@ -145,13 +167,7 @@ impl Avoider {
                     base + k as f32 * HEADING_STEP * (1.0 + self.jitter() * p.distortion)
                 };
                 let v = Vec2::new(angle.sin(), angle.cos()) * speed;
-                let mut cost = self.cost(me, v, desired, previous, pref, p);
-                if side != 0 && self.side != 0 && side != self.side {
-                    cost += p.keep_side;
-                }
-                if side > 0 {
-                    cost += RIGHT_BIAS;
-                }
+                let cost = self.cost(me, v, desired, previous, pref, p) + extra(side, self.side);
                 if cost < best.0 {
                     best = (cost, v);
                 }

@@ -15,6 +15,8 @@
 pub mod avoid;
 pub mod contact;
 pub mod profile;
+pub mod quality;
+pub mod scenes;
 pub mod sim;
 pub mod snapshot;
 

@@ -95,6 +95,7 @@ pub struct Sim {
     /// How everyone avoids others.
     pub profile: Profile,
     steps: u64,
+    decide_all: bool,
 }
 
 impl Sim {
@@ -105,7 +106,14 @@ impl Sim {
             movers,
             profile: Profile::default(),
             steps: 0,
+            decide_all: false,
         }
+    }
+
+    /// Makes every mover choose its velocity in the next step (not only its share of them),
+    /// to measure the choice itself.
+    pub fn force_decisions(&mut self) {
+        self.decide_all = true;
     }
 
     /// Whether everyone has arrived.
@@ -117,9 +125,10 @@ impl Sim {
     pub fn step(&mut self, dt: f32) {
         let crowd = Crowd::unnamed(self.time, self.movers.iter().map(Mover::agent).collect());
         let every = ((DECIDE_PERIOD / f64::from(dt)).round() as u64).max(1);
-        let (steps, profile, time) = (self.steps, self.profile, self.time);
+        let (steps, profile, time, all) = (self.steps, self.profile, self.time, self.decide_all);
+        self.decide_all = false;
         let one = |(i, m): (usize, &mut Mover)| {
-            let decide = (steps + i as u64).is_multiple_of(every);
+            let decide = all || (steps + i as u64).is_multiple_of(every);
             step_one(m, i, &crowd, &profile, decide, every as f32 * dt, dt, time);
         };
         if self.movers.len() >= PARALLEL_MOVERS {
