@@ -23,6 +23,8 @@ use super::snapshot::Agent;
 
 /// Spacing of the headings sampled (rad): the 4.5° of Karamouzas and Overmars.
 pub const HEADING_STEP: f32 = 0.078;
+/// Most headings sampled on each side of the desired one.
+pub const MAX_HEADINGS: i32 = 12;
 /// Speeds sampled between the range's ends (besides standing).
 pub const SPEED_SAMPLES: usize = 7;
 /// Most contacts weighed (the soonest; the thesis keeps at least 5).
@@ -124,7 +126,9 @@ impl Avoider {
         };
         // a walker kept waiting looks wider, up to turning about, to find a way round
         let span = span + self.impatience() * (std::f32::consts::PI - span);
-        let n = (span / HEADING_STEP).floor() as i32;
+        // the thesis' 4.5° spacing within ±52°; a wider look keeps as many headings, wider apart
+        let n = ((span / HEADING_STEP).floor() as i32).min(MAX_HEADINGS);
+        let step = span / n.max(1) as f32;
         // desired first, then right (clockwise seen from above: decreasing angle), then left
         let offsets = std::iter::once(0).chain((1..=n).map(|k| -k)).chain(1..=n);
         let side_of = |v: Vec2| {
@@ -147,8 +151,18 @@ impl Avoider {
         // without it a walker would wobble from one near-equal sample to the next
         let mut best = (f32::INFINITY, desired);
         if previous.length() > 0.05 {
-            let cost = self.cost(me, previous, desired, previous, pref, p);
-            best = (cost + extra(side_of(previous), self.side), previous);
+            let e = extra(side_of(previous), self.side);
+            let cost = self.cost(
+                me,
+                (previous, None),
+                desired,
+                previous,
+                pref,
+                p,
+                e,
+                f32::INFINITY,
+            );
+            best = (cost, previous);
         }
         let wanted_speed = desired.length();
         for k in offsets {
@@ -161,13 +175,20 @@ impl Avoider {
                     let u = (lo + (hi - lo) * f) * pref;
                     (u + self.jitter() * p.distortion * pref / SPEED_SAMPLES as f32).max(0.0)
                 };
-                let angle = if k == 0 {
-                    base
+                let turn = if k == 0 {
+                    0.0
                 } else {
-                    base + k as f32 * HEADING_STEP * (1.0 + self.jitter() * p.distortion)
+                    k as f32 * step * (1.0 + self.jitter() * p.distortion)
                 };
-                let v = Vec2::new(angle.sin(), angle.cos()) * speed;
-                let cost = self.cost(me, v, desired, previous, pref, p) + extra(side, self.side);
+                let v = Vec2::new((base + turn).sin(), (base + turn).cos()) * speed;
+                // measured from the desired heading (none when standing is desired)
+                let angle = if speed > 1e-3 && desired.length() > 1e-3 {
+                    Some(turn)
+                } else {
+                    Some(0.0)
+                };
+                let e = extra(side, self.side);
+                let cost = self.cost(me, (v, angle), desired, previous, pref, p, e, best.0);
                 if cost < best.0 {
                     best = (cost, v);
                 }
@@ -210,28 +231,48 @@ impl Avoider {
         self.contacts.truncate(MAX_CONTACTS);
     }
 
-    fn cost(&self, me: Agent, v: Vec2, desired: Vec2, previous: Vec2, u: f32, p: &Profile) -> f32 {
+    /// The cost of candidate `v` plus `extra`; past `bound` the contacts are not weighed
+    /// (they only add: such a candidate cannot win, and most candidates are cut here).
+    /// `angle` is its angle from `desired` when the caller knows it.
+    #[allow(clippy::too_many_arguments)] // the cost's inputs, each a number or a vector
+    fn cost(
+        &self,
+        me: Agent,
+        (v, angle): (Vec2, Option<f32>),
+        desired: Vec2,
+        previous: Vec2,
+        u: f32,
+        p: &Profile,
+        extra: f32,
+        bound: f32,
+    ) -> f32 {
         let effort = p.alpha * (v - previous).length() / (2.0 * u)
             + p.beta * (v.length() - previous.length()).abs() / u;
-        let angle = if v.length() > 1e-3 && desired.length() > 1e-3 {
-            v.angle_to(desired).abs()
-        } else {
-            0.0
+        let angle = match angle {
+            Some(a) => a.abs(),
+            None if v.length() > 1e-3 && desired.length() > 1e-3 => v.angle_to(desired).abs(),
+            None => 0.0,
         };
         let slower = (desired.length() - v.length()).max(0.0) / u;
         let hurry = self.impatience();
         let deviation =
             p.gamma * (angle / std::f32::consts::PI + 0.5 * (1.0 + 2.0 * hurry) * slower);
+        let cheap = effort + deviation + extra;
+        if cheap >= bound {
+            return cheap;
+        }
         let (mut soonest, mut touch) = (p.tc_max, f32::INFINITY);
         for &(_, o) in &self.contacts {
             let dx = o.at - me.at;
             let dv = o.velocity - v;
             let reach = (me.radius + o.radius) * p.incr;
+            // the bodies' reach is within the personal one: no personal contact, no touch
             if let Some(t) = time_to_contact(dx, dv, reach) {
                 soonest = soonest.min(t);
-            }
-            if let Some(t) = time_to_contact(dx, dv, me.radius + o.radius + BODY_MARGIN) {
-                touch = touch.min(t);
+                let body = (me.radius + o.radius + BODY_MARGIN).min(reach);
+                if let Some(t) = time_to_contact(dx, dv, body) {
+                    touch = touch.min(t);
+                }
             }
         }
         let risk = p.delta * (1.0 - 0.75 * hurry) * (1.0 - soonest / p.tc_max);
@@ -240,7 +281,7 @@ impl Avoider {
         } else {
             0.0
         };
-        effort + deviation + risk + bodies
+        cheap + risk + bodies
     }
 }
 

@@ -29,6 +29,25 @@ pub fn time_to_contact(dx: Vec2, dv: Vec2, reach: f32) -> Option<f32> {
     (t >= 0.0).then_some(t)
 }
 
+/// Overlaps shrink with this time constant (s) when bodies are pushed apart.
+pub const PUSH_TIME: f32 = 0.02;
+/// Slowest bodies are pushed apart (m/s) while they overlap by more than that covers.
+pub const PUSH_SPEED: f32 = 1.0;
+
+/// How far a body that overlaps others by the sum `push` (the direction out times the depth)
+/// moves out in `dt`: a share of the depth that takes it out with time constant
+/// [`PUSH_TIME`], and at least [`PUSH_SPEED`] × `dt` (never past the depth). A shallow overlap
+/// parts gently, a deep one quickly, and nobody jumps in one step however short the step.
+pub fn push_step(push: Vec2, dt: f32) -> Vec2 {
+    let depth = push.length();
+    if depth < 1e-9 {
+        return Vec2::ZERO;
+    }
+    let share = 1.0 - (-dt / PUSH_TIME).exp();
+    let step = (depth * share).max((PUSH_SPEED * dt).min(depth));
+    push / depth * step
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

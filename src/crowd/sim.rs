@@ -21,8 +21,6 @@ pub const SLOW_RADIUS: f32 = 1.0;
 pub const ARRIVED: f32 = 0.05;
 /// Kept between bodies beyond their radii by the push-out (m), as for walkers.
 pub const MARGIN: f32 = 0.04;
-/// Fastest a mover is pushed out of another (m/s).
-pub const PUSH_SPEED: f32 = 1.0;
 /// How far a mover looks for others (m).
 pub const NEIGHBOUR_RADIUS: f32 = 8.0;
 /// Fewest movers stepped on several threads.
@@ -155,9 +153,16 @@ fn step_one(
 ) {
     let desired = m.desired();
     let mut near = Vec::new();
-    crowd.near(m.at, NEIGHBOUR_RADIUS, &mut near);
+    // everyone within sight when choosing, only those it may touch otherwise
+    let decide = decide && m.arrived.is_none();
+    let reach = if decide {
+        NEIGHBOUR_RADIUS
+    } else {
+        2.0 * m.radius + 1.0
+    };
+    crowd.near(m.at, reach, &mut near);
     let others = near.iter().filter(|&&i| i != me).map(|&i| crowd.agent(i));
-    if decide && m.arrived.is_none() {
+    if decide {
         let held = m.velocity.length() < 0.5 * m.speed;
         m.avoider.wait(period, held);
         let heading = if m.velocity.length() > 0.05 {
@@ -189,7 +194,7 @@ fn step_one(
             push += if l > 1e-6 { d / l } else { Vec2::X } * (reach - l);
         }
     }
-    at += push.clamp_length_max(PUSH_SPEED * dt);
+    at += super::contact::push_step(push, dt);
     m.at = at;
     if m.arrived.is_none() && m.at.distance(m.goal) < ARRIVED {
         m.arrived = Some(time + f64::from(dt));

@@ -497,8 +497,6 @@ pub const PEOPLE_MARGIN: f32 = 0.04;
 pub const WATCH_EVERY: i64 = 6;
 /// A course that touches someone sooner than this (s) is chosen again at once.
 pub const URGENT_HORIZON: f32 = 0.4;
-/// Fastest a walker is pushed out of others it overlaps (m/s).
-pub const PUSH_SPEED: f32 = 1.0;
 /// How far a walker looks for others (m).
 pub const NEIGHBOUR_RADIUS: f32 = 8.0;
 
@@ -582,9 +580,9 @@ fn neighbours(o: Others<'_>, time: f64, here: Vec2, r: f32) -> Vec<Agent> {
         .collect()
 }
 
-/// `here` moved out of the other bodies it overlaps, by the sum of the overlaps but at most
-/// [`PUSH_SPEED`] × `dt`: bodies part over a few steps rather than jump (in a press of people
-/// moving out of one body at once may lead into the next, and they shove back).
+/// `here` moved out of the other bodies it overlaps, by the sum of the overlaps, over a few
+/// steps rather than at once (`crowd::contact::push_step`: in a press of people moving out
+/// of one body at once may lead into the next, and they shove back).
 fn push_out_of_people(o: Others<'_>, time: f64, here: Vec2, radius: f32, dt: f32) -> Vec2 {
     let mut push = Vec2::ZERO;
     for other in neighbours(o, time, here, radius + 1.0) {
@@ -596,7 +594,7 @@ fn push_out_of_people(o: Others<'_>, time: f64, here: Vec2, radius: f32, dt: f32
             push += away * (reach - l);
         }
     }
-    here + push.clamp_length_max(PUSH_SPEED * dt)
+    here + crate::crowd::contact::push_step(push, dt)
 }
 
 impl Active {

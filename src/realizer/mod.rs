@@ -438,9 +438,9 @@ impl Realizer {
 /// Fewest characters stepped in parallel (below it, threads cost more than they save).
 pub const PARALLEL_CHARACTERS: usize = 4;
 
-/// How often walkers among others see where the others are (s): every 0.1 s of global time,
+/// How often walkers among others see where the others are (s): every 0.05 s of global time,
 /// on a grid of its multiples, so that no result depends on the host's frames.
-pub const CROWD_PERIOD: f64 = 0.1;
+pub const CROWD_PERIOD: f64 = 0.05;
 
 /// The index of the crowd grid time at or before `t` (a time within a millionth of a period
 /// of a grid time counts as on it: `k * 0.1 / 0.1` may fall just short of `k`).
