@@ -6,7 +6,7 @@
 //! realizer's normalised form, with u the preferred speed):
 //!
 //! ```text
-//! α‖v − v_prev‖/2u  +  β·| |v| − |v_prev| |/u  +  γ·(angle(v, v_des)/π + ½·max(0, |v_des| − |v|)/u)
+//! α‖v − v_prev‖/2u  +  β·| |v| − |v_prev| |/u  +  γ·(angle(v, v_des)/π + ½·| |v_des| − |v| |/u)
 //!   +  δ·(1 − min(tc(v), tcMax)/tcMax)  +  keepSide (turning to the side not chosen)
 //!   +  a small cost on the left (people keep right)  +  a prohibitive cost for bodies touching
 //!      within half a second
@@ -255,8 +255,10 @@ impl Avoider {
         };
         let slower = (desired.length() - v.length()).max(0.0) / u;
         let hurry = self.impatience();
-        let deviation =
-            p.gamma * (angle / std::f32::consts::PI + 0.5 * (1.0 + 2.0 * hurry) * slower);
+        // faster than desired costs as much as slower (arriving, the desired speed falls)
+        let faster = (v.length() - desired.length()).max(0.0) / u;
+        let deviation = p.gamma
+            * (angle / std::f32::consts::PI + 0.5 * ((1.0 + 2.0 * hurry) * slower + faster));
         let cheap = effort + deviation + extra;
         if cheap >= bound {
             return cheap;
