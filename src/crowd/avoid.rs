@@ -12,8 +12,8 @@
 //!      within half a second
 //! ```
 //!
-//! Candidates are visited desired first, then to the right from the centre out, then to the
-//! left; a later one must be strictly cheaper.
+//! Candidates are visited going on as it goes first, then desired, then to the right from the
+//! centre out, then to the left; a later one must be strictly cheaper.
 
 use glam::Vec2;
 
