@@ -23,6 +23,9 @@ use super::snapshot::Agent;
 
 /// Spacing of the headings sampled (rad): the 4.5° of Karamouzas and Overmars.
 pub const HEADING_STEP: f32 = 0.078;
+/// The widest an impatient walker looks to either side (rad): square to its way, a sidestep,
+/// never turning about (walkers that turned about went round the whole crowd).
+pub const WIDEST: f32 = std::f32::consts::FRAC_PI_2;
 /// Most headings sampled on each side of the desired one.
 pub const MAX_HEADINGS: i32 = 12;
 /// Speeds sampled between the range's ends (besides standing).
@@ -125,7 +128,7 @@ impl Avoider {
             heading
         };
         // a walker kept waiting looks wider, up to turning about, to find a way round
-        let span = span + self.impatience() * (std::f32::consts::PI - span);
+        let span = span + self.impatience() * (WIDEST - span).max(0.0);
         // the thesis' 4.5° spacing within ±52°; a wider look keeps as many headings, wider apart
         let n = ((span / HEADING_STEP).floor() as i32).min(MAX_HEADINGS);
         let step = span / n.max(1) as f32;
