@@ -24,11 +24,14 @@ fn lattice(n: usize) -> Vec<(Vec2, Vec2)> {
         .collect()
 }
 
-fn ours(n: usize) -> Sim {
-    let movers = (lattice(n).into_iter())
+fn movers(n: usize) -> Vec<Mover> {
+    (lattice(n).into_iter())
         .map(|(a, b)| Mover::new(a, b, 0.25, 1.3))
-        .collect();
-    let mut s = Sim::new(movers);
+        .collect()
+}
+
+fn ours(n: usize) -> Sim {
+    let mut s = Sim::new(movers(n));
     for _ in 0..90 {
         s.step(1.0 / 30.0);
     }
@@ -36,17 +39,7 @@ fn ours(n: usize) -> Sim {
 }
 
 fn theirs(n: usize) -> orca::Orca {
-    let agents = (lattice(n).into_iter())
-        .map(|(at, goal)| orca::OrcaAgent {
-            at,
-            velocity: Vec2::ZERO,
-            goal,
-            radius: 0.25,
-            speed: 1.3,
-            arrived: None,
-        })
-        .collect();
-    let mut s = orca::Orca::new(agents);
+    let mut s = orca::Orca::new(movers(n));
     for _ in 0..90 {
         s.step(1.0 / 30.0);
     }

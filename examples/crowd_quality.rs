@@ -10,67 +10,75 @@ mod orca;
 use bml_realizer::crowd::quality::{measure, Quality, Track};
 use bml_realizer::crowd::scenes::{self, Walk};
 use bml_realizer::crowd::sim::{Mover, Sim};
-use glam::Vec2;
 
 const DT: f32 = 1.0 / 30.0;
 const LIMIT: f64 = 120.0;
 
-fn tracks(walks: &[Walk]) -> Vec<Track> {
+/// A crowd of movers that steps as a whole.
+trait Stepped {
+    fn step(&mut self, dt: f32);
+    fn time(&self) -> f64;
+    fn movers(&self) -> &[Mover];
+}
+
+impl Stepped for Sim {
+    fn step(&mut self, dt: f32) {
+        Sim::step(self, dt)
+    }
+    fn time(&self) -> f64 {
+        self.time
+    }
+    fn movers(&self) -> &[Mover] {
+        &self.movers
+    }
+}
+
+impl Stepped for orca::Orca {
+    fn step(&mut self, dt: f32) {
+        orca::Orca::step(self, dt)
+    }
+    fn time(&self) -> f64 {
+        self.time
+    }
+    fn movers(&self) -> &[Mover] {
+        &self.movers
+    }
+}
+
+fn movers(walks: &[Walk]) -> Vec<Mover> {
     (walks.iter())
-        .map(|w| Track {
-            at: vec![w.from],
-            goal: w.to,
-            speed: w.speed,
-            radius: 0.25,
-            arrived: None,
-        })
+        .map(|w| Mover::new(w.from, w.to, 0.25, w.speed))
         .collect()
 }
 
-fn ours(walks: &[Walk]) -> Quality {
-    let movers = (walks.iter())
-        .map(|w| Mover::new(w.from, w.to, 0.25, w.speed))
+/// Steps `crowd` until everyone has arrived or [`LIMIT`], recording everyone's track.
+fn walk(mut crowd: impl Stepped) -> Quality {
+    let mut tracks: Vec<Track> = (crowd.movers().iter())
+        .map(|m| Track {
+            at: vec![m.at],
+            goal: m.goal,
+            speed: m.speed,
+            radius: m.radius,
+            arrived: None,
+        })
         .collect();
-    let mut s = Sim::new(movers);
-    let mut t = tracks(walks);
-    while !s.all_arrived() && s.time < LIMIT {
-        s.step(DT);
-        for (t, m) in t.iter_mut().zip(&s.movers) {
+    while crowd.movers().iter().any(|m| m.arrived.is_none()) && crowd.time() < LIMIT {
+        crowd.step(DT);
+        for (t, m) in tracks.iter_mut().zip(crowd.movers()) {
             t.at.push(m.at);
             t.arrived = m.arrived;
         }
     }
-    measure(&t, DT)
-}
-
-fn orca(walks: &[Walk]) -> Quality {
-    let agents = (walks.iter())
-        .map(|w| orca::OrcaAgent {
-            at: w.from,
-            velocity: Vec2::ZERO,
-            goal: w.to,
-            radius: 0.25,
-            speed: w.speed,
-            arrived: None,
-        })
-        .collect();
-    let mut s = orca::Orca::new(agents);
-    let mut t = tracks(walks);
-    while !s.all_arrived() && s.time < LIMIT {
-        s.step(DT);
-        for (t, a) in t.iter_mut().zip(&s.agents) {
-            t.at.push(a.at);
-            t.arrived = a.arrived;
-        }
-    }
-    measure(&t, DT)
+    measure(&tracks, DT)
 }
 
 fn main() {
     println!("| scene | who | collisions (pairs) | deepest (cm) | stranded | time / straight (mean, worst) | path / straight | energy / least | heading reversals |");
     println!("|---|---|---|---|---|---|---|---|---|");
     for (name, walks) in scenes::all() {
-        for (who, q) in [("realizer", ours(&walks)), ("ORCA", orca(&walks))] {
+        let ours = walk(Sim::new(movers(&walks)));
+        let theirs = walk(orca::Orca::new(movers(&walks)));
+        for (who, q) in [("realizer", ours), ("ORCA", theirs)] {
             println!(
                 "| {name} ({}) | {who} | {} | {:.1} | {} | {:.2}, {:.2} | {:.3} | {:.3} | {:.2} |",
                 walks.len(),

@@ -34,6 +34,7 @@ pub mod feedback;
 pub mod locomotion;
 pub mod plan;
 pub mod realizer;
+pub mod rng;
 pub mod schedule;
 pub mod sound;
 #[cfg(test)]

@@ -66,10 +66,10 @@ fn realize(walkers: &[Walker], seconds: f64, fps: f64) -> Crowd {
 
 /// Realizes the scene with characters stepped in parallel or not; also gives every frame
 /// (poses and feedback) as text.
-fn realize_with(walkers: &[Walker], seconds: f64, fps: f64, parallel: bool) -> (Crowd, String) {
+/// A realizer with the walkers placed and their walks sent.
+fn prepared(walkers: &[Walker], parallel: bool) -> Realizer {
     let mut r = Realizer::new();
     r.set_parallel(parallel);
-    let mut text = String::new();
     *r.world_mut() = World::from_json(&world_json(walkers)).expect("a world").0;
     for (k, w) in walkers.iter().enumerate() {
         let bml = format!(
@@ -80,6 +80,17 @@ fn realize_with(walkers: &[Walker], seconds: f64, fps: f64, parallel: bool) -> (
         );
         let _ = r.perform_bml(&bml);
     }
+    r
+}
+
+fn realize_with(walkers: &[Walker], seconds: f64, fps: f64, parallel: bool) -> (Crowd, String) {
+    ticked(prepared(walkers, parallel), walkers.len(), seconds, fps)
+}
+
+/// Ticks `r` for `seconds` at `fps`: where its `n` walkers stood, the feedback, and every frame
+/// (poses and feedback) as text.
+fn ticked(mut r: Realizer, n: usize, seconds: f64, fps: f64) -> (Crowd, String) {
+    let mut text = String::new();
     let mut crowd = Crowd {
         tracks: BTreeMap::new(),
         feedback: Vec::new(),
@@ -88,7 +99,7 @@ fn realize_with(walkers: &[Walker], seconds: f64, fps: f64, parallel: bool) -> (
         let f = r.tick(f64::from(i) / fps);
         text += &format!("{:?}\n", f.poses);
         crowd.feedback.extend(f.feedback);
-        for k in 0..walkers.len() {
+        for k in 0..n {
             let at = r.world().placement(&id(k)).position;
             (crowd.tracks.entry(id(k)).or_default()).push(Vec2::new(at.x, at.z));
         }
@@ -264,9 +275,23 @@ fn characters_stepped_in_parallel_give_exactly_what_one_thread_gives() {
 }
 
 #[test]
-fn a_realizer_may_be_owned_by_any_thread() {
-    fn send<T: Send>() {}
-    send::<Realizer>();
+fn a_realizer_made_on_one_thread_runs_on_another_exactly_as_at_home() {
+    let walkers = [
+        walker((0.0, -5.0), (0.0, 5.0)),
+        walker((0.0, 5.0), (0.0, -5.0)),
+    ];
+    let (home, expected) = realize_with(&walkers, 14.0, 30.0, true);
+    let r = prepared(&walkers, true);
+    let (away, got) = std::thread::spawn(move || ticked(r, 2, 14.0, 30.0))
+        .join()
+        .unwrap();
+    assert!(got == expected, "the run on another thread differs");
+    // and it did walk there: both ended, at their goals
+    for (k, w) in walkers.iter().enumerate() {
+        assert!(away.end(&format!("b{k}")).is_some());
+        assert!(away.last(&id(k)).distance(w.to) < 0.1);
+    }
+    assert_eq!(home.end("b0"), away.end("b0"));
 }
 
 #[test]

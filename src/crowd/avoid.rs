@@ -20,6 +20,7 @@ use glam::Vec2;
 use super::contact::time_to_contact;
 use super::profile::Profile;
 use super::snapshot::Agent;
+use crate::rng::Rng;
 
 /// Spacing of the headings sampled (rad): the 4.5° of Karamouzas and Overmars.
 pub const HEADING_STEP: f32 = 0.078;
@@ -41,6 +42,10 @@ pub const BODY_MARGIN: f32 = 0.05;
 pub const RIGHT_BIAS: f32 = 0.05;
 /// How long a walker held below half its preferred speed waits before it is fully impatient (s).
 pub const PATIENCE: f32 = 3.0;
+/// How often a walker chooses its velocity among others (s).
+pub const DECIDE_PERIOD: f64 = 0.1;
+/// How far a walker looks for others (m).
+pub const NEIGHBOUR_RADIUS: f32 = 8.0;
 
 /// One walker's avoidance state: the side it chose, its last velocity, its random jitter.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,7 +56,7 @@ pub struct Avoider {
     pub avoiding: bool,
     /// How long it has been held back (s), up to [`PATIENCE`].
     waited: f32,
-    rng: u64,
+    rng: Rng,
     contacts: Vec<(f32, Agent)>,
 }
 
@@ -62,14 +67,20 @@ impl Avoider {
             side: 0,
             avoiding: false,
             waited: 0.0,
-            rng: seed | 1,
+            rng: Rng(seed),
             contacts: Vec::new(),
         }
     }
 
-    /// Counts `dt` seconds of being held back (moving at under half the preferred speed while
-    /// avoiding) or of walking freely (which calms it twice as fast).
-    pub fn wait(&mut self, dt: f32, held: bool) {
+    /// A walker's state seeded by where it starts (walkers starting apart jitter apart).
+    pub fn starting_at(at: Vec2) -> Avoider {
+        Avoider::new(0x5eed ^ (u64::from(at.x.to_bits()) << 20) ^ u64::from(at.y.to_bits()))
+    }
+
+    /// Counts `dt` seconds of being held back (moving at `speed`, under half the preferred
+    /// speed `pref`, while avoiding) or of walking freely (which calms it twice as fast).
+    pub fn wait(&mut self, dt: f32, speed: f32, pref: f32) {
+        let held = speed < 0.5 * pref;
         self.waited = if held && self.avoiding {
             (self.waited + dt).min(PATIENCE)
         } else {
@@ -85,23 +96,16 @@ impl Avoider {
     }
 
     fn jitter(&mut self) -> f32 {
-        let mut x = self.rng;
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        self.rng = x;
-        (x >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        self.rng.next_f32() - 0.5
     }
 
     /// The velocity `me` takes among `others`, wanting `desired` at preferred speed `pref`
-    /// (m/s), having last moved at `previous`; `heading` is where it looks (rad about +y from
+    /// (m/s), going on from its velocity now; `heading` is where it looks (rad about +y from
     /// +z), for its field of view.
-    #[allow(clippy::too_many_arguments)] // the thesis' inputs, each a number or a vector
     pub fn choose(
         &mut self,
         me: Agent,
         desired: Vec2,
-        previous: Vec2,
         heading: f32,
         pref: f32,
         others: impl Iterator<Item = Agent>,
@@ -153,19 +157,10 @@ impl Avoider {
         // going on as it goes is a candidate too, visited first: the samples are jittered, and
         // without it a walker would wobble from one near-equal sample to the next
         let mut best = (f32::INFINITY, desired);
-        if previous.length() > 0.05 {
-            let e = extra(side_of(previous), self.side);
-            let cost = self.cost(
-                me,
-                (previous, None),
-                desired,
-                previous,
-                pref,
-                p,
-                e,
-                f32::INFINITY,
-            );
-            best = (cost, previous);
+        if me.velocity.length() > 0.05 {
+            let e = extra(side_of(me.velocity), self.side);
+            let cost = self.cost(me, me.velocity, desired, pref, p, f32::INFINITY) + e;
+            best = (cost, me.velocity);
         }
         let wanted_speed = desired.length();
         for k in offsets {
@@ -184,22 +179,16 @@ impl Avoider {
                     k as f32 * step * (1.0 + self.jitter() * p.distortion)
                 };
                 let v = Vec2::new((base + turn).sin(), (base + turn).cos()) * speed;
-                // measured from the desired heading (none when standing is desired)
-                let angle = if speed > 1e-3 && desired.length() > 1e-3 {
-                    Some(turn)
-                } else {
-                    Some(0.0)
-                };
                 let e = extra(side, self.side);
-                let cost = self.cost(me, (v, angle), desired, previous, pref, p, e, best.0);
+                let cost = self.cost(me, v, desired, pref, p, best.0 - e) + e;
                 if cost < best.0 {
                     best = (cost, v);
                 }
             }
         }
-        let dev = crate::body::limits::wrap(best.1.x.atan2(best.1.y) - base);
-        if best.1.length() > 0.05 && dev.abs() > HEADING_STEP * 0.5 {
-            self.side = if dev < 0.0 { -1 } else { 1 };
+        let side = side_of(best.1);
+        if side != 0 {
+            self.side = side;
         }
         best.1
     }
@@ -234,27 +223,17 @@ impl Avoider {
         self.contacts.truncate(MAX_CONTACTS);
     }
 
-    /// The cost of candidate `v` plus `extra`; past `bound` the contacts are not weighed
-    /// (they only add: such a candidate cannot win, and most candidates are cut here).
-    /// `angle` is its angle from `desired` when the caller knows it.
-    #[allow(clippy::too_many_arguments)] // the cost's inputs, each a number or a vector
-    fn cost(
-        &self,
-        me: Agent,
-        (v, angle): (Vec2, Option<f32>),
-        desired: Vec2,
-        previous: Vec2,
-        u: f32,
-        p: &Profile,
-        extra: f32,
-        bound: f32,
-    ) -> f32 {
+    /// The cost of candidate `v` for `me`; infinite when the cost without the contacts already
+    /// reaches `bound` (the contacts only add: such a candidate cannot win, and most
+    /// candidates are cut here before their contacts are weighed).
+    fn cost(&self, me: Agent, v: Vec2, desired: Vec2, u: f32, p: &Profile, bound: f32) -> f32 {
+        let previous = me.velocity;
         let effort = p.alpha * (v - previous).length() / (2.0 * u)
             + p.beta * (v.length() - previous.length()).abs() / u;
-        let angle = match angle {
-            Some(a) => a.abs(),
-            None if v.length() > 1e-3 && desired.length() > 1e-3 => v.angle_to(desired).abs(),
-            None => 0.0,
+        let angle = if v.length() > 1e-3 && desired.length() > 1e-3 {
+            v.angle_to(desired).abs()
+        } else {
+            0.0
         };
         let slower = (desired.length() - v.length()).max(0.0) / u;
         let hurry = self.impatience();
@@ -262,9 +241,9 @@ impl Avoider {
         let faster = (v.length() - desired.length()).max(0.0) / u;
         let deviation = p.gamma
             * (angle / std::f32::consts::PI + 0.5 * ((1.0 + 2.0 * hurry) * slower + faster));
-        let cheap = effort + deviation + extra;
+        let cheap = effort + deviation;
         if cheap >= bound {
-            return cheap;
+            return f32::INFINITY;
         }
         let (mut soonest, mut touch) = (p.tc_max, f32::INFINITY);
         for &(_, o) in &self.contacts {
@@ -308,7 +287,7 @@ mod tests {
         let me = agent(0.0, 0.0, 0.0, 1.3);
         let far = [agent(0.0, 30.0, 0.0, -1.3), agent(5.0, 0.0, 0.0, 1.3)];
         let d = Vec2::new(0.0, 1.3);
-        let v = a.choose(me, d, d, 0.0, 1.3, far.into_iter(), &Profile::default());
+        let v = a.choose(me, d, 0.0, 1.3, far.into_iter(), &Profile::default());
         assert_eq!(v, d);
         assert!(!a.avoiding);
     }
@@ -320,26 +299,22 @@ mod tests {
         let mut a = Avoider::new(7);
         let me = agent(0.0, 0.0, 0.0, 1.3);
         let them = agent(0.0, 6.0, 0.0, -1.3);
-        let mine = a.choose(me, d, d, 0.0, 1.3, [them].into_iter(), &p);
+        let mine = a.choose(me, d, 0.0, 1.3, [them].into_iter(), &p);
         // facing +z, the right hand is −x
         assert!(mine.x < -0.05, "{mine}");
         assert!(a.avoiding);
         // the other, facing −z, also turns to its right: +x
         let mut b = Avoider::new(9);
-        let v = b.choose(
-            them,
-            -d,
-            -d,
-            std::f32::consts::PI,
-            1.3,
-            [me].into_iter(),
-            &p,
-        );
+        let v = b.choose(them, -d, std::f32::consts::PI, 1.3, [me].into_iter(), &p);
         assert!(v.x > 0.05, "{v}");
         // having chosen, the other drifting onto its side does not flip it (a fresh walker also
         // stays right here: the right-hand order alone holds; keepSide is not yet shown to matter)
         let nudged = agent(-0.1, 6.0, 0.0, -1.3);
-        let v = a.choose(me, d, mine, 0.0, 1.3, [nudged].into_iter(), &p);
+        let going = Agent {
+            velocity: mine,
+            ..me
+        };
+        let v = a.choose(going, d, 0.0, 1.3, [nudged].into_iter(), &p);
         assert!(v.x < 0.0, "{v}");
     }
 
@@ -351,7 +326,7 @@ mod tests {
         let me = agent(0.0, 0.0, 0.0, 1.3);
         // someone standing just ahead, slightly to the right
         let there = agent(-0.1, 0.7, 0.0, 0.0);
-        let v = a.choose(me, d, d, 0.0, 1.3, [there].into_iter(), &p);
+        let v = a.choose(me, d, 0.0, 1.3, [there].into_iter(), &p);
         let t = time_to_contact(there.at - me.at, -v, 0.5);
         assert!(t.is_none_or(|t| t > BODY_HORIZON), "{v} {t:?}");
     }

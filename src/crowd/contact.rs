@@ -5,6 +5,8 @@
 
 use glam::Vec2;
 
+use super::snapshot::Agent;
+
 /// The first time (s) at which discs whose centres differ by `dx` (other − me) and whose
 /// velocities differ by `dv` (other − me) come within `reach` of each other; `Some(0.0)` when
 /// they are within it and closing in, `None` when they never touch (or are within it and moving
@@ -34,18 +36,32 @@ pub const PUSH_TIME: f32 = 0.02;
 /// Slowest bodies are pushed apart (m/s) while they overlap by more than that covers.
 pub const PUSH_SPEED: f32 = 1.0;
 
-/// How far a body that overlaps others by the sum `push` (the direction out times the depth)
-/// moves out in `dt`: a share of the depth that takes it out with time constant
-/// [`PUSH_TIME`], and at least [`PUSH_SPEED`] × `dt` (never past the depth). A shallow overlap
-/// parts gently, a deep one quickly, and nobody jumps in one step however short the step.
-pub fn push_step(push: Vec2, dt: f32) -> Vec2 {
+/// Kept between bodies beyond their radii when they are pressed apart (m): a walker's pelvis
+/// sways about 2 cm to each side of its track, and the others' places are a moment old.
+pub const PUSH_MARGIN: f32 = 0.04;
+
+/// A body of `radius` at `at` moved out of the `others` it overlaps (within their radii plus
+/// [`PUSH_MARGIN`]) in `dt`: by a share of the summed overlap that takes it out with time
+/// constant [`PUSH_TIME`], at least [`PUSH_SPEED`] × `dt` (never past the overlap). A shallow
+/// overlap parts gently, a deep one quickly, and nobody jumps in one step however short the
+/// step (in a press of people, moving out of one body at once may lead into the next).
+pub fn pushed_out(at: Vec2, radius: f32, others: impl IntoIterator<Item = Agent>, dt: f32) -> Vec2 {
+    let mut push = Vec2::ZERO;
+    for o in others {
+        let d = at - o.at;
+        let reach = radius + o.radius + PUSH_MARGIN;
+        let l = d.length();
+        if l < reach {
+            push += if l > 1e-6 { d / l } else { Vec2::X } * (reach - l);
+        }
+    }
     let depth = push.length();
     if depth < 1e-9 {
-        return Vec2::ZERO;
+        return at;
     }
     let share = 1.0 - (-dt / PUSH_TIME).exp();
     let step = (depth * share).max((PUSH_SPEED * dt).min(depth));
-    push / depth * step
+    at + push / depth * step
 }
 
 #[cfg(test)]
@@ -83,5 +99,30 @@ mod tests {
         let dv = Vec2::new(5.0, 0.0) - Vec2::new(0.0, 1.0);
         assert_eq!(time_to_contact(Vec2::new(-5.0, 2.0), dv, 0.5), None);
         assert!(time_to_contact(Vec2::new(-5.0, 2.0), dv, 1.0).is_some());
+    }
+
+    #[test]
+    fn overlapping_bodies_part_with_the_time_constant_and_never_beyond_the_margin() {
+        let other = |x: f32| Agent {
+            at: Vec2::new(x, 0.0),
+            velocity: Vec2::ZERO,
+            radius: 0.25,
+        };
+        let dt = 1.0 / 240.0;
+        // clear of each other: nothing moves
+        assert_eq!(pushed_out(Vec2::ZERO, 0.25, [other(1.0)], dt), Vec2::ZERO);
+        // 4 cm inside the reach (0.5 + the margin): out by the share of a 20 ms time constant
+        let at = pushed_out(Vec2::ZERO, 0.25, [other(0.5)], dt);
+        let share = 1.0 - (-dt / PUSH_TIME).exp();
+        assert!((at.x + 0.04 * share).abs() < 1e-6 && at.y == 0.0, "{at}");
+        // a second of it: at the reach, not past it
+        let mut at = Vec2::ZERO;
+        for _ in 0..240 {
+            at = pushed_out(at, 0.25, [other(0.5)], dt);
+        }
+        assert!((at.x + 0.04).abs() < 1e-5, "{at}");
+        // squeezed between two: the pushes cancel, nobody is flung out
+        let at = pushed_out(Vec2::ZERO, 0.25, [other(0.4), other(-0.4)], dt);
+        assert!(at.length() < 1e-6, "{at}");
     }
 }

@@ -57,7 +57,9 @@ pub fn measure(tracks: &[Track], dt: f32) -> Quality {
     let mut q = Quality::default();
     let n = tracks.len().max(1) as f32;
     let steps = tracks.iter().map(|t| t.at.len()).min().unwrap_or(0);
-    let mut grid = Vec::new();
+    let widest = tracks.iter().map(|t| t.radius).fold(0.0, f32::max);
+    let mut pairs = std::collections::BTreeSet::new();
+    let mut near = Vec::new();
     for k in 0..steps {
         let agents: Vec<super::Agent> = (tracks.iter())
             .map(|t| super::Agent {
@@ -68,22 +70,13 @@ pub fn measure(tracks: &[Track], dt: f32) -> Quality {
             .collect();
         let crowd = super::Crowd::unnamed(0.0, agents);
         for (i, t) in tracks.iter().enumerate() {
-            crowd.near(t.at[k], 2.0 * t.radius + 0.5, &mut grid);
-            for &j in grid.iter().filter(|&&j| j > i) {
+            crowd.near(t.at[k], t.radius + widest, &mut near);
+            for &j in near.iter().filter(|&&j| j > i) {
                 let overlap = t.radius + tracks[j].radius - t.at[k].distance(tracks[j].at[k]);
                 if overlap > 1e-3 {
                     q.deepest = q.deepest.max(overlap);
+                    pairs.insert((i, j));
                 }
-            }
-        }
-    }
-    let mut pairs = std::collections::BTreeSet::new();
-    for (i, a) in tracks.iter().enumerate() {
-        for (j, b) in tracks.iter().enumerate().skip(i + 1) {
-            let touched =
-                (a.at.iter().zip(&b.at)).any(|(p, q)| a.radius + b.radius - p.distance(*q) > 1e-3);
-            if touched {
-                pairs.insert((i, j));
             }
         }
     }

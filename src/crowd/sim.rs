@@ -1,6 +1,6 @@
 //! A crowd of roots only: discs that walk to their goals choosing their velocities among each
-//! other exactly as the realizer's walkers do ([`Avoider`], the same push-out), without bodies,
-//! routes or obstacles. It serves where whole bodies would cost too much (ten thousand people
+//! other as the realizer's walkers do (the same [`Avoider`] and push-out), without bodies,
+//! routes, obstacles, or the walker's urgent re-choice between two regular ones. It serves where whole bodies would cost too much (ten thousand people
 //! at 30 Hz) and as the avoidance layer measured on its own, beside other algorithms, in
 //! `benches/crowd.rs` and `examples/crowd_quality.rs`. A step reads one snapshot of everyone
 //! and moves everyone from it, on all cores, in a fixed order: the result is the same on any
@@ -9,20 +9,15 @@
 use glam::Vec2;
 use rayon::prelude::*;
 
+use super::avoid::{DECIDE_PERIOD, NEIGHBOUR_RADIUS};
 use super::{Agent, Avoider, Crowd, Profile};
 
-/// How often each mover chooses its velocity (s), staggered over the movers.
-pub const DECIDE_PERIOD: f64 = 0.1;
 /// Most a mover's velocity changes in a second (m/s²), as a walker's steering allows.
 pub const MAX_ACCELERATION: f32 = 2.0;
 /// Within this of its goal a mover slows linearly (m).
 pub const SLOW_RADIUS: f32 = 1.0;
 /// Within this of its goal a mover has arrived (m).
 pub const ARRIVED: f32 = 0.05;
-/// Kept between bodies beyond their radii by the push-out (m), as for walkers.
-pub const MARGIN: f32 = 0.04;
-/// How far a mover looks for others (m).
-pub const NEIGHBOUR_RADIUS: f32 = 8.0;
 /// Fewest movers stepped on several threads.
 const PARALLEL_MOVERS: usize = 64;
 
@@ -48,7 +43,6 @@ pub struct Mover {
 impl Mover {
     /// A mover standing at `at`, going to `goal`.
     pub fn new(at: Vec2, goal: Vec2, radius: f32, speed: f32) -> Mover {
-        let seed = 0x5eed ^ (u64::from(at.x.to_bits()) << 20) ^ u64::from(at.y.to_bits());
         Mover {
             at,
             velocity: Vec2::ZERO,
@@ -56,7 +50,7 @@ impl Mover {
             radius,
             speed,
             arrived: None,
-            avoider: Avoider::new(seed),
+            avoider: Avoider::starting_at(at),
             chosen: None,
         }
     }
@@ -72,6 +66,15 @@ impl Mover {
             return Vec2::ZERO;
         }
         d / l * self.speed * (l / SLOW_RADIUS).min(1.0)
+    }
+
+    /// Marks it arrived at `time` if it is within [`ARRIVED`] of its goal (it then stands).
+    pub fn arrive_if_there(&mut self, time: f64) {
+        if self.arrived.is_none() && self.at.distance(self.goal) < ARRIVED {
+            self.arrived = Some(time);
+            self.velocity = Vec2::ZERO;
+            self.chosen = None;
+        }
     }
 
     fn agent(&self) -> Agent {
@@ -163,8 +166,7 @@ fn step_one(
     crowd.near(m.at, reach, &mut near);
     let others = near.iter().filter(|&&i| i != me).map(|&i| crowd.agent(i));
     if decide {
-        let held = m.velocity.length() < 0.5 * m.speed;
-        m.avoider.wait(period, held);
+        m.avoider.wait(period, m.velocity.length(), m.speed);
         let heading = if m.velocity.length() > 0.05 {
             m.velocity.x.atan2(m.velocity.y)
         } else {
@@ -174,7 +176,6 @@ fn step_one(
         let v = (m.avoider).choose(
             m.agent(),
             desired,
-            m.velocity,
             heading,
             m.speed,
             others.clone(),
@@ -184,23 +185,8 @@ fn step_one(
     }
     let target = m.chosen.filter(|_| m.arrived.is_none()).unwrap_or(desired);
     m.velocity += (target - m.velocity).clamp_length_max(MAX_ACCELERATION * dt);
-    let mut at = m.at + m.velocity * dt;
-    let mut push = Vec2::ZERO;
-    for o in others {
-        let d = at - o.at;
-        let reach = m.radius + o.radius + MARGIN;
-        let l = d.length();
-        if l < reach && l < NEIGHBOUR_RADIUS {
-            push += if l > 1e-6 { d / l } else { Vec2::X } * (reach - l);
-        }
-    }
-    at += super::contact::push_step(push, dt);
-    m.at = at;
-    if m.arrived.is_none() && m.at.distance(m.goal) < ARRIVED {
-        m.arrived = Some(time + f64::from(dt));
-        m.velocity = Vec2::ZERO;
-        m.chosen = None;
-    }
+    m.at = super::contact::pushed_out(m.at + m.velocity * dt, m.radius, others, dt);
+    m.arrive_if_there(time + f64::from(dt));
 }
 
 #[cfg(test)]

@@ -59,16 +59,7 @@ impl Crowd {
         all.sort_by(|a, b| a.0.cmp(&b.0));
         all.dedup_by(|a, b| a.0 == b.0);
         let (ids, agents): (Vec<String>, Vec<Agent>) = all.into_iter().unzip();
-        let mut cells: Vec<(u64, u32)> = (agents.iter().enumerate())
-            .map(|(i, a)| (key(cell_of(a.at)), i as u32))
-            .collect();
-        cells.sort_unstable();
-        Crowd {
-            time,
-            ids,
-            agents,
-            cells,
-        }
+        Crowd::with_cells(time, ids, agents)
     }
 
     /// The crowd of `agents` without names (agent `i` is index `i`; [`Crowd::index`] finds
@@ -82,13 +73,18 @@ impl Crowd {
                 a.velocity = Vec2::ZERO;
             }
         }
+        Crowd::with_cells(time, Vec::new(), agents)
+    }
+
+    /// The crowd of `agents` named `ids` (or unnamed), with its grid.
+    fn with_cells(time: f64, ids: Vec<String>, agents: Vec<Agent>) -> Crowd {
         let mut cells: Vec<(u64, u32)> = (agents.iter().enumerate())
             .map(|(i, a)| (key(cell_of(a.at)), i as u32))
             .collect();
         cells.sort_unstable();
         Crowd {
             time,
-            ids: Vec::new(),
+            ids,
             agents,
             cells,
         }

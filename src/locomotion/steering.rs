@@ -8,6 +8,7 @@
 //! avoidance; combiners: the truncated weighted sum, the prioritised running sum and prioritised
 //! dithering. The module is a library a host can use on its own; the realizer's walkers use it.
 
+pub use crate::rng::Rng;
 use glam::{Vec2, Vec3};
 
 use super::obstacles::Obstacles;
@@ -160,23 +161,6 @@ pub const STOP_EPSILON: f32 = 1e-3;
 pub struct Context<'a> {
     /// Obstacles (for [`Behaviour::AvoidObstacles`]).
     pub obstacles: Option<&'a Obstacles>,
-}
-
-/// A small deterministic generator (xorshift64) for wander and dithering: the same seed gives
-/// the same motion on every run.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// A number in [0, 1).
-    pub fn next_f32(&mut self) -> f32 {
-        let mut x = self.0.max(1);
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        self.0 = x;
-        (x >> 40) as f32 / (1u64 << 24) as f32
-    }
 }
 
 impl Behaviour {

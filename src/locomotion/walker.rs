@@ -12,6 +12,7 @@ use super::gait::{angle_diff, forward, Body, Gait};
 use super::obstacles::Obstacles;
 use super::path::{self, PathError};
 use super::steering::{flat, ArriveParams, Behaviour, Combine, Context, Part, Steering, Vehicle};
+use crate::crowd::avoid::NEIGHBOUR_RADIUS;
 use crate::crowd::{Agent, Avoider, Crowd, Profile};
 
 /// The walker's fixed step (s).
@@ -79,8 +80,11 @@ pub struct Walker {
     pub gait: Gait,
     /// Its body radius (m).
     pub radius: f32,
-    /// The time of its last step.
+    /// The time of its last step: `origin` + `steps` × [`STEP`], counted rather than summed so
+    /// that it is the same however the steps were grouped into frames.
     pub time: f64,
+    origin: f64,
+    steps: u64,
     /// How its steering behaviours combine (prioritised by default).
     pub combine: Combine,
     /// How it avoids other people.
@@ -111,9 +115,11 @@ impl Walker {
             gait: Gait::standing(body),
             radius,
             time,
+            origin: time,
+            steps: 0,
             combine: Combine::Prioritised,
             profile: Profile::default(),
-            avoider: Avoider::new(0x5eed ^ (at.x.to_bits() as u64) << 20 ^ at.y.to_bits() as u64),
+            avoider: Avoider::starting_at(at),
             chosen: None,
             active: None,
         }
@@ -282,17 +288,22 @@ impl Walker {
         let mut ended = None;
         while self.time + STEP <= t + 1e-9 {
             if self.active.is_none() && self.gait.at_rest(self.body()) && self.gait.amount < 1e-3 {
-                let steps = ((t + 1e-9 - self.time) / STEP).floor();
-                self.time += steps * STEP;
+                self.count(((t + 1e-9 - self.time) / STEP).floor() as u64);
                 self.gait.amount = 0.0;
                 break;
             }
-            self.time += STEP;
+            self.count(1);
             if let Some(m) = self.step(STEP as f32, obstacles, others) {
                 ended = Some(m);
             }
         }
         ended
+    }
+
+    /// Moves its clock on by `n` steps.
+    fn count(&mut self, n: u64) {
+        self.steps += n;
+        self.time = self.origin + self.steps as f64 * STEP;
     }
 
     /// One step; the moments when the walk ends in it.
@@ -329,6 +340,8 @@ impl Walker {
                     a.stopped = true;
                 }
             } else if !a.stopped {
+                let route = a.route_from(here);
+                let left = path::length(&route);
                 if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
                     // turn on the spot before setting off
                     let brake = Behaviour::Stop.force(
@@ -351,8 +364,6 @@ impl Walker {
                     );
                     let f = match others {
                         Some(o) if o.crowd.len() > 1 => {
-                            let route = a.route_from(here);
-                            let left = path::length(&route);
                             let toward = (route.get(1).copied().unwrap_or(a.walk.goal) - here)
                                 .normalize_or_zero();
                             let slowing = (left / a.slow_radius()).clamp(0.1, 1.0);
@@ -391,7 +402,6 @@ impl Walker {
                 if a.moments.ready.is_none() && speed >= 0.95 * a.walk.speed {
                     a.moments.ready = Some(time);
                 }
-                let left = path::length(&a.route_from(here));
                 if a.moments.relax.is_none() && left < a.slow_radius() && speed > 0.0 {
                     a.moments.relax = Some(time);
                     a.moments.ready.get_or_insert(time);
@@ -420,7 +430,8 @@ impl Walker {
         // never into another body, nor into an obstacle
         if let Some(o) = others {
             let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
-            let out = push_out_of_people(o, time, here, self.radius, dt);
+            let near = neighbours(o, time, here, self.radius + 1.0);
+            let out = crate::crowd::contact::pushed_out(here, self.radius, near, dt);
             self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
         }
         let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
@@ -487,18 +498,14 @@ impl Walker {
     }
 }
 
-/// How often a walker among others chooses its velocity again (steps): 10 times a second.
-pub const DECIDE_EVERY: i64 = 24;
-/// Kept between two bodies beyond their radii (m): the pelvis sways about 2 cm to each side
-/// of the walker's track, and others' places are a frame old, moved on by their velocity.
-pub const PEOPLE_MARGIN: f32 = 0.04;
+/// How often a walker among others chooses its velocity again (steps): every
+/// [`DECIDE_PERIOD`](crate::crowd::avoid::DECIDE_PERIOD).
+pub const DECIDE_EVERY: i64 = (crate::crowd::avoid::DECIDE_PERIOD / STEP + 0.5) as i64;
 /// How often a walker checks that its course does not touch someone within
 /// [`URGENT_HORIZON`] (steps: 40 times a second).
 pub const WATCH_EVERY: i64 = 6;
 /// A course that touches someone sooner than this (s) is chosen again at once.
 pub const URGENT_HORIZON: f32 = 0.4;
-/// How far a walker looks for others (m).
-pub const NEIGHBOUR_RADIUS: f32 = 8.0;
 
 /// What a walker among others needs to steer round them.
 struct Near<'a, 'b> {
@@ -526,10 +533,7 @@ impl Near<'_, '_> {
         let tick = (self.time / STEP).round() as i64;
         let regular = tick % DECIDE_EVERY == 0;
         if regular {
-            avoider.wait(
-                DECIDE_EVERY as f32 * STEP as f32,
-                velocity.length() < 0.5 * pref,
-            );
+            avoider.wait(DECIDE_EVERY as f32 * STEP as f32, velocity.length(), pref);
         }
         // between the regular choices, a course about to touch someone is chosen again at once
         let urgent = !regular
@@ -545,15 +549,8 @@ impl Near<'_, '_> {
                 velocity,
                 radius: self.radius,
             };
-            let v = avoider.choose(
-                me,
-                desired,
-                velocity,
-                facing,
-                pref,
-                neighbours(self.others, self.time, here, NEIGHBOUR_RADIUS).into_iter(),
-                self.profile,
-            );
+            let near = neighbours(self.others, self.time, here, NEIGHBOUR_RADIUS);
+            let v = avoider.choose(me, desired, facing, pref, near.into_iter(), self.profile);
             let clear = self
                 .obstacles
                 .segment_clear(here, here + v * 0.6, self.radius);
@@ -578,23 +575,6 @@ fn neighbours(o: Others<'_>, time: f64, here: Vec2, r: f32) -> Vec<Agent> {
             }
         })
         .collect()
-}
-
-/// `here` moved out of the other bodies it overlaps, by the sum of the overlaps, over a few
-/// steps rather than at once (`crowd::contact::push_step`: in a press of people moving out
-/// of one body at once may lead into the next, and they shove back).
-fn push_out_of_people(o: Others<'_>, time: f64, here: Vec2, radius: f32, dt: f32) -> Vec2 {
-    let mut push = Vec2::ZERO;
-    for other in neighbours(o, time, here, radius + 1.0) {
-        let d = here - other.at;
-        let reach = radius + other.radius + PEOPLE_MARGIN;
-        let l = d.length();
-        if l < reach {
-            let away = if l > 1e-6 { d / l } else { Vec2::X };
-            push += away * (reach - l);
-        }
-    }
-    here + crate::crowd::contact::push_step(push, dt)
 }
 
 impl Active {
