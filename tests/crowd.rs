@@ -68,9 +68,15 @@ fn realize(walkers: &[Walker], seconds: f64, fps: f64) -> Crowd {
 /// (poses and feedback) as text.
 /// A realizer with the walkers placed and their walks sent.
 fn prepared(walkers: &[Walker], parallel: bool) -> Realizer {
+    let world = World::from_json(&world_json(walkers)).expect("a world").0;
+    prepared_in(world, walkers, parallel)
+}
+
+/// A realizer in `world` (which places the walkers) with the walkers' walks sent.
+fn prepared_in(world: World, walkers: &[Walker], parallel: bool) -> Realizer {
     let mut r = Realizer::new();
     r.set_parallel(parallel);
-    *r.world_mut() = World::from_json(&world_json(walkers)).expect("a world").0;
+    *r.world_mut() = world;
     for (k, w) in walkers.iter().enumerate() {
         let bml = format!(
             r#"<bml {NS} id="b{k}" characterId="{}"><locomotion id="w" target="{},{}"/></bml>"#,
@@ -309,6 +315,94 @@ fn profiles_come_from_the_world_file_and_bad_ones_are_refused() {
     assert!(e.contains("profiles.shy") && e.contains("alpha"), "{e}");
     let typo = r#"{"profiles": {"shy": {"tc_max": 3}}, "characters": {}}"#;
     assert!(World::from_json(typo).is_err());
+}
+
+/// Three people conversing on a ring of 0.9 m round the origin, facing its middle, and the
+/// walkers: the world file's JSON (the group declared or left to be found).
+fn conversation(walkers: &[Walker], declared: bool) -> World {
+    let json = world_json(walkers);
+    let ring: Vec<String> = (0..3)
+        .map(|k| {
+            let a = (30.0 + 120.0 * k as f32).to_radians();
+            let (x, z) = (0.9 * a.sin(), 0.9 * a.cos());
+            let facing = (-x).atan2(-z).to_degrees();
+            format!(r#""g{k}": {{"position": [{x}, 0, {z}], "facing": {facing}}}"#)
+        })
+        .collect();
+    let groups = if declared {
+        r#", "groups": [{"members": ["g0", "g1", "g2"]}]"#
+    } else {
+        ""
+    };
+    let json = json.replacen(
+        r#"{"characters": {"#,
+        &format!(r#"{{"characters": {{{}, "#, ring.join(", ")),
+        1,
+    );
+    let json = format!("{}{groups}}}", json.strip_suffix('}').unwrap());
+    World::from_json(&json).expect("a world").0
+}
+
+#[test]
+fn walkers_go_round_a_conversing_group_never_between_its_members() {
+    // walkers whose straight lines cross the group's middle, from both sides
+    let walkers = [
+        walker((0.2, -6.0), (-0.2, 6.0)),
+        walker((-6.0, 0.3), (6.0, -0.1)),
+        walker((0.4, 6.0), (0.3, -6.0)),
+    ];
+    for declared in [true, false] {
+        let world = conversation(&walkers, declared);
+        assert_eq!(world.groups().len(), 1, "{:?}", world.groups());
+        let (crowd, _) = ticked(
+            prepared_in(world, &walkers, true),
+            walkers.len(),
+            16.0,
+            30.0,
+        );
+        crowd.all_arrive_apart(&walkers);
+        for (k, w) in walkers.iter().enumerate() {
+            // the members' bodies reach 0.9 + 0.25 m from the middle; the walker's own body
+            // stays outside that ring
+            let inside = (crowd.tracks[&id(k)].iter())
+                .map(|p| p.length())
+                .fold(f32::INFINITY, f32::min);
+            assert!(
+                inside >= 1.15 + 0.25 - 0.01,
+                "{} came {inside} m from the middle (declared: {declared})",
+                id(k)
+            );
+            let path = crowd.path_length(&id(k));
+            assert!(
+                path <= 1.35 * w.from.distance(w.to),
+                "{} walked {path} m",
+                id(k)
+            );
+        }
+    }
+}
+
+#[test]
+fn groups_naming_unknown_or_shared_members_are_refused() {
+    let world = |groups: &str| {
+        World::from_json(&format!(
+            r#"{{"characters": {{"a": {{"position": [0, 0, 0]}}, "b": {{"position": [1, 0, 0]}},
+                 "c": {{"position": [2, 0, 0]}}}}, "groups": {groups}}}"#
+        ))
+    };
+    let e = world(r#"[{"members": ["a", "zed"]}]"#).unwrap_err();
+    assert!(e.contains("groups[0]") && e.contains("'zed'"), "{e}");
+    let e = world(r#"[{"members": ["a", "b"]}, {"members": ["c", "b"]}]"#).unwrap_err();
+    assert!(
+        e.contains("groups[1]") && e.contains("already in groups[0]"),
+        "{e}"
+    );
+    let e = world(r#"[{"members": ["a"]}]"#).unwrap_err();
+    assert!(e.contains("2 to 32"), "{e}");
+    let e = world(r#"[{"members": ["a", "b"], "talking": true}]"#).unwrap_err();
+    assert!(e.contains("talking"), "{e}");
+    // standing side by side, facing the same way, nobody is grouped
+    assert!(world("[]").unwrap().0.groups().is_empty());
 }
 
 #[test]

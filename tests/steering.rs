@@ -225,3 +225,25 @@ fn pursuit_heads_for_where_the_target_will_be_and_catches_it_sooner_than_seek() 
     let f = e.force(&mut v, Context::default(), &mut Rng(1)).unwrap();
     assert!(f.x < -0.3 && f.z < 0.0, "{f}");
 }
+
+#[test]
+fn a_follower_pushed_past_a_point_goes_on_rather_than_back() {
+    let mut rng = Rng(1);
+    let pts: Vec<Vec3> = (1..=3)
+        .map(|k| Vec3::new(0.0, 0.0, 2.0 * k as f32))
+        .collect();
+    let mut b = Behaviour::FollowPoints {
+        points: pts,
+        next: 1,
+        reach: 0.3,
+        params: ArriveParams {
+            slow_radius: 1.0,
+            stop_radius: 0.05,
+            floor_speed: 0.1,
+        },
+    };
+    // pushed aside a metre, half a metre beyond the point it sought
+    let mut v = Vehicle::new(Vec3::new(1.0, 0.0, 4.5), 1.0, 3.0, 1.2);
+    let f = b.force(&mut v, Context::default(), &mut rng).unwrap();
+    assert!(f.z > 0.0, "turned back: {f}");
+}

@@ -18,6 +18,7 @@
 //!   unknown one NO_SUCH_TARGET.
 
 use std::cell::RefCell;
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -27,7 +28,7 @@ use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitK
 use crate::feedback::KnownWarning;
 use crate::locomotion::posing::{lead_the_turn, pose_gait, GaitJoints};
 use crate::locomotion::targets::{resolve, Pursuit};
-use crate::locomotion::{walker, Moments, Walk, Walker};
+use crate::locomotion::{walker, Moments, Obstacles, Walk, Walker};
 use crate::timing::{SyncName, TimingModel, TimingModels};
 use crate::world::{Placement, World};
 
@@ -78,6 +79,8 @@ pub struct LocomotionEngine {
     rehearsed: RefCell<Option<(Walker, Walk, Moments)>>,
     /// The pursuit of the current walk's target (which may move).
     pursuit: Pursuit,
+    /// What the walk under way goes round (see [`LocomotionEngine::round`]).
+    obstacles: Arc<Obstacles>,
 }
 
 /// Reads a locomotion behaviour's order.
@@ -151,6 +154,17 @@ impl LocomotionEngine {
         w
     }
 
+    /// What `walker` goes round on `walk`: the obstacles and the space of every conversing group
+    /// it is not in, or the obstacles alone when the groups leave no way there.
+    fn round(&self, world: &World, walker: &Walker, walk: &Walk) -> Arc<Obstacles> {
+        let all = world.obstacles_for(&self.id);
+        if Arc::ptr_eq(&all, world.obstacles_shared()) || walker.can_route(walk, &all) {
+            all
+        } else {
+            world.obstacles_shared().clone()
+        }
+    }
+
     /// The moments of `walk` from the walker's state, relative to its start.
     fn rehearse(
         &self,
@@ -198,14 +212,15 @@ impl LocomotionEngine {
         if let Some(old) = self.current.take() {
             self.end_now(&old);
         }
-        let obstacles = world.obstacles().clone();
         let Some(walker) = self.walker.clone() else {
             return;
         };
+        let obstacles = self.round(world, &walker, &walk);
         let planned = self.rehearse(&walker, &walk, &obstacles);
         let w = self.walker.as_mut().expect("a walker");
         match w.start(walk, &obstacles) {
             Ok(()) => {
+                self.obstacles = obstacles;
                 self.walked = true;
                 self.current = Some(key.clone());
                 self.pursuit = Pursuit::default();
@@ -353,7 +368,7 @@ impl Engine for LocomotionEngine {
             running: o.running,
             face,
         };
-        let m = match self.rehearse(walker, &walk, world.obstacles()) {
+        let m = match self.rehearse(walker, &walk, &self.round(world, walker, &walk)) {
             Ok(m) => m,
             Err(_) => return fallback,
         };
@@ -495,7 +510,6 @@ impl Travel for LocomotionEngine {
             .filter_map(|(syncs, u)| (!u.started).then(|| syncs.first().map(|s| s.1)).flatten())
             .fold(now, f64::min);
         self.walker(at, world, first);
-        let obstacles = world.obstacles().clone();
         loop {
             // the next walk to start by now
             let next = (self.units.all())
@@ -516,7 +530,7 @@ impl Travel for LocomotionEngine {
             let ended = self
                 .walker
                 .as_mut()
-                .and_then(|w| w.advance_among(stop, &obstacles, Some(others)));
+                .and_then(|w| w.advance_among(stop, &self.obstacles, Some(others)));
             self.follow_moments(stop, ended);
             if stop < until {
                 continue;
@@ -535,7 +549,7 @@ impl Travel for LocomotionEngine {
             if let Some((goal, face)) = resolve(world, id, &o.target, from) {
                 self.pursuit.observe(now, face.unwrap_or(goal));
                 let aim = self.pursuit.aim(goal, from, o.speed);
-                w.retarget(aim, face, &obstacles);
+                w.retarget(aim, face, &self.obstacles);
             }
         }
         let body = self.walker.as_ref().map(|w| w.body());

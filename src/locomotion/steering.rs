@@ -204,9 +204,7 @@ impl Behaviour {
                 reach,
                 params,
             } => {
-                while *next + 1 < points.len()
-                    && flat(points[*next] - v.position).length() <= *reach
-                {
+                while *next + 1 < points.len() && passed(v.position, points, *next, *reach, &ctx) {
                     *next += 1;
                 }
                 let p = *points.get(*next)?;
@@ -222,6 +220,27 @@ impl Behaviour {
         };
         Some(truncate(flat(raw), v.max_force))
     }
+}
+
+/// Whether a follower at `at` is done with point `i` of `points` (not the last): within `reach`
+/// of it, or past the line through it square to the way it came from the point before, with the
+/// next point in sight (a follower pushed aside by others does not turn back for a point it
+/// went round).
+fn passed(at: Vec3, points: &[Vec3], i: usize, reach: f32, ctx: &Context) -> bool {
+    let (p, q) = (flat(points[i]), flat(points[i + 1]));
+    let at = flat(at);
+    if (p - at).length() <= reach {
+        return true;
+    }
+    let Some(before) = i.checked_sub(1).map(|k| flat(points[k])) else {
+        return false;
+    };
+    let beyond = (at - p).dot(p - before) > 0.0;
+    let xz = |v: Vec3| glam::Vec2::new(v.x, v.z);
+    beyond
+        && ctx
+            .obstacles
+            .is_none_or(|o| o.segment_clear(xz(at), xz(q), 0.05))
 }
 
 /// Reynolds' seek: the desired velocity toward `t` at full speed, less the current velocity.

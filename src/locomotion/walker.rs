@@ -174,6 +174,17 @@ impl Walker {
         angle_diff(to.x.atan2(to.y), self.facing)
     }
 
+    /// Whether a route for `walk` from where it stands goes round `obstacles`.
+    pub fn can_route(&self, walk: &Walk, obstacles: &Obstacles) -> bool {
+        path::plan(
+            obstacles,
+            self.body().at,
+            walk.goal,
+            self.radius + PLAN_MARGIN,
+        )
+        .is_ok()
+    }
+
     /// Starts `walk` now, along a route around `obstacles`.
     pub fn start(&mut self, walk: Walk, obstacles: &Obstacles) -> Result<(), PathError> {
         let clearance = self.radius + PLAN_MARGIN;

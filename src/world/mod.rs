@@ -9,7 +9,8 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use glam::{Quat, Vec3};
-use serde::Deserialize;
+
+mod file;
 
 /// Where a character stands: a place on the ground and the way it faces.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -77,6 +78,8 @@ pub struct World {
     obstacles: Arc<crate::locomotion::Obstacles>,
     /// The avoidance profile of characters the world file gives one.
     profiles: Arc<BTreeMap<String, crate::crowd::Profile>>,
+    /// Groups of characters: declared in the world file or found there.
+    groups: Arc<Vec<crate::crowd::group::Group>>,
     /// Every character as walkers see it this frame, in world coordinates (a view has none).
     crowd: Arc<crate::crowd::Crowd>,
     /// The frame things are read and written in: the origin for the world itself, where a
@@ -96,48 +99,6 @@ impl Default for World {
     }
 }
 
-/// The world file: `{"points": {"user": [0, 1.6, 1.5]}, "paths": {"walker": {"keys": [[0, [1,
-/// 1.6, 2]], [4, [-1, 1.6, 2]]]}}, "characters": {"Bob": {"position": [1, 0, 2], "facing":
-/// -150}}, "obstacles": [...]}` (`facing` in degrees about +y from facing +z).
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct WorldFile {
-    #[serde(default)]
-    points: BTreeMap<String, [f64; 3]>,
-    #[serde(default)]
-    paths: BTreeMap<String, PathFile>,
-    #[serde(default)]
-    characters: BTreeMap<String, CharacterFile>,
-    #[serde(default)]
-    obstacles: Vec<crate::locomotion::obstacles::ObstacleFile>,
-    #[serde(default)]
-    profiles: BTreeMap<String, crate::crowd::Profile>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PathFile {
-    keys: Vec<(f64, [f64; 3])>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CharacterFile {
-    position: [f64; 3],
-    /// Degrees about +y from facing +z.
-    #[serde(default)]
-    facing: f64,
-    /// Body radius (m).
-    #[serde(default)]
-    radius: Option<f64>,
-    /// How its steering behaviours combine: `prioritised` (default), `weighted`, `dithering`.
-    #[serde(default)]
-    steering: Option<String>,
-    /// The name of its avoidance profile (in `profiles`).
-    #[serde(default)]
-    profile: Option<String>,
-}
-
 /// A character's body radius unless the world file gives one (m).
 pub const DEFAULT_RADIUS: f32 = 0.25;
 
@@ -155,16 +116,6 @@ pub const MAX_PATH_KEYS: usize = 100_000;
 /// `f32::MAX` that turning a point into a character's frame stays finite.
 pub const MAX_COORDINATE: f64 = 1e9;
 
-fn vec3(name: &str, v: [f64; 3]) -> Result<Vec3, String> {
-    if v.iter().all(|c| c.abs() <= MAX_COORDINATE) {
-        Ok(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
-    } else {
-        Err(format!(
-            "'{name}': coordinates must be numbers of at most {MAX_COORDINATE} m"
-        ))
-    }
-}
-
 impl World {
     /// A world without points.
     pub fn empty() -> Self {
@@ -176,91 +127,10 @@ impl World {
             combiners: Default::default(),
             obstacles: Default::default(),
             profiles: Default::default(),
+            groups: Default::default(),
             crowd: Default::default(),
             frame: Placement::default(),
         }
-    }
-
-    /// The default scene with the points, paths, characters and obstacles of a world file (its
-    /// points win over the default ones of the same name). Returns the world and how many
-    /// obstacles the file lists. The error says what is wrong.
-    pub fn from_json(text: &str) -> Result<(World, usize), String> {
-        let file: WorldFile = crate::data::from_json(text)?;
-        let mut w = World::default();
-        for (name, at) in file.points {
-            w.set(&name, vec3(&name, at)?);
-        }
-        for (name, path) in file.paths {
-            let keys = path
-                .keys
-                .into_iter()
-                .map(|(t, at)| Ok((t, vec3(&name, at)?)))
-                .collect::<Result<Vec<_>, String>>()?;
-            w.set_path(&name, keys)?;
-        }
-        if file.characters.len() > MAX_CHARACTERS {
-            return Err(format!(
-                "characters: at most {MAX_CHARACTERS} characters, not {}",
-                file.characters.len()
-            ));
-        }
-        for (name, p) in &file.profiles {
-            p.check().map_err(|e| format!("profiles.{name}: {e}"))?;
-        }
-        for (name, c) in file.characters {
-            let at = vec3(&name, c.position)?;
-            if let Some(p) = c.profile.as_deref() {
-                let Some(profile) = file.profiles.get(p) else {
-                    let known: Vec<&str> = file.profiles.keys().map(String::as_str).collect();
-                    return Err(format!(
-                        "character '{name}': profile '{p}' is not among the world's profiles ({})",
-                        known.join(", ")
-                    ));
-                };
-                Arc::make_mut(&mut w.profiles).insert(name.clone(), *profile);
-            }
-            if !c.facing.is_finite() || c.facing.abs() > MAX_COORDINATE {
-                return Err(format!(
-                    "character '{name}': its facing must be a finite number of degrees"
-                ));
-            }
-            w.place(&name, Placement::new(at, c.facing as f32))?;
-            if let Some(r) = c.radius {
-                if !(r > 0.0 && r <= 10.0) {
-                    return Err(format!(
-                        "character '{name}': its radius must be above 0 and at most 10 m"
-                    ));
-                }
-                Arc::make_mut(&mut w.radii).insert(name.clone(), r as f32);
-            }
-            if let Some(c) = c.steering.as_deref() {
-                use crate::locomotion::steering::Combine;
-                let combine = match c {
-                    "prioritised" => Combine::Prioritised,
-                    "weighted" => Combine::WeightedSum,
-                    "dithering" => Combine::Dithering,
-                    other => {
-                        return Err(format!(
-                            "character '{name}': steering '{other}' is not one of prioritised, weighted, dithering"
-                        ))
-                    }
-                };
-                Arc::make_mut(&mut w.combiners).insert(name.clone(), combine);
-            }
-        }
-        if file.obstacles.len() > crate::locomotion::obstacles::MAX_OBSTACLES {
-            return Err(format!(
-                "obstacles: at most {} obstacles, not {}",
-                crate::locomotion::obstacles::MAX_OBSTACLES,
-                file.obstacles.len()
-            ));
-        }
-        let list = (file.obstacles.iter().enumerate())
-            .map(|(i, o)| o.obstacle(i))
-            .collect::<Result<Vec<_>, String>>()?;
-        let n = list.len();
-        w.set_obstacles(crate::locomotion::Obstacles::new(list));
-        Ok((w, n))
     }
 
     /// Character `id`'s avoidance profile (the defaults unless the world file names one).
@@ -281,6 +151,40 @@ impl World {
     /// The obstacles (world coordinates).
     pub fn obstacles(&self) -> &crate::locomotion::Obstacles {
         &self.obstacles
+    }
+
+    /// The obstacles (shared).
+    pub fn obstacles_shared(&self) -> &Arc<crate::locomotion::Obstacles> {
+        &self.obstacles
+    }
+
+    /// What character `id` walks round: the obstacles and the space of every conversing group
+    /// it is not in, as those groups stand now (each a circle through its members' far sides).
+    pub fn obstacles_for(&self, id: &str) -> Arc<crate::locomotion::Obstacles> {
+        use crate::locomotion::obstacles::{Obstacle, Shape};
+        let spaces: Vec<Obstacle> = (self.groups.iter())
+            .filter(|g| g.members.binary_search_by(|m| m.as_str().cmp(id)).is_err())
+            .filter_map(|g| {
+                let members: Vec<_> = (g.members.iter())
+                    .filter(|m| self.is_placed(m))
+                    .map(|m| self.member(m))
+                    .collect();
+                g.space(&members)
+            })
+            .map(|s| Obstacle {
+                shape: Shape::Circle {
+                    centre: s.centre,
+                    radius: s.outer,
+                },
+                height: 0.0,
+            })
+            .collect();
+        if spaces.is_empty() {
+            return self.obstacles.clone();
+        }
+        let mut all = self.obstacles.all().to_vec();
+        all.extend(spaces);
+        Arc::new(crate::locomotion::Obstacles::new(all))
     }
 
     /// Sets the obstacles.
@@ -367,6 +271,7 @@ impl World {
             combiners: self.combiners.clone(),
             obstacles: Default::default(),
             profiles: self.profiles.clone(),
+            groups: self.groups.clone(),
             crowd: Default::default(),
             characters: self.characters.clone(),
             // `from` is given in this world's frame
