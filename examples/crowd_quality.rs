@@ -1,14 +1,16 @@
 //! The quality table of `docs/crowds.md`: every scene of `crowd::scenes` walked by the
 //! realizer's avoidance (`crowd::sim`, roots only) and by ORCA (`dodgy_2d`), side by side, at
-//! 30 steps a second for at most 120 s.
+//! 30 steps a second for at most 120 s, on the same routes round the same walls.
 //!
 //! `cargo run --release --example crowd_quality`
 
 #[path = "../benches/common/orca.rs"]
 mod orca;
 
+use std::sync::Arc;
+
 use bml_realizer::crowd::quality::{measure, Quality, Track};
-use bml_realizer::crowd::scenes::{self, Walk};
+use bml_realizer::crowd::scenes::{self, Scene, Walk};
 use bml_realizer::crowd::sim::{Mover, Sim};
 
 const DT: f32 = 1.0 / 30.0;
@@ -51,8 +53,9 @@ fn movers(walks: &[Walk]) -> Vec<Mover> {
         .collect()
 }
 
-/// Steps `crowd` until everyone has arrived or [`LIMIT`], recording everyone's track.
-fn walk(mut crowd: impl Stepped) -> Quality {
+/// Steps `crowd` until everyone has arrived or [`LIMIT`], recording everyone's track, and
+/// measures it in `scene`.
+fn walk(mut crowd: impl Stepped, scene: &Scene) -> Quality {
     let mut tracks: Vec<Track> = (crowd.movers().iter())
         .map(|m| Track {
             at: vec![m.at],
@@ -69,21 +72,26 @@ fn walk(mut crowd: impl Stepped) -> Quality {
             t.arrived = m.arrived;
         }
     }
-    measure(&tracks, DT)
+    let walls = bml_realizer::locomotion::Obstacles::new(scene.walls.clone());
+    measure(&tracks, DT, &walls, &scene.spaces)
 }
 
 fn main() {
-    println!("| scene | who | collisions (pairs) | deepest (cm) | stranded | time / straight (mean, worst) | path / straight | energy / least | heading reversals |");
-    println!("|---|---|---|---|---|---|---|---|---|");
-    for (name, walks) in scenes::all() {
-        let ours = walk(Sim::new(movers(&walks)));
-        let theirs = walk(orca::Orca::new(movers(&walks)));
+    println!("| scene | who | collisions (pairs) | deepest (cm) | into walls / groups | stranded | time / straight (mean, worst) | path / straight | energy / least | heading reversals |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for scene in scenes::all() {
+        let walls = Arc::new(scene.obstacles());
+        let ours = walk(Sim::among(movers(&scene.walks), walls.clone()), &scene);
+        let theirs = walk(orca::Orca::among(movers(&scene.walks), walls), &scene);
         for (who, q) in [("realizer", ours), ("ORCA", theirs)] {
             println!(
-                "| {name} ({}) | {who} | {} | {:.1} | {} | {:.2}, {:.2} | {:.3} | {:.3} | {:.2} |",
-                walks.len(),
+                "| {} ({}) | {who} | {} | {:.1} | {} / {} | {} | {:.2}, {:.2} | {:.3} | {:.3} | {:.2} |",
+                scene.name,
+                scene.walks.len(),
                 q.collisions,
                 q.deepest * 100.0,
+                q.through_walls,
+                q.into_groups,
                 q.stranded,
                 q.time_ratio,
                 q.worst_time_ratio,

@@ -9,7 +9,7 @@
 //! α‖v − v_prev‖/2u  +  β·| |v| − |v_prev| |/u  +  γ·(angle(v, v_des)/π + ½·| |v_des| − |v| |/u)
 //!   +  δ·(1 − min(tc(v), tcMax)/tcMax)  +  keepSide (turning to the side not chosen)
 //!   +  a small cost on the left (people keep right)  +  a prohibitive cost for bodies touching
-//!      within half a second
+//!      within half a second, or for walking into a wall within half a second
 //! ```
 //!
 //! Candidates are visited going on as it goes first, then desired, then to the right from the
@@ -20,6 +20,7 @@ use glam::Vec2;
 use super::contact::time_to_contact;
 use super::profile::Profile;
 use super::snapshot::Agent;
+use crate::locomotion::Obstacles;
 use crate::rng::Rng;
 
 /// Spacing of the headings sampled (rad): the 4.5° of Karamouzas and Overmars.
@@ -58,6 +59,8 @@ pub struct Avoider {
     waited: f32,
     rng: Rng,
     contacts: Vec<(f32, Agent)>,
+    /// The radii's widening to a personal space for this choice.
+    incr: f32,
 }
 
 impl Avoider {
@@ -69,6 +72,7 @@ impl Avoider {
             waited: 0.0,
             rng: Rng(seed),
             contacts: Vec::new(),
+            incr: 1.0,
         }
     }
 
@@ -99,9 +103,10 @@ impl Avoider {
         self.rng.next_f32() - 0.5
     }
 
-    /// The velocity `me` takes among `others`, wanting `desired` at preferred speed `pref`
-    /// (m/s), going on from its velocity now; `heading` is where it looks (rad about +y from
-    /// +z), for its field of view.
+    /// The velocity `me` takes among `others` and `walls`, wanting `desired` at preferred
+    /// speed `pref` (m/s), going on from its velocity now; `heading` is where it looks (rad
+    /// about +y from +z), for its field of view.
+    #[allow(clippy::too_many_arguments)] // who, where to, how fast, among whom and what walls
     pub fn choose(
         &mut self,
         me: Agent,
@@ -109,9 +114,14 @@ impl Avoider {
         heading: f32,
         pref: f32,
         others: impl Iterator<Item = Agent>,
+        walls: &Obstacles,
         p: &Profile,
     ) -> Vec2 {
         let pref = pref.max(0.1);
+        // arriving (wanting less than its preferred speed), the personal space shrinks to the
+        // body: one steps into its place beside someone standing there
+        let arriving = (desired.length() / pref).min(1.0);
+        self.incr = 1.0 + (p.incr - 1.0) * arriving;
         self.collect_contacts(me, desired, heading, others, p);
         self.avoiding = !self.contacts.is_empty();
         if !self.avoiding {
@@ -159,7 +169,7 @@ impl Avoider {
         let mut best = (f32::INFINITY, desired);
         if me.velocity.length() > 0.05 {
             let e = extra(side_of(me.velocity), self.side);
-            let cost = self.cost(me, me.velocity, desired, pref, p, f32::INFINITY) + e;
+            let cost = self.cost(me, me.velocity, desired, pref, p, f32::INFINITY, walls) + e;
             best = (cost, me.velocity);
         }
         let wanted_speed = desired.length();
@@ -180,7 +190,7 @@ impl Avoider {
                 };
                 let v = Vec2::new((base + turn).sin(), (base + turn).cos()) * speed;
                 let e = extra(side, self.side);
-                let cost = self.cost(me, v, desired, pref, p, best.0 - e) + e;
+                let cost = self.cost(me, v, desired, pref, p, best.0 - e, walls) + e;
                 if cost < best.0 {
                     best = (cost, v);
                 }
@@ -212,7 +222,7 @@ impl Avoider {
             if !seen {
                 continue;
             }
-            let reach = (me.radius + o.radius) * p.incr;
+            let reach = (me.radius + o.radius) * self.incr;
             if let Some(t) = time_to_contact(dx, o.velocity - desired, reach) {
                 if t < p.tc_max {
                     self.contacts.push((t, o));
@@ -226,7 +236,17 @@ impl Avoider {
     /// The cost of candidate `v` for `me`; infinite when the cost without the contacts already
     /// reaches `bound` (the contacts only add: such a candidate cannot win, and most
     /// candidates are cut here before their contacts are weighed).
-    fn cost(&self, me: Agent, v: Vec2, desired: Vec2, u: f32, p: &Profile, bound: f32) -> f32 {
+    #[allow(clippy::too_many_arguments)] // the candidate, what it is weighed against, the bound
+    fn cost(
+        &self,
+        me: Agent,
+        v: Vec2,
+        desired: Vec2,
+        u: f32,
+        p: &Profile,
+        bound: f32,
+        walls: &Obstacles,
+    ) -> f32 {
         let previous = me.velocity;
         let effort = p.alpha * (v - previous).length() / (2.0 * u)
             + p.beta * (v.length() - previous.length()).abs() / u;
@@ -241,7 +261,10 @@ impl Avoider {
         let faster = (v.length() - desired.length()).max(0.0) / u;
         let deviation = p.gamma
             * (angle / std::f32::consts::PI + 0.5 * ((1.0 + 2.0 * hurry) * slower + faster));
-        let cheap = effort + deviation;
+        let mut cheap = effort + deviation;
+        if !walls.is_empty() && into_wall(me, v, walls) {
+            cheap += 11.0;
+        }
         if cheap >= bound {
             return f32::INFINITY;
         }
@@ -249,7 +272,7 @@ impl Avoider {
         for &(_, o) in &self.contacts {
             let dx = o.at - me.at;
             let dv = o.velocity - v;
-            let reach = (me.radius + o.radius) * p.incr;
+            let reach = (me.radius + o.radius) * self.incr;
             // the bodies' reach is within the personal one: no personal contact, no touch
             if let Some(t) = time_to_contact(dx, dv, reach) {
                 soonest = soonest.min(t);
@@ -267,6 +290,13 @@ impl Avoider {
         };
         cheap + risk + bodies
     }
+}
+
+/// Whether going at `v` for [`BODY_HORIZON`] brings `me`'s body into a wall, or nearer one it
+/// already touches (walking along a wall it touches is not walking into it).
+fn into_wall(me: Agent, v: Vec2, walls: &Obstacles) -> bool {
+    let now = walls.clearance(me.at, me.radius).min(me.radius);
+    !walls.segment_clear(me.at, me.at + v * BODY_HORIZON, now - 1e-3)
 }
 
 #[cfg(test)]
@@ -287,7 +317,15 @@ mod tests {
         let me = agent(0.0, 0.0, 0.0, 1.3);
         let far = [agent(0.0, 30.0, 0.0, -1.3), agent(5.0, 0.0, 0.0, 1.3)];
         let d = Vec2::new(0.0, 1.3);
-        let v = a.choose(me, d, 0.0, 1.3, far.into_iter(), &Profile::default());
+        let v = a.choose(
+            me,
+            d,
+            0.0,
+            1.3,
+            far.into_iter(),
+            &Obstacles::default(),
+            &Profile::default(),
+        );
         assert_eq!(v, d);
         assert!(!a.avoiding);
     }
@@ -299,13 +337,29 @@ mod tests {
         let mut a = Avoider::new(7);
         let me = agent(0.0, 0.0, 0.0, 1.3);
         let them = agent(0.0, 6.0, 0.0, -1.3);
-        let mine = a.choose(me, d, 0.0, 1.3, [them].into_iter(), &p);
+        let mine = a.choose(
+            me,
+            d,
+            0.0,
+            1.3,
+            [them].into_iter(),
+            &Obstacles::default(),
+            &p,
+        );
         // facing +z, the right hand is −x
         assert!(mine.x < -0.05, "{mine}");
         assert!(a.avoiding);
         // the other, facing −z, also turns to its right: +x
         let mut b = Avoider::new(9);
-        let v = b.choose(them, -d, std::f32::consts::PI, 1.3, [me].into_iter(), &p);
+        let v = b.choose(
+            them,
+            -d,
+            std::f32::consts::PI,
+            1.3,
+            [me].into_iter(),
+            &Obstacles::default(),
+            &p,
+        );
         assert!(v.x > 0.05, "{v}");
         // having chosen, the other drifting onto its side does not flip it (a fresh walker also
         // stays right here: the right-hand order alone holds; keepSide is not yet shown to matter)
@@ -314,7 +368,15 @@ mod tests {
             velocity: mine,
             ..me
         };
-        let v = a.choose(going, d, 0.0, 1.3, [nudged].into_iter(), &p);
+        let v = a.choose(
+            going,
+            d,
+            0.0,
+            1.3,
+            [nudged].into_iter(),
+            &Obstacles::default(),
+            &p,
+        );
         assert!(v.x < 0.0, "{v}");
     }
 
@@ -326,7 +388,15 @@ mod tests {
         let me = agent(0.0, 0.0, 0.0, 1.3);
         // someone standing just ahead, slightly to the right
         let there = agent(-0.1, 0.7, 0.0, 0.0);
-        let v = a.choose(me, d, 0.0, 1.3, [there].into_iter(), &p);
+        let v = a.choose(
+            me,
+            d,
+            0.0,
+            1.3,
+            [there].into_iter(),
+            &Obstacles::default(),
+            &p,
+        );
         let t = time_to_contact(there.at - me.at, -v, 0.5);
         assert!(t.is_none_or(|t| t > BODY_HORIZON), "{v} {t:?}");
     }

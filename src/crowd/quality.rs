@@ -3,9 +3,14 @@
 //! the least-effort energy of SteerBench (∫ e_s + e_w·|v|² dt with e_s = 2.23, e_w = 1.26,
 //! against the least energy for the straight line, 2·√(e_s·e_w) per metre), and heading
 //! reversals (each time a walker's turning changes direction after it turned more than 2° the
-//! other way: the wobble of a walker that cannot make up its mind).
+//! other way: the wobble of a walker that cannot make up its mind); walkers that came into a
+//! wall or into a conversing group's space. A walker whose goal is its start stands (a group's
+//! member): it counts in collisions, not in the walkers' means.
 
 use glam::Vec2;
+
+use super::group::Space;
+use crate::locomotion::Obstacles;
 
 /// SteerBench's energy per second of standing (e_s) and per m²/s² (e_w).
 pub const E_S: f32 = 2.23;
@@ -50,12 +55,25 @@ pub struct Quality {
     pub energy_ratio: f32,
     /// Heading reversals per walker.
     pub reversals: f32,
+    /// Walkers whose body came more than [`TOLERANCE`] into a wall.
+    pub through_walls: usize,
+    /// Walkers whose body came more than [`TOLERANCE`] into a conversing group's space.
+    pub into_groups: usize,
 }
 
-/// Measures `tracks` sampled every `dt` seconds.
-pub fn measure(tracks: &[Track], dt: f32) -> Quality {
+/// How far a body may come into a wall or a group's space unnoticed (m).
+pub const TOLERANCE: f32 = 0.01;
+
+impl Track {
+    /// Whether it stands (its goal is its start).
+    pub fn stands(&self) -> bool {
+        self.at[0].distance(self.goal) < 1e-3
+    }
+}
+
+/// Measures `tracks` sampled every `dt` seconds among `walls` and the groups' `spaces`.
+pub fn measure(tracks: &[Track], dt: f32, walls: &Obstacles, spaces: &[Space]) -> Quality {
     let mut q = Quality::default();
-    let n = tracks.len().max(1) as f32;
     let steps = tracks.iter().map(|t| t.at.len()).min().unwrap_or(0);
     let widest = tracks.iter().map(|t| t.radius).fold(0.0, f32::max);
     let mut pairs = std::collections::BTreeSet::new();
@@ -81,8 +99,26 @@ pub fn measure(tracks: &[Track], dt: f32) -> Quality {
         }
     }
     q.collisions = pairs.len();
-    let n_arrived = tracks.iter().filter(|t| t.arrived.is_some()).count().max(1) as f32;
-    for t in tracks {
+    let walkers: Vec<&Track> = tracks.iter().filter(|t| !t.stands()).collect();
+    let n = walkers.len().max(1) as f32;
+    let n_arrived = walkers
+        .iter()
+        .filter(|t| t.arrived.is_some())
+        .count()
+        .max(1) as f32;
+    for t in &walkers {
+        let into = |p: &Vec2| {
+            walls
+                .nearest(*p, t.radius)
+                .is_some_and(|(d, _)| d < t.radius - TOLERANCE)
+        };
+        q.through_walls += usize::from(t.at.iter().any(into));
+        let into = |p: &Vec2| {
+            (spaces.iter()).any(|s| p.distance(s.centre) < s.outer + t.radius - TOLERANCE)
+        };
+        q.into_groups += usize::from(t.at.iter().any(into));
+    }
+    for t in walkers {
         let straight = t.at[0].distance(t.goal).max(1e-3);
         let path: f32 = t.at.windows(2).map(|w| w[0].distance(w[1])).sum();
         q.path_ratio += path / straight / n;
@@ -149,7 +185,7 @@ mod tests {
             radius: 0.25,
             arrived: Some(10.0),
         };
-        let q = measure(std::slice::from_ref(&t), dt);
+        let q = measure(std::slice::from_ref(&t), dt, &Obstacles::default(), &[]);
         assert!((q.energy_ratio - 1.0).abs() < 1e-3, "{q:?}");
         assert!((q.time_ratio - 1.0).abs() < 1e-3 && (q.path_ratio - 1.0).abs() < 1e-3);
         assert_eq!(q.reversals, 0.0);
@@ -163,6 +199,8 @@ mod tests {
                 ..t.clone()
             }],
             dt,
+            &Obstacles::default(),
+            &[],
         );
         assert!(q.reversals >= 15.0, "{q:?}");
         assert!(q.path_ratio > 1.0 && q.energy_ratio > 1.0);
@@ -178,6 +216,8 @@ mod tests {
                 },
             ],
             dt,
+            &Obstacles::default(),
+            &[],
         );
         assert_eq!(q.collisions, 1);
         assert!((q.deepest - 0.5).abs() < 0.07, "{q:?}");

@@ -1,16 +1,20 @@
 //! A crowd of roots only: discs that walk to their goals choosing their velocities among each
-//! other as the realizer's walkers do (the same [`Avoider`] and push-out), without bodies,
-//! routes, obstacles, or the walker's urgent re-choice between two regular ones. It serves where whole bodies would cost too much (ten thousand people
-//! at 30 Hz) and as the avoidance layer measured on its own, beside other algorithms, in
-//! `benches/crowd.rs` and `examples/crowd_quality.rs`. A step reads one snapshot of everyone
+//! other as the realizer's walkers do (the same [`Avoider`] and push-out, routes round the same
+//! obstacles), without bodies or the walker's urgent re-choice between two regular ones. It
+//! serves where whole bodies would cost too much (ten thousand people at 30 Hz) and as the
+//! avoidance layer measured on its own, beside other algorithms, in `benches/crowd.rs` and
+//! `examples/crowd_quality.rs`. A step reads one snapshot of everyone
 //! and moves everyone from it, on all cores, in a fixed order: the result is the same on any
 //! number of threads.
+
+use std::sync::Arc;
 
 use glam::Vec2;
 use rayon::prelude::*;
 
 use super::avoid::{DECIDE_PERIOD, NEIGHBOUR_RADIUS};
 use super::{Agent, Avoider, Crowd, Profile};
+use crate::locomotion::{path, Obstacles};
 
 /// Most a mover's velocity changes in a second (m/s²), as a walker's steering allows.
 pub const MAX_ACCELERATION: f32 = 2.0;
@@ -18,6 +22,12 @@ pub const MAX_ACCELERATION: f32 = 2.0;
 pub const SLOW_RADIUS: f32 = 1.0;
 /// Within this of its goal a mover has arrived (m).
 pub const ARRIVED: f32 = 0.05;
+/// Kept from obstacles beyond the radius when routing (m), as walkers do.
+pub const ROUTE_MARGIN: f32 = 0.1;
+/// Within this of a point of its route a mover goes on to the next (m).
+pub const REACH: f32 = 0.45;
+/// Shortest time between two plans of a mover's route (s).
+pub const REPLAN_PERIOD: f64 = 1.0;
 /// Fewest movers stepped on several threads.
 const PARALLEL_MOVERS: usize = 64;
 
@@ -38,6 +48,11 @@ pub struct Mover {
     pub arrived: Option<f64>,
     avoider: Avoider,
     chosen: Option<Vec2>,
+    /// The points to walk through (the last is the goal), and the one sought now.
+    route: Vec<Vec2>,
+    next: usize,
+    /// When it last planned its route again.
+    replanned: f64,
 }
 
 impl Mover {
@@ -49,28 +64,79 @@ impl Mover {
             goal,
             radius,
             speed,
-            arrived: None,
+            // one whose goal is where it stands has arrived (a group's member, standing)
+            arrived: (at.distance(goal) < ARRIVED).then_some(0.0),
             avoider: Avoider::starting_at(at),
             chosen: None,
+            route: vec![goal],
+            next: 0,
+            replanned: f64::NEG_INFINITY,
         }
     }
 
-    /// The velocity it wants: toward its goal, slowing in the last [`SLOW_RADIUS`].
+    /// Plans its route round `obstacles` (keeping its radius and [`ROUTE_MARGIN`]).
+    pub fn route_round(&mut self, obstacles: &Obstacles) -> Result<(), path::PathError> {
+        let route = path::plan(obstacles, self.at, self.goal, self.radius + ROUTE_MARGIN)?;
+        self.route = route.into_iter().skip(1).collect();
+        if self.route.is_empty() {
+            self.route.push(self.goal);
+        }
+        self.next = 0;
+        Ok(())
+    }
+
+    /// Goes on along its route: past every point it is within [`REACH`] of, or from which the
+    /// point after it is in sight with its body's clearance. Pushed by others to where the
+    /// point it seeks is out of sight, it plans its route again from there (at most every
+    /// [`REPLAN_PERIOD`]).
+    pub fn follow(&mut self, obstacles: &Obstacles, time: f64) {
+        let aim = self.route.get(self.next).copied().unwrap_or(self.goal);
+        let lost = !obstacles.is_empty()
+            && self.arrived.is_none()
+            && !obstacles.segment_clear(self.at, aim, 0.5 * self.radius);
+        if lost && time >= self.replanned + REPLAN_PERIOD {
+            self.replanned = time;
+            let _ = self.route_round(obstacles);
+        }
+        while self.next + 1 < self.route.len() {
+            let after = self.route[self.next + 1];
+            let reached = self.at.distance(self.route[self.next]) <= REACH;
+            if !(reached || obstacles.segment_clear(self.at, after, self.radius)) {
+                break;
+            }
+            self.next += 1;
+        }
+    }
+
+    /// The velocity it wants: toward the point of its route it seeks, slowing in the last
+    /// [`SLOW_RADIUS`] before its goal.
     pub fn desired(&self) -> Vec2 {
         if self.arrived.is_some() {
             return Vec2::ZERO;
         }
-        let d = self.goal - self.at;
+        let aim = self.route.get(self.next).copied().unwrap_or(self.goal);
+        let d = aim - self.at;
         let l = d.length();
         if l < 1e-6 {
             return Vec2::ZERO;
         }
-        d / l * self.speed * (l / SLOW_RADIUS).min(1.0)
+        let last = self.next + 1 >= self.route.len();
+        d / l
+            * self.speed
+            * if last {
+                (l / SLOW_RADIUS).min(1.0)
+            } else {
+                1.0
+            }
     }
 
-    /// Marks it arrived at `time` if it is within [`ARRIVED`] of its goal (it then stands).
+    /// Marks it arrived at `time` if it is within [`ARRIVED`] of its goal, or within its radius
+    /// of it and fully impatient (its spot is crowded: it stands as near as it can); it then
+    /// stands.
     pub fn arrive_if_there(&mut self, time: f64) {
-        if self.arrived.is_none() && self.at.distance(self.goal) < ARRIVED {
+        let d = self.at.distance(self.goal);
+        let near_enough = d < self.radius && self.avoider.impatience() >= 1.0;
+        if self.arrived.is_none() && (d < ARRIVED || near_enough) {
             self.arrived = Some(time);
             self.velocity = Vec2::ZERO;
             self.chosen = None;
@@ -95,6 +161,8 @@ pub struct Sim {
     pub movers: Vec<Mover>,
     /// How everyone avoids others.
     pub profile: Profile,
+    /// What everyone walks round.
+    pub obstacles: Arc<Obstacles>,
     steps: u64,
     decide_all: bool,
 }
@@ -106,8 +174,21 @@ impl Sim {
             time: 0.0,
             movers,
             profile: Profile::default(),
+            obstacles: Arc::default(),
             steps: 0,
             decide_all: false,
+        }
+    }
+
+    /// The movers at time 0 among `obstacles`, each with its route round them; those that
+    /// have none go straight (and are counted as not arrived, as they will not).
+    pub fn among(mut movers: Vec<Mover>, obstacles: Arc<Obstacles>) -> Sim {
+        for m in &mut movers {
+            let _ = m.route_round(&obstacles);
+        }
+        Sim {
+            obstacles,
+            ..Sim::new(movers)
         }
     }
 
@@ -128,9 +209,15 @@ impl Sim {
         let every = ((DECIDE_PERIOD / f64::from(dt)).round() as u64).max(1);
         let (steps, profile, time, all) = (self.steps, self.profile, self.time, self.decide_all);
         self.decide_all = false;
+        let walls = &*self.obstacles;
         let one = |(i, m): (usize, &mut Mover)| {
             let decide = all || (steps + i as u64).is_multiple_of(every);
-            step_one(m, i, &crowd, &profile, decide, every as f32 * dt, dt, time);
+            let world = World {
+                crowd: &crowd,
+                walls,
+                profile: &profile,
+            };
+            step_one(m, i, world, decide, every as f32 * dt, dt, time);
         };
         if self.movers.len() >= PARALLEL_MOVERS {
             self.movers.par_iter_mut().enumerate().for_each(one);
@@ -142,18 +229,22 @@ impl Sim {
     }
 }
 
-/// One mover's step from the snapshot `crowd` (where it is index `me`).
-#[allow(clippy::too_many_arguments)] // the step's inputs, each a number or a shared snapshot
-fn step_one(
-    m: &mut Mover,
-    me: usize,
-    crowd: &Crowd,
-    profile: &Profile,
-    decide: bool,
-    period: f32,
-    dt: f32,
-    time: f64,
-) {
+/// What every mover's step reads: the snapshot of everyone, the walls, the profile.
+#[derive(Clone, Copy)]
+struct World<'a> {
+    crowd: &'a Crowd,
+    walls: &'a Obstacles,
+    profile: &'a Profile,
+}
+
+/// One mover's step from the snapshot (where it is index `me`).
+fn step_one(m: &mut Mover, me: usize, w: World, decide: bool, period: f32, dt: f32, time: f64) {
+    let World {
+        crowd,
+        walls,
+        profile,
+    } = w;
+    m.follow(walls, time);
     let desired = m.desired();
     let mut near = Vec::new();
     // everyone within sight when choosing, only those it may touch otherwise
@@ -179,6 +270,7 @@ fn step_one(
             heading,
             m.speed,
             others.clone(),
+            walls,
             profile,
         );
         m.chosen = m.avoider.avoiding.then_some(v);
@@ -186,6 +278,9 @@ fn step_one(
     let target = m.chosen.filter(|_| m.arrived.is_none()).unwrap_or(desired);
     m.velocity += (target - m.velocity).clamp_length_max(MAX_ACCELERATION * dt);
     m.at = super::contact::pushed_out(m.at + m.velocity * dt, m.radius, others, dt);
+    if m.arrived.is_none() && !walls.is_empty() {
+        m.at = walls.push_out(m.at, m.radius);
+    }
     m.arrive_if_there(time + f64::from(dt));
 }
 

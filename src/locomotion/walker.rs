@@ -561,7 +561,15 @@ impl Near<'_, '_> {
                 radius: self.radius,
             };
             let near = neighbours(self.others, self.time, here, NEIGHBOUR_RADIUS);
-            let v = avoider.choose(me, desired, facing, pref, near.into_iter(), self.profile);
+            let v = avoider.choose(
+                me,
+                desired,
+                facing,
+                pref,
+                near.into_iter(),
+                self.obstacles,
+                self.profile,
+            );
             let clear = self
                 .obstacles
                 .segment_clear(here, here + v * 0.6, self.radius);
