@@ -196,3 +196,14 @@ fn walking_to_the_door_then_speaking() {
     assert_eq!(sync(&fb, "door:s:start"), sync(&fb, "door:w:end"));
     assert_eq!(block(&fb, "door", "end").1, Some(BlockStatus::Done));
 }
+
+#[test]
+fn forty_walkers_cross_the_plaza_round_the_group() {
+    let fb = run("run --world fixtures/examples/plaza/world.json fixtures/examples/plaza");
+    no_warnings(&fb);
+    for k in 0..40 {
+        let (t, status) = block(&fb, &format!("cross{k:02}"), "end");
+        assert_eq!(status, Some(BlockStatus::Done), "cross{k:02}");
+        assert!(t < 35.0, "cross{k:02} ended at {t} s");
+    }
+}

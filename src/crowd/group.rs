@@ -20,6 +20,9 @@ pub const FOCUS: f32 = 0.6;
 pub const FOCUS_GAP: f32 = 0.6;
 /// Most distance between two members found as a group (m).
 pub const REACH: f32 = 3.0;
+/// Kept beyond a group's space by walkers going round it (m): their personal space, so that
+/// passing the members is not a contact to avoid.
+pub const PASSING: f32 = 0.3;
 /// Most members a group may have.
 pub const MAX_MEMBERS: usize = 32;
 /// A group whose members stand further than this from its centre holds no space (m): they have

@@ -17,6 +17,9 @@ use crate::crowd::{Agent, Avoider, Crowd, Profile};
 
 /// The walker's fixed step (s).
 pub const STEP: f64 = 1.0 / 240.0;
+/// How often a walker among others checks that the point its route seeks is still in sight
+/// (steps: once a second).
+pub const REPLAN_EVERY: i64 = 240;
 /// How fast the body turns toward its direction of travel (rad/s).
 pub const TURN_RATE: f32 = 2.0;
 /// How fast the body turns on the spot (rad/s): about 45° a step, the most a planted foot lets
@@ -196,11 +199,9 @@ impl Walker {
             stop_radius: STOP_RADIUS,
             floor_speed: 0.12,
         };
-        let points = route
-            .iter()
-            .skip(1)
-            .map(|p| Vec3::new(p.x, 0.0, p.y))
-            .collect();
+        // the start leads the points (already passed), so that the first point sought is
+        // passed like the others when the walker is pushed past it
+        let points = route.iter().map(|p| Vec3::new(p.x, 0.0, p.y)).collect();
         let mut avoid = Part::new(Behaviour::AvoidObstacles {
             radius: self.radius,
             lookahead: 0.6,
@@ -209,7 +210,7 @@ impl Walker {
         steering.add(avoid);
         steering.add(Part::new(Behaviour::FollowPoints {
             points,
-            next: 0,
+            next: 1,
             reach,
             params,
         }));
@@ -268,18 +269,42 @@ impl Walker {
             return;
         }
         let mut walk = a.walk.clone();
-        let moments = a.moments;
         walk.goal = goal;
         walk.face = face;
-        if self.start(walk, obstacles).is_ok() {
-            if let Some(a) = self.active.as_mut() {
-                // (a relax that happened stays: it has been reported)
-                a.moments = Moments {
-                    end: None,
-                    ..moments
-                };
-            }
+        self.restart(walk, obstacles);
+    }
+
+    /// Plans the walk under way again from where the body stands when the point its route
+    /// seeks is out of sight within its radius (others pressed it behind an obstacle's
+    /// clearance, where seeking that point only pushes it along the obstacle); true if it did.
+    fn replan_if_lost(&mut self, obstacles: &Obstacles) -> bool {
+        let Some(a) = self.active.as_ref() else {
+            return false;
+        };
+        let here = self.body().at;
+        let route = a.route_from(here);
+        let aim = route.get(1).copied().unwrap_or(a.walk.goal);
+        if a.halting || a.stopped || obstacles.segment_clear(here, aim, 0.5 * self.radius) {
+            return false;
         }
+        let walk = a.walk.clone();
+        self.restart(walk, obstacles)
+    }
+
+    /// Starts `walk` again from here, keeping the moments that happened.
+    fn restart(&mut self, walk: Walk, obstacles: &Obstacles) -> bool {
+        let Some(moments) = self.active.as_ref().map(|a| a.moments) else {
+            return false;
+        };
+        let ok = self.start(walk, obstacles).is_ok();
+        if let (true, Some(a)) = (ok, self.active.as_mut()) {
+            // (a relax that happened stays: it has been reported)
+            a.moments = Moments {
+                end: None,
+                ..moments
+            };
+        }
+        ok
     }
 
     /// Steps until `t` (whole steps of [`STEP`]); returns the walk's moments if it ended in
@@ -325,12 +350,19 @@ impl Walker {
         others: Option<Others<'_>>,
     ) -> Option<Moments> {
         let time = self.time;
+        // among others, who may press it behind an obstacle: once a second on the global grid
+        if others.is_some() && (time / STEP).round() as i64 % REPLAN_EVERY == 0 {
+            self.replan_if_lost(obstacles);
+        }
         let facing_before = self.facing;
         let mut ended = None;
         if let Some(a) = self.active.as_mut() {
             let to_goal = a.walk.goal - Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
-            let next = a.route.get(1).copied().unwrap_or(a.walk.goal);
             let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+            // the point sought now (not the route's first: one pushed past it and slowed down
+            // turned back to it on the spot)
+            let ahead = a.route_from(here);
+            let next = ahead.get(1).copied().unwrap_or(a.walk.goal);
             let wanted = (next - here).normalize_or_zero();
             let behind = wanted != Vec2::ZERO
                 && angle_diff(wanted.x.atan2(wanted.y), self.facing).abs() > TURN_FIRST;
@@ -339,7 +371,7 @@ impl Walker {
             let speed = self.vehicle.speed();
             let braking = speed * speed / (2.0 * HALT_DECELERATION);
             if !a.halting && speed < 0.3 && to_goal.length() <= STOP_RADIUS + braking {
-                a.halting = a.route_from(here).len() <= 2;
+                a.halting = ahead.len() <= 2;
             }
             if a.halting && !a.stopped {
                 let v = self.vehicle.velocity;
@@ -351,7 +383,7 @@ impl Walker {
                     a.stopped = true;
                 }
             } else if !a.stopped {
-                let route = a.route_from(here);
+                let route = ahead;
                 let left = path::length(&route);
                 if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
                     // turn on the spot before setting off
@@ -561,13 +593,16 @@ impl Near<'_, '_> {
                 radius: self.radius,
             };
             let near = neighbours(self.others, self.time, here, NEIGHBOUR_RADIUS);
+            // the walls are left to the route and the obstacle steering: a walker going round a
+            // group's space at its clearance found every forward candidate "into a wall" and
+            // stood (seen in the plaza); a choice that would meet a wall is dropped below
             let v = avoider.choose(
                 me,
                 desired,
                 facing,
                 pref,
                 near.into_iter(),
-                self.obstacles,
+                &Obstacles::default(),
                 self.profile,
             );
             let clear = self
@@ -604,7 +639,7 @@ impl Active {
             .parts()
             .iter()
             .find_map(|p| match &p.behaviour {
-                Behaviour::FollowPoints { next, .. } => Some(*next + 1),
+                Behaviour::FollowPoints { next, .. } => Some(*next),
                 _ => None,
             })
             .unwrap_or(self.route.len() - 1);

@@ -174,7 +174,7 @@ impl World {
             .map(|s| Obstacle {
                 shape: Shape::Circle {
                     centre: s.centre,
-                    radius: s.outer,
+                    radius: s.outer + crate::crowd::group::PASSING,
                 },
                 height: 0.0,
             })

@@ -70,8 +70,8 @@ pub struct RunArgs {
     /// a header with the skeleton, then one line every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.jsonl")]
     frames: Option<std::path::PathBuf>,
-    /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
-    /// clock before the next item.
+    /// BML files (one block each; a directory: its .xml files by name), '-' for a stream of
+    /// blocks on stdin, '+SECS' to advance the clock before the next item.
     #[arg(required = true, value_name = "ITEM")]
     items: Vec<String>,
 }
@@ -253,9 +253,42 @@ pub enum Item {
     Stdin,
 }
 
-/// The items of a command line: files read, clock advances checked.
+/// Most `.xml` files a directory on the command line may hold.
+pub const MAX_DIRECTORY_FILES: usize = 20_000;
+
+/// The `.xml` files in directory `dir`, by name, or why not.
+fn xml_files(dir: &Path) -> Result<Vec<String>, String> {
+    let cannot = |e: std::io::Error| format!("{}: cannot read the directory: {e}", dir.display());
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(cannot)? {
+        let path = entry.map_err(cannot)?.path();
+        if path.is_file() && path.extension().is_some_and(|x| x == "xml") {
+            files.push(path.to_string_lossy().into_owned());
+        }
+    }
+    if files.is_empty() || files.len() > MAX_DIRECTORY_FILES {
+        return Err(format!(
+            "{}: a directory must hold 1 to {MAX_DIRECTORY_FILES} .xml files, not {}",
+            dir.display(),
+            files.len()
+        ));
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// The items of a command line: files read (a directory: its `.xml` files by name), clock
+/// advances checked.
 pub fn read_items(items: &[String]) -> Result<Vec<Item>, String> {
-    items
+    let mut expanded = Vec::new();
+    for a in items {
+        if Path::new(a).is_dir() {
+            expanded.extend(xml_files(Path::new(a))?);
+        } else {
+            expanded.push(a.clone());
+        }
+    }
+    expanded
         .iter()
         .map(|a| {
             if a == "-" {
