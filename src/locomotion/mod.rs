@@ -8,6 +8,7 @@
 //! (`engines::locomotion`) realizes BML `<locomotion>` with them; `docs/locomotion.md` explains
 //! the whole.
 
+pub mod among;
 pub mod gait;
 pub mod obstacles;
 pub mod path;

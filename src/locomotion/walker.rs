@@ -8,12 +8,13 @@
 
 use glam::{Vec2, Vec3};
 
+pub use super::among::Others;
+use super::among::{neighbours, Near};
 use super::gait::{angle_diff, forward, Body, Gait};
 use super::obstacles::Obstacles;
 use super::path::{self, PathError};
 use super::steering::{flat, ArriveParams, Behaviour, Combine, Context, Part, Steering, Vehicle};
-use crate::crowd::avoid::NEIGHBOUR_RADIUS;
-use crate::crowd::{Agent, Avoider, Crowd, Profile};
+use crate::crowd::{Avoider, Profile};
 
 /// The walker's fixed step (s).
 pub const STEP: f64 = 1.0 / 240.0;
@@ -97,15 +98,6 @@ pub struct Walker {
     avoider: Avoider,
     chosen: Option<Vec2>,
     active: Option<Active>,
-}
-
-/// The others a walker shares the ground with: the frame's crowd and its own place in it.
-#[derive(Debug, Clone, Copy)]
-pub struct Others<'a> {
-    /// The crowd (places as of its time, moved on by their velocities).
-    pub crowd: &'a Crowd,
-    /// The walker's own index in it.
-    pub me: Option<usize>,
 }
 
 impl Walker {
@@ -539,96 +531,6 @@ impl Walker {
         m.ready.get_or_insert(relax);
         Ok(m)
     }
-}
-
-/// How often a walker among others chooses its velocity again (steps): every
-/// [`DECIDE_PERIOD`](crate::crowd::avoid::DECIDE_PERIOD).
-pub const DECIDE_EVERY: i64 = (crate::crowd::avoid::DECIDE_PERIOD / STEP + 0.5) as i64;
-/// How often a walker checks that its course does not touch someone within
-/// [`URGENT_HORIZON`] (steps: 40 times a second).
-pub const WATCH_EVERY: i64 = 6;
-/// A course that touches someone sooner than this (s) is chosen again at once.
-pub const URGENT_HORIZON: f32 = 0.4;
-
-/// What a walker among others needs to steer round them.
-struct Near<'a, 'b> {
-    others: Others<'b>,
-    time: f64,
-    radius: f32,
-    profile: &'a Profile,
-    obstacles: &'a Obstacles,
-}
-
-impl Near<'_, '_> {
-    /// The force toward the velocity chosen among the others ([`DECIDE_EVERY`] steps), or
-    /// `None` when nobody is in the way (or the choice would lead into an obstacle).
-    fn steer(
-        &self,
-        avoider: &mut Avoider,
-        chosen: &mut Option<Vec2>,
-        vehicle: &Vehicle,
-        facing: f32,
-        desired: Vec2,
-        pref: f32,
-    ) -> Option<Vec3> {
-        let here = Vec2::new(vehicle.position.x, vehicle.position.z);
-        let velocity = Vec2::new(vehicle.velocity.x, vehicle.velocity.z);
-        let tick = (self.time / STEP).round() as i64;
-        let regular = tick % DECIDE_EVERY == 0;
-        if regular {
-            avoider.wait(DECIDE_EVERY as f32 * STEP as f32, velocity.length(), pref);
-        }
-        // between the regular choices, a course about to touch someone is chosen again at once
-        let urgent = !regular
-            && tick % WATCH_EVERY == 0
-            && (neighbours(self.others, self.time, here, 2.0).iter()).any(|o| {
-                let reach = self.radius + o.radius + crate::crowd::avoid::BODY_MARGIN;
-                crate::crowd::contact::time_to_contact(o.at - here, o.velocity - velocity, reach)
-                    .is_some_and(|t| t < URGENT_HORIZON)
-            });
-        if regular || urgent {
-            let me = Agent {
-                at: here,
-                velocity,
-                radius: self.radius,
-            };
-            let near = neighbours(self.others, self.time, here, NEIGHBOUR_RADIUS);
-            // the walls are left to the route and the obstacle steering: a walker going round a
-            // group's space at its clearance found every forward candidate "into a wall" and
-            // stood (seen in the plaza); a choice that would meet a wall is dropped below
-            let v = avoider.choose(
-                me,
-                desired,
-                facing,
-                pref,
-                near.into_iter(),
-                &Obstacles::default(),
-                self.profile,
-            );
-            let clear = self
-                .obstacles
-                .segment_clear(here, here + v * 0.6, self.radius);
-            *chosen = (avoider.avoiding && clear).then_some(v);
-        }
-        chosen.map(|v| Vec3::new(v.x, 0.0, v.y) - flat(vehicle.velocity))
-    }
-}
-
-/// The others within `r` of `here` at `time` (their places moved on by their velocities).
-fn neighbours(o: Others<'_>, time: f64, here: Vec2, r: f32) -> Vec<Agent> {
-    let mut found = Vec::new();
-    o.crowd.near(here, r, &mut found);
-    let ahead = (time - o.crowd.time) as f32;
-    (found.into_iter())
-        .filter(|&i| Some(i) != o.me)
-        .map(|i| {
-            let a = o.crowd.agent(i);
-            Agent {
-                at: a.at + a.velocity * ahead,
-                ..a
-            }
-        })
-        .collect()
 }
 
 impl Active {
