@@ -303,6 +303,19 @@ fn into_wall(me: Agent, v: Vec2, walls: &Obstacles) -> bool {
 mod tests {
     use super::*;
 
+    /// `a`'s choice for `me` wanting `desired`, looking along `heading`, at 1.3 m/s preferred,
+    /// among `others` and no walls.
+    fn choose(
+        a: &mut Avoider,
+        me: Agent,
+        desired: Vec2,
+        heading: f32,
+        others: impl Iterator<Item = Agent>,
+        p: &Profile,
+    ) -> Vec2 {
+        a.choose(me, desired, heading, 1.3, others, &Obstacles::default(), p)
+    }
+
     fn agent(x: f32, z: f32, vx: f32, vz: f32) -> Agent {
         Agent {
             at: Vec2::new(x, z),
@@ -317,15 +330,7 @@ mod tests {
         let me = agent(0.0, 0.0, 0.0, 1.3);
         let far = [agent(0.0, 30.0, 0.0, -1.3), agent(5.0, 0.0, 0.0, 1.3)];
         let d = Vec2::new(0.0, 1.3);
-        let v = a.choose(
-            me,
-            d,
-            0.0,
-            1.3,
-            far.into_iter(),
-            &Obstacles::default(),
-            &Profile::default(),
-        );
+        let v = choose(&mut a, me, d, 0.0, far.into_iter(), &Profile::default());
         assert_eq!(v, d);
         assert!(!a.avoiding);
     }
@@ -337,29 +342,13 @@ mod tests {
         let mut a = Avoider::new(7);
         let me = agent(0.0, 0.0, 0.0, 1.3);
         let them = agent(0.0, 6.0, 0.0, -1.3);
-        let mine = a.choose(
-            me,
-            d,
-            0.0,
-            1.3,
-            [them].into_iter(),
-            &Obstacles::default(),
-            &p,
-        );
+        let mine = choose(&mut a, me, d, 0.0, [them].into_iter(), &p);
         // facing +z, the right hand is −x
         assert!(mine.x < -0.05, "{mine}");
         assert!(a.avoiding);
         // the other, facing −z, also turns to its right: +x
         let mut b = Avoider::new(9);
-        let v = b.choose(
-            them,
-            -d,
-            std::f32::consts::PI,
-            1.3,
-            [me].into_iter(),
-            &Obstacles::default(),
-            &p,
-        );
+        let v = choose(&mut b, them, -d, std::f32::consts::PI, [me].into_iter(), &p);
         assert!(v.x > 0.05, "{v}");
         // having chosen, the other drifting onto its side does not flip it (a fresh walker also
         // stays right here: the right-hand order alone holds; keepSide is not yet shown to matter)
@@ -368,15 +357,7 @@ mod tests {
             velocity: mine,
             ..me
         };
-        let v = a.choose(
-            going,
-            d,
-            0.0,
-            1.3,
-            [nudged].into_iter(),
-            &Obstacles::default(),
-            &p,
-        );
+        let v = choose(&mut a, going, d, 0.0, [nudged].into_iter(), &p);
         assert!(v.x < 0.0, "{v}");
     }
 
@@ -388,16 +369,29 @@ mod tests {
         let me = agent(0.0, 0.0, 0.0, 1.3);
         // someone standing just ahead, slightly to the right
         let there = agent(-0.1, 0.7, 0.0, 0.0);
-        let v = a.choose(
-            me,
-            d,
-            0.0,
-            1.3,
-            [there].into_iter(),
-            &Obstacles::default(),
-            &p,
-        );
+        let v = choose(&mut a, me, d, 0.0, [there].into_iter(), &p);
         let t = time_to_contact(there.at - me.at, -v, 0.5);
         assert!(t.is_none_or(|t| t > BODY_HORIZON), "{v} {t:?}");
+    }
+
+    #[test]
+    fn into_a_wall_is_toward_it_not_along_one_already_touched() {
+        use crate::locomotion::obstacles::{Obstacle, Shape};
+        let wall = Obstacles::new(vec![Obstacle {
+            shape: Shape::Segment {
+                a: Vec2::new(-5.0, 0.0),
+                b: Vec2::new(5.0, 0.0),
+            },
+            height: 2.0,
+        }]);
+        // touching the wall (its radius from it): along it is fine, toward it is not
+        let me = agent(0.0, -0.25, 0.0, 0.0);
+        assert!(!into_wall(me, Vec2::new(1.3, 0.0), &wall));
+        assert!(into_wall(me, Vec2::new(1.0, 0.3), &wall));
+        assert!(!into_wall(me, Vec2::new(0.0, -1.3), &wall));
+        // a metre off, going at it at 1.3 m/s: within half a second it touches
+        let me = agent(0.0, -0.8, 0.0, 0.0);
+        assert!(into_wall(me, Vec2::new(0.0, 1.3), &wall));
+        assert!(!into_wall(me, Vec2::new(0.0, 0.5), &wall));
     }
 }
