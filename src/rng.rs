@@ -16,4 +16,12 @@ impl Rng {
         self.0 = x;
         (x >> 40) as f32 / (1u64 << 24) as f32
     }
+
+    /// Moves on by `n` numbers without making them (where a caller knows it will not use
+    /// them, but the numbers after them must stay the same).
+    pub fn skip(&mut self, n: usize) {
+        for _ in 0..n {
+            self.next_f32();
+        }
+    }
 }

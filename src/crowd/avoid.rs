@@ -17,7 +17,7 @@
 
 use glam::Vec2;
 
-use super::contact::time_to_contact;
+use super::contact::{time_to_contact, Approach};
 use super::profile::Profile;
 use super::snapshot::Agent;
 use crate::locomotion::Obstacles;
@@ -43,6 +43,9 @@ pub const BODY_MARGIN: f32 = 0.05;
 pub const RIGHT_BIAS: f32 = 0.05;
 /// How long a walker held below half its preferred speed waits before it is fully impatient (s).
 pub const PATIENCE: f32 = 3.0;
+/// Kept under a candidate's cost floor for rounding, so that a floor never cuts a candidate its
+/// cost would have kept.
+const FLOOR_MARGIN: f32 = 1e-3;
 /// How often a walker chooses its velocity among others (s).
 pub const DECIDE_PERIOD: f64 = 0.1;
 /// How far a walker looks for others (m).
@@ -173,8 +176,18 @@ impl Avoider {
             best = (cost, me.velocity);
         }
         let wanted_speed = desired.length();
+        let turning_costs = desired.length() > 1e-3;
         for k in offsets {
             let side = k.signum() as i8;
+            let e = extra(side, self.side);
+            // a heading that turns too far for any of its speeds to win is passed over whole
+            // (its jitter drawn all the same, so that the rest are jittered as ever)
+            let least = (k.abs() as f32 * step * (1.0 - 0.5 * p.distortion)).max(0.0);
+            let floor = p.gamma * least / std::f32::consts::PI - FLOOR_MARGIN;
+            if k != 0 && turning_costs && floor + e >= best.0 {
+                self.rng.skip(2 * (SPEED_SAMPLES + 1));
+                continue;
+            }
             for s in 0..=SPEED_SAMPLES {
                 let f = 1.0 - s as f32 / SPEED_SAMPLES as f32;
                 let speed = if k == 0 && s == 0 {
@@ -188,8 +201,12 @@ impl Avoider {
                 } else {
                     k as f32 * step * (1.0 + self.jitter() * p.distortion)
                 };
+                // most candidates cost more than the best from their speed and turn alone
+                let angle = if turning_costs { turn } else { 0.0 };
+                if self.floor(me, speed, angle, desired, pref, p) + e >= best.0 {
+                    continue;
+                }
                 let v = Vec2::new((base + turn).sin(), (base + turn).cos()) * speed;
-                let e = extra(side, self.side);
                 let cost = self.cost(me, v, desired, pref, p, best.0 - e, walls) + e;
                 if cost < best.0 {
                     best = (cost, v);
@@ -217,8 +234,10 @@ impl Avoider {
         let half_fov = (0.5 * p.field_of_view).to_radians().cos();
         for o in others {
             let dx = o.at - me.at;
-            let d = dx.length();
-            let seen = d < 1.0 || dx.dot(look) >= half_fov * d;
+            // (in front with a field of view over 180° is seen without the distance's root)
+            let (dd, ahead) = (dx.length_squared(), dx.dot(look));
+            let seen =
+                dd < 1.0 || (half_fov <= 0.0 && ahead >= 0.0) || ahead >= half_fov * dd.sqrt();
             if !seen {
                 continue;
             }
@@ -231,6 +250,36 @@ impl Avoider {
         }
         self.contacts.sort_by(|a, b| a.0.total_cmp(&b.0));
         self.contacts.truncate(MAX_CONTACTS);
+    }
+
+    /// The costs of changing speed from `me`'s to `speed`, and of deviating by `angle` (rad)
+    /// and in speed from `desired`, at preferred speed `u`.
+    fn speed_and_turn(
+        &self,
+        me: Agent,
+        speed: f32,
+        angle: f32,
+        desired: Vec2,
+        u: f32,
+        p: &Profile,
+    ) -> (f32, f32) {
+        let change = p.beta * (speed - me.velocity.length()).abs() / u;
+        let slower = (desired.length() - speed).max(0.0) / u;
+        let hurry = self.impatience();
+        // faster than desired costs as much as slower (arriving, the desired speed falls)
+        let faster = (speed - desired.length()).max(0.0) / u;
+        let deviation = p.gamma
+            * (angle / std::f32::consts::PI + 0.5 * ((1.0 + 2.0 * hurry) * slower + faster));
+        (change, deviation)
+    }
+
+    /// A floor under the cost of the candidate at `speed` turned by `turn` from the desired
+    /// heading, known before the candidate is made: the cost of its speed and turn, less a
+    /// margin for the rounding of the angle measured between the vectors.
+    fn floor(&self, me: Agent, speed: f32, turn: f32, desired: Vec2, u: f32, p: &Profile) -> f32 {
+        let angle = if speed > 1e-3 { turn.abs() } else { 0.0 };
+        let (change, deviation) = self.speed_and_turn(me, speed, angle, desired, u, p);
+        change + deviation - FLOOR_MARGIN
     }
 
     /// The cost of candidate `v` for `me`; infinite when the cost without the contacts already
@@ -248,19 +297,13 @@ impl Avoider {
         walls: &Obstacles,
     ) -> f32 {
         let previous = me.velocity;
-        let effort = p.alpha * (v - previous).length() / (2.0 * u)
-            + p.beta * (v.length() - previous.length()).abs() / u;
         let angle = if v.length() > 1e-3 && desired.length() > 1e-3 {
             v.angle_to(desired).abs()
         } else {
             0.0
         };
-        let slower = (desired.length() - v.length()).max(0.0) / u;
-        let hurry = self.impatience();
-        // faster than desired costs as much as slower (arriving, the desired speed falls)
-        let faster = (v.length() - desired.length()).max(0.0) / u;
-        let deviation = p.gamma
-            * (angle / std::f32::consts::PI + 0.5 * ((1.0 + 2.0 * hurry) * slower + faster));
+        let (change, deviation) = self.speed_and_turn(me, v.length(), angle, desired, u, p);
+        let effort = p.alpha * (v - previous).length() / (2.0 * u) + change;
         let mut cheap = effort + deviation;
         if !walls.is_empty() && into_wall(me, v, walls) {
             cheap += 11.0;
@@ -268,27 +311,36 @@ impl Avoider {
         if cheap >= bound {
             return f32::INFINITY;
         }
+        let hurry = self.impatience();
+        // the contacts only add to the cost, more the sooner: a candidate is dropped as soon
+        // as what is known of them reaches the bound (the soonest contacts are weighed first)
+        let caution = p.delta * (1.0 - 0.75 * hurry);
+        let weighed = |soonest: f32, touch: f32| {
+            let risk = caution * (1.0 - soonest / p.tc_max);
+            let bodies = if touch < BODY_HORIZON {
+                10.0 * (1.0 - touch / BODY_HORIZON) + 1.0
+            } else {
+                0.0
+            };
+            cheap + risk + bodies
+        };
         let (mut soonest, mut touch) = (p.tc_max, f32::INFINITY);
         for &(_, o) in &self.contacts {
-            let dx = o.at - me.at;
-            let dv = o.velocity - v;
             let reach = (me.radius + o.radius) * self.incr;
+            let approach = Approach::new(o.at - me.at, o.velocity - v);
             // the bodies' reach is within the personal one: no personal contact, no touch
-            if let Some(t) = time_to_contact(dx, dv, reach) {
+            if let Some(t) = approach.time_to(reach) {
                 soonest = soonest.min(t);
                 let body = (me.radius + o.radius + BODY_MARGIN).min(reach);
-                if let Some(t) = time_to_contact(dx, dv, body) {
+                if let Some(t) = approach.time_to(body) {
                     touch = touch.min(t);
+                }
+                if weighed(soonest, touch) >= bound {
+                    return f32::INFINITY;
                 }
             }
         }
-        let risk = p.delta * (1.0 - 0.75 * hurry) * (1.0 - soonest / p.tc_max);
-        let bodies = if touch < BODY_HORIZON {
-            10.0 * (1.0 - touch / BODY_HORIZON) + 1.0
-        } else {
-            0.0
-        };
-        cheap + risk + bodies
+        weighed(soonest, touch)
     }
 }
 

@@ -12,23 +12,50 @@ use super::snapshot::Agent;
 /// they are within it and closing in, `None` when they never touch (or are within it and moving
 /// apart).
 pub fn time_to_contact(dx: Vec2, dv: Vec2, reach: f32) -> Option<f32> {
-    let c = dx.dot(dx) - reach * reach;
-    let b = 2.0 * dx.dot(dv);
-    if c <= 0.0 {
-        // already within reach: a contact now unless they part
-        return (b < 0.0).then_some(0.0);
+    Approach::new(dx, dv).time_to(reach)
+}
+
+/// Two discs' relative place and velocity, kept to ask [`time_to_contact`] at several reaches
+/// without computing the same products again.
+#[derive(Debug, Clone, Copy)]
+pub struct Approach {
+    /// ‖Δx‖².
+    dd: f32,
+    /// 2 Δx·Δv.
+    b: f32,
+    /// ‖Δv‖².
+    a: f32,
+}
+
+impl Approach {
+    /// The approach of discs differing by `dx` in place and `dv` in velocity (other − me).
+    pub fn new(dx: Vec2, dv: Vec2) -> Approach {
+        Approach {
+            dd: dx.dot(dx),
+            b: 2.0 * dx.dot(dv),
+            a: dv.dot(dv),
+        }
     }
-    let a = dv.dot(dv);
-    if a < 1e-9 || b >= 0.0 {
-        // same velocity, or moving apart
-        return None;
+
+    /// The first time they come within `reach`, as [`time_to_contact`] says.
+    pub fn time_to(&self, reach: f32) -> Option<f32> {
+        let (a, b) = (self.a, self.b);
+        let c = self.dd - reach * reach;
+        if c <= 0.0 {
+            // already within reach: a contact now unless they part
+            return (b < 0.0).then_some(0.0);
+        }
+        if a < 1e-9 || b >= 0.0 {
+            // same velocity, or moving apart
+            return None;
+        }
+        let disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            return None;
+        }
+        let t = (-b - disc.sqrt()) / (2.0 * a);
+        (t >= 0.0).then_some(t)
     }
-    let disc = b * b - 4.0 * a * c;
-    if disc < 0.0 {
-        return None;
-    }
-    let t = (-b - disc.sqrt()) / (2.0 * a);
-    (t >= 0.0).then_some(t)
 }
 
 /// Overlaps shrink with this time constant (s) when bodies are pushed apart.

@@ -36,6 +36,8 @@ pub struct Crowd {
     agents: Vec<Agent>,
     /// (cell key, agent index), sorted.
     cells: Vec<(u64, u32)>,
+    /// The agents' places in the order of `cells` (read together when searching a cell).
+    placed: Vec<Vec2>,
 }
 
 fn cell_of(p: Vec2) -> (i32, i32) {
@@ -82,11 +84,13 @@ impl Crowd {
             .map(|(i, a)| (key(cell_of(a.at)), i as u32))
             .collect();
         cells.sort_unstable();
+        let placed = cells.iter().map(|&(_, i)| agents[i as usize].at).collect();
         Crowd {
             time,
             ids,
             agents,
             cells,
+            placed,
         }
     }
 
@@ -141,11 +145,12 @@ impl Crowd {
                     continue;
                 }
                 let start = self.cells.partition_point(|c| c.0 < a);
-                for &(k, i) in &self.cells[start..] {
+                let run = self.cells[start..].iter().zip(&self.placed[start..]);
+                for (&(k, i), at) in run {
                     if k > b {
                         break;
                     }
-                    if self.agents[i as usize].at.distance_squared(p) <= r * r {
+                    if at.distance_squared(p) <= r * r {
                         out.push(i as usize);
                     }
                 }
