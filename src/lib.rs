@@ -10,6 +10,7 @@
 //! - [`plan`]: the flexible plan of pegs;
 //! - [`engine`]: the engine interface, registry and timing models; [`engines`]: built-in engines;
 //! - [`body`]: the skeleton (H-Anim), poses and forward kinematics;
+//! - [`avatar`]: skinned avatars (glTF/VRM) and the realizer's motion retargeted onto them;
 //! - [`clock`]: virtual and wall clocks;
 //! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`;
 //!   feature `conformance`, on by default);
@@ -18,6 +19,7 @@
 
 #![warn(missing_docs)]
 
+pub mod avatar;
 pub mod blocks;
 pub mod bml;
 pub mod body;

@@ -213,9 +213,9 @@ def skin_weights(weights, n, names):
 
 
 def straighten(joints):
-    """The H-Anim rest of the A-posed body: arms, hands and fingers straight down (the palms
-    then face the thighs, as they do in the A-pose: checked by `check`), legs straight down,
-    the feet as they were. Returns the joints' names, parents, new places, the rotation that
+    """The H-Anim rest of the A-posed body: arms, hands, fingers and legs along the realizer's
+    rest bones (`fixtures/skeletons/adult.json`: straight down, the hand a little forward; the
+    palms then face the thighs, as the A-pose's do), the feet as they were. Returns the joints' names, parents, new places, the rotation that
     takes each joint's part of the body there, and the old places."""
     names = [j for j, _, _ in joints]
     index = {j: i for i, j in enumerate(names)}
@@ -224,7 +224,10 @@ def straighten(joints):
     child = {}
     for i, p in enumerate(parent):
         child.setdefault(p, []).append(i)
-    down = np.array([0.0, -1.0, 0.0])
+    # the realizer's rest direction of every bone: its child's offset (adult.json)
+    adult = json.load(open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
+                                        "fixtures", "skeletons", "adult.json")))
+    offset = {j["name"]: np.array(j["offset"], dtype=np.float64) for j in adult["joints"]}
     # the joint whose place a joint's bone points at
     aim = {}
     for s in "lr":
@@ -246,7 +249,7 @@ def straighten(joints):
             new[i] = new[p] + rp @ (place[i] - place[p])
         if name in aim:
             d = rp @ (place[index[aim[name]]] - place[i])
-            rot[i] = arc(d, down) @ rp
+            rot[i] = arc(d, offset[aim[name]]) @ rp
         elif name.endswith(("index3", "middle3", "ring3", "pinky3")):
             rot[i] = rot[p]
         elif name in keep_world:

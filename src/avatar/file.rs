@@ -1,0 +1,229 @@
+//! Reading an avatar file: a binary glTF (`.glb`, and VRM 0.x/1.0 `.vrm`, which are GLB) or a
+//! JSON glTF (`.gltf`) whose buffers are files beside it. The `gltf` crate checks the document
+//! (every index in range, the structure valid); the file's own JSON is kept as it is (VRM's
+//! extensions included) together with its binary buffer, so that an export can write the
+//! avatar back unchanged with the animation added. Out of the document come the nodes (names,
+//! parents, rest transforms), the first skin's joints and every mesh's morph target names.
+
+use std::path::Path;
+
+use glam::{Mat4, Quat, Vec3};
+use serde_json::Value;
+
+/// The largest avatar file read (bytes).
+pub const MAX_AVATAR_BYTES: u64 = 256 << 20;
+
+/// Something wrong with an avatar file: the file and what is wrong or missing.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}: {what}")]
+pub struct AvatarError {
+    /// The file (or the name the avatar was given).
+    pub file: String,
+    /// What is wrong or missing, in a sentence.
+    pub what: String,
+}
+
+impl AvatarError {
+    pub(crate) fn new(file: &str, what: impl Into<String>) -> AvatarError {
+        AvatarError {
+            file: file.to_string(),
+            what: what.into(),
+        }
+    }
+}
+
+/// One node of the avatar's scene graph at rest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// Its name (`""` when it has none).
+    pub name: String,
+    /// Its parent node.
+    pub parent: Option<usize>,
+    /// Its rest translation, relative to its parent.
+    pub translation: Vec3,
+    /// Its rest rotation, relative to its parent.
+    pub rotation: Quat,
+    /// Its rest scale.
+    pub scale: Vec3,
+}
+
+impl Node {
+    /// Its rest transform relative to its parent.
+    pub fn local(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation)
+    }
+}
+
+/// An avatar file read: its nodes, skin and morph targets, and the file's JSON and binary
+/// buffer as they were.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// The file's name, for messages.
+    pub file: String,
+    /// Every node, in the file's order.
+    pub nodes: Vec<Node>,
+    /// The nodes of the first skin's joints.
+    pub joints: Vec<usize>,
+    /// Per mesh (by index) the names of its morph targets (empty when it has none or they are
+    /// unnamed).
+    pub morphs: Vec<Vec<String>>,
+    /// The file's glTF JSON.
+    pub json: Value,
+    /// The binary buffer (the GLB's BIN chunk, or a `.gltf`'s single buffer).
+    pub bin: Vec<u8>,
+}
+
+const GLB_MAGIC: u32 = 0x4654_6C67;
+const CHUNK_JSON: u32 = 0x4E4F_534A;
+const CHUNK_BIN: u32 = 0x004E_4942;
+
+impl Model {
+    /// Reads the avatar at `path` (`.glb`, `.vrm` or `.gltf`).
+    pub fn read(path: &Path) -> Result<Model, AvatarError> {
+        let file = path.display().to_string();
+        let size = std::fs::metadata(path)
+            .map_err(|e| AvatarError::new(&file, format!("cannot read it: {e}")))?
+            .len();
+        if size > MAX_AVATAR_BYTES {
+            return Err(AvatarError::new(
+                &file,
+                format!("{size} bytes, more than the {MAX_AVATAR_BYTES} an avatar may have"),
+            ));
+        }
+        let bytes = std::fs::read(path)
+            .map_err(|e| AvatarError::new(&file, format!("cannot read it: {e}")))?;
+        if bytes.starts_with(b"glTF") {
+            return Model::from_glb(&file, &bytes);
+        }
+        let json: Value = serde_json::from_slice(&bytes)
+            .map_err(|e| AvatarError::new(&file, format!("neither GLB nor glTF JSON: {e}")))?;
+        let bin = match json["buffers"].as_array().map(Vec::as_slice) {
+            None | Some([]) => Vec::new(),
+            Some([one]) => {
+                let uri = one["uri"].as_str().unwrap_or("");
+                if uri.is_empty() || uri.starts_with("data:") {
+                    return Err(AvatarError::new(
+                        &file,
+                        "its buffer is embedded as a data: URI; convert it to .glb",
+                    ));
+                }
+                let beside = path.parent().unwrap_or(Path::new(".")).join(uri);
+                std::fs::read(&beside).map_err(|e| {
+                    AvatarError::new(&file, format!("buffer {}: {e}", beside.display()))
+                })?
+            }
+            Some(_) => {
+                return Err(AvatarError::new(
+                    &file,
+                    "more than one buffer; convert it to .glb",
+                ))
+            }
+        };
+        Model::from_parts(&file, json, bin)
+    }
+
+    /// Reads an avatar from the bytes of a GLB (or VRM) file named `file`.
+    pub fn from_glb(file: &str, bytes: &[u8]) -> Result<Model, AvatarError> {
+        let bad = |what: &str| AvatarError::new(file, format!("not a valid GLB: {what}"));
+        let word = |at: usize| -> Result<u32, AvatarError> {
+            let b = bytes.get(at..at + 4).ok_or_else(|| bad("it ends early"))?;
+            Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        };
+        if word(0)? != GLB_MAGIC || word(4)? != 2 {
+            return Err(bad("not glTF 2.0"));
+        }
+        let total = (word(8)? as usize).min(bytes.len());
+        let (mut at, mut json, mut bin) = (12, None, Vec::new());
+        while at + 8 <= total {
+            let (length, kind) = (word(at)? as usize, word(at + 4)?);
+            let chunk = bytes
+                .get(at + 8..at + 8 + length)
+                .ok_or_else(|| bad("a chunk runs past the end"))?;
+            match kind {
+                CHUNK_JSON if json.is_none() => json = Some(chunk),
+                CHUNK_BIN if bin.is_empty() => bin = chunk.to_vec(),
+                _ => {}
+            }
+            at += 8 + length.next_multiple_of(4);
+        }
+        let json = json.ok_or_else(|| bad("no JSON chunk"))?;
+        let json: Value = serde_json::from_slice(json)
+            .map_err(|e| AvatarError::new(file, format!("its JSON: {e}")))?;
+        Model::from_parts(file, json, bin)
+    }
+
+    /// The avatar of glTF `json` with binary buffer `bin`.
+    fn from_parts(file: &str, json: Value, bin: Vec<u8>) -> Result<Model, AvatarError> {
+        let text = serde_json::to_vec(&json).expect("a JSON value serialises");
+        let document = gltf::Gltf::from_slice(&text)
+            .map_err(|e| AvatarError::new(file, format!("not valid glTF: {e}")))?
+            .document;
+        let mut nodes: Vec<Node> = document
+            .nodes()
+            .map(|n| {
+                let (t, r, s) = n.transform().decomposed();
+                Node {
+                    name: n.name().unwrap_or("").to_string(),
+                    parent: None,
+                    translation: Vec3::from(t),
+                    rotation: Quat::from_array(r).normalize(),
+                    scale: Vec3::from(s),
+                }
+            })
+            .collect();
+        for n in document.nodes() {
+            for c in n.children() {
+                nodes[c.index()].parent = Some(n.index());
+            }
+        }
+        let joints = match document.skins().next() {
+            Some(skin) => skin.joints().map(|j| j.index()).collect(),
+            None => return Err(AvatarError::new(file, "it has no skin (no skinned mesh)")),
+        };
+        let morphs = document
+            .meshes()
+            .map(|m| target_names(&json["meshes"][m.index()]))
+            .collect();
+        Ok(Model {
+            file: file.to_string(),
+            nodes,
+            joints,
+            morphs,
+            json,
+            bin,
+        })
+    }
+
+    /// The rest transform of node `i` in the scene (its parents' transforms applied).
+    pub fn rest_world(&self, i: usize) -> Mat4 {
+        let mut m = self.nodes[i].local();
+        let mut at = self.nodes[i].parent;
+        // (a cycle is refused by the glTF check; the count bounds the walk all the same)
+        for _ in 0..self.nodes.len() {
+            let Some(p) = at else { break };
+            m = self.nodes[p].local() * m;
+            at = self.nodes[p].parent;
+        }
+        m
+    }
+
+    /// The node named `name`.
+    pub fn node(&self, name: &str) -> Option<usize> {
+        self.nodes.iter().position(|n| n.name == name)
+    }
+}
+
+/// The morph target names of a glTF mesh: `extras.targetNames` of the mesh or of its first
+/// primitive (exporters use either).
+fn target_names(mesh: &Value) -> Vec<String> {
+    let names = mesh["extras"]["targetNames"]
+        .as_array()
+        .or_else(|| mesh["primitives"][0]["extras"]["targetNames"].as_array());
+    names
+        .map(|a| {
+            a.iter()
+                .map(|v| v.as_str().unwrap_or("").to_string())
+                .collect()
+        })
+        .unwrap_or_default()
+}

@@ -1,0 +1,453 @@
+//! Which node of an avatar is which human bone. Bones are named here as VRM 1.0 names them
+//! (`hips`, `leftUpperArm`, …): the one vocabulary every scheme maps into. An avatar's skeleton
+//! is recognised from VRM 1.0's or VRM 0.x's humanoid extension, from a JSON bone map the user
+//! gives, or by its node names: the realizer's own H-Anim names, Mixamo's (`mixamorig:LeftArm`),
+//! or Unreal's (`upperarm_l`). Each human bone has a realizer joint as its source: the avatar
+//! bone takes the world rotation of that joint. Where the realizer has more vertebrae than the
+//! avatar has spine bones, the avatar's spine bones take the joints at the top of the spans
+//! they stand for (so that the chest and the head end up turned as the realizer's).
+
+use std::collections::BTreeMap;
+
+use serde_json::Value;
+
+use super::file::{AvatarError, Model};
+
+/// The human bones in parents-first order, each with its parent bone (`""` for the hips).
+pub const BONES: &[(&str, &str)] = &[
+    ("hips", ""),
+    ("spine", "hips"),
+    ("chest", "spine"),
+    ("upperChest", "chest"),
+    ("neck", "upperChest"),
+    ("head", "neck"),
+    ("leftEye", "head"),
+    ("rightEye", "head"),
+    ("jaw", "head"),
+    ("leftUpperLeg", "hips"),
+    ("leftLowerLeg", "leftUpperLeg"),
+    ("leftFoot", "leftLowerLeg"),
+    ("leftToes", "leftFoot"),
+    ("rightUpperLeg", "hips"),
+    ("rightLowerLeg", "rightUpperLeg"),
+    ("rightFoot", "rightLowerLeg"),
+    ("rightToes", "rightFoot"),
+    ("leftShoulder", "upperChest"),
+    ("leftUpperArm", "leftShoulder"),
+    ("leftLowerArm", "leftUpperArm"),
+    ("leftHand", "leftLowerArm"),
+    ("rightShoulder", "upperChest"),
+    ("rightUpperArm", "rightShoulder"),
+    ("rightLowerArm", "rightUpperArm"),
+    ("rightHand", "rightLowerArm"),
+    ("leftThumbMetacarpal", "leftHand"),
+    ("leftThumbProximal", "leftThumbMetacarpal"),
+    ("leftThumbDistal", "leftThumbProximal"),
+    ("leftIndexProximal", "leftHand"),
+    ("leftIndexIntermediate", "leftIndexProximal"),
+    ("leftIndexDistal", "leftIndexIntermediate"),
+    ("leftMiddleProximal", "leftHand"),
+    ("leftMiddleIntermediate", "leftMiddleProximal"),
+    ("leftMiddleDistal", "leftMiddleIntermediate"),
+    ("leftRingProximal", "leftHand"),
+    ("leftRingIntermediate", "leftRingProximal"),
+    ("leftRingDistal", "leftRingIntermediate"),
+    ("leftLittleProximal", "leftHand"),
+    ("leftLittleIntermediate", "leftLittleProximal"),
+    ("leftLittleDistal", "leftLittleIntermediate"),
+    ("rightThumbMetacarpal", "rightHand"),
+    ("rightThumbProximal", "rightThumbMetacarpal"),
+    ("rightThumbDistal", "rightThumbProximal"),
+    ("rightIndexProximal", "rightHand"),
+    ("rightIndexIntermediate", "rightIndexProximal"),
+    ("rightIndexDistal", "rightIndexIntermediate"),
+    ("rightMiddleProximal", "rightHand"),
+    ("rightMiddleIntermediate", "rightMiddleProximal"),
+    ("rightMiddleDistal", "rightMiddleIntermediate"),
+    ("rightRingProximal", "rightHand"),
+    ("rightRingIntermediate", "rightRingProximal"),
+    ("rightRingDistal", "rightRingIntermediate"),
+    ("rightLittleProximal", "rightHand"),
+    ("rightLittleIntermediate", "rightLittleProximal"),
+    ("rightLittleDistal", "rightLittleIntermediate"),
+];
+
+/// The bones an avatar must have to be driven.
+pub const REQUIRED: &[&str] = &[
+    "hips",
+    "spine",
+    "head",
+    "leftUpperArm",
+    "leftLowerArm",
+    "leftHand",
+    "rightUpperArm",
+    "rightLowerArm",
+    "rightHand",
+    "leftUpperLeg",
+    "leftLowerLeg",
+    "leftFoot",
+    "rightUpperLeg",
+    "rightLowerLeg",
+    "rightFoot",
+];
+
+/// The realizer (H-Anim) joint whose world rotation a bone takes, for bones other than the
+/// spine's (which depend on how many the avatar has, see [`spine_sources`]).
+pub fn source(bone: &str) -> Option<&'static str> {
+    let (side, rest) = if let Some(r) = bone.strip_prefix("left") {
+        ("l", r)
+    } else if let Some(r) = bone.strip_prefix("right") {
+        ("r", r)
+    } else {
+        ("", bone)
+    };
+    let name = match (side, rest) {
+        ("", "hips") => "sacroiliac",
+        ("", "neck") => "vc4",
+        ("", "head") => "skullbase",
+        ("", "jaw") => "temporomandibular",
+        (s, "Eye") => {
+            return Some(if s == "l" {
+                "l_eyeball_joint"
+            } else {
+                "r_eyeball_joint"
+            })
+        }
+        (_, "Shoulder") => "sternoclavicular",
+        (_, "UpperArm") => "shoulder",
+        (_, "LowerArm") => "elbow",
+        (_, "Hand") => "wrist",
+        (_, "UpperLeg") => "hip",
+        (_, "LowerLeg") => "knee",
+        (_, "Foot") => "talocrural",
+        (_, "Toes") => "metatarsal",
+        (_, "ThumbMetacarpal") => "thumb1",
+        (_, "ThumbProximal") => "thumb2",
+        (_, "ThumbDistal") => "thumb3",
+        (_, finger) => return finger_source(side, finger),
+    };
+    if side.is_empty() {
+        return Some(name);
+    }
+    HANIM
+        .iter()
+        .copied()
+        .find(|j| j.strip_prefix(side).and_then(|j| j.strip_prefix('_')) == Some(name))
+}
+
+fn finger_source(side: &str, finger: &str) -> Option<&'static str> {
+    let digit = ["Index", "Middle", "Ring", "Little"]
+        .iter()
+        .position(|f| finger.starts_with(f))?;
+    let k = ["Proximal", "Intermediate", "Distal"]
+        .iter()
+        .position(|p| finger.ends_with(p))?;
+    let name = format!(
+        "{side}_{}{}",
+        ["index", "middle", "ring", "pinky"][digit],
+        k + 1
+    );
+    HANIM.iter().copied().find(|j| *j == name)
+}
+
+/// The realizer's joints that bones take their rotations from.
+const HANIM: &[&str] = &[
+    "l_sternoclavicular",
+    "l_shoulder",
+    "l_elbow",
+    "l_wrist",
+    "l_hip",
+    "l_knee",
+    "l_talocrural",
+    "l_metatarsal",
+    "l_thumb1",
+    "l_thumb2",
+    "l_thumb3",
+    "l_index1",
+    "l_index2",
+    "l_index3",
+    "l_middle1",
+    "l_middle2",
+    "l_middle3",
+    "l_ring1",
+    "l_ring2",
+    "l_ring3",
+    "l_pinky1",
+    "l_pinky2",
+    "l_pinky3",
+    "r_sternoclavicular",
+    "r_shoulder",
+    "r_elbow",
+    "r_wrist",
+    "r_hip",
+    "r_knee",
+    "r_talocrural",
+    "r_metatarsal",
+    "r_thumb1",
+    "r_thumb2",
+    "r_thumb3",
+    "r_index1",
+    "r_index2",
+    "r_index3",
+    "r_middle1",
+    "r_middle2",
+    "r_middle3",
+    "r_ring1",
+    "r_ring2",
+    "r_ring3",
+    "r_pinky1",
+    "r_pinky2",
+    "r_pinky3",
+];
+
+/// The realizer's joints that an avatar's spine bones (`spine`, `chest`, `upperChest`, those
+/// it has, bottom up) take their rotations from.
+pub fn spine_sources(count: usize) -> &'static [&'static str] {
+    match count {
+        0 => &[],
+        1 => &["vt6"],
+        2 => &["vt12", "vt6"],
+        _ => &["vl5", "vt12", "vt6"],
+    }
+}
+
+/// Which node each human bone is (bone name → node), as found in `model`: by the bone map
+/// given (keys: bone names or realizer joint names; values: node names), else by VRM's
+/// humanoid extension, else by the node names.
+pub fn recognise(
+    model: &Model,
+    map: Option<&BTreeMap<String, String>>,
+) -> Result<BTreeMap<&'static str, usize>, AvatarError> {
+    let found = if let Some(map) = map {
+        from_map(model, map)?
+    } else if let Some(bones) = vrm_bones(&model.json) {
+        bones
+            .into_iter()
+            .filter(|&(_, n)| n < model.nodes.len())
+            .collect()
+    } else {
+        by_names(model)
+    };
+    let missing: Vec<&str> = REQUIRED
+        .iter()
+        .copied()
+        .filter(|b| !found.contains_key(b))
+        .collect();
+    if missing.len() == REQUIRED.len() {
+        return Err(AvatarError::new(
+            &model.file,
+            "its skeleton's names match no known scheme (H-Anim, Mixamo, VRM, Unreal); \
+             give a bone map",
+        ));
+    }
+    if !missing.is_empty() {
+        return Err(AvatarError::new(
+            &model.file,
+            format!("its skeleton lacks the bones {}", missing.join(", ")),
+        ));
+    }
+    Ok(found)
+}
+
+/// The bone of a VRM 1.0 name, as a `'static` name from [`BONES`].
+fn bone(name: &str) -> Option<&'static str> {
+    BONES.iter().map(|b| b.0).find(|b| *b == name)
+}
+
+/// The human bones of VRM 1.0 (`VRMC_vrm.humanoid.humanBones`) or VRM 0.x
+/// (`VRM.humanoid.humanBones`, whose thumb bones are named one step further out).
+fn vrm_bones(json: &Value) -> Option<BTreeMap<&'static str, usize>> {
+    let ext = &json["extensions"];
+    if let Some(bones) = ext["VRMC_vrm"]["humanoid"]["humanBones"].as_object() {
+        return Some(
+            bones
+                .iter()
+                .filter_map(|(k, v)| Some((bone(k)?, v["node"].as_u64()? as usize)))
+                .collect(),
+        );
+    }
+    let bones = ext["VRM"]["humanoid"]["humanBones"].as_array()?;
+    Some(
+        bones
+            .iter()
+            .filter_map(|b| {
+                let name = b["bone"].as_str()?;
+                let name = match name {
+                    n if n.ends_with("ThumbProximal") => n.replace("Proximal", "Metacarpal"),
+                    n if n.ends_with("ThumbIntermediate") => n.replace("Intermediate", "Proximal"),
+                    n => n.to_string(),
+                };
+                Some((bone(&name)?, b["node"].as_u64()? as usize))
+            })
+            .collect(),
+    )
+}
+
+/// The bones of a user's map (bone or realizer joint → node name).
+fn from_map(
+    model: &Model,
+    map: &BTreeMap<String, String>,
+) -> Result<BTreeMap<&'static str, usize>, AvatarError> {
+    let mut found = BTreeMap::new();
+    for (key, node) in map {
+        let b = bone(key)
+            .or_else(|| {
+                BONES
+                    .iter()
+                    .map(|b| b.0)
+                    .find(|b| hanim_name(b) == Some(key))
+            })
+            .ok_or_else(|| {
+                AvatarError::new(&model.file, format!("bone map: unknown bone '{key}'"))
+            })?;
+        let n = model.node(node).ok_or_else(|| {
+            AvatarError::new(
+                &model.file,
+                format!("bone map: {key}: no node named '{node}'"),
+            )
+        })?;
+        found.insert(b, n);
+    }
+    Ok(found)
+}
+
+/// The realizer's own name of a bone when an avatar uses H-Anim names.
+fn hanim_name(bone: &str) -> Option<&'static str> {
+    match bone {
+        "hips" => Some("sacroiliac"),
+        "spine" => Some("vl5"),
+        "chest" => Some("vt12"),
+        "upperChest" => Some("vt6"),
+        "neck" => Some("vc4"),
+        b => source(b),
+    }
+}
+
+/// A naming scheme: the node name it gives a bone.
+type NameScheme = fn(&str) -> Option<String>;
+
+/// The bones found by node names, trying each scheme and keeping the one that finds most.
+fn by_names(model: &Model) -> BTreeMap<&'static str, usize> {
+    let schemes: [NameScheme; 3] = [hanim, mixamo, unreal];
+    let mut best = BTreeMap::new();
+    for name_of in schemes {
+        let mut found = BTreeMap::new();
+        for (b, _) in BONES {
+            let Some(want) = name_of(b) else { continue };
+            if let Some(n) = model.nodes.iter().position(|n| same(&n.name, &want)) {
+                found.insert(*b, n);
+            }
+        }
+        if found.len() > best.len() {
+            best = found;
+        }
+    }
+    best
+}
+
+/// Whether node name `node` is `want`, ignoring case and a `mixamorig:`-like prefix.
+fn same(node: &str, want: &str) -> bool {
+    let bare = node.rsplit([':', '|']).next().unwrap_or(node);
+    let bare = bare.strip_prefix("mixamorig").unwrap_or(bare);
+    let bare = bare.trim_start_matches('_');
+    bare.eq_ignore_ascii_case(want)
+}
+
+fn hanim(bone: &str) -> Option<String> {
+    if bone == "neck" {
+        return Some("vc4".into());
+    }
+    hanim_name(bone).map(str::to_string)
+}
+
+fn mixamo(bone: &str) -> Option<String> {
+    let (side, rest) = split_side(bone);
+    let side = match side {
+        "l" => "Left",
+        "r" => "Right",
+        _ => "",
+    };
+    let name = match rest {
+        "hips" => "Hips",
+        "spine" => "Spine",
+        "chest" => "Spine1",
+        "upperChest" => "Spine2",
+        "neck" => "Neck",
+        "head" => "Head",
+        "Eye" => "Eye",
+        "Shoulder" => "Shoulder",
+        "UpperArm" => "Arm",
+        "LowerArm" => "ForeArm",
+        "Hand" => "Hand",
+        "UpperLeg" => "UpLeg",
+        "LowerLeg" => "Leg",
+        "Foot" => "Foot",
+        "Toes" => "ToeBase",
+        finger => return digit(finger).map(|(f, k)| format!("{side}Hand{}{k}", mixamo_finger(f))),
+    };
+    Some(format!("{side}{name}"))
+}
+
+fn mixamo_finger(f: &str) -> &str {
+    if f == "Little" {
+        "Pinky"
+    } else {
+        f
+    }
+}
+
+fn unreal(bone: &str) -> Option<String> {
+    let (side, rest) = split_side(bone);
+    let name = match rest {
+        "hips" => "pelvis",
+        "spine" => "spine_01",
+        "chest" => "spine_02",
+        "upperChest" => "spine_03",
+        "neck" => "neck_01",
+        "head" => "head",
+        "Eye" => "eye",
+        "Shoulder" => "clavicle",
+        "UpperArm" => "upperarm",
+        "LowerArm" => "lowerarm",
+        "Hand" => "hand",
+        "UpperLeg" => "thigh",
+        "LowerLeg" => "calf",
+        "Foot" => "foot",
+        "Toes" => "ball",
+        finger => {
+            let (f, k) = digit(finger)?;
+            let f = if f == "Little" { "pinky" } else { f };
+            return Some(format!("{}_0{k}_{side}", f.to_ascii_lowercase()));
+        }
+    };
+    Some(if side.is_empty() {
+        name.to_string()
+    } else {
+        format!("{name}_{side}")
+    })
+}
+
+/// A bone's side (`l`, `r` or none) and the rest of its name.
+fn split_side(bone: &str) -> (&str, &str) {
+    if let Some(r) = bone.strip_prefix("left") {
+        ("l", r)
+    } else if let Some(r) = bone.strip_prefix("right") {
+        ("r", r)
+    } else {
+        ("", bone)
+    }
+}
+
+/// A finger bone's finger (`Thumb`, `Index`, … `Little`) and its number from the hand (1–3).
+fn digit(rest: &str) -> Option<(&str, usize)> {
+    let finger = ["Thumb", "Index", "Middle", "Ring", "Little"]
+        .into_iter()
+        .find(|f| rest.starts_with(f))?;
+    let part = &rest[finger.len()..];
+    let order: &[&str] = if finger == "Thumb" {
+        &["Metacarpal", "Proximal", "Distal"]
+    } else {
+        &["Proximal", "Intermediate", "Distal"]
+    };
+    Some((finger, order.iter().position(|p| *p == part)? + 1))
+}

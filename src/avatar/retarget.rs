@@ -1,0 +1,291 @@
+//! The realizer's motion on an avatar's skeleton, rest-pose aware. Each avatar bone paired
+//! with a realizer joint takes that joint's world rotation since rest. Before that the two rest
+//! poses are aligned bone by bone: a limb bone of the avatar (upper and lower arm, hand, finger,
+//! thigh, shin, foot) is turned, the short way, so that it points where its realizer joint's
+//! bone points at rest, whatever pose the avatar was made in (T, A) and whatever its bones'
+//! own axes. The avatar's frame may differ from the realizer's (y up, facing +z, left +x):
+//! it is found from the skeleton itself (left from the right upper arm to the left, up from
+//! the hips to the head), so that a VRM 0.x facing −z or a file in centimetres under a turned
+//! armature are driven alike. The root's travel is scaled by the ratio of leg lengths. Bones
+//! with no realizer joint keep their rest rotation relative to their parent.
+
+use std::collections::BTreeMap;
+
+use glam::{Mat3, Mat4, Quat, Vec3};
+
+use super::file::{AvatarError, Model};
+use super::humanoid::{self, BONES};
+use crate::body::pose::Pose;
+use crate::body::skeleton::Skeleton;
+
+/// The joint a realizer joint's bone points at, for aligning rest poses.
+fn points_at(joint: &str) -> Option<String> {
+    let (side, rest) = joint.split_at_checked(2)?;
+    let next = match rest {
+        "shoulder" => "elbow".to_string(),
+        "elbow" => "wrist".to_string(),
+        "wrist" => "middle1".to_string(),
+        "hip" => "knee".to_string(),
+        "knee" => "talocrural".to_string(),
+        "talocrural" => "metatarsal".to_string(),
+        r => {
+            let (finger, k) = r.split_at_checked(r.len().checked_sub(1)?)?;
+            let k: u32 = k.parse().ok()?;
+            if !["thumb", "index", "middle", "ring", "pinky"].contains(&finger) || k >= 3 {
+                return None;
+            }
+            format!("{finger}{}", k + 1)
+        }
+    };
+    matches!(side, "l_" | "r_").then(|| format!("{side}{next}"))
+}
+
+/// How one avatar is driven by one realizer skeleton.
+#[derive(Debug, Clone)]
+pub struct Retarget {
+    /// Per node, the realizer joint it follows.
+    source: Vec<Option<usize>>,
+    /// Per node, the world rotation that aligns its rest with the realizer's (identity for
+    /// nodes that follow none).
+    align: Vec<Quat>,
+    /// The nodes in parents-first order.
+    order: Vec<usize>,
+    /// Per node, its rest transform relative to its parent, and its rest world rotation.
+    local: Vec<Mat4>,
+    rest_rotation: Vec<Quat>,
+    /// The realizer's frame in the avatar's: realizer x (left), y (up), z (forward).
+    frame: Quat,
+    /// The node that carries the root's travel, its rest world place, and the travel's scale.
+    hips: usize,
+    hips_rest: Vec3,
+    scale: f32,
+    /// The realizer's root at rest.
+    root_rest: Vec3,
+}
+
+/// An avatar's skeleton posed: per node its local rotation, and the local translation of the
+/// node that carries the root's travel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Posed {
+    /// Every node's local rotation (rest for those that follow no joint).
+    pub rotations: Vec<Quat>,
+    /// The travelling node and its local translation.
+    pub hips: (usize, Vec3),
+    /// Every node's world transform.
+    pub world: Vec<Mat4>,
+}
+
+impl Retarget {
+    /// The driving of `model` by `skeleton`, its bones recognised by `map` or by
+    /// [`humanoid::recognise`]; an avatar whose nodes carry the realizer's own joint names
+    /// follows joint by joint.
+    pub fn new(
+        model: &Model,
+        skeleton: &Skeleton,
+        map: Option<&BTreeMap<String, String>>,
+    ) -> Result<Retarget, AvatarError> {
+        let pairs = pairs(model, skeleton, map)?;
+        let n = model.nodes.len();
+        let mut source = vec![None; n];
+        for &(node, joint) in &pairs {
+            source[node] = Some(joint);
+        }
+        let world: Vec<Mat4> = (0..n).map(|i| model.rest_world(i)).collect();
+        let place = |i: usize| world[i].w_axis.truncate();
+        let node_of = |joint: &str| {
+            let j = skeleton.joint(joint)?;
+            pairs.iter().find(|p| p.1 == j).map(|p| p.0)
+        };
+        let need = |joint: &str| {
+            node_of(joint).ok_or_else(|| {
+                AvatarError::new(
+                    &model.file,
+                    format!("no bone follows the realizer's {joint}"),
+                )
+            })
+        };
+        // the avatar's frame: left, up, forward
+        let left = (place(need("l_shoulder")?) - place(need("r_shoulder")?)).normalize_or_zero();
+        let up = place(need("skullbase")?) - place(need("sacroiliac")?);
+        let up = (up - left * up.dot(left)).normalize_or_zero();
+        if left == Vec3::ZERO || up == Vec3::ZERO {
+            return Err(AvatarError::new(
+                &model.file,
+                "its shoulders or its hips and head are in one place: no frame",
+            ));
+        }
+        let frame = Quat::from_mat3(&Mat3::from_cols(left, up, left.cross(up)));
+        // the realizer's rest places
+        let rest = Pose::rest(skeleton).world(skeleton);
+        let order = parents_first(model);
+        let mut align = vec![Quat::IDENTITY; n];
+        for &i in &order {
+            let inherited = ancestors(model, i)
+                .find(|&a| source[a].is_some())
+                .map_or(Quat::IDENTITY, |a| align[a]);
+            align[i] = inherited;
+            let Some(j) = source[i] else { continue };
+            let name = &skeleton.joints()[j].name;
+            let Some(next) = points_at(name) else {
+                // trunk, head, clavicles: their rests are taken to agree
+                if !is_limb(name) {
+                    align[i] = Quat::IDENTITY;
+                }
+                continue;
+            };
+            let (Some(t), Some(m)) = (skeleton.joint(&next), node_of(&next)) else {
+                continue;
+            };
+            let theirs = frame * (rest.positions[t] - rest.positions[j]);
+            let ours = place(m) - place(i);
+            if theirs.length() > 1e-6 && ours.length() > 1e-6 {
+                align[i] = Quat::from_rotation_arc(ours.normalize(), theirs.normalize());
+            }
+        }
+        let leg = |a: &str, b: &str, c: &str| -> Result<f32, AvatarError> {
+            Ok(place(need(a)?).distance(place(need(b)?))
+                + place(need(b)?).distance(place(need(c)?)))
+        };
+        let theirs = |a: &str, b: &str| {
+            let (a, b) = (skeleton.joint(a), skeleton.joint(b));
+            a.zip(b)
+                .map_or(0.0, |(a, b)| rest.positions[a].distance(rest.positions[b]))
+        };
+        let ours = leg("l_hip", "l_knee", "l_talocrural")?;
+        let realizer = theirs("l_hip", "l_knee") + theirs("l_knee", "l_talocrural");
+        let hips = match node_of("HumanoidRoot") {
+            Some(root) => root,
+            None => need("sacroiliac")?,
+        };
+        Ok(Retarget {
+            source,
+            align,
+            order,
+            local: model.nodes.iter().map(|n| n.local()).collect(),
+            rest_rotation: world.iter().map(rotation_of).collect(),
+            frame,
+            hips,
+            hips_rest: place(hips),
+            scale: if realizer > 1e-6 {
+                ours / realizer
+            } else {
+                1.0
+            },
+            root_rest: rest.positions[0],
+        })
+    }
+
+    /// The avatar posed as the realizer's `pose` of `skeleton`.
+    pub fn pose(&self, skeleton: &Skeleton, pose: &Pose, parents: &[Option<usize>]) -> Posed {
+        let w = pose.world(skeleton);
+        let n = self.local.len();
+        let mut world = vec![Mat4::IDENTITY; n];
+        let mut rotations = vec![Quat::IDENTITY; n];
+        let travel = self.frame * (pose.root - self.root_rest) * self.scale;
+        let mut hips = (self.hips, Vec3::ZERO);
+        for &i in &self.order {
+            let parent = parents[i].map_or(Mat4::IDENTITY, |p| world[p]);
+            let (scale, rest, mut translation) = self.local[i].to_scale_rotation_translation();
+            let rotation = match self.source[i] {
+                Some(j) => {
+                    let turned = self.frame * w.orientations[j] * self.frame.inverse();
+                    let target = turned * self.align[i] * self.rest_rotation[i];
+                    (rotation_of(&parent).inverse() * target).normalize()
+                }
+                None => rest,
+            };
+            if i == self.hips {
+                let there = self.hips_rest + travel;
+                translation = parent.inverse().transform_point3(there);
+                hips = (i, translation);
+            }
+            rotations[i] = rotation;
+            world[i] = parent * Mat4::from_scale_rotation_translation(scale, rotation, translation);
+        }
+        Posed {
+            rotations,
+            hips,
+            world,
+        }
+    }
+
+    /// The realizer joint node `i` follows.
+    pub fn source(&self, i: usize) -> Option<usize> {
+        self.source.get(i).copied().flatten()
+    }
+
+    /// The realizer's frame in the avatar's (its x, y, z: left, up, forward).
+    pub fn frame(&self) -> Quat {
+        self.frame
+    }
+}
+
+/// Whether a realizer joint is part of a limb (its alignment is inherited down the limb).
+fn is_limb(joint: &str) -> bool {
+    joint.starts_with("l_") || joint.starts_with("r_")
+}
+
+/// The rotation of a transform with uniform scale.
+fn rotation_of(m: &Mat4) -> Quat {
+    m.to_scale_rotation_translation().1.normalize()
+}
+
+/// Node `i`'s ancestors, nearest first.
+fn ancestors(model: &Model, i: usize) -> impl Iterator<Item = usize> + '_ {
+    let mut at = model.nodes[i].parent;
+    let mut left = model.nodes.len();
+    std::iter::from_fn(move || {
+        let p = at.filter(|_| left > 0)?;
+        left -= 1;
+        at = model.nodes[p].parent;
+        Some(p)
+    })
+}
+
+/// Every node, parents before children.
+fn parents_first(model: &Model) -> Vec<usize> {
+    let mut depth: Vec<(usize, usize)> = (0..model.nodes.len())
+        .map(|i| (ancestors(model, i).count(), i))
+        .collect();
+    depth.sort_unstable();
+    depth.into_iter().map(|(_, i)| i).collect()
+}
+
+/// The (avatar node, realizer joint) pairs: node by node when the avatar's joints carry the
+/// realizer's names, else bone by bone.
+fn pairs(
+    model: &Model,
+    skeleton: &Skeleton,
+    map: Option<&BTreeMap<String, String>>,
+) -> Result<Vec<(usize, usize)>, AvatarError> {
+    if map.is_none() {
+        let named: Vec<(usize, usize)> = model
+            .joints
+            .iter()
+            .filter_map(|&n| Some((n, skeleton.joint(&model.nodes[n].name)?)))
+            .collect();
+        if named.len() * 2 > skeleton.len() {
+            return Ok(named);
+        }
+    }
+    let bones = humanoid::recognise(model, map)?;
+    let spine: Vec<&str> = ["spine", "chest", "upperChest"]
+        .into_iter()
+        .filter(|b| bones.contains_key(b))
+        .collect();
+    let spine_sources = humanoid::spine_sources(spine.len());
+    let mut out = Vec::new();
+    for (bone, _) in BONES {
+        let Some(&node) = bones.get(bone) else {
+            continue;
+        };
+        let joint = match spine.iter().position(|b| b == bone) {
+            Some(k) => Some(spine_sources[k]),
+            None => humanoid::source(bone),
+        };
+        if let Some(j) = joint.and_then(|j| skeleton.joint(j)) {
+            out.push((node, j));
+        }
+    }
+    Ok(out)
+}

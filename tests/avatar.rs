@@ -1,0 +1,527 @@
+//! Avatars: the default avatar's make (size, skin weights, face targets, rest pose), and the
+//! realizer's motion retargeted onto avatars built here: a Mixamo-named T-pose in centimetres
+//! under a turned armature, a VRM 1.0 in an A-pose with every bone's axes turned at random and
+//! two spine bones, and a VRM 0.x in a T-pose facing −z. Over random realizer poses the world
+//! direction of every limb bone must match the realizer's.
+
+use std::collections::BTreeMap;
+use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+use bml_realizer::avatar::{self, Model, Retarget};
+use bml_realizer::body::pose::Pose;
+use bml_realizer::body::skeleton::Skeleton;
+use bml_realizer::rng::Rng;
+use glam::{Mat4, Quat, Vec3};
+use serde_json::{json, Value};
+
+/// A test avatar's bones: (bone as VRM 1.0 names it, where it sits: a realizer joint, its
+/// parent bone, its Mixamo name).
+const BONES: &[(&str, &str, &str, &str)] = &[
+    ("hips", "sacroiliac", "", "Hips"),
+    ("spine", "vl5", "hips", "Spine"),
+    ("chest", "vt12", "spine", "Spine1"),
+    ("upperChest", "vt6", "chest", "Spine2"),
+    ("neck", "vc7", "upperChest", "Neck"),
+    ("head", "skullbase", "neck", "Head"),
+    (
+        "leftShoulder",
+        "l_sternoclavicular",
+        "upperChest",
+        "LeftShoulder",
+    ),
+    ("leftUpperArm", "l_shoulder", "leftShoulder", "LeftArm"),
+    ("leftLowerArm", "l_elbow", "leftUpperArm", "LeftForeArm"),
+    ("leftHand", "l_wrist", "leftLowerArm", "LeftHand"),
+    (
+        "leftThumbMetacarpal",
+        "l_thumb1",
+        "leftHand",
+        "LeftHandThumb1",
+    ),
+    (
+        "leftThumbProximal",
+        "l_thumb2",
+        "leftThumbMetacarpal",
+        "LeftHandThumb2",
+    ),
+    (
+        "leftThumbDistal",
+        "l_thumb3",
+        "leftThumbProximal",
+        "LeftHandThumb3",
+    ),
+    (
+        "leftIndexProximal",
+        "l_index1",
+        "leftHand",
+        "LeftHandIndex1",
+    ),
+    (
+        "leftIndexIntermediate",
+        "l_index2",
+        "leftIndexProximal",
+        "LeftHandIndex2",
+    ),
+    (
+        "leftIndexDistal",
+        "l_index3",
+        "leftIndexIntermediate",
+        "LeftHandIndex3",
+    ),
+    (
+        "leftMiddleProximal",
+        "l_middle1",
+        "leftHand",
+        "LeftHandMiddle1",
+    ),
+    (
+        "leftMiddleIntermediate",
+        "l_middle2",
+        "leftMiddleProximal",
+        "LeftHandMiddle2",
+    ),
+    (
+        "rightShoulder",
+        "r_sternoclavicular",
+        "upperChest",
+        "RightShoulder",
+    ),
+    ("rightUpperArm", "r_shoulder", "rightShoulder", "RightArm"),
+    ("rightLowerArm", "r_elbow", "rightUpperArm", "RightForeArm"),
+    ("rightHand", "r_wrist", "rightLowerArm", "RightHand"),
+    (
+        "rightMiddleProximal",
+        "r_middle1",
+        "rightHand",
+        "RightHandMiddle1",
+    ),
+    (
+        "rightMiddleIntermediate",
+        "r_middle2",
+        "rightMiddleProximal",
+        "RightHandMiddle2",
+    ),
+    ("leftUpperLeg", "l_hip", "hips", "LeftUpLeg"),
+    ("leftLowerLeg", "l_knee", "leftUpperLeg", "LeftLeg"),
+    ("leftFoot", "l_talocrural", "leftLowerLeg", "LeftFoot"),
+    ("leftToes", "l_metatarsal", "leftFoot", "LeftToeBase"),
+    ("rightUpperLeg", "r_hip", "hips", "RightUpLeg"),
+    ("rightLowerLeg", "r_knee", "rightUpperLeg", "RightLeg"),
+    ("rightFoot", "r_talocrural", "rightLowerLeg", "RightFoot"),
+    ("rightToes", "r_metatarsal", "rightFoot", "RightToeBase"),
+];
+
+/// The limb bones checked, each with the bone it points at.
+const LIMBS: &[(&str, &str)] = &[
+    ("leftUpperArm", "leftLowerArm"),
+    ("leftLowerArm", "leftHand"),
+    ("leftHand", "leftMiddleProximal"),
+    ("leftIndexProximal", "leftIndexIntermediate"),
+    ("leftIndexIntermediate", "leftIndexDistal"),
+    ("leftThumbMetacarpal", "leftThumbProximal"),
+    ("leftMiddleProximal", "leftMiddleIntermediate"),
+    ("rightUpperArm", "rightLowerArm"),
+    ("rightLowerArm", "rightHand"),
+    ("rightHand", "rightMiddleProximal"),
+    ("leftUpperLeg", "leftLowerLeg"),
+    ("leftLowerLeg", "leftFoot"),
+    ("leftFoot", "leftToes"),
+    ("rightUpperLeg", "rightLowerLeg"),
+    ("rightLowerLeg", "rightFoot"),
+    ("rightFoot", "rightToes"),
+];
+
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    /// Mixamo names, T-pose, centimetres under an armature turned a quarter about x.
+    Mixamo,
+    /// VRM 1.0, A-pose, bones' axes turned at random, no upper chest.
+    Vrm1,
+    /// VRM 0.x, T-pose, facing −z.
+    Vrm0,
+}
+
+/// A GLB holding `json` alone.
+fn glb(json: &Value) -> Vec<u8> {
+    let mut text = serde_json::to_vec(json).unwrap();
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    let mut out = Vec::new();
+    for word in [0x4654_6C67u32, 2, (12 + 8 + text.len()) as u32] {
+        out.extend(word.to_le_bytes());
+    }
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(0x4E4F_534Au32.to_le_bytes());
+    out.extend(text);
+    out
+}
+
+fn random_rotation(rng: &mut Rng, most: f32) -> Quat {
+    let axis = Vec3::new(
+        rng.next_f32() - 0.5,
+        rng.next_f32() - 0.5,
+        rng.next_f32() - 0.5,
+    )
+    .normalize_or(Vec3::Y);
+    Quat::from_axis_angle(axis, (rng.next_f32() * 2.0 - 1.0) * most)
+}
+
+/// A test avatar of `kind`: its GLB bytes.
+fn test_avatar(kind: Kind) -> Vec<u8> {
+    let skeleton = Skeleton::adult();
+    let mut pose = Pose::rest(&skeleton);
+    let arms = if kind == Kind::Vrm1 {
+        FRAC_PI_4
+    } else {
+        FRAC_PI_2
+    };
+    pose.rotate(
+        skeleton.joint("l_shoulder").unwrap(),
+        Quat::from_rotation_z(arms),
+    );
+    pose.rotate(
+        skeleton.joint("r_shoulder").unwrap(),
+        Quat::from_rotation_z(-arms),
+    );
+    let places = pose.world(&skeleton).positions;
+    let facing = if kind == Kind::Vrm0 {
+        Quat::from_rotation_y(PI)
+    } else {
+        Quat::IDENTITY
+    };
+    // the armature: its world rotation and scale
+    let (armature, scale) = match kind {
+        Kind::Mixamo => (Quat::from_rotation_x(FRAC_PI_2), 0.01),
+        _ => (Quat::IDENTITY, 1.0),
+    };
+    let mut rng = Rng(17);
+    let bones: Vec<_> = BONES
+        .iter()
+        .filter(|b| !(kind == Kind::Vrm1 && b.0 == "chest"))
+        .map(|&(bone, at, parent, mixamo)| {
+            let parent = if kind == Kind::Vrm1 && parent == "chest" {
+                "spine"
+            } else {
+                parent
+            };
+            (bone, at, parent, mixamo)
+        })
+        .collect();
+    let index = |bone: &str| 1 + bones.iter().position(|b| b.0 == bone).unwrap();
+    let mut world_rotation = vec![armature];
+    let mut world_place = vec![Vec3::ZERO];
+    let mut nodes = vec![json!({
+        "name": "Armature",
+        "rotation": armature.to_array(),
+        "scale": [scale, scale, scale],
+        "children": [1],
+    })];
+    for &(bone, at, parent, mixamo) in &bones {
+        let w = facing * places[skeleton.joint(at).unwrap()];
+        let g = match kind {
+            Kind::Vrm1 => random_rotation(&mut rng, PI),
+            _ => armature,
+        };
+        let p = if parent.is_empty() { 0 } else { index(parent) };
+        let (gp, wp) = (world_rotation[p], world_place[p]);
+        let s = if p == 0 { scale } else { 1.0 };
+        let t = gp.inverse() * (w - wp) / s;
+        let name = match kind {
+            Kind::Mixamo => format!("mixamorig:{mixamo}"),
+            _ => format!("J_{bone}"),
+        };
+        let children: Vec<usize> = bones
+            .iter()
+            .filter(|b| b.2 == bone)
+            .map(|b| index(b.0))
+            .collect();
+        let mut node = json!({
+            "name": name,
+            "translation": t.to_array(),
+            "rotation": (gp.inverse() * g).normalize().to_array(),
+        });
+        if !children.is_empty() {
+            node["children"] = json!(children);
+        }
+        nodes.push(node);
+        world_rotation.push(g);
+        world_place.push(w);
+    }
+    let joints: Vec<usize> = (1..nodes.len()).collect();
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": nodes,
+        "skins": [{"joints": joints}],
+    });
+    match kind {
+        Kind::Vrm1 => {
+            let map: serde_json::Map<String, Value> = bones
+                .iter()
+                .map(|b| (b.0.to_string(), json!({"node": index(b.0)})))
+                .collect();
+            doc["extensionsUsed"] = json!(["VRMC_vrm"]);
+            doc["extensions"] = json!({"VRMC_vrm": {"specVersion": "1.0",
+                                        "humanoid": {"humanBones": map}}});
+        }
+        Kind::Vrm0 => {
+            let list: Vec<Value> = bones
+                .iter()
+                .map(|b| {
+                    let name =
+                        b.0.replace("ThumbProximal", "ThumbIntermediate")
+                            .replace("ThumbMetacarpal", "ThumbProximal");
+                    json!({"bone": name, "node": index(b.0)})
+                })
+                .collect();
+            doc["extensionsUsed"] = json!(["VRM"]);
+            doc["extensions"] = json!({"VRM": {"humanoid": {"humanBones": list}}});
+        }
+        Kind::Mixamo => {}
+    }
+    glb(&doc)
+}
+
+/// A random pose of the realizer: every joint turned up to `most` radians, the root moved and
+/// turned.
+fn random_pose(skeleton: &Skeleton, rng: &mut Rng, most: f32) -> Pose {
+    let mut pose = Pose::rest(skeleton);
+    for r in &mut pose.rotations {
+        *r = random_rotation(rng, most);
+    }
+    pose.root += Vec3::new(
+        rng.next_f32() * 4.0 - 2.0,
+        rng.next_f32() * 0.3,
+        rng.next_f32() * 4.0 - 2.0,
+    );
+    pose
+}
+
+/// The angles (degrees) between every limb bone of the posed avatar and its realizer bone.
+fn limb_errors(model: &Model, retarget: &Retarget, skeleton: &Skeleton, pose: &Pose) -> Vec<f32> {
+    let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
+    let posed = retarget.pose(skeleton, pose, &parents);
+    let realizer = pose.world(skeleton);
+    let node_of = |bone: &str| {
+        model.nodes.iter().position(|n| {
+            n.name.ends_with(&format!("J_{bone}")) || {
+                let m = BONES.iter().find(|b| b.0 == bone).unwrap().3;
+                n.name == format!("mixamorig:{m}")
+            }
+        })
+    };
+    let place = |m: &Mat4| m.w_axis.truncate();
+    LIMBS
+        .iter()
+        .filter_map(|&(a, b)| {
+            let (na, nb) = (node_of(a)?, node_of(b)?);
+            let ours = place(&posed.world[nb]) - place(&posed.world[na]);
+            let (ja, jb) = (retarget.source(na)?, retarget.source(nb)?);
+            let theirs = retarget.frame() * (realizer.positions[jb] - realizer.positions[ja]);
+            Some(ours.angle_between(theirs).to_degrees())
+        })
+        .collect()
+}
+
+#[test]
+fn every_limb_bone_of_three_kinds_of_avatar_points_where_the_realizer_s_does() {
+    let skeleton = Skeleton::adult();
+    for (kind, what) in [
+        (Kind::Mixamo, "Mixamo T-pose in cm"),
+        (Kind::Vrm1, "VRM 1.0 A-pose, odd axes"),
+        (Kind::Vrm0, "VRM 0.x facing -z"),
+    ] {
+        let model = Model::from_glb(what, &test_avatar(kind)).unwrap();
+        let retarget = Retarget::new(&model, &skeleton, None).unwrap();
+        let rest = limb_errors(&model, &retarget, &skeleton, &Pose::rest(&skeleton));
+        // every limb is checked (none dropped for want of a bone)
+        assert_eq!(rest.len(), LIMBS.len(), "{what}");
+        let worst = rest.iter().fold(0.0f32, |a, &b| a.max(b));
+        assert!(worst < 2.0, "{what}: at rest a limb is {worst}° off");
+        let mut rng = Rng(99);
+        let (mut sum, mut count, mut worst) = (0.0, 0, 0.0f32);
+        for _ in 0..500 {
+            let pose = random_pose(&skeleton, &mut rng, 1.2);
+            for e in limb_errors(&model, &retarget, &skeleton, &pose) {
+                sum += e;
+                count += 1;
+                worst = worst.max(e);
+            }
+        }
+        let mean = sum / count as f32;
+        assert!(
+            mean < 1.0 && worst < 2.0,
+            "{what}: mean {mean}°, worst {worst}°"
+        );
+    }
+}
+
+#[test]
+fn the_travel_of_the_root_is_scaled_by_leg_length_and_turned_into_the_avatar_s_frame() {
+    let skeleton = Skeleton::adult();
+    let model = Model::from_glb("vrm0", &test_avatar(Kind::Vrm0)).unwrap();
+    let retarget = Retarget::new(&model, &skeleton, None).unwrap();
+    let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
+    let mut pose = Pose::rest(&skeleton);
+    let at_rest = retarget.pose(&skeleton, &pose, &parents);
+    pose.root += Vec3::new(0.0, 0.0, 1.0);
+    let walked = retarget.pose(&skeleton, &pose, &parents);
+    let hips = at_rest.hips.0;
+    let moved = walked.world[hips].w_axis.truncate() - at_rest.world[hips].w_axis.truncate();
+    // same leg length (built from the realizer's skeleton), facing −z: a metre forward is −z
+    assert!(moved.distance(Vec3::new(0.0, 0.0, -1.0)) < 1e-4, "{moved}");
+}
+
+#[test]
+fn bad_avatars_are_refused_naming_the_file_and_what_is_missing() {
+    let skeleton = Skeleton::adult();
+    // no skin
+    let doc = json!({"asset": {"version": "2.0"}, "nodes": [{"name": "a"}]});
+    let e = Model::from_glb("noskin.glb", &glb(&doc)).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "noskin.glb: it has no skin (no skinned mesh)"
+    );
+    // names that match nothing
+    let doc = json!({"asset": {"version": "2.0"}, "nodes": [{"name": "bone1"}, {"name": "bone2"}],
+                     "skins": [{"joints": [0, 1]}]});
+    let model = Model::from_glb("odd.glb", &glb(&doc)).unwrap();
+    let e = Retarget::new(&model, &skeleton, None).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("odd.glb: its skeleton's names match no known scheme"),
+        "{e}"
+    );
+    // a VRM without a lower arm
+    let model = Model::from_glb("vrm.glb", &test_avatar(Kind::Vrm1)).unwrap();
+    let mut json = model.json.clone();
+    json["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"]
+        .as_object_mut()
+        .unwrap()
+        .remove("leftLowerArm");
+    let model = Model::from_glb("vrm.vrm", &glb(&json)).unwrap();
+    let e = Retarget::new(&model, &skeleton, None).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "vrm.vrm: its skeleton lacks the bones leftLowerArm"
+    );
+    // broken bytes
+    for bytes in [
+        &b"glTF\x02\0\0\0\xff\xff"[..],
+        b"not a model",
+        b"glTF\x02\0\0\0\x40\0\0\0\x10\0\0\0JSON{",
+    ] {
+        let e = Model::from_glb("broken.glb", bytes).unwrap_err();
+        assert!(e.to_string().starts_with("broken.glb: "), "{e}");
+    }
+    // a glTF whose node names a child out of range
+    let doc = json!({"asset": {"version": "2.0"}, "nodes": [{"name": "a", "children": [5]}],
+                     "skins": [{"joints": [0]}]});
+    let e = Model::from_glb("range.glb", &glb(&doc)).unwrap_err();
+    assert!(
+        e.to_string().starts_with("range.glb: not valid glTF"),
+        "{e}"
+    );
+    // a huge file (sparse: no disk is used)
+    let dir = std::env::temp_dir().join(format!("bmlr-avatar-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let huge = dir.join("huge.glb");
+    std::fs::File::create(&huge)
+        .unwrap()
+        .set_len(avatar::MAX_AVATAR_BYTES + 1)
+        .unwrap();
+    let e = Model::read(&huge).unwrap_err();
+    assert!(e.to_string().contains("more than the"), "{e}");
+    // a bone map naming a node that is not there
+    let model = Model::from_glb("mixamo.glb", &test_avatar(Kind::Mixamo)).unwrap();
+    let map = BTreeMap::from([("leftUpperArm".to_string(), "Arm.L".to_string())]);
+    let e = Retarget::new(&model, &skeleton, Some(&map)).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "mixamo.glb: bone map: leftUpperArm: no node named 'Arm.L'"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_default_avatar_is_a_skinned_person_standing_in_the_realizer_s_rest() {
+    let g = gltf::Gltf::from_slice(avatar::DEFAULT_GLB).unwrap();
+    let blob = g.blob.as_deref().unwrap();
+    let mesh = g.document.meshes().next().unwrap();
+    let mut triangles = 0;
+    for p in mesh.primitives() {
+        let r = p.reader(|_| Some(blob));
+        triangles += r.read_indices().unwrap().into_u32().count() / 3;
+    }
+    assert!(triangles >= 10_000, "{triangles} triangles");
+    let first = mesh.primitives().next().unwrap();
+    let r = first.reader(|_| Some(blob));
+    let places: Vec<Vec3> = r.read_positions().unwrap().map(Vec3::from).collect();
+    let weights: Vec<[f32; 4]> = r.read_weights(0).unwrap().into_f32().collect();
+    for w in &weights {
+        let sum: f32 = w.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-3, "weights {w:?}");
+    }
+    let blended = weights
+        .iter()
+        .filter(|w| w.iter().filter(|&&x| x > 0.0).count() >= 2);
+    let share = blended.count() as f32 / weights.len() as f32;
+    assert!(
+        share >= 0.3,
+        "{share} of the vertices blend two joints or more"
+    );
+    let (low, high) = places
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p.y), h.max(p.y)));
+    assert!(low.abs() < 0.005, "the feet are {low} m off the floor");
+    assert!((1.6..=1.9).contains(&(high - low)), "{} m tall", high - low);
+    // facing +z: the foremost point above the shoulders is the nose, ahead of the eyes
+    let nose = places
+        .iter()
+        .filter(|p| p.y > 1.4)
+        .fold(Vec3::NEG_INFINITY, |a, &p| if p.z > a.z { p } else { a });
+    let model = avatar::default_model();
+    let eye = model
+        .rest_world(model.node("l_eyeball_joint").unwrap())
+        .w_axis
+        .truncate();
+    assert!(
+        nose.z > eye.z + 0.005 && (nose.y - eye.y).abs() < 0.08,
+        "nose {nose}, eye {eye}"
+    );
+    // the 52 ARKit targets by name
+    let names: std::collections::BTreeSet<&str> =
+        model.morphs[0].iter().map(String::as_str).collect();
+    let arkit: std::collections::BTreeSet<&str> =
+        bml_realizer::face::model::ARKIT.into_iter().collect();
+    assert_eq!(names, arkit);
+    // the realizer's rest: arms and legs straight down, limb by limb as the realizer's skeleton
+    let skeleton = Skeleton::adult();
+    let rest = Pose::rest(&skeleton).world(&skeleton);
+    for (a, b) in [
+        ("l_shoulder", "l_elbow"),
+        ("l_elbow", "l_wrist"),
+        ("r_shoulder", "r_elbow"),
+        ("r_elbow", "r_wrist"),
+        ("l_wrist", "l_middle1"),
+        ("l_hip", "l_knee"),
+        ("l_knee", "l_talocrural"),
+        ("r_hip", "r_knee"),
+        ("r_knee", "r_talocrural"),
+    ] {
+        let at = |n: &str| model.rest_world(model.node(n).unwrap()).w_axis.truncate();
+        let ours = at(b) - at(a);
+        let theirs =
+            rest.positions[skeleton.joint(b).unwrap()] - rest.positions[skeleton.joint(a).unwrap()];
+        let angle = ours.angle_between(theirs).to_degrees();
+        assert!(angle < 2.0, "{a}→{b} is {angle}° from the realizer's rest");
+    }
+    // and the realizer drives it joint by joint
+    let retarget = Retarget::new(&model, &skeleton, None).unwrap();
+    assert_eq!(
+        retarget.source(model.node("l_elbow").unwrap()),
+        skeleton.joint("l_elbow")
+    );
+}
