@@ -6,11 +6,15 @@
 //! data (`assets/avatar/NOTICE.md`), is compiled in: its skeleton is the realizer's own, its
 //! face has the 52 ARKit morph targets.
 
+mod export;
 mod file;
 pub mod humanoid;
+mod morph;
 mod retarget;
 
+pub use export::{animated_glb, Frame};
 pub use file::{AvatarError, Model, Node, MAX_AVATAR_BYTES};
+pub use morph::MorphMap;
 pub use retarget::{Posed, Retarget};
 
 /// The default avatar's GLB (`assets/avatar/default.glb`, CC0 data; notice beside it).

@@ -1,5 +1,6 @@
 //! `bmlr`: the command-line front end of the BML realizer.
 
+mod avatar;
 mod diff;
 mod live;
 mod record;

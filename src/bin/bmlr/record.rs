@@ -3,10 +3,13 @@
 
 use std::path::Path;
 
+use bml_realizer::avatar::{animated_glb, Frame};
 use bml_realizer::body::{Pose, Skeleton};
 use bml_realizer::engine::CharacterPose;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::sound::{SoundEvent, Track};
+
+use crate::avatar::{Avatar, AvatarArgs};
 
 /// The frame period, the next frame's time, and every character's pose in each frame so far
 /// (which characters a file shows is decided at the end).
@@ -118,14 +121,16 @@ impl Recording {
         Ok(())
     }
 
-    /// Writes the glTF mannequin of the character `asked` with its motion, or without one asked
-    /// a scene of every character that received blocks, each where it stands. An error has the
-    /// exit code.
+    /// Writes `avatar` with the motion and face of the character `asked` (or of the one that
+    /// received blocks); without one asked among several, a scene of mannequins, one per
+    /// character, each where it stands. An error has the exit code.
     pub fn write_gltf(
         &self,
         realizer: &Realizer,
         path: &Path,
         asked: Option<&str>,
+        avatar: Option<&Avatar>,
+        options: &AvatarArgs,
     ) -> Result<(), (u8, String)> {
         let everyone = received(realizer);
         let ids: Vec<String> = match asked {
@@ -133,6 +138,18 @@ impl Recording {
             _ => vec![recorded_character(realizer, asked, "--gltf")
                 .map_err(|e| (1, format!("--gltf: {e}")))?],
         };
+        if let ([id], Some(avatar)) = (ids.as_slice(), avatar) {
+            return self.write_avatar(path, id, avatar);
+        }
+        if options.avatar.is_some() {
+            return Err((
+                1,
+                format!(
+                    "--avatar shows one character and {} received blocks: name one with --character",
+                    ids.len()
+                ),
+            ));
+        }
         let poses: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
         let frames: Vec<Vec<(f64, &Pose)>> = (poses.iter())
             .map(|p| {
@@ -155,6 +172,32 @@ impl Recording {
             skeleton.len(),
             ids.len(),
             if ids.len() == 1 { "" } else { "s" },
+            glb.len() / 1024
+        );
+        Ok(())
+    }
+
+    /// Writes `avatar` moving as character `id` did.
+    fn write_avatar(&self, path: &Path, id: &str, avatar: &Avatar) -> Result<(), (u8, String)> {
+        let poses = self.poses_of(id);
+        let frames: Vec<Frame> = (self.frames.iter().zip(&poses))
+            .map(|((t, _), p)| Frame {
+                time: *t,
+                pose: &p.pose,
+                face: &p.face,
+            })
+            .collect();
+        let skeleton = Skeleton::adult();
+        let name = if id.is_empty() { "bml" } else { id };
+        let glb = animated_glb(&avatar.model, &avatar.retarget, &skeleton, &frames, name);
+        write_file(path, &glb)?;
+        eprintln!(
+            "wrote {} ({} on {}, {} frames at {} fps, {} kB)",
+            path.display(),
+            if id.is_empty() { "the character" } else { id },
+            avatar.model.file,
+            frames.len(),
+            self.fps,
             glb.len() / 1024
         );
         Ok(())

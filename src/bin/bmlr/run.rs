@@ -57,11 +57,14 @@ pub struct RunArgs {
     /// one frame every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.bvh")]
     bvh: Option<std::path::PathBuf>,
-    /// Write a skinned mannequin with the realized motion of the character --character names
-    /// (without it, a scene of every character that received blocks) as binary glTF, one key
-    /// every 1/--fps seconds (virtual clock only).
+    /// Write the avatar (--avatar, else the default one) with the realized motion and face of
+    /// the character --character names, or of the one character that received blocks, as
+    /// binary glTF, one key every 1/--fps seconds (virtual clock only). Several characters
+    /// without --character: a scene of box mannequins, one per character.
     #[arg(long, value_name = "OUT.glb")]
     gltf: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    pub avatar: crate::avatar::AvatarArgs,
     /// Write the run's sound as a WAV file: synthesized speech (--tts flite) and audiofile clips,
     /// each at its peg and volume (virtual clock only).
     #[arg(long, value_name = "OUT.wav")]
@@ -471,7 +474,11 @@ impl VirtualRun {
     }
 
     /// Writes the --bvh, --frames and --gltf files asked for.
-    fn write_recordings(&mut self, args: &RunArgs) -> Result<(), (u8, String)> {
+    fn write_recordings(
+        &mut self,
+        args: &RunArgs,
+        avatar: Option<&crate::avatar::Avatar>,
+    ) -> Result<(), (u8, String)> {
         let Some(m) = self.take_motion() else {
             return Ok(());
         };
@@ -482,7 +489,8 @@ impl VirtualRun {
             m.write_frames(&self.realizer, path)?;
         }
         if let Some(path) = &args.gltf {
-            m.write_gltf(&self.realizer, path, args.setup.character.as_deref())?;
+            let asked = args.setup.character.as_deref();
+            m.write_gltf(&self.realizer, path, asked, avatar, &args.avatar)?;
         }
         if let Some(path) = &args.wav {
             m.write_wav(&self.realizer, path)?;
@@ -500,7 +508,7 @@ impl VirtualRun {
 
 /// `bmlr run`.
 pub fn run(args: RunArgs) -> ExitCode {
-    let (items, realizer) = match checked(&args) {
+    let (items, realizer, avatar) = match checked(&args) {
         Ok(ok) => ok,
         Err(e) => {
             eprintln!("bmlr run: {e}");
@@ -526,7 +534,7 @@ pub fn run(args: RunArgs) -> ExitCode {
     };
     run.items(items);
     report_unfinished(&run.realizer);
-    if let Err((code, e)) = run.write_recordings(&args) {
+    if let Err((code, e)) = run.write_recordings(&args, avatar.as_ref()) {
         eprintln!("bmlr run: {e}");
         return ExitCode::from(code);
     }
@@ -534,7 +542,8 @@ pub fn run(args: RunArgs) -> ExitCode {
 }
 
 /// The items and the realizer of `bmlr run`, or what is wrong with the command line (exit 2).
-fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer), String> {
+#[allow(clippy::type_complexity)] // what runs, what runs it, what shows it
+fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer, Option<crate::avatar::Avatar>), String> {
     let items = read_items(&args.items)?;
     if args.until.is_some_and(|u| !(u.is_finite() && u >= 0.0)) {
         return Err("--until must be a number of seconds >= 0".into());
@@ -554,7 +563,14 @@ fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer), String> {
             ));
         }
     }
-    Ok((items, args.setup.realizer(args.realtime)?))
+    if args.gltf.is_none() && args.avatar.avatar.is_some() {
+        return Err("--avatar shows the motion in --gltf OUT.glb; give it too".into());
+    }
+    let avatar = match &args.gltf {
+        Some(_) => Some(args.avatar.load()?),
+        None => None,
+    };
+    Ok((items, args.setup.realizer(args.realtime)?, avatar))
 }
 
 /// Tells stderr which blocks did not finish (waiting for activation, persistent behaviour, or

@@ -1,0 +1,163 @@
+//! `bmlr run --gltf` with avatars: the default one carries the frames' face weights, a
+//! Mixamo one moves, bad ones are refused with exit 2 naming the file.
+
+#[path = "common/avatars.rs"]
+mod avatars;
+
+use avatars::{glb, test_avatar, Kind};
+use bml_realizer::avatar::{self, Model};
+use serde_json::Value;
+
+/// `bmlr run` with `args`: its exit code and stderr.
+fn bmlr(args: &[&str]) -> (i32, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn the_exported_avatar_carries_the_frames_face_weights_and_its_own_node_names() {
+    let dir = std::env::temp_dir().join(format!("bmlr-avatar-run-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (glb, frames) = (dir.join("welcome.glb"), dir.join("welcome.jsonl"));
+    let (code, err) = bmlr(&[
+        "run",
+        "--gltf",
+        glb.to_str().unwrap(),
+        "--frames",
+        frames.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let g = gltf::Gltf::from_slice(&std::fs::read(&glb).unwrap()).unwrap();
+    let blob = g.blob.as_deref().unwrap();
+    let names: Vec<&str> = g.document.nodes().filter_map(|n| n.name()).collect();
+    assert!(
+        names.contains(&"l_elbow") && names.contains(&"body"),
+        "{names:?}"
+    );
+    let animation = g.document.animations().next().unwrap();
+    let weights = animation
+        .channels()
+        .find(|c| c.target().property() == gltf::animation::Property::MorphTargetWeights)
+        .unwrap();
+    let r = weights.reader(|_| Some(blob));
+    let times: Vec<f32> = r.read_inputs().unwrap().collect();
+    let values: Vec<f32> = match r.read_outputs().unwrap() {
+        gltf::animation::util::ReadOutputs::MorphTargetWeights(w) => w.into_f32().collect(),
+        _ => unreachable!(),
+    };
+    let targets = avatar::default_model().morphs[0].clone();
+    let lines: Vec<Value> = std::fs::read_to_string(&frames)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), times.len());
+    let mut spoken = 0;
+    for (k, line) in lines.iter().enumerate() {
+        assert!((line["time"].as_f64().unwrap() as f32 - times[k]).abs() < 1e-6);
+        let morphs = line["characters"][""]["morphs"]
+            .as_object()
+            .cloned()
+            .unwrap_or_default();
+        for (m, name) in targets.iter().enumerate() {
+            let want = morphs.get(name).and_then(Value::as_f64).unwrap_or(0.0) as f32;
+            let got = values[k * targets.len() + m];
+            assert!(
+                (want - got).abs() < 1e-3,
+                "frame {k} {name}: {got} in the file, {want} in the frames"
+            );
+        }
+        spoken += usize::from(morphs.get("jawOpen").and_then(Value::as_f64).unwrap_or(0.0) > 0.2);
+    }
+    assert!(spoken > 20, "the mouth opens in {spoken} frames");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bmlr_refuses_a_bad_avatar_with_exit_2_naming_the_file() {
+    let dir = std::env::temp_dir().join(format!("bmlr-avatar-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("broken.glb");
+    std::fs::write(&bad, b"glTF\x02\0\0\0garbage").unwrap();
+    let out = dir.join("out.glb");
+    let (code, err) = bmlr(&[
+        "run",
+        "--gltf",
+        out.to_str().unwrap(),
+        "--avatar",
+        bad.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("broken.glb: not a valid GLB"), "{err}");
+    assert!(!out.exists());
+    let vrm = dir.join("nolowerarm.vrm");
+    let model = Model::from_glb("x", &test_avatar(Kind::Vrm1)).unwrap();
+    let mut json = model.json.clone();
+    json["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"]
+        .as_object_mut()
+        .unwrap()
+        .remove("rightLowerArm");
+    std::fs::write(&vrm, glb(&json)).unwrap();
+    let (code, err) = bmlr(&[
+        "run",
+        "--gltf",
+        out.to_str().unwrap(),
+        "--avatar",
+        vrm.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("nolowerarm.vrm: its skeleton lacks the bones rightLowerArm"),
+        "{err}"
+    );
+    let (code, err) = bmlr(&[
+        "run",
+        "--avatar",
+        vrm.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_mixamo_avatar_moves_under_bmlr_run_and_the_file_passes_through_gltf() {
+    let dir = std::env::temp_dir().join(format!("bmlr-avatar-mixamo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let avatar = dir.join("mixamo.glb");
+    std::fs::write(&avatar, test_avatar(Kind::Mixamo)).unwrap();
+    let out = dir.join("out.glb");
+    let (code, err) = bmlr(&[
+        "run",
+        "--gltf",
+        out.to_str().unwrap(),
+        "--avatar",
+        avatar.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let model = Model::read(&out).unwrap();
+    assert!(model.node("mixamorig:RightForeArm").is_some());
+    let g = gltf::Gltf::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    let animation = g.document.animations().next().unwrap();
+    let turned: Vec<String> = animation
+        .channels()
+        .filter(|c| c.target().property() == gltf::animation::Property::Rotation)
+        .filter_map(|c| c.target().node().name().map(str::to_string))
+        .collect();
+    assert!(
+        turned.contains(&"mixamorig:RightArm".to_string()),
+        "{turned:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
