@@ -5,8 +5,10 @@
 // the mannequin with three.js (loaded from the page's own text, so that the page works opened
 // from disk) with its face (brows, lids and mouth moved by the frames' blendshapes), the world's
 // points, a cursor over the timeline and the feedback up to the cursor, with play / pause /
-// scrub / speed, and the run's sound (if it has any) played in step with the cursor. It opens paused at #t=SECONDS and sets the title to
-// "bmlr view: ready" once the first frame is drawn.
+// scrub / speed, and the run's sound (if it has any) played in step with the cursor. Characters
+// with an avatar in the page data are drawn as that avatar (GLTFLoader, an animation per
+// character; M toggles the mannequin). It opens paused at #t=SECONDS and sets the title to
+// "bmlr view: ready" once the first frame is drawn with every avatar loaded.
 'use strict';
 
 (function () {
@@ -14,7 +16,7 @@
   const source = document.getElementById('three-source').textContent;
   const url = URL.createObjectURL(new Blob([source], { type: 'text/javascript' }));
   import(url).then(
-    (THREE) => new Viewer(THREE, data).start(),
+    (THREE) => new Viewer(THREE, data, url).start(),
     (e) => fail('three.js did not load: ' + e),
   );
 
@@ -158,8 +160,11 @@
   }
 
   class Viewer {
-    constructor(THREE, data) {
+    constructor(THREE, data, threeURL) {
       this.THREE = THREE;
+      this.threeURL = threeURL;
+      // characters' avatars still loading (the page is not ready before they are drawn)
+      this.avatarsLoading = 0;
       this.data = data;
       this.clip = new Clip(data.header);
       data.frames.forEach((f) => this.clip.push(f));
@@ -181,6 +186,7 @@
       this.figures = this.clip.characters.map((id, k) => this.figure(k));
       this.clip.added = (k) => this.figures.push(this.figure(k));
       this.worldPoints();
+      this.loadAvatars();
       this.controls();
       this.orbit();
       this.setTimeline(this.data.timeline);
@@ -278,6 +284,61 @@
       const face = this.face(index, rest, nodes);
       const balance = this.balanceMarks(index);
       return { nodes, face, balance, pose: new Float32Array(7 + 4 * joints.length), k };
+    }
+
+    /**
+     * Each character's avatar (a GLB in the page data, with its motion and face as an
+     * animation, made by the realizer as `bmlr run --gltf` makes it), loaded with three.js's
+     * GLTFLoader from the page's own text; the mannequin is hidden behind it (M shows it
+     * again).
+     */
+    loadAvatars() {
+      const THREE = this.THREE;
+      const avatars = this.data.avatars || [];
+      if (!avatars.length) return;
+      const text = (id) => document.getElementById(id).textContent;
+      const module = (s) => URL.createObjectURL(new Blob([s], { type: 'text/javascript' }));
+      const three = (s) => s.replace(/from 'three'/g, `from '${this.threeURL}'`);
+      const utils = module(three(text('three-geometry-utils')));
+      const loader = module(
+        three(text('three-gltf')).replace("'../utils/BufferGeometryUtils.js'", `'${utils}'`),
+      );
+      this.avatarsLoading = avatars.length;
+      const done = () => {
+        this.avatarsLoading--;
+        this.draw();
+      };
+      import(loader).then(
+        ({ GLTFLoader }) => avatars.forEach((glb, k) => {
+          const bytes = Uint8Array.from(atob(glb), (c) => c.charCodeAt(0));
+          new GLTFLoader().parse(bytes.buffer, '', (gltf) => {
+            gltf.scene.traverse((o) => { if (o.isSkinnedMesh) o.frustumCulled = false; });
+            this.scene.add(gltf.scene);
+            const mixer = new THREE.AnimationMixer(gltf.scene);
+            if (gltf.animations.length) {
+              const action = mixer.clipAction(gltf.animations[0]);
+              action.setLoop(THREE.LoopOnce);
+              action.clampWhenFinished = true;
+              action.play();
+            }
+            if (k === 0) {
+              // the close look at the face at the first avatar's eyes (about 11 cm under the
+              // top of its head), not the mannequin's
+              const top = new THREE.Box3().setFromObject(gltf.scene).max.y;
+              if (Number.isFinite(top) && top > 0.5) {
+                const close = this.view.height === this.close.height;
+                this.close.height = top - 0.11;
+                if (close) this.view.height = this.close.height;
+              }
+            }
+            const f = this.figures[k];
+            f.avatar = { root: gltf.scene, mixer };
+            f.nodes[0].visible = false;
+            done();
+          }, (e) => { fail('an avatar did not load: ' + e); done(); });
+        }),
+        (e) => { fail("three.js's GLTFLoader did not load: " + e); this.avatarsLoading = 0; },
+      );
     }
 
     /**
@@ -518,6 +579,13 @@
           this.view = { ...(this.view.height === this.body.height ? this.close : this.body) };
         }
         if (e.key === 'c' || e.key === 'C') this.showBalance = !this.showBalance;
+        if (e.key === 'm' || e.key === 'M') {
+          for (const f of this.figures) {
+            if (!f.avatar) continue;
+            f.avatar.root.visible = !f.avatar.root.visible;
+            f.nodes[0].visible = !f.avatar.root.visible;
+          }
+        }
       });
       let drag = null;
       this.canvas.addEventListener('pointerdown', (e) => {
@@ -600,6 +668,7 @@
           for (let j = 1; j < f.nodes.length; j++) f.nodes[j].quaternion.fromArray(pose, 7 + 4 * j);
           this.expression(f, this.t);
           this.balance(f);
+          if (f.avatar) f.avatar.mixer.setTime(this.t);
         }
       }
       for (const p of this.points) if (p.keys) p.ball.position.fromArray(along(p.keys, this.t));
@@ -621,7 +690,7 @@
       this.clock.textContent = fmt(this.t) + ' / ' + fmt(this.clip.duration);
       this.moveCursor();
       this.showFeedbackUpTo(this.t);
-      if (!this.drawn) {
+      if (!this.drawn && this.avatarsLoading === 0) {
         this.drawn = true;
         document.title = 'bmlr view: ready';
       }

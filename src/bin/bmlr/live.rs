@@ -51,6 +51,8 @@ impl LiveView {
             log: &[],
             world,
             audio: None,
+            // the live page shows mannequins: its frames arrive one by one
+            avatars: Vec::new(),
         }
         .to_json();
         let live = Live::new(BACKLOG);

@@ -179,6 +179,22 @@ impl Recording {
 
     /// Writes `avatar` moving as character `id` did.
     fn write_avatar(&self, path: &Path, id: &str, avatar: &Avatar) -> Result<(), (u8, String)> {
+        let glb = self.avatar_glb(id, avatar);
+        write_file(path, &glb)?;
+        eprintln!(
+            "wrote {} ({} on {}, {} frames at {} fps, {} kB)",
+            path.display(),
+            if id.is_empty() { "the character" } else { id },
+            avatar.model.file,
+            self.frames.len(),
+            self.fps,
+            glb.len() / 1024
+        );
+        Ok(())
+    }
+
+    /// `avatar` moving as character `id` did, as GLB bytes.
+    pub fn avatar_glb(&self, id: &str, avatar: &Avatar) -> Vec<u8> {
         let poses = self.poses_of(id);
         let frames: Vec<Frame> = (self.frames.iter().zip(&poses))
             .map(|((t, _), p)| Frame {
@@ -189,18 +205,7 @@ impl Recording {
             .collect();
         let skeleton = Skeleton::adult();
         let name = if id.is_empty() { "bml" } else { id };
-        let glb = animated_glb(&avatar.model, &avatar.retarget, &skeleton, &frames, name);
-        write_file(path, &glb)?;
-        eprintln!(
-            "wrote {} ({} on {}, {} frames at {} fps, {} kB)",
-            path.display(),
-            if id.is_empty() { "the character" } else { id },
-            avatar.model.file,
-            frames.len(),
-            self.fps,
-            glb.len() / 1024
-        );
-        Ok(())
+        animated_glb(&avatar.model, &avatar.retarget, &skeleton, &frames, name)
     }
 
     /// The frames of the one character a BVH or glTF file (`flag`) shows.

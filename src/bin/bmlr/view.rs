@@ -39,11 +39,17 @@ pub struct ViewArgs {
     /// on stderr) until interrupted.
     #[arg(long, value_name = "ADDR", conflicts_with = "out")]
     serve: Option<String>,
+    #[command(flatten)]
+    avatar: crate::avatar::AvatarArgs,
     /// BML files (one block each), '-' for a stream of blocks on stdin, '+SECS' to advance the
     /// clock before the next item.
     #[arg(required = true, value_name = "ITEM")]
     items: Vec<String>,
 }
+
+/// Most characters the page shows as avatars (each carries its own copy of the avatar); more
+/// are shown as mannequins.
+pub const MAX_VIEW_AVATARS: usize = 4;
 
 /// `bmlr view`.
 pub fn view(args: ViewArgs) -> ExitCode {
@@ -77,6 +83,7 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
         return Err("--until must be a number of seconds >= 0".into());
     }
     let items = crate::run::read_items(&args.items)?;
+    let avatar = args.avatar.load()?;
     let until = args.until.unwrap_or(f64::INFINITY);
     let mut run = VirtualRun::recording(args.setup.realizer(false)?, args.fps, until);
     run.items(items);
@@ -93,6 +100,18 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
         true => Some(motion.wav(&run.realizer)?.0),
         false => None,
     };
+    // each character on its avatar, moving as in `bmlr run --gltf`
+    let avatars = if characters.len() <= MAX_VIEW_AVATARS {
+        (characters.iter())
+            .map(|id| motion.avatar_glb(id, &avatar))
+            .collect()
+    } else {
+        eprintln!(
+            "bmlr view: {} characters, shown as mannequins (avatars for at most {MAX_VIEW_AVATARS})",
+            characters.len()
+        );
+        Vec::new()
+    };
     let data = PageData {
         title: &title(&args.items),
         live: false,
@@ -101,6 +120,7 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
         log: &log,
         world: run.realizer.world(),
         audio,
+        avatars,
     };
     let page = web::page(&data.to_json());
     let s = if characters.len() == 1 { "" } else { "s" };
@@ -138,6 +158,9 @@ pub struct PageData<'a> {
     pub world: &'a World,
     /// The run's sound as a WAV file, if it made any.
     pub audio: Option<Vec<u8>>,
+    /// Per character (in the header's order) its avatar with its motion, as GLB; none: the
+    /// mannequins.
+    pub avatars: Vec<Vec<u8>>,
 }
 
 impl PageData<'_> {
@@ -153,7 +176,16 @@ impl PageData<'_> {
             let b64 = base64::engine::general_purpose::STANDARD.encode(wav);
             format!("data:audio/wav;base64,{b64}")
         });
+        let avatars: Vec<String> = self
+            .avatars
+            .iter()
+            .map(|glb| {
+                use base64::Engine as _;
+                base64::engine::general_purpose::STANDARD.encode(glb)
+            })
+            .collect();
         let data = json!({
+            "avatars": avatars,
             "title": self.title,
             "live": self.live,
             "segments": mannequin::segments(&Skeleton::adult()),

@@ -14,6 +14,9 @@ use std::time::Duration;
 const TEMPLATE: &str = include_str!("../../../assets/viewer/index.html");
 const VIEWER: &str = include_str!("../../../assets/viewer/viewer.js");
 const THREE: &str = include_str!("../../../assets/viewer/three/three.module.min.js");
+/// three.js's glTF loader and the geometry helpers it imports (the same release, same licence).
+const GLTF_LOADER: &str = include_str!("../../../assets/viewer/three/GLTFLoader.js");
+const GEOMETRY_UTILS: &str = include_str!("../../../assets/viewer/three/BufferGeometryUtils.js");
 /// three.js's MIT licence, written beside the page.
 pub const THREE_LICENSE: &str = include_str!("../../../assets/viewer/three/LICENSE");
 /// The vendored three.js (npm `three`, `build/three.module.min.js`).
@@ -37,6 +40,8 @@ pub fn page(data: &str) -> String {
             ("DATA", &data),
             ("THREE_VERSION", THREE_VERSION),
             ("THREE", THREE),
+            ("GLTF_LOADER", GLTF_LOADER),
+            ("GEOMETRY_UTILS", GEOMETRY_UTILS),
             ("VIEWER", VIEWER),
         ],
     )
