@@ -258,3 +258,34 @@ fn the_default_avatar_is_a_skinned_person_standing_in_the_realizer_s_rest() {
         skeleton.joint("l_elbow")
     );
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(200))]
+
+    /// Built avatars with bytes changed or cut: read, recognised and retargeted, or refused,
+    /// never a panic.
+    #[test]
+    fn damaged_avatars_are_refused_or_driven_never_a_panic(
+        kind in 0..3usize,
+        changes in proptest::collection::vec((0.0..1.0f64, proptest::prelude::any::<u8>()), 0..12),
+        cut in 0.0..1.0f64,
+    ) {
+        let kind = [Kind::Mixamo, Kind::Vrm1, Kind::Vrm0][kind];
+        let mut bytes = test_avatar(kind);
+        for (at, value) in changes {
+            let i = (at * bytes.len() as f64) as usize % bytes.len();
+            bytes[i] = value;
+        }
+        if cut > 0.8 {
+            bytes.truncate((cut * bytes.len() as f64) as usize);
+        }
+        let skeleton = Skeleton::adult();
+        if let Ok(model) = Model::from_glb("damaged.glb", &bytes) {
+            if let Ok(retarget) = Retarget::new(&model, &skeleton, None) {
+                let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
+                let posed = retarget.pose(&skeleton, &Pose::rest(&skeleton), &parents);
+                proptest::prop_assert_eq!(posed.rotations.len(), model.nodes.len());
+            }
+        }
+    }
+}

@@ -187,3 +187,78 @@ fn expression_binds(json: &Value, node: usize, mesh: usize) -> Vec<(&'static str
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use serde_json::json;
+
+    use super::*;
+    use crate::face::model::{morph_index, Morphs};
+
+    fn model(json: Value) -> Model {
+        Model {
+            file: "face.vrm".into(),
+            nodes: Vec::new(),
+            joints: Vec::new(),
+            morphs: vec![vec![
+                "jawOpen".into(),
+                "viseme_aa".into(),
+                "Fcl_MTH_A".into(),
+                "Fcl_EYE_Close".into(),
+                "unrelated".into(),
+            ]],
+            json,
+            bin: Vec::new(),
+        }
+    }
+
+    fn speaking() -> Face {
+        let mut morphs = Morphs::default();
+        for (name, w) in [
+            ("jawOpen", 0.4),
+            ("eyeBlinkLeft", 1.0),
+            ("eyeBlinkRight", 0.8),
+        ] {
+            morphs.0[morph_index(name).unwrap()] = w;
+        }
+        Face {
+            morphs,
+            viseme: VISEMES.iter().position(|v| *v == "aa"),
+            ..Face::default()
+        }
+    }
+
+    #[test]
+    fn arkit_names_visemes_and_vrm_expressions_drive_their_targets() {
+        // VRM 1.0: expressions bind nodes
+        let vrm1 = model(json!({
+            "nodes": [{"mesh": 0}],
+            "extensions": {"VRMC_vrm": {"expressions": {"preset": {
+                "aa": {"morphTargetBinds": [{"node": 0, "index": 2, "weight": 1.0}]},
+                "blink": {"morphTargetBinds": [{"node": 0, "index": 3, "weight": 0.5}]}
+            }}}}
+        }));
+        // VRM 0.x: blend shape groups bind meshes, weights 0-100
+        let vrm0 = model(json!({
+            "nodes": [{"mesh": 0}],
+            "extensions": {"VRM": {"blendShapeMaster": {"blendShapeGroups": [
+                {"presetName": "a", "binds": [{"mesh": 0, "index": 2, "weight": 100}]},
+                {"presetName": "blink", "binds": [{"mesh": 0, "index": 3, "weight": 50}]}
+            ]}}}
+        }));
+        for m in [vrm1, vrm0] {
+            let map = MorphMap::new(&m);
+            assert_eq!(map.nodes().collect::<Vec<_>>(), vec![(0, 5)]);
+            let mut w = Vec::new();
+            map.weights(0, &speaking(), &mut w);
+            // jawOpen as is, the viseme on, the expression aa on, blink (the lesser eye) × 0.5
+            assert_eq!(w, vec![0.4, 1.0, 1.0, 0.4, 0.0]);
+            map.weights(0, &Face::default(), &mut w);
+            assert_eq!(w, vec![0.0; 5]);
+        }
+        // nothing the face drives: nothing animated
+        let mut plain = model(json!({"nodes": [{"mesh": 0}]}));
+        plain.morphs = vec![vec!["Key 1".into()]];
+        assert!(MorphMap::new(&plain).is_empty());
+    }
+}
