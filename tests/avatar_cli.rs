@@ -161,3 +161,50 @@ fn a_mixamo_avatar_moves_under_bmlr_run_and_the_file_passes_through_gltf() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_character_takes_the_avatar_the_world_file_gives_it() {
+    let dir = std::env::temp_dir().join(format!("bmlr-avatar-world-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("mixamo.glb"), test_avatar(Kind::Mixamo)).unwrap();
+    let mut world: Value =
+        serde_json::from_str(&std::fs::read_to_string("fixtures/examples/world.json").unwrap())
+            .unwrap();
+    world["characters"]["Alice"]["avatar"] = Value::from("mixamo.glb");
+    let file = dir.join("world.json");
+    std::fs::write(&file, world.to_string()).unwrap();
+    let (alice, bob) = (dir.join("alice.glb"), dir.join("bob.glb"));
+    let run = |out: &std::path::Path, who: &str, blocks: &str| {
+        bmlr(&[
+            "run",
+            "--world",
+            file.to_str().unwrap(),
+            "--character",
+            who,
+            "--gltf",
+            out.to_str().unwrap(),
+            blocks,
+        ])
+    };
+    let (code, err) = run(&alice, "Alice", "fixtures/examples/two-alice.xml");
+    assert_eq!(code, 0, "{err}");
+    assert!(Model::read(&alice)
+        .unwrap()
+        .node("mixamorig:RightArm")
+        .is_some());
+    // Bob has none in the world file: the default avatar
+    let (code, err) = run(&bob, "Bob", "fixtures/examples/two-bob.xml");
+    assert_eq!(code, 0, "{err}");
+    assert!(Model::read(&bob).unwrap().node("l_eyeball_joint").is_some());
+    // a world file naming an avatar that is not there: exit 2 naming the character and file
+    world["characters"]["Bob"]["avatar"] = Value::from("missing.vrm");
+    std::fs::write(&file, world.to_string()).unwrap();
+    let (code, err) = run(&bob, "Bob", "fixtures/examples/two-bob.xml");
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("world file: character 'Bob': ")
+            && err.contains("missing.vrm: cannot read it"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -53,6 +53,9 @@ struct CharacterFile {
     /// The name of its avoidance profile (in `profiles`).
     #[serde(default)]
     profile: Option<String>,
+    /// Its avatar file (glTF/GLB/VRM; relative to the world file).
+    #[serde(default)]
+    avatar: Option<String>,
 }
 
 fn vec3(name: &str, v: [f64; 3]) -> Result<Vec3, String> {
@@ -110,6 +113,14 @@ impl World {
                 ));
             }
             w.place(&name, Placement::new(at, c.facing as f32))?;
+            if let Some(a) = c.avatar.as_deref() {
+                if a.is_empty() || a.len() > 4096 {
+                    return Err(format!(
+                        "character '{name}': its avatar must name a file (1 to 4096 bytes)"
+                    ));
+                }
+                Arc::make_mut(&mut w.avatars).insert(name.clone(), a.to_string());
+            }
             if let Some(r) = c.radius {
                 if !(r > 0.0 && r <= 10.0) {
                     return Err(format!(

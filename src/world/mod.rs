@@ -78,6 +78,8 @@ pub struct World {
     obstacles: Arc<crate::locomotion::Obstacles>,
     /// The avoidance profile of characters the world file gives one.
     profiles: Arc<BTreeMap<String, crate::crowd::Profile>>,
+    /// The avatar file of characters the world file gives one (as written there).
+    avatars: Arc<BTreeMap<String, String>>,
     /// Groups of characters: declared in the world file or found there.
     groups: Arc<Vec<crate::crowd::group::Group>>,
     /// Every character as walkers see it this frame, in world coordinates (a view has none).
@@ -127,6 +129,7 @@ impl World {
             combiners: Default::default(),
             obstacles: Default::default(),
             profiles: Default::default(),
+            avatars: Default::default(),
             groups: Default::default(),
             crowd: Default::default(),
             frame: Placement::default(),
@@ -190,6 +193,12 @@ impl World {
     /// Sets the obstacles.
     pub fn set_obstacles(&mut self, obstacles: crate::locomotion::Obstacles) {
         self.obstacles = Arc::new(obstacles);
+    }
+
+    /// The avatar file the world file gives character `id` (as written there; a host resolves a
+    /// relative one against the world file's directory).
+    pub fn avatar(&self, id: &str) -> Option<&str> {
+        self.avatars.get(id).map(String::as_str)
     }
 
     /// Character `id`'s body radius ([`DEFAULT_RADIUS`] unless the world file gives one).
@@ -271,6 +280,7 @@ impl World {
             combiners: self.combiners.clone(),
             obstacles: Default::default(),
             profiles: self.profiles.clone(),
+            avatars: self.avatars.clone(),
             groups: self.groups.clone(),
             crowd: Default::default(),
             characters: self.characters.clone(),

@@ -3,10 +3,11 @@
 //! with exit 2 and a sentence naming the file.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use bml_realizer::avatar::{self, Model, Retarget};
 use bml_realizer::body::Skeleton;
+use bml_realizer::world::World;
 use clap::Args;
 
 /// The avatar options.
@@ -30,20 +31,55 @@ pub struct Avatar {
     pub retarget: Retarget,
 }
 
-impl AvatarArgs {
-    /// The avatar asked for (the default one when none is), or what is wrong with it.
-    pub fn load(&self) -> Result<Avatar, String> {
-        let model = match &self.avatar {
+impl Avatar {
+    /// The avatar at `path` (the default one for none), its bones by `map` or recognised.
+    fn read(path: Option<&Path>, map: Option<&BTreeMap<String, String>>) -> Result<Avatar, String> {
+        let model = match path {
             Some(path) => Model::read(path).map_err(|e| e.to_string())?,
             None => avatar::default_model(),
         };
+        let retarget = Retarget::new(&model, &Skeleton::adult(), map).map_err(|e| e.to_string())?;
+        Ok(Avatar { model, retarget })
+    }
+}
+
+/// The avatar of every character: the world file's for those it gives one, else the one of
+/// the command line (or the default one).
+pub struct Avatars {
+    /// For characters the world file gives none.
+    pub common: Avatar,
+    /// By character id, from the world file.
+    pub own: BTreeMap<String, Avatar>,
+}
+
+impl Avatars {
+    /// Character `id`'s avatar.
+    pub fn of(&self, id: &str) -> &Avatar {
+        self.own.get(id).unwrap_or(&self.common)
+    }
+}
+
+impl AvatarArgs {
+    /// The avatars of `world`'s characters (read from `world_file`'s directory when relative)
+    /// and the one asked for on the command line (the default one when none is), or what is
+    /// wrong with one of them.
+    pub fn load(&self, world: &World, world_file: Option<&Path>) -> Result<Avatars, String> {
         let map = match &self.bone_map {
             Some(path) => Some(read_map(path)?),
             None => None,
         };
-        let retarget =
-            Retarget::new(&model, &Skeleton::adult(), map.as_ref()).map_err(|e| e.to_string())?;
-        Ok(Avatar { model, retarget })
+        let common = Avatar::read(self.avatar.as_deref(), map.as_ref())?;
+        let dir = world_file.and_then(Path::parent).unwrap_or(Path::new(""));
+        let mut own = BTreeMap::new();
+        for (id, _) in world.placements() {
+            if let Some(file) = world.avatar(id) {
+                let path = dir.join(file);
+                let avatar = Avatar::read(Some(&path), None)
+                    .map_err(|e| format!("world file: character '{id}': {e}"))?;
+                own.insert(id.to_string(), avatar);
+            }
+        }
+        Ok(Avatars { common, own })
     }
 }
 

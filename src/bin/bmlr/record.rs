@@ -9,7 +9,7 @@ use bml_realizer::engine::CharacterPose;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::sound::{SoundEvent, Track};
 
-use crate::avatar::{Avatar, AvatarArgs};
+use crate::avatar::{Avatar, AvatarArgs, Avatars};
 
 /// The frame period, the next frame's time, and every character's pose in each frame so far
 /// (which characters a file shows is decided at the end).
@@ -129,7 +129,7 @@ impl Recording {
         realizer: &Realizer,
         path: &Path,
         asked: Option<&str>,
-        avatar: Option<&Avatar>,
+        avatar: Option<&Avatars>,
         options: &AvatarArgs,
     ) -> Result<(), (u8, String)> {
         let everyone = received(realizer);
@@ -138,8 +138,8 @@ impl Recording {
             _ => vec![recorded_character(realizer, asked, "--gltf")
                 .map_err(|e| (1, format!("--gltf: {e}")))?],
         };
-        if let ([id], Some(avatar)) = (ids.as_slice(), avatar) {
-            return self.write_avatar(path, id, avatar);
+        if let ([id], Some(avatars)) = (ids.as_slice(), avatar) {
+            return self.write_avatar(path, id, avatars.of(id));
         }
         if options.avatar.is_some() {
             return Err((

@@ -477,7 +477,7 @@ impl VirtualRun {
     fn write_recordings(
         &mut self,
         args: &RunArgs,
-        avatar: Option<&crate::avatar::Avatar>,
+        avatar: Option<&crate::avatar::Avatars>,
     ) -> Result<(), (u8, String)> {
         let Some(m) = self.take_motion() else {
             return Ok(());
@@ -543,7 +543,9 @@ pub fn run(args: RunArgs) -> ExitCode {
 
 /// The items and the realizer of `bmlr run`, or what is wrong with the command line (exit 2).
 #[allow(clippy::type_complexity)] // what runs, what runs it, what shows it
-fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer, Option<crate::avatar::Avatar>), String> {
+fn checked(
+    args: &RunArgs,
+) -> Result<(Vec<Item>, Realizer, Option<crate::avatar::Avatars>), String> {
     let items = read_items(&args.items)?;
     if args.until.is_some_and(|u| !(u.is_finite() && u >= 0.0)) {
         return Err("--until must be a number of seconds >= 0".into());
@@ -566,11 +568,15 @@ fn checked(args: &RunArgs) -> Result<(Vec<Item>, Realizer, Option<crate::avatar:
     if args.gltf.is_none() && args.avatar.avatar.is_some() {
         return Err("--avatar shows the motion in --gltf OUT.glb; give it too".into());
     }
+    let realizer = args.setup.realizer(args.realtime)?;
     let avatar = match &args.gltf {
-        Some(_) => Some(args.avatar.load()?),
+        Some(_) => Some(
+            args.avatar
+                .load(realizer.world(), args.setup.world.as_deref())?,
+        ),
         None => None,
     };
-    Ok((items, args.setup.realizer(args.realtime)?, avatar))
+    Ok((items, realizer, avatar))
 }
 
 /// Tells stderr which blocks did not finish (waiting for activation, persistent behaviour, or

@@ -83,9 +83,10 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
         return Err("--until must be a number of seconds >= 0".into());
     }
     let items = crate::run::read_items(&args.items)?;
-    let avatar = args.avatar.load()?;
     let until = args.until.unwrap_or(f64::INFINITY);
-    let mut run = VirtualRun::recording(args.setup.realizer(false)?, args.fps, until);
+    let realizer = args.setup.realizer(false)?;
+    let avatars = (args.avatar).load(realizer.world(), args.setup.world.as_deref())?;
+    let mut run = VirtualRun::recording(realizer, args.fps, until);
     run.items(items);
     crate::run::report_unfinished(&run.realizer);
     let motion = run.take_motion().expect("a recording run records");
@@ -103,7 +104,7 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
     // each character on its avatar, moving as in `bmlr run --gltf`
     let avatars = if characters.len() <= MAX_VIEW_AVATARS {
         (characters.iter())
-            .map(|id| motion.avatar_glb(id, &avatar))
+            .map(|id| motion.avatar_glb(id, avatars.of(id)))
             .collect()
     } else {
         eprintln!(
