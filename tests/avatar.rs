@@ -34,8 +34,7 @@ fn random_pose(skeleton: &Skeleton, rng: &mut Rng, most: f32) -> Pose {
 
 /// The angles (degrees) between every limb bone of the posed avatar and its realizer bone.
 fn limb_errors(model: &Model, retarget: &Retarget, skeleton: &Skeleton, pose: &Pose) -> Vec<f32> {
-    let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
-    let posed = retarget.pose(skeleton, pose, &parents);
+    let posed = retarget.world(&retarget.pose(skeleton, pose));
     let realizer = pose.world(skeleton);
     let node_of = |bone: &str| {
         model.nodes.iter().position(|n| {
@@ -50,7 +49,7 @@ fn limb_errors(model: &Model, retarget: &Retarget, skeleton: &Skeleton, pose: &P
         .iter()
         .filter_map(|&(a, b)| {
             let (na, nb) = (node_of(a)?, node_of(b)?);
-            let ours = place(&posed.world[nb]) - place(&posed.world[na]);
+            let ours = place(&posed[nb]) - place(&posed[na]);
             let (ja, jb) = (retarget.source(na)?, retarget.source(nb)?);
             let theirs = retarget.frame() * (realizer.positions[jb] - realizer.positions[ja]);
             Some(ours.angle_between(theirs).to_degrees())
@@ -96,13 +95,13 @@ fn the_travel_of_the_root_is_scaled_by_leg_length_and_turned_into_the_avatar_s_f
     let skeleton = Skeleton::adult();
     let model = Model::from_glb("vrm0", &test_avatar(Kind::Vrm0)).unwrap();
     let retarget = Retarget::new(&model, &skeleton, None).unwrap();
-    let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
     let mut pose = Pose::rest(&skeleton);
-    let at_rest = retarget.pose(&skeleton, &pose, &parents);
+    let at_rest = retarget.pose(&skeleton, &pose);
+    let rest_world = retarget.world(&at_rest);
     pose.root += Vec3::new(0.0, 0.0, 1.0);
-    let walked = retarget.pose(&skeleton, &pose, &parents);
+    let walked = retarget.world(&retarget.pose(&skeleton, &pose));
     let hips = at_rest.hips.0;
-    let moved = walked.world[hips].w_axis.truncate() - at_rest.world[hips].w_axis.truncate();
+    let moved = walked[hips].w_axis.truncate() - rest_world[hips].w_axis.truncate();
     // same leg length (built from the realizer's skeleton), facing −z: a metre forward is −z
     assert!(moved.distance(Vec3::new(0.0, 0.0, -1.0)) < 1e-4, "{moved}");
 }
@@ -251,12 +250,31 @@ fn the_default_avatar_is_a_skinned_person_standing_in_the_realizer_s_rest() {
         let angle = ours.angle_between(theirs).to_degrees();
         assert!(angle < 2.0, "{a}→{b} is {angle}° from the realizer's rest");
     }
-    // and the realizer drives it joint by joint
+    // and the realizer drives it joint by joint, each node turning as its joint (no
+    // arithmetic): its limbs point where the realizer's do
     let retarget = Retarget::new(&model, &skeleton, None).unwrap();
+    assert!(retarget.is_direct());
     assert_eq!(
         retarget.source(model.node("l_elbow").unwrap()),
         skeleton.joint("l_elbow")
     );
+    let mut rng = Rng(5);
+    for _ in 0..100 {
+        let pose = random_pose(&skeleton, &mut rng, 1.0);
+        let world = retarget.world(&retarget.pose(&skeleton, &pose));
+        let theirs = pose.world(&skeleton);
+        for (a, b) in [
+            ("l_shoulder", "l_elbow"),
+            ("r_elbow", "r_wrist"),
+            ("l_hip", "l_knee"),
+        ] {
+            let at = |n: &str| world[model.node(n).unwrap()].w_axis.truncate();
+            let ours = at(b) - at(a);
+            let (ja, jb) = (skeleton.joint(a).unwrap(), skeleton.joint(b).unwrap());
+            let angle = ours.angle_between(theirs.positions[jb] - theirs.positions[ja]);
+            assert!(angle.to_degrees() < 0.5, "{a}→{b}: {}°", angle.to_degrees());
+        }
+    }
 }
 
 proptest::proptest! {
@@ -282,8 +300,7 @@ proptest::proptest! {
         let skeleton = Skeleton::adult();
         if let Ok(model) = Model::from_glb("damaged.glb", &bytes) {
             if let Ok(retarget) = Retarget::new(&model, &skeleton, None) {
-                let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
-                let posed = retarget.pose(&skeleton, &Pose::rest(&skeleton), &parents);
+                let posed = retarget.pose(&skeleton, &Pose::rest(&skeleton));
                 proptest::prop_assert_eq!(posed.rotations.len(), model.nodes.len());
             }
         }

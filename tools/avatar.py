@@ -213,7 +213,7 @@ def skin_weights(weights, n, names):
 
 
 def straighten(joints):
-    """The H-Anim rest of the A-posed body: arms, hands, fingers and legs along the realizer's
+    """The H-Anim rest of the A-posed body: arms, hands, fingers, thumbs and legs along the realizer's
     rest bones (`fixtures/skeletons/adult.json`: straight down, the hand a little forward; the
     palms then face the thighs, as the A-pose's do), the feet as they were. Returns the joints' names, parents, new places, the rotation that
     takes each joint's part of the body there, and the old places."""
@@ -236,7 +236,7 @@ def straighten(joints):
         aim[f"{s}_wrist"] = f"{s}_middle1"
         aim[f"{s}_hip"] = f"{s}_knee"
         aim[f"{s}_knee"] = f"{s}_talocrural"
-        for f in ("index", "middle", "ring", "pinky"):
+        for f in ("thumb", "index", "middle", "ring", "pinky"):
             aim[f"{s}_{f}1"] = f"{s}_{f}2"
             aim[f"{s}_{f}2"] = f"{s}_{f}3"
     keep_world = {"l_talocrural", "r_talocrural"}
@@ -250,7 +250,7 @@ def straighten(joints):
         if name in aim:
             d = rp @ (place[index[aim[name]]] - place[i])
             rot[i] = arc(d, offset[aim[name]]) @ rp
-        elif name.endswith(("index3", "middle3", "ring3", "pinky3")):
+        elif name.endswith(("thumb3", "index3", "middle3", "ring3", "pinky3")):
             rot[i] = rot[p]
         elif name in keep_world:
             rot[i] = np.eye(3)

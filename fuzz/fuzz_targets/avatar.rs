@@ -14,7 +14,6 @@ fuzz_target!(|data: &[u8]| {
     };
     let skeleton = Skeleton::adult();
     if let Ok(retarget) = Retarget::new(&model, &skeleton, None) {
-        let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
-        let _ = retarget.pose(&skeleton, &Pose::rest(&skeleton), &parents);
+        let _ = retarget.pose(&skeleton, &Pose::rest(&skeleton));
     }
 });

@@ -96,7 +96,6 @@ fn animate(
     frames: &[Frame<'_>],
     name: &str,
 ) {
-    let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
     let bones: Vec<usize> = (0..model.nodes.len())
         .filter(|&i| retarget.source(i).is_some())
         .collect();
@@ -104,7 +103,7 @@ fn animate(
     let mut travel = Vec::with_capacity(3 * frames.len());
     let mut hips = 0;
     for f in frames {
-        let posed = retarget.pose(skeleton, f.pose, &parents);
+        let posed = retarget.pose(skeleton, f.pose);
         for (k, &b) in bones.iter().enumerate() {
             turns[k].extend(posed.rotations[b].to_array());
         }

@@ -1,9 +1,9 @@
 //! The realizer's motion on an avatar's skeleton, rest-pose aware. Each avatar bone paired
 //! with a realizer joint takes that joint's world rotation since rest. Before that the two rest
 //! poses are aligned bone by bone: a limb bone of the avatar (upper and lower arm, hand, finger,
-//! thigh, shin, foot) is turned, the short way, so that it points where its realizer joint's
-//! bone points at rest, whatever pose the avatar was made in (T, A) and whatever its bones'
-//! own axes. The avatar's frame may differ from the realizer's (y up, facing +z, left +x):
+//! thigh, shin) is turned, the short way, so that it points where its realizer joint's bone
+//! points at rest, whatever pose the avatar was made in (T, A) and whatever its bones' own axes;
+//! the feet, like the trunk, are taken to rest alike (soles on the floor). The avatar's frame may differ from the realizer's (y up, facing +z, left +x):
 //! it is found from the skeleton itself (left from the right upper arm to the left, up from
 //! the hips to the head), so that a VRM 0.x facing −z or a file in centimetres under a turned
 //! armature are driven alike. The root's travel is scaled by the ratio of leg lengths. Bones
@@ -27,7 +27,6 @@ fn points_at(joint: &str) -> Option<String> {
         "wrist" => "middle1".to_string(),
         "hip" => "knee".to_string(),
         "knee" => "talocrural".to_string(),
-        "talocrural" => "metatarsal".to_string(),
         r => {
             let (finger, k) = r.split_at_checked(r.len().checked_sub(1)?)?;
             let k: u32 = k.parse().ok()?;
@@ -45,22 +44,30 @@ fn points_at(joint: &str) -> Option<String> {
 pub struct Retarget {
     /// Per node, the realizer joint it follows.
     source: Vec<Option<usize>>,
-    /// Per node, the world rotation that aligns its rest with the realizer's (identity for
-    /// nodes that follow none).
-    align: Vec<Quat>,
+    /// Per node, its parent node.
+    parents: Vec<Option<usize>>,
     /// The nodes in parents-first order.
     order: Vec<usize>,
-    /// Per node, its rest transform relative to its parent, and its rest world rotation.
-    local: Vec<Mat4>,
-    rest_rotation: Vec<Quat>,
+    /// Per node, its rest scale, rotation and translation relative to its parent.
+    rest: Vec<(Vec3, Quat, Vec3)>,
+    /// Per node that follows a joint, what its joint's world rotation since rest (in the
+    /// realizer's frame) is applied to: its rest world rotation, aligned with the realizer's
+    /// rest, taken into the realizer's frame.
+    pre: Vec<Quat>,
     /// The realizer's frame in the avatar's: realizer x (left), y (up), z (forward).
     frame: Quat,
     /// The node that carries the root's travel, its rest world place, and the travel's scale.
     hips: usize,
     hips_rest: Vec3,
     scale: f32,
+    /// The rest world rotation, place and scale of the hips' parent (none: the identity).
+    hips_parent: (Quat, Vec3, Vec3),
     /// The realizer's root at rest.
     root_rest: Vec3,
+    /// Whether the avatar's skeleton is the realizer's (same hierarchy, same frame, every rest
+    /// rotation and alignment the identity): then each node's local rotation is its joint's,
+    /// with no arithmetic (the default avatar).
+    direct: bool,
 }
 
 /// An avatar's skeleton posed: per node its local rotation, and the local translation of the
@@ -71,8 +78,6 @@ pub struct Posed {
     pub rotations: Vec<Quat>,
     /// The travelling node and its local translation.
     pub hips: (usize, Vec3),
-    /// Every node's world transform.
-    pub world: Vec<Mat4>,
 }
 
 impl Retarget {
@@ -114,7 +119,7 @@ impl Retarget {
                 "its shoulders or its hips and head are in one place: no frame",
             ));
         }
-        let frame = Quat::from_mat3(&Mat3::from_cols(left, up, left.cross(up)));
+        let frame = snapped(Quat::from_mat3(&Mat3::from_cols(left, up, left.cross(up))));
         // the realizer's rest places
         let rest = Pose::rest(skeleton).world(skeleton);
         let order = parents_first(model);
@@ -127,8 +132,9 @@ impl Retarget {
             let Some(j) = source[i] else { continue };
             let name = &skeleton.joints()[j].name;
             let Some(next) = points_at(name) else {
-                // trunk, head, clavicles: their rests are taken to agree
-                if !is_limb(name) {
+                // trunk, head, clavicles and feet (soles flat on the floor in both): their
+                // rests are taken to agree
+                if !is_limb(name) || name.ends_with("talocrural") || name.ends_with("metatarsal") {
                     align[i] = Quat::IDENTITY;
                 }
                 continue;
@@ -157,12 +163,29 @@ impl Retarget {
             Some(root) => root,
             None => need("sacroiliac")?,
         };
+        let parents: Vec<Option<usize>> = model.nodes.iter().map(|n| n.parent).collect();
+        let rest_rotation: Vec<Quat> = world.iter().map(rotation_of).collect();
+        // (within a tenth of a degree: the default avatar's file keeps places in f32)
+        let near = |q: Quat| q.normalize().angle_between(Quat::IDENTITY) < 1.7e-3;
+        let node_of_joint = |j: usize| pairs.iter().find(|p| p.1 == j).map(|p| p.0);
+        let direct = near(frame)
+            && parents[hips].is_none()
+            && pairs.iter().all(|&(i, j)| {
+                let parent_joint = skeleton.joints()[j].parent;
+                near(align[i])
+                    && near(rest_rotation[i])
+                    && parents[i] == parent_joint.and_then(node_of_joint)
+            });
         Ok(Retarget {
+            pre: (0..n)
+                .map(|i| frame.inverse() * align[i] * rest_rotation[i])
+                .collect(),
             source,
-            align,
+            parents,
             order,
-            local: model.nodes.iter().map(|n| n.local()).collect(),
-            rest_rotation: world.iter().map(rotation_of).collect(),
+            rest: (model.nodes.iter())
+                .map(|n| (n.scale, n.rotation, n.translation))
+                .collect(),
             frame,
             hips,
             hips_rest: place(hips),
@@ -172,41 +195,80 @@ impl Retarget {
                 1.0
             },
             root_rest: rest.positions[0],
+            hips_parent: match model.nodes[hips].parent {
+                Some(p) => {
+                    let (scale, rotation, place) = world[p].to_scale_rotation_translation();
+                    (rotation.normalize(), place, scale)
+                }
+                None => (Quat::IDENTITY, Vec3::ZERO, Vec3::ONE),
+            },
+            direct,
         })
     }
 
     /// The avatar posed as the realizer's `pose` of `skeleton`.
-    pub fn pose(&self, skeleton: &Skeleton, pose: &Pose, parents: &[Option<usize>]) -> Posed {
-        let w = pose.world(skeleton);
-        let n = self.local.len();
-        let mut world = vec![Mat4::IDENTITY; n];
-        let mut rotations = vec![Quat::IDENTITY; n];
+    pub fn pose(&self, skeleton: &Skeleton, pose: &Pose) -> Posed {
+        let mut rotations: Vec<Quat> = self.rest.iter().map(|r| r.1).collect();
         let travel = self.frame * (pose.root - self.root_rest) * self.scale;
-        let mut hips = (self.hips, Vec3::ZERO);
-        for &i in &self.order {
-            let parent = parents[i].map_or(Mat4::IDENTITY, |p| world[p]);
-            let (scale, rest, mut translation) = self.local[i].to_scale_rotation_translation();
-            let rotation = match self.source[i] {
-                Some(j) => {
-                    let turned = self.frame * w.orientations[j] * self.frame.inverse();
-                    let target = turned * self.align[i] * self.rest_rotation[i];
-                    (rotation_of(&parent).inverse() * target).normalize()
+        let turn = |j: usize| pose.rotations.get(j).copied().unwrap_or(Quat::IDENTITY);
+        if self.direct {
+            for (i, s) in self.source.iter().enumerate() {
+                if let Some(j) = *s {
+                    rotations[i] = turn(j);
                 }
-                None => rest,
-            };
-            if i == self.hips {
-                let there = self.hips_rest + travel;
-                translation = parent.inverse().transform_point3(there);
-                hips = (i, translation);
             }
-            rotations[i] = rotation;
-            world[i] = parent * Mat4::from_scale_rotation_translation(scale, rotation, translation);
+            let hips = (self.hips, self.hips_rest + travel);
+            return Posed { rotations, hips };
         }
-        Posed {
-            rotations,
-            hips,
-            world,
+        // the realizer's joints' world rotations, then the avatar's nodes' (parents first)
+        let mut world: Vec<Quat> = Vec::with_capacity(skeleton.len() + self.rest.len());
+        for (j, joint) in skeleton.joints().iter().enumerate() {
+            let parent = joint.parent.map_or(Quat::IDENTITY, |p| world[p]);
+            world.push(parent * turn(j));
         }
+        let (turned, nodes) = {
+            world.resize(skeleton.len() + self.rest.len(), Quat::IDENTITY);
+            world.split_at_mut(skeleton.len())
+        };
+        for &i in &self.order {
+            let parent = self.parents[i].map_or(Quat::IDENTITY, |p| nodes[p]);
+            match self.source[i] {
+                Some(j) => {
+                    let target = self.frame * turned[j] * self.pre[i];
+                    rotations[i] = (parent.inverse() * target).normalize();
+                    nodes[i] = target;
+                }
+                None => nodes[i] = parent * rotations[i],
+            }
+        }
+        // the hips' ancestors follow no joint: they stay at rest
+        let (pr, pp, ps) = self.hips_parent;
+        let hips = (
+            self.hips,
+            pr.inverse() * (self.hips_rest + travel - pp) / ps,
+        );
+        Posed { rotations, hips }
+    }
+
+    /// Every node's world transform in `posed`.
+    pub fn world(&self, posed: &Posed) -> Vec<Mat4> {
+        let mut world = vec![Mat4::IDENTITY; self.rest.len()];
+        for &i in &self.order {
+            let parent = self.parents[i].map_or(Mat4::IDENTITY, |p| world[p]);
+            let (scale, _, mut translation) = self.rest[i];
+            if i == posed.hips.0 {
+                translation = posed.hips.1;
+            }
+            let local =
+                Mat4::from_scale_rotation_translation(scale, posed.rotations[i], translation);
+            world[i] = parent * local;
+        }
+        world
+    }
+
+    /// Whether the avatar's skeleton is the realizer's own (each node turns as its joint).
+    pub fn is_direct(&self) -> bool {
+        self.direct
     }
 
     /// The realizer joint node `i` follows.
@@ -218,6 +280,29 @@ impl Retarget {
     pub fn frame(&self) -> Quat {
         self.frame
     }
+}
+
+/// Within this of glTF's +y up an avatar's frame is taken to be upright (rad); within this
+/// of facing along an axis, to face along it: a body's own asymmetries (a head a little
+/// forward of the hips) do not tilt the realizer's motion.
+const SNAP: f32 = 0.17;
+
+/// `frame` made upright and facing along an axis when it is within [`SNAP`] of that.
+fn snapped(frame: Quat) -> Quat {
+    let up = frame * Vec3::Y;
+    if up.angle_between(Vec3::Y) > SNAP {
+        return frame;
+    }
+    let forward = frame * Vec3::Z;
+    let heading = forward.x.atan2(forward.z);
+    let quarter = std::f32::consts::FRAC_PI_2;
+    let axis = (heading / quarter).round() * quarter;
+    let heading = if (heading - axis).abs() < SNAP {
+        axis
+    } else {
+        heading
+    };
+    Quat::from_rotation_y(heading)
 }
 
 /// Whether a realizer joint is part of a limb (its alignment is inherited down the limb).
