@@ -8,6 +8,18 @@ use avatars::{glb, test_avatar, Kind};
 use bml_realizer::avatar::{self, Model};
 use serde_json::Value;
 
+/// `bmlr run --gltf out --avatar avatar fixtures/examples/welcome.xml`: exit code and stderr.
+fn welcome_on(avatar: &std::path::Path, out: &std::path::Path) -> (i32, String) {
+    bmlr(&[
+        "run",
+        "--gltf",
+        out.to_str().unwrap(),
+        "--avatar",
+        avatar.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ])
+}
+
 /// `bmlr run` with `args`: its exit code and stderr.
 fn bmlr(args: &[&str]) -> (i32, String) {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_bmlr"))
@@ -88,14 +100,7 @@ fn bmlr_refuses_a_bad_avatar_with_exit_2_naming_the_file() {
     let bad = dir.join("broken.glb");
     std::fs::write(&bad, b"glTF\x02\0\0\0garbage").unwrap();
     let out = dir.join("out.glb");
-    let (code, err) = bmlr(&[
-        "run",
-        "--gltf",
-        out.to_str().unwrap(),
-        "--avatar",
-        bad.to_str().unwrap(),
-        "fixtures/examples/welcome.xml",
-    ]);
+    let (code, err) = welcome_on(&bad, &out);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("broken.glb: not a valid GLB"), "{err}");
     assert!(!out.exists());
@@ -107,14 +112,7 @@ fn bmlr_refuses_a_bad_avatar_with_exit_2_naming_the_file() {
         .unwrap()
         .remove("rightLowerArm");
     std::fs::write(&vrm, glb(&json)).unwrap();
-    let (code, err) = bmlr(&[
-        "run",
-        "--gltf",
-        out.to_str().unwrap(),
-        "--avatar",
-        vrm.to_str().unwrap(),
-        "fixtures/examples/welcome.xml",
-    ]);
+    let (code, err) = welcome_on(&vrm, &out);
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("nolowerarm.vrm: its skeleton lacks the bones rightLowerArm"),
@@ -127,6 +125,7 @@ fn bmlr_refuses_a_bad_avatar_with_exit_2_naming_the_file() {
         "fixtures/examples/welcome.xml",
     ]);
     assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--avatar shows the motion in --gltf"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -137,27 +136,35 @@ fn a_mixamo_avatar_moves_under_bmlr_run_and_the_file_passes_through_gltf() {
     let avatar = dir.join("mixamo.glb");
     std::fs::write(&avatar, test_avatar(Kind::Mixamo)).unwrap();
     let out = dir.join("out.glb");
-    let (code, err) = bmlr(&[
-        "run",
-        "--gltf",
-        out.to_str().unwrap(),
-        "--avatar",
-        avatar.to_str().unwrap(),
-        "fixtures/examples/welcome.xml",
-    ]);
+    let (code, err) = welcome_on(&avatar, &out);
     assert_eq!(code, 0, "{err}");
     let model = Model::read(&out).unwrap();
     assert!(model.node("mixamorig:RightForeArm").is_some());
     let g = gltf::Gltf::from_slice(&std::fs::read(&out).unwrap()).unwrap();
     let animation = g.document.animations().next().unwrap();
-    let turned: Vec<String> = animation
+    // the beat lifts the right upper arm: its keys turn it well away from its first one
+    let blob = g.blob.as_deref().unwrap();
+    let arm = animation
         .channels()
-        .filter(|c| c.target().property() == gltf::animation::Property::Rotation)
-        .filter_map(|c| c.target().node().name().map(str::to_string))
-        .collect();
+        .find(|c| {
+            c.target().property() == gltf::animation::Property::Rotation
+                && c.target().node().name() == Some("mixamorig:RightArm")
+        })
+        .expect("a rotation channel for mixamorig:RightArm");
+    let keys: Vec<glam::Quat> = match arm.reader(|_| Some(blob)).read_outputs().unwrap() {
+        gltf::animation::util::ReadOutputs::Rotations(r) => {
+            r.into_f32().map(glam::Quat::from_array).collect()
+        }
+        _ => unreachable!(),
+    };
+    let widest = keys
+        .iter()
+        .map(|q| q.angle_between(keys[0]))
+        .fold(0.0f32, f32::max);
     assert!(
-        turned.contains(&"mixamorig:RightArm".to_string()),
-        "{turned:?}"
+        widest.to_degrees() > 20.0,
+        "the right arm turns {}°",
+        widest.to_degrees()
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -196,6 +203,23 @@ fn a_character_takes_the_avatar_the_world_file_gives_it() {
     let (code, err) = run(&bob, "Bob", "fixtures/examples/two-bob.xml");
     assert_eq!(code, 0, "{err}");
     assert!(Model::read(&bob).unwrap().node("l_eyeball_joint").is_some());
+    // --avatar shows one character: two without --character is exit 1
+    let (code, err) = bmlr(&[
+        "run",
+        "--world",
+        file.to_str().unwrap(),
+        "--gltf",
+        bob.to_str().unwrap(),
+        "--avatar",
+        dir.join("mixamo.glb").to_str().unwrap(),
+        "fixtures/examples/two-alice.xml",
+        "fixtures/examples/two-bob.xml",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("--avatar shows one character and 2 received blocks"),
+        "{err}"
+    );
     // a world file naming an avatar that is not there: exit 2 naming the character and file
     world["characters"]["Bob"]["avatar"] = Value::from("missing.vrm");
     std::fs::write(&file, world.to_string()).unwrap();

@@ -9,11 +9,10 @@ use serde_json::{json, Value};
 use super::file::Model;
 use super::morph::MorphMap;
 use super::retarget::Retarget;
+use crate::body::gltf::{glb, Buffer};
 use crate::body::pose::Pose;
 use crate::body::skeleton::Skeleton;
 use crate::face::model::Face;
-
-const FLOAT: u32 = 5126;
 
 /// One frame of a character: when, its pose, its face.
 #[derive(Debug, Clone, Copy)]
@@ -26,49 +25,6 @@ pub struct Frame<'a> {
     pub face: &'a Face,
 }
 
-/// The file's JSON and binary buffer, growing.
-struct Out {
-    json: Value,
-    bin: Vec<u8>,
-}
-
-impl Out {
-    /// Appends `data` as a buffer view and `accessor` into it; the accessor's index.
-    fn push(&mut self, data: &[u8], mut accessor: Value) -> usize {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        let view = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": data.len()});
-        self.bin.extend_from_slice(data);
-        accessor["bufferView"] = json!(push(&mut self.json, "bufferViews", view));
-        push(&mut self.json, "accessors", accessor)
-    }
-
-    /// Appends the floats `values` as an accessor of `kind` (`SCALAR`, `VEC3`, `VEC4`).
-    fn floats(&mut self, values: &[f32], kind: &str, count: usize, bounds: bool) -> usize {
-        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let mut accessor = json!({"componentType": FLOAT, "count": count, "type": kind});
-        if bounds {
-            let (lo, hi) = values
-                .iter()
-                .fold((f32::MAX, f32::MIN), |(l, h), &v| (l.min(v), h.max(v)));
-            accessor["min"] = json!([lo]);
-            accessor["max"] = json!([hi]);
-        }
-        self.push(&bytes, accessor)
-    }
-}
-
-/// Appends `item` to the array `key` of `json` (made when absent); its index.
-fn push(json: &mut Value, key: &str, item: Value) -> usize {
-    if !json[key].is_array() {
-        json[key] = json!([]);
-    }
-    let list = json[key].as_array_mut().expect("made an array above");
-    list.push(item);
-    list.len() - 1
-}
-
 /// The avatar `model` moving as `frames` of `skeleton` say, as GLB bytes; the animation is
 /// named `name`.
 pub fn animated_glb(
@@ -78,40 +34,72 @@ pub fn animated_glb(
     frames: &[Frame<'_>],
     name: &str,
 ) -> Vec<u8> {
-    let mut out = Out {
-        json: model.json.clone(),
-        bin: model.bin.clone(),
+    let mut json = model.json.clone();
+    // the file's own buffer, views and accessors, the animation's appended to them
+    let mut take = |key: &str| match json.as_object_mut().and_then(|o| o.remove(key)) {
+        Some(Value::Array(a)) => a,
+        _ => Vec::new(),
+    };
+    let mut buf = Buffer {
+        bytes: model.bin.clone(),
+        views: take("bufferViews"),
+        accessors: take("accessors"),
     };
     if !frames.is_empty() {
-        animate(&mut out, model, retarget, skeleton, frames, name);
+        let animation = animation(&mut buf, model, retarget, skeleton, frames, name);
+        match json["animations"].as_array_mut() {
+            Some(list) => list.push(animation),
+            None => json["animations"] = json!([animation]),
+        }
     }
-    glb(out)
+    if !buf.bytes.is_empty() {
+        while !buf.bytes.len().is_multiple_of(4) {
+            buf.bytes.push(0);
+        }
+        // the GLB's binary chunk is buffer 0 (a .gltf's file buffer becomes it)
+        if json["buffers"].as_array().is_none_or(Vec::is_empty) {
+            json["buffers"] = json!([{}]);
+        }
+        let buffer = &mut json["buffers"][0];
+        if let Some(b) = buffer.as_object_mut() {
+            b.remove("uri");
+        }
+        buffer["byteLength"] = json!(buf.bytes.len());
+    }
+    if !buf.views.is_empty() {
+        json["bufferViews"] = Value::Array(buf.views);
+        json["accessors"] = Value::Array(buf.accessors);
+    }
+    let text = serde_json::to_vec(&json).expect("a JSON value serialises");
+    glb(&text, buf.bytes)
 }
 
-fn animate(
-    out: &mut Out,
+/// The animation of `frames` on `model`, its keys appended to `buf`.
+fn animation(
+    buf: &mut Buffer,
     model: &Model,
     retarget: &Retarget,
     skeleton: &Skeleton,
     frames: &[Frame<'_>],
     name: &str,
-) {
+) -> Value {
     let bones: Vec<usize> = (0..model.nodes.len())
         .filter(|&i| retarget.source(i).is_some())
         .collect();
     let mut turns: Vec<Vec<f32>> = vec![Vec::with_capacity(4 * frames.len()); bones.len()];
     let mut travel = Vec::with_capacity(3 * frames.len());
-    let mut hips = 0;
     for f in frames {
         let posed = retarget.pose(skeleton, f.pose);
         for (k, &b) in bones.iter().enumerate() {
             turns[k].extend(posed.rotations[b].to_array());
         }
-        hips = posed.hips.0;
         travel.extend(posed.hips.1.to_array());
     }
     let times: Vec<f32> = frames.iter().map(|f| f.time as f32).collect();
-    let input = out.floats(&times, "SCALAR", times.len(), true);
+    let input = buf.floats(&times, "SCALAR", times.len(), None);
+    let (first, last) = (times[0], times[times.len() - 1]);
+    buf.accessors[input]["min"] = json!([first]);
+    buf.accessors[input]["max"] = json!([last]);
     let (mut samplers, mut channels) = (Vec::new(), Vec::new());
     let mut channel = |node: usize, path: &str, output: usize| {
         samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
@@ -119,11 +107,11 @@ fn animate(
                              "target": {"node": node, "path": path}}));
     };
     for (k, &b) in bones.iter().enumerate() {
-        let output = out.floats(&turns[k], "VEC4", frames.len(), false);
+        let output = buf.floats(&turns[k], "VEC4", frames.len(), None);
         channel(b, "rotation", output);
     }
-    let output = out.floats(&travel, "VEC3", frames.len(), false);
-    channel(hips, "translation", output);
+    let output = buf.floats(&travel, "VEC3", frames.len(), None);
+    channel(retarget.hips(), "translation", output);
     let morphs = MorphMap::new(model);
     let mut weights = Vec::new();
     for (k, (node, targets)) in morphs.nodes().enumerate() {
@@ -132,58 +120,8 @@ fn animate(
             morphs.weights(k, f.face, &mut weights);
             all.extend_from_slice(&weights);
         }
-        let output = out.floats(&all, "SCALAR", all.len(), false);
+        let output = buf.floats(&all, "SCALAR", all.len(), None);
         channel(node, "weights", output);
     }
-    push(
-        &mut out.json,
-        "animations",
-        json!({"name": name, "samplers": samplers, "channels": channels}),
-    );
-}
-
-/// The GLB container of `out`.
-fn glb(mut out: Out) -> Vec<u8> {
-    while !out.bin.len().is_multiple_of(4) {
-        out.bin.push(0);
-    }
-    if !out.bin.is_empty() {
-        if !out.json["buffers"].is_array()
-            || out.json["buffers"].as_array().is_some_and(Vec::is_empty)
-        {
-            out.json["buffers"] = json!([{}]);
-        }
-        let buffer = &mut out.json["buffers"][0];
-        if let Some(b) = buffer.as_object_mut() {
-            b.remove("uri");
-        }
-        buffer["byteLength"] = json!(out.bin.len());
-    }
-    let mut text = serde_json::to_vec(&out.json).expect("a JSON value serialises");
-    while !text.len().is_multiple_of(4) {
-        text.push(b' ');
-    }
-    let bin_chunk = if out.bin.is_empty() {
-        0
-    } else {
-        8 + out.bin.len()
-    };
-    let total = 12 + 8 + text.len() + bin_chunk;
-    let mut bytes = Vec::with_capacity(total);
-    for word in [
-        0x4654_6C67u32,
-        2,
-        total as u32,
-        text.len() as u32,
-        0x4E4F_534A,
-    ] {
-        bytes.extend(word.to_le_bytes());
-    }
-    bytes.extend(text);
-    if !out.bin.is_empty() {
-        bytes.extend((out.bin.len() as u32).to_le_bytes());
-        bytes.extend(0x004E_4942u32.to_le_bytes());
-        bytes.extend(out.bin);
-    }
-    bytes
+    json!({"name": name, "samplers": samplers, "channels": channels})
 }

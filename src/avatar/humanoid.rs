@@ -93,112 +93,36 @@ pub const REQUIRED: &[&str] = &[
 
 /// The realizer (H-Anim) joint whose world rotation a bone takes, for bones other than the
 /// spine's (which depend on how many the avatar has, see [`spine_sources`]).
-pub fn source(bone: &str) -> Option<&'static str> {
-    let (side, rest) = if let Some(r) = bone.strip_prefix("left") {
-        ("l", r)
-    } else if let Some(r) = bone.strip_prefix("right") {
-        ("r", r)
-    } else {
-        ("", bone)
-    };
-    let name = match (side, rest) {
-        ("", "hips") => "sacroiliac",
-        ("", "neck") => "vc4",
-        ("", "head") => "skullbase",
-        ("", "jaw") => "temporomandibular",
-        (s, "Eye") => {
-            return Some(if s == "l" {
-                "l_eyeball_joint"
-            } else {
-                "r_eyeball_joint"
-            })
-        }
-        (_, "Shoulder") => "sternoclavicular",
-        (_, "UpperArm") => "shoulder",
-        (_, "LowerArm") => "elbow",
-        (_, "Hand") => "wrist",
-        (_, "UpperLeg") => "hip",
-        (_, "LowerLeg") => "knee",
-        (_, "Foot") => "talocrural",
-        (_, "Toes") => "metatarsal",
-        (_, "ThumbMetacarpal") => "thumb1",
-        (_, "ThumbProximal") => "thumb2",
-        (_, "ThumbDistal") => "thumb3",
-        (_, finger) => return finger_source(side, finger),
-    };
+pub fn source(bone: &str) -> Option<String> {
+    let (side, rest) = split_side(bone);
     if side.is_empty() {
-        return Some(name);
+        let joint = match rest {
+            "hips" => "sacroiliac",
+            "neck" => "vc4",
+            "head" => "skullbase",
+            "jaw" => "temporomandibular",
+            _ => return None,
+        };
+        return Some(joint.to_string());
     }
-    HANIM
-        .iter()
-        .copied()
-        .find(|j| j.strip_prefix(side).and_then(|j| j.strip_prefix('_')) == Some(name))
+    let joint = match rest {
+        "Eye" => "eyeball_joint",
+        "Shoulder" => "sternoclavicular",
+        "UpperArm" => "shoulder",
+        "LowerArm" => "elbow",
+        "Hand" => "wrist",
+        "UpperLeg" => "hip",
+        "LowerLeg" => "knee",
+        "Foot" => "talocrural",
+        "Toes" => "metatarsal",
+        finger => {
+            let (f, k) = digit(finger)?;
+            let f = if f == "Little" { "pinky" } else { f };
+            return Some(format!("{side}_{}{k}", f.to_ascii_lowercase()));
+        }
+    };
+    Some(format!("{side}_{joint}"))
 }
-
-fn finger_source(side: &str, finger: &str) -> Option<&'static str> {
-    let digit = ["Index", "Middle", "Ring", "Little"]
-        .iter()
-        .position(|f| finger.starts_with(f))?;
-    let k = ["Proximal", "Intermediate", "Distal"]
-        .iter()
-        .position(|p| finger.ends_with(p))?;
-    let name = format!(
-        "{side}_{}{}",
-        ["index", "middle", "ring", "pinky"][digit],
-        k + 1
-    );
-    HANIM.iter().copied().find(|j| *j == name)
-}
-
-/// The realizer's joints that bones take their rotations from.
-const HANIM: &[&str] = &[
-    "l_sternoclavicular",
-    "l_shoulder",
-    "l_elbow",
-    "l_wrist",
-    "l_hip",
-    "l_knee",
-    "l_talocrural",
-    "l_metatarsal",
-    "l_thumb1",
-    "l_thumb2",
-    "l_thumb3",
-    "l_index1",
-    "l_index2",
-    "l_index3",
-    "l_middle1",
-    "l_middle2",
-    "l_middle3",
-    "l_ring1",
-    "l_ring2",
-    "l_ring3",
-    "l_pinky1",
-    "l_pinky2",
-    "l_pinky3",
-    "r_sternoclavicular",
-    "r_shoulder",
-    "r_elbow",
-    "r_wrist",
-    "r_hip",
-    "r_knee",
-    "r_talocrural",
-    "r_metatarsal",
-    "r_thumb1",
-    "r_thumb2",
-    "r_thumb3",
-    "r_index1",
-    "r_index2",
-    "r_index3",
-    "r_middle1",
-    "r_middle2",
-    "r_middle3",
-    "r_ring1",
-    "r_ring2",
-    "r_ring3",
-    "r_pinky1",
-    "r_pinky2",
-    "r_pinky3",
-];
 
 /// The realizer's joints that an avatar's spine bones (`spine`, `chest`, `upperChest`, those
 /// it has, bottom up) take their rotations from.
@@ -295,7 +219,7 @@ fn from_map(
                 BONES
                     .iter()
                     .map(|b| b.0)
-                    .find(|b| hanim_name(b) == Some(key))
+                    .find(|b| hanim(b).as_deref() == Some(key.as_str()))
             })
             .ok_or_else(|| {
                 AvatarError::new(&model.file, format!("bone map: unknown bone '{key}'"))
@@ -312,13 +236,11 @@ fn from_map(
 }
 
 /// The realizer's own name of a bone when an avatar uses H-Anim names.
-fn hanim_name(bone: &str) -> Option<&'static str> {
+fn hanim(bone: &str) -> Option<String> {
     match bone {
-        "hips" => Some("sacroiliac"),
-        "spine" => Some("vl5"),
-        "chest" => Some("vt12"),
-        "upperChest" => Some("vt6"),
-        "neck" => Some("vc4"),
+        "spine" => Some("vl5".into()),
+        "chest" => Some("vt12".into()),
+        "upperChest" => Some("vt6".into()),
         b => source(b),
     }
 }
@@ -351,13 +273,6 @@ fn same(node: &str, want: &str) -> bool {
     let bare = bare.strip_prefix("mixamorig").unwrap_or(bare);
     let bare = bare.trim_start_matches('_');
     bare.eq_ignore_ascii_case(want)
-}
-
-fn hanim(bone: &str) -> Option<String> {
-    if bone == "neck" {
-        return Some("vc4".into());
-    }
-    hanim_name(bone).map(str::to_string)
 }
 
 fn mixamo(bone: &str) -> Option<String> {

@@ -271,6 +271,11 @@ impl Retarget {
         self.direct
     }
 
+    /// The node that carries the root's travel (the hips, or `HumanoidRoot`).
+    pub fn hips(&self) -> usize {
+        self.hips
+    }
+
     /// The realizer joint node `i` follows.
     pub fn source(&self, i: usize) -> Option<usize> {
         self.source.get(i).copied().flatten()
@@ -365,10 +370,10 @@ fn pairs(
             continue;
         };
         let joint = match spine.iter().position(|b| b == bone) {
-            Some(k) => Some(spine_sources[k]),
+            Some(k) => Some(spine_sources[k].to_string()),
             None => humanoid::source(bone),
         };
-        if let Some(j) = joint.and_then(|j| skeleton.joint(j)) {
+        if let Some(j) = joint.and_then(|j| skeleton.joint(&j)) {
             out.push((node, j));
         }
     }

@@ -64,12 +64,13 @@ impl Mesh {
     }
 }
 
-/// The binary buffer and the accessors into it.
+/// The binary buffer and the accessors into it (also used to add an animation to an avatar's
+/// own buffer, `avatar::animated_glb`).
 #[derive(Default)]
-struct Buffer {
-    bytes: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+pub(crate) struct Buffer {
+    pub(crate) bytes: Vec<u8>,
+    pub(crate) views: Vec<Value>,
+    pub(crate) accessors: Vec<Value>,
 }
 
 impl Buffer {
@@ -91,7 +92,14 @@ impl Buffer {
         self.accessors.len() - 1
     }
 
-    fn floats(&mut self, values: &[f32], kind: &str, count: usize, target: Option<u32>) -> usize {
+    /// Appends `values` as an accessor of `count` elements of `kind` (`SCALAR`, `VEC3`, …).
+    pub(crate) fn floats(
+        &mut self,
+        values: &[f32],
+        kind: &str,
+        count: usize,
+        target: Option<u32>,
+    ) -> usize {
         let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
         self.add(
             data.as_slice(),
@@ -293,8 +301,9 @@ impl Animation {
     }
 }
 
-/// The GLB container: header, JSON chunk (padded with spaces), binary chunk (padded with zeros).
-fn glb(json: &[u8], mut bin: Vec<u8>) -> Vec<u8> {
+/// The GLB container: header, JSON chunk (padded with spaces), binary chunk (padded with zeros;
+/// left out when there is no binary data).
+pub(crate) fn glb(json: &[u8], mut bin: Vec<u8>) -> Vec<u8> {
     let mut json = json.to_vec();
     while !json.len().is_multiple_of(4) {
         json.push(b' ');
@@ -302,7 +311,8 @@ fn glb(json: &[u8], mut bin: Vec<u8>) -> Vec<u8> {
     while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
-    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let bin_chunk = if bin.is_empty() { 0 } else { 8 + bin.len() };
+    let total = 12 + 8 + json.len() + bin_chunk;
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
@@ -310,9 +320,11 @@ fn glb(json: &[u8], mut bin: Vec<u8>) -> Vec<u8> {
     out.extend_from_slice(&(json.len() as u32).to_le_bytes());
     out.extend_from_slice(b"JSON");
     out.extend_from_slice(&json);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
+    if !bin.is_empty() {
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+    }
     out
 }
 

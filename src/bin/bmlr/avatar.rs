@@ -48,6 +48,8 @@ impl Avatar {
 pub struct Avatars {
     /// For characters the world file gives none.
     pub common: Avatar,
+    /// Whether `common` was asked for (`--avatar`) rather than the default one.
+    pub asked: bool,
     /// By character id, from the world file.
     pub own: BTreeMap<String, Avatar>,
 }
@@ -79,11 +81,12 @@ impl AvatarArgs {
                 own.insert(id.to_string(), avatar);
             }
         }
-        Ok(Avatars { common, own })
+        let asked = self.avatar.is_some();
+        Ok(Avatars { common, asked, own })
     }
 }
 
-fn read_map(path: &PathBuf) -> Result<BTreeMap<String, String>, String> {
+fn read_map(path: &Path) -> Result<BTreeMap<String, String>, String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("{}: cannot read it: {e}", path.display()))?;
     serde_json::from_str(&text).map_err(|e| {

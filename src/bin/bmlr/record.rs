@@ -9,7 +9,7 @@ use bml_realizer::engine::CharacterPose;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::sound::{SoundEvent, Track};
 
-use crate::avatar::{Avatar, AvatarArgs, Avatars};
+use crate::avatar::{Avatar, Avatars};
 
 /// The frame period, the next frame's time, and every character's pose in each frame so far
 /// (which characters a file shows is decided at the end).
@@ -130,7 +130,6 @@ impl Recording {
         path: &Path,
         asked: Option<&str>,
         avatar: Option<&Avatars>,
-        options: &AvatarArgs,
     ) -> Result<(), (u8, String)> {
         let everyone = received(realizer);
         let ids: Vec<String> = match asked {
@@ -141,7 +140,7 @@ impl Recording {
         if let ([id], Some(avatars)) = (ids.as_slice(), avatar) {
             return self.write_avatar(path, id, avatars.of(id));
         }
-        if options.avatar.is_some() {
+        if avatar.is_some_and(|a| a.asked) {
             return Err((
                 1,
                 format!(

@@ -490,7 +490,7 @@ impl VirtualRun {
         }
         if let Some(path) = &args.gltf {
             let asked = args.setup.character.as_deref();
-            m.write_gltf(&self.realizer, path, asked, avatar, &args.avatar)?;
+            m.write_gltf(&self.realizer, path, asked, avatar)?;
         }
         if let Some(path) = &args.wav {
             m.write_wav(&self.realizer, path)?;
