@@ -234,10 +234,8 @@ impl Avoider {
         let half_fov = (0.5 * p.field_of_view).to_radians().cos();
         for o in others {
             let dx = o.at - me.at;
-            // (in front with a field of view over 180° is seen without the distance's root)
-            let (dd, ahead) = (dx.length_squared(), dx.dot(look));
-            let seen =
-                dd < 1.0 || (half_fov <= 0.0 && ahead >= 0.0) || ahead >= half_fov * dd.sqrt();
+            let d = dx.length();
+            let seen = d < 1.0 || dx.dot(look) >= half_fov * d;
             if !seen {
                 continue;
             }
