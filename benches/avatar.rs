@@ -42,13 +42,13 @@ fn avatar(c: &mut Criterion) {
     let skeleton = Skeleton::adult();
     let retarget = Retarget::new(&model, &skeleton, None).unwrap();
     g.bench_function("retarget onto the default avatar", |b| {
-        b.iter(|| black_box(retarget.pose(&skeleton, &pose)))
+        b.iter(|| black_box(retarget.pose(&pose)))
     });
     // a Mixamo T-pose in centimetres under a turned armature: every bone aligned and turned
     let mixamo = Model::from_glb("mixamo", &avatars::test_avatar(avatars::Kind::Mixamo)).unwrap();
     let retarget = Retarget::new(&mixamo, &skeleton, None).unwrap();
     g.bench_function("retarget onto a Mixamo avatar", |b| {
-        b.iter(|| black_box(retarget.pose(&skeleton, &pose)))
+        b.iter(|| black_box(retarget.pose(&pose)))
     });
     g.finish();
 }

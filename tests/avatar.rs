@@ -9,12 +9,12 @@ mod avatars;
 
 use std::collections::BTreeMap;
 
-use avatars::{glb, random_rotation, test_avatar, Kind, BONES, LIMBS};
+use avatars::{glb, random_rotation, test_avatar, Kind, BONES, LIMBS, TWISTS};
 use bml_realizer::avatar::{self, Model, Retarget};
 use bml_realizer::body::pose::Pose;
 use bml_realizer::body::skeleton::Skeleton;
 use bml_realizer::rng::Rng;
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Quat, Vec3};
 use serde_json::json;
 
 /// A random pose of the realizer: every joint turned up to `most` radians, the root moved and
@@ -34,7 +34,7 @@ fn random_pose(skeleton: &Skeleton, rng: &mut Rng, most: f32) -> Pose {
 
 /// The angles (degrees) between every limb bone of the posed avatar and its realizer bone.
 fn limb_errors(model: &Model, retarget: &Retarget, skeleton: &Skeleton, pose: &Pose) -> Vec<f32> {
-    let posed = retarget.world(&retarget.pose(skeleton, pose));
+    let posed = retarget.world(&retarget.pose(pose));
     let realizer = pose.world(skeleton);
     let node_of = |bone: &str| {
         model.nodes.iter().position(|n| {
@@ -91,15 +91,62 @@ fn every_limb_bone_of_three_kinds_of_avatar_points_where_the_realizer_s_does() {
 }
 
 #[test]
+fn forearm_twist_bones_take_their_share_of_the_wrist_s_twist() {
+    let skeleton = Skeleton::adult();
+    let model = Model::from_glb("vrm1", &test_avatar(Kind::Vrm1)).unwrap();
+    let retarget = Retarget::new(&model, &skeleton, None).unwrap();
+    let node = |name: &str| {
+        (model.nodes.iter())
+            .position(|n| n.name == name || n.name == format!("J_{name}"))
+            .unwrap()
+    };
+    let rotation = |m: &Mat4| m.to_scale_rotation_translation().1;
+    let rest = retarget.world(&retarget.pose(&Pose::rest(&skeleton)));
+    let mut rng = Rng(5);
+    let mut worst = 0.0f32;
+    for _ in 0..300 {
+        let pose = random_pose(&skeleton, &mut rng, 1.2);
+        let posed = retarget.world(&retarget.pose(&pose));
+        for &(name, _, lower, share) in TWISTS {
+            let (t, e) = (node(name), node(lower));
+            let hand = node(&lower.replace("LowerArm", "Hand"));
+            let side = if lower.starts_with("left") {
+                "l_"
+            } else {
+                "r_"
+            };
+            let joint = |j: &str| skeleton.joint(&format!("{side}{j}")).unwrap();
+            // the wrist's twist about the realizer's forearm
+            let realizer_rest = Pose::rest(&skeleton).world(&skeleton).positions;
+            let forearm =
+                (realizer_rest[joint("wrist")] - realizer_rest[joint("elbow")]).normalize();
+            let q = pose.rotations[joint("wrist")];
+            let angle = 2.0 * Vec3::new(q.x, q.y, q.z).dot(forearm).atan2(q.w);
+            // the twist bone turned, since rest, relative to its lower arm: about the
+            // avatar's forearm by its share of that
+            let axis = (rest[hand].w_axis - rest[e].w_axis).truncate().normalize();
+            let since = |i: usize| rotation(&posed[i]) * rotation(&rest[i]).inverse();
+            let relative = since(e).inverse() * since(t);
+            let expected = Quat::from_axis_angle(axis, share * angle);
+            worst = worst.max(relative.angle_between(expected).to_degrees());
+        }
+    }
+    assert!(
+        worst < 0.5,
+        "a twist bone is {worst}° off its share of the wrist's twist"
+    );
+}
+
+#[test]
 fn the_travel_of_the_root_is_scaled_by_leg_length_and_turned_into_the_avatar_s_frame() {
     let skeleton = Skeleton::adult();
     let model = Model::from_glb("vrm0", &test_avatar(Kind::Vrm0)).unwrap();
     let retarget = Retarget::new(&model, &skeleton, None).unwrap();
     let mut pose = Pose::rest(&skeleton);
-    let at_rest = retarget.pose(&skeleton, &pose);
+    let at_rest = retarget.pose(&pose);
     let rest_world = retarget.world(&at_rest);
     pose.root += Vec3::new(0.0, 0.0, 1.0);
-    let walked = retarget.world(&retarget.pose(&skeleton, &pose));
+    let walked = retarget.world(&retarget.pose(&pose));
     let hips = at_rest.hips.0;
     let moved = walked[hips].w_axis.truncate() - rest_world[hips].w_axis.truncate();
     // same leg length (built from the realizer's skeleton), facing −z: a metre forward is −z
@@ -261,7 +308,7 @@ fn the_default_avatar_is_a_skinned_person_standing_in_the_realizer_s_rest() {
     let mut rng = Rng(5);
     for _ in 0..100 {
         let pose = random_pose(&skeleton, &mut rng, 1.0);
-        let world = retarget.world(&retarget.pose(&skeleton, &pose));
+        let world = retarget.world(&retarget.pose(&pose));
         let theirs = pose.world(&skeleton);
         for (a, b) in [
             ("l_shoulder", "l_elbow"),
@@ -300,7 +347,7 @@ proptest::proptest! {
         let skeleton = Skeleton::adult();
         if let Ok(model) = Model::from_glb("damaged.glb", &bytes) {
             if let Ok(retarget) = Retarget::new(&model, &skeleton, None) {
-                let posed = retarget.pose(&skeleton, &Pose::rest(&skeleton));
+                let posed = retarget.pose(&Pose::rest(&skeleton));
                 proptest::prop_assert_eq!(posed.rotations.len(), model.nodes.len());
             }
         }

@@ -170,6 +170,27 @@ fn a_mixamo_avatar_moves_under_bmlr_run_and_the_file_passes_through_gltf() {
 }
 
 #[test]
+fn the_exported_avatar_animates_its_forearm_twist_bones() {
+    let dir = std::env::temp_dir().join(format!("bmlr-avatar-twist-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let avatar = dir.join("twist.vrm");
+    std::fs::write(&avatar, test_avatar(Kind::Vrm1)).unwrap();
+    let out = dir.join("out.glb");
+    let (code, err) = welcome_on(&avatar, &out);
+    assert_eq!(code, 0, "{err}");
+    let g = gltf::Gltf::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    let animation = g.document.animations().next().unwrap();
+    let turned: Vec<String> = (animation.channels())
+        .filter(|c| c.target().property() == gltf::animation::Property::Rotation)
+        .filter_map(|c| c.target().node().name().map(str::to_string))
+        .collect();
+    for (twist, ..) in avatars::TWISTS {
+        assert!(turned.iter().any(|n| n == twist), "no keys for {twist}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_character_takes_the_avatar_the_world_file_gives_it() {
     let dir = std::env::temp_dir().join(format!("bmlr-avatar-world-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

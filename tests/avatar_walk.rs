@@ -55,7 +55,7 @@ fn planted(model: &Model, feet: [[&str; 2]; 2], frames: &[(Pose, [bool; 2])]) ->
     let (mut height, mut slide) = (0.0f32, 0.0f32);
     let mut stance: [Option<(usize, Vec3)>; 2] = [None, None];
     for (pose, contacts) in frames {
-        let world = retarget.world(&retarget.pose(&skeleton, pose));
+        let world = retarget.world(&retarget.pose(pose));
         let theirs = pose.world(&skeleton);
         for side in 0..2 {
             let joints = sides[side].map(|j| skeleton.joint(j).unwrap());

@@ -14,6 +14,6 @@ fuzz_target!(|data: &[u8]| {
     };
     let skeleton = Skeleton::adult();
     if let Ok(retarget) = Retarget::new(&model, &skeleton, None) {
-        let _ = retarget.pose(&skeleton, &Pose::rest(&skeleton));
+        let _ = retarget.pose(&Pose::rest(&skeleton));
     }
 });

@@ -11,7 +11,6 @@ use super::morph::MorphMap;
 use super::retarget::Retarget;
 use crate::body::gltf::{glb, Buffer};
 use crate::body::pose::Pose;
-use crate::body::skeleton::Skeleton;
 use crate::face::model::Face;
 
 /// One frame of a character: when, its pose, its face.
@@ -25,12 +24,11 @@ pub struct Frame<'a> {
     pub face: &'a Face,
 }
 
-/// The avatar `model` moving as `frames` of `skeleton` say, as GLB bytes; the animation is
+/// The avatar `model` moving as `frames` say, as GLB bytes; the animation is
 /// named `name`.
 pub fn animated_glb(
     model: &Model,
     retarget: &Retarget,
-    skeleton: &Skeleton,
     frames: &[Frame<'_>],
     name: &str,
 ) -> Vec<u8> {
@@ -46,7 +44,7 @@ pub fn animated_glb(
         accessors: take("accessors"),
     };
     if !frames.is_empty() {
-        let animation = animation(&mut buf, model, retarget, skeleton, frames, name);
+        let animation = animation(&mut buf, model, retarget, frames, name);
         match json["animations"].as_array_mut() {
             Some(list) => list.push(animation),
             None => json["animations"] = json!([animation]),
@@ -79,17 +77,16 @@ fn animation(
     buf: &mut Buffer,
     model: &Model,
     retarget: &Retarget,
-    skeleton: &Skeleton,
     frames: &[Frame<'_>],
     name: &str,
 ) -> Value {
     let bones: Vec<usize> = (0..model.nodes.len())
-        .filter(|&i| retarget.source(i).is_some())
+        .filter(|&i| retarget.moves(i))
         .collect();
     let mut turns: Vec<Vec<f32>> = vec![Vec::with_capacity(4 * frames.len()); bones.len()];
     let mut travel = Vec::with_capacity(3 * frames.len());
     for f in frames {
-        let posed = retarget.pose(skeleton, f.pose);
+        let posed = retarget.pose(f.pose);
         for (k, &b) in bones.iter().enumerate() {
             turns[k].extend(posed.rotations[b].to_array());
         }

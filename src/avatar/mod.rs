@@ -11,6 +11,7 @@ mod file;
 pub mod humanoid;
 mod morph;
 mod retarget;
+mod twist;
 
 pub use export::{animated_glb, Frame};
 pub use file::{AvatarError, Model, Node, MAX_AVATAR_BYTES};

@@ -15,6 +15,7 @@ use glam::{Mat3, Mat4, Quat, Vec3};
 
 use super::file::{AvatarError, Model};
 use super::humanoid::{self, BONES};
+use super::twist;
 use crate::body::pose::Pose;
 use crate::body::skeleton::Skeleton;
 
@@ -39,6 +40,30 @@ fn points_at(joint: &str) -> Option<String> {
     matches!(side, "l_" | "r_").then(|| format!("{side}{next}"))
 }
 
+/// How one node turns each frame.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Drive {
+    /// It keeps its rest rotation relative to its parent.
+    Rest,
+    /// It follows a realizer joint: its local rotation is `before · Π steps · after`, where
+    /// the steps (`Retarget::steps[from..to]`) are the realizer's local rotations (or their
+    /// inverses) on the way from the joint its nearest following ancestor follows to its own.
+    Follow {
+        before: Quat,
+        from: usize,
+        to: usize,
+        after: Quat,
+    },
+    /// A forearm twist bone: it turns about `axis` (in its parent's frame) by `share` of the
+    /// wrist's twist about the realizer's forearm (`forearm`, in the elbow's frame).
+    Twist {
+        wrist: usize,
+        forearm: Vec3,
+        axis: Vec3,
+        share: f32,
+    },
+}
+
 /// How one avatar is driven by one realizer skeleton.
 #[derive(Debug, Clone)]
 pub struct Retarget {
@@ -50,10 +75,10 @@ pub struct Retarget {
     order: Vec<usize>,
     /// Per node, its rest scale, rotation and translation relative to its parent.
     rest: Vec<(Vec3, Quat, Vec3)>,
-    /// Per node that follows a joint, what its joint's world rotation since rest (in the
-    /// realizer's frame) is applied to: its rest world rotation, aligned with the realizer's
-    /// rest, taken into the realizer's frame.
-    pre: Vec<Quat>,
+    /// Per node, how it turns.
+    drives: Vec<Drive>,
+    /// The realizer joints (and whether inverted) the followers' rotations are made of.
+    steps: Vec<(usize, bool)>,
     /// The realizer's frame in the avatar's: realizer x (left), y (up), z (forward).
     frame: Quat,
     /// The node that carries the root's travel, its rest world place, and the travel's scale.
@@ -176,16 +201,35 @@ impl Retarget {
                     && near(rest_rotation[i])
                     && parents[i] == parent_joint.and_then(node_of_joint)
             });
+        // what a follower's joint's world rotation since rest (in the realizer's frame) is
+        // applied to: its rest world rotation, aligned with the realizer's rest, taken into the
+        // realizer's frame
+        let pre: Vec<Quat> = (0..n)
+            .map(|i| frame.inverse() * align[i] * rest_rotation[i])
+            .collect();
+        let rest_local: Vec<(Vec3, Quat, Vec3)> = (model.nodes.iter())
+            .map(|n| (n.scale, n.rotation, n.translation))
+            .collect();
+        let mut plan = Plan {
+            model,
+            skeleton,
+            source: &source,
+            pre: &pre,
+            rest: &rest_local,
+            frame,
+            steps: Vec::new(),
+        };
+        let mut drives: Vec<Drive> = (0..n).map(|i| plan.follow(i)).collect();
+        for (i, drive) in twist::drives(model, skeleton, &source, &pre, &rest.positions, &world) {
+            drives[i] = drive;
+        }
         Ok(Retarget {
-            pre: (0..n)
-                .map(|i| frame.inverse() * align[i] * rest_rotation[i])
-                .collect(),
+            steps: plan.steps,
+            drives,
             source,
             parents,
             order,
-            rest: (model.nodes.iter())
-                .map(|n| (n.scale, n.rotation, n.translation))
-                .collect(),
+            rest: rest_local,
             frame,
             hips,
             hips_rest: place(hips),
@@ -206,8 +250,8 @@ impl Retarget {
         })
     }
 
-    /// The avatar posed as the realizer's `pose` of `skeleton`.
-    pub fn pose(&self, skeleton: &Skeleton, pose: &Pose) -> Posed {
+    /// The avatar posed as the realizer's `pose` (of the skeleton it was made for).
+    pub fn pose(&self, pose: &Pose) -> Posed {
         let mut rotations: Vec<Quat> = self.rest.iter().map(|r| r.1).collect();
         let travel = self.frame * (pose.root - self.root_rest) * self.scale;
         let turn = |j: usize| pose.rotations.get(j).copied().unwrap_or(Quat::IDENTITY);
@@ -220,25 +264,36 @@ impl Retarget {
             let hips = (self.hips, self.hips_rest + travel);
             return Posed { rotations, hips };
         }
-        // the realizer's joints' world rotations, then the avatar's nodes' (parents first)
-        let mut world: Vec<Quat> = Vec::with_capacity(skeleton.len() + self.rest.len());
-        for (j, joint) in skeleton.joints().iter().enumerate() {
-            let parent = joint.parent.map_or(Quat::IDENTITY, |p| world[p]);
-            world.push(parent * turn(j));
-        }
-        let (turned, nodes) = {
-            world.resize(skeleton.len() + self.rest.len(), Quat::IDENTITY);
-            world.split_at_mut(skeleton.len())
-        };
-        for &i in &self.order {
-            let parent = self.parents[i].map_or(Quat::IDENTITY, |p| nodes[p]);
-            match self.source[i] {
-                Some(j) => {
-                    let target = self.frame * turned[j] * self.pre[i];
-                    rotations[i] = (parent.inverse() * target).normalize();
-                    nodes[i] = target;
+        // each node on its own: its local rotation from the realizer's local rotations between
+        // its joint and its nearest following ancestor's (no world rotations needed)
+        for (rotation, drive) in rotations.iter_mut().zip(&self.drives) {
+            match *drive {
+                Drive::Rest => {}
+                Drive::Follow {
+                    before,
+                    from,
+                    to,
+                    after,
+                } => {
+                    let mut q = before;
+                    for &(j, inverse) in &self.steps[from..to] {
+                        q *= if inverse {
+                            turn(j).conjugate()
+                        } else {
+                            turn(j)
+                        };
+                    }
+                    *rotation = (q * after).normalize();
                 }
-                None => nodes[i] = parent * rotations[i],
+                Drive::Twist {
+                    wrist,
+                    forearm,
+                    axis,
+                    share,
+                } => {
+                    let angle = twist::angle(turn(wrist), forearm);
+                    *rotation = Quat::from_axis_angle(axis, share * angle) * *rotation;
+                }
             }
         }
         // the hips' ancestors follow no joint: they stay at rest
@@ -281,9 +336,78 @@ impl Retarget {
         self.source.get(i).copied().flatten()
     }
 
+    /// Whether node `i` turns with the realizer's motion (follows a joint or is a twist bone).
+    pub fn moves(&self, i: usize) -> bool {
+        !matches!(self.drives.get(i), None | Some(Drive::Rest))
+    }
+
     /// The realizer's frame in the avatar's (its x, y, z: left, up, forward).
     pub fn frame(&self) -> Quat {
         self.frame
+    }
+}
+
+/// What making the followers' drives needs.
+struct Plan<'a> {
+    model: &'a Model,
+    skeleton: &'a Skeleton,
+    source: &'a [Option<usize>],
+    pre: &'a [Quat],
+    rest: &'a [(Vec3, Quat, Vec3)],
+    frame: Quat,
+    steps: Vec<(usize, bool)>,
+}
+
+impl Plan<'_> {
+    /// How node `i` turns: if it follows a joint, its world rotation in the realizer's frame is
+    /// its joint's world rotation times its `pre`, and its local rotation is that seen from
+    /// its parent, whose world rotation is its nearest following ancestor's times the rest
+    /// rotations between them. Joint world rotations cancel down to the realizer's local
+    /// rotations on the way between the two joints.
+    fn follow(&mut self, i: usize) -> Drive {
+        let Some(j) = self.source[i] else {
+            return Drive::Rest;
+        };
+        let mut between = Quat::IDENTITY;
+        let mut anchor = None;
+        for a in ancestors(self.model, i) {
+            if let Some(ja) = self.source[a] {
+                anchor = Some((a, ja));
+                break;
+            }
+            between = self.rest[a].1 * between;
+        }
+        let from = self.steps.len();
+        let before = match anchor {
+            Some((a, ja)) => {
+                let up = self.chain(ja);
+                let down = self.chain(j);
+                let common = up.iter().filter(|k| down.contains(k)).count();
+                let (up, down) = (&up[..up.len() - common], &down[..down.len() - common]);
+                self.steps.extend(up.iter().map(|&k| (k, true)));
+                self.steps.extend(down.iter().rev().map(|&k| (k, false)));
+                (self.pre[a] * between).inverse()
+            }
+            None => {
+                let down = self.chain(j);
+                self.steps.extend(down.iter().rev().map(|&k| (k, false)));
+                between.inverse() * self.frame
+            }
+        };
+        Drive::Follow {
+            before,
+            from,
+            to: self.steps.len(),
+            after: self.pre[i],
+        }
+    }
+
+    /// Joint `j` and its ancestors, nearest first.
+    fn chain(&self, j: usize) -> Vec<usize> {
+        let joints = self.skeleton.joints();
+        std::iter::successors(Some(j), |&k| joints[k].parent)
+            .take(joints.len())
+            .collect()
     }
 }
 

@@ -1,6 +1,6 @@
 //! Test avatars built here, as small GLBs without meshes: a Mixamo-named T-pose in centimetres
-//! under a turned armature, a VRM 1.0 in an A-pose with every bone's axes turned at random and
-//! no upper chest, a VRM 0.x in a T-pose facing −z. Shared by `tests/avatar.rs` and
+//! under a turned armature, a VRM 1.0 in an A-pose with every bone's axes turned at random, no
+//! upper chest and forearm twist bones, a VRM 0.x in a T-pose facing −z. Shared by `tests/avatar.rs` and
 //! `tests/avatar_cli.rs`.
 
 #![allow(dead_code)]
@@ -130,6 +130,19 @@ pub const LIMBS: &[(&str, &str)] = &[
     ("rightFoot", "rightToes"),
 ];
 
+/// The VRM 1.0 avatar's forearm twist bones: (name, parent node, lower arm bone, share of the
+/// way from elbow to wrist).
+pub const TWISTS: &[(&str, &str, &str, f32)] = &[
+    ("J_leftLowerArmTwist1", "leftLowerArm", "leftLowerArm", 0.5),
+    (
+        "J_leftLowerArmTwist2",
+        "J_leftLowerArmTwist1",
+        "leftLowerArm",
+        0.9,
+    ),
+    ("lowerarm_twist_01_r", "rightLowerArm", "rightLowerArm", 0.3),
+];
+
 #[derive(Clone, Copy, PartialEq)]
 pub enum Kind {
     /// Mixamo names, T-pose, centimetres under an armature turned a quarter about x.
@@ -246,6 +259,30 @@ pub fn test_avatar(kind: Kind) -> Vec<u8> {
         nodes.push(node);
         world_rotation.push(g);
         world_place.push(w);
+    }
+    if kind == Kind::Vrm1 {
+        // forearm twist bones: two chained on the left, one on the right
+        for &(name, parent, lower, share) in TWISTS {
+            let p = match bones.iter().position(|b| b.0 == parent) {
+                Some(k) => 1 + k,
+                None => nodes.iter().position(|n| n["name"] == parent).unwrap(),
+            };
+            let (elbow, wrist) = (index(lower), index(&lower.replace("LowerArm", "Hand")));
+            let w = world_place[elbow].lerp(world_place[wrist], share);
+            let g = random_rotation(&mut rng, PI);
+            let (gp, wp) = (world_rotation[p], world_place[p]);
+            let k = nodes.len();
+            let mut children = nodes[p]["children"].as_array().cloned().unwrap_or_default();
+            children.push(json!(k));
+            nodes[p]["children"] = json!(children);
+            nodes.push(json!({
+                "name": name,
+                "translation": (gp.inverse() * (w - wp)).to_array(),
+                "rotation": (gp.inverse() * g).normalize().to_array(),
+            }));
+            world_rotation.push(g);
+            world_place.push(w);
+        }
     }
     let joints: Vec<usize> = (1..nodes.len()).collect();
     let mut doc = json!({

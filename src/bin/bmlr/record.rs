@@ -202,9 +202,8 @@ impl Recording {
                 face: &p.face,
             })
             .collect();
-        let skeleton = Skeleton::adult();
         let name = if id.is_empty() { "bml" } else { id };
-        animated_glb(&avatar.model, &avatar.retarget, &skeleton, &frames, name)
+        animated_glb(&avatar.model, &avatar.retarget, &frames, name)
     }
 
     /// The frames of the one character a BVH or glTF file (`flag`) shows.
