@@ -10,7 +10,9 @@
 //! - [`plan`]: the flexible plan of pegs;
 //! - [`engine`]: the engine interface, registry and timing models; [`engines`]: built-in engines;
 //! - [`body`]: the skeleton (H-Anim), poses and forward kinematics;
-//! - [`avatar`]: skinned avatars (glTF/VRM) and the realizer's motion retargeted onto them;
+//! - [`body`] and [`face`] know nothing of each other; [`character`] joins them: a character's
+//!   frame assembled (lids following the eyes, the jaw opened by the mouth, limits, placement),
+//!   the frames file, and skinned avatars (glTF/VRM, [`avatar`]) the motion is retargeted onto;
 //! - [`clock`]: virtual and wall clocks;
 //! - [`conformance`]: this realizer as a port of the RealizerTester suite (`realizer-tests`;
 //!   feature `conformance`, on by default);
@@ -19,10 +21,11 @@
 
 #![warn(missing_docs)]
 
-pub mod avatar;
+pub use character::avatar;
 pub mod blocks;
 pub mod bml;
 pub mod body;
+pub mod character;
 pub mod clock;
 #[cfg(feature = "conformance")]
 pub mod conformance;

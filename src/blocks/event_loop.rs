@@ -145,8 +145,7 @@ impl BlockManager {
         self.apply_changes(to);
         self.predict_poses(to);
         let mut pose = self.base_pose(to);
-        let model = crate::face::FaceModel::default_model();
-        let mut face = crate::face::Face::neutral(model);
+        let mut face = crate::face::Face::neutral(crate::face::FaceModel::default_model());
         let mut warnings = Vec::new();
         for e in self.registry.engines_mut() {
             e.play(to, frame);
@@ -161,20 +160,8 @@ impl BlockManager {
         for (key, text) in warnings {
             self.warn(key.to_string(), KnownWarning::ExecutionFailure, text);
         }
-        if let Some(b) = self.blinks.as_mut() {
-            b.apply(to, &self.skeleton, &pose, &mut face);
-        }
-        model.finish(&mut face);
-        if let Some(jaw) = self.skeleton.joint("temporomandibular") {
-            let open = face.morphs.get("jawOpen") * crate::face::JAW_OPEN;
-            pose.rotate(jaw, glam::Quat::from_rotation_x(open));
-        }
-        let clamped = self.skeleton.limits().clamp(&mut pose);
-        // from the character's own frame to where it stands in the world
-        if !self.placement.is_origin() {
-            pose.root = self.placement.to_world(pose.root);
-            pose.rotations[0] = self.placement.rotation() * pose.rotations[0];
-        }
+        let clamped =
+            (self.assembler).finish(to, &self.skeleton, &self.placement, &mut pose, &mut face);
         let (sounds, events) = self.sounds(to);
         let contacts = self.contacts();
         frame.poses.push(CharacterPose {

@@ -94,8 +94,8 @@ pub struct BlockManager {
     skeleton: Skeleton,
     /// The idle layer every frame's pose starts from (`None`: the rest pose).
     idle: Option<crate::body::idle::Idle>,
-    /// The lids' idle life (blinks, lids following the eyes), with the idle layer.
-    blinks: Option<crate::face::blink::Blinker>,
+    /// What the character adds to its engines' pose and face (lids, jaw, limits, placement).
+    assembler: crate::character::Assembler,
     /// The sounds that played in the last frame (ids).
     playing: Vec<String>,
     /// The world as of the last advance (shared with the realizer).
@@ -118,7 +118,7 @@ impl BlockManager {
     ) -> Self {
         let skeleton = Skeleton::adult();
         let idle = crate::body::idle::Idle::new(character.as_deref().unwrap_or(""), &skeleton);
-        let blinks = crate::face::blink::Blinker::new(character.as_deref().unwrap_or(""));
+        let assembler = crate::character::Assembler::new(character.as_deref().unwrap_or(""), true);
         BlockManager {
             due: std::cell::RefCell::new(BinaryHeap::new()),
             due_stale: std::cell::Cell::new(true),
@@ -134,7 +134,7 @@ impl BlockManager {
             retiring: Vec::new(),
             skeleton,
             idle: Some(idle),
-            blinks: Some(blinks),
+            assembler,
             playing: Vec::new(),
             shared: std::sync::Arc::new(World::default()),
             world: std::sync::Arc::new(World::default()),
@@ -174,7 +174,7 @@ impl BlockManager {
     pub fn set_idle(&mut self, on: bool) {
         let id = self.character.as_deref().unwrap_or("");
         self.idle = on.then(|| crate::body::idle::Idle::new(id, &self.skeleton));
-        self.blinks = on.then(|| crate::face::blink::Blinker::new(id));
+        self.assembler.set_idle(id, on);
     }
 
     /// The pose a frame at `t` starts from: the idle layer's, or the rest pose.

@@ -4,7 +4,6 @@
 //! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians.
 
 pub mod bvh;
-pub mod frames;
 pub mod gltf;
 pub mod idle;
 pub mod ik;

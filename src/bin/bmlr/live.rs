@@ -8,6 +8,7 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 
 use bml_realizer::body::Skeleton;
+use bml_realizer::character::frames;
 use bml_realizer::engine::CharacterPose;
 use bml_realizer::feedback::Feedback;
 use bml_realizer::world::World;
@@ -42,7 +43,7 @@ impl LiveView {
     pub fn start(addr: &str, world: &World) -> Result<LiveView, String> {
         let (listener, at) = web::bind(addr)?;
         let skeleton = Skeleton::adult();
-        let header = bml_realizer::body::frames::header(&skeleton, FPS, &[""]);
+        let header = frames::header(&skeleton, FPS, &[""]);
         let data = crate::view::PageData {
             title: "bmlr serve",
             live: true,
@@ -80,20 +81,10 @@ impl LiveView {
             return;
         }
         self.next_frame = t + 1.0 / FPS;
-        let poses: Vec<bml_realizer::body::frames::Character> = (poses.iter())
-            .map(|p| {
-                let id = p.character.as_deref().unwrap_or("");
-                (
-                    id,
-                    &p.pose,
-                    p.clamped.as_slice(),
-                    Some(&p.face),
-                    p.events.as_slice(),
-                    p.contacts,
-                )
-            })
+        let poses: Vec<(&str, &CharacterPose)> = (poses.iter())
+            .map(|p| (p.character.as_deref().unwrap_or(""), p))
             .collect();
-        let line = bml_realizer::body::frames::line(&self.skeleton, t, &poses);
+        let line = frames::line(&self.skeleton, t, &poses);
         self.live.send(format!("{{\"frame\":{line}}}"));
     }
 

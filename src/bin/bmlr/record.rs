@@ -5,6 +5,7 @@ use std::path::Path;
 
 use bml_realizer::avatar::{animated_glb, Frame};
 use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::frames;
 use bml_realizer::engine::CharacterPose;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::sound::{SoundEvent, Track};
@@ -244,25 +245,15 @@ impl Recording {
     /// default character is `""`).
     pub fn lines(&self, ids: &[&str]) -> (String, Vec<String>) {
         let skeleton = Skeleton::adult();
-        let header = bml_realizer::body::frames::header(&skeleton, self.fps, ids);
+        let header = frames::header(&skeleton, self.fps, ids);
         let per_character: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
         let lines = (self.frames.iter().enumerate())
             .map(|(k, (time, _))| {
-                let poses: Vec<bml_realizer::body::frames::Character> = (ids.iter())
+                let poses: Vec<(&str, &CharacterPose)> = (ids.iter())
                     .zip(&per_character)
-                    .map(|(&id, p)| {
-                        let p = &p[k];
-                        (
-                            id,
-                            &p.pose,
-                            p.clamped.as_slice(),
-                            Some(&p.face),
-                            p.events.as_slice(),
-                            p.contacts,
-                        )
-                    })
+                    .map(|(&id, p)| (id, &p[k]))
                     .collect();
-                bml_realizer::body::frames::line(&skeleton, *time, &poses)
+                frames::line(&skeleton, *time, &poses)
             })
             .collect();
         (header, lines)

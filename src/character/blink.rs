@@ -5,11 +5,10 @@
 //! Blinks are AU45 on both sides; lowered lids AU43, raised lids AU5. This is part of the idle
 //! layer: off with it.
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
-use super::model::{Face, FaceModel};
 use crate::bml::Side;
-use crate::body::{Pose, Skeleton};
+use crate::face::model::{Face, FaceModel};
 
 /// Seconds to close, stay closed, and open again.
 pub const BLINK: (f64, f64, f64) = (0.06, 0.03, 0.12);
@@ -22,6 +21,25 @@ pub const SHIFT_ANGLE: f32 = 0.44; // 25°
 pub const SHIFT_WINDOW: f64 = 0.15;
 /// How much the lids follow the eyes: AU intensity per radian of pitch.
 pub const LID_FOLLOW: f32 = 1.5;
+
+/// Where the eyes look, in the head's frame (from the body: `assemble::eyes`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eyes {
+    /// Their mean pitch (radians, up positive).
+    pub pitch: f32,
+    /// Their mean direction.
+    pub direction: Vec3,
+}
+
+impl Default for Eyes {
+    /// Straight ahead.
+    fn default() -> Eyes {
+        Eyes {
+            pitch: 0.0,
+            direction: Vec3::Z,
+        }
+    }
+}
 
 /// The blinks of one character.
 #[derive(Debug, Clone)]
@@ -54,11 +72,11 @@ fn closure(t: f64, start: f64) -> f64 {
     if x <= 0.0 || x >= close + hold + open {
         0.0
     } else if x < close {
-        super::mixer::ease(x / close)
+        crate::face::mixer::ease(x / close)
     } else if x <= close + hold {
         1.0
     } else {
-        1.0 - super::mixer::ease((x - close - hold) / open)
+        1.0 - crate::face::mixer::ease((x - close - hold) / open)
     }
 }
 
@@ -86,14 +104,14 @@ impl Blinker {
         INTERVAL.0 + (INTERVAL.1 - INTERVAL.0) * unit(self.seed, k)
     }
 
-    /// Closes and opens the lids of `face` at `now`, for the eyes of `pose`.
-    pub fn apply(&mut self, now: f64, skeleton: &Skeleton, pose: &Pose, face: &mut Face) {
+    /// Closes and opens the lids of `face` at `now`, for `eyes` looking where they do.
+    pub fn apply(&mut self, now: f64, eyes: Eyes, face: &mut Face) {
         while self.next <= now {
             self.started.push(self.next);
             self.count += 1;
             self.next += self.interval(self.count);
         }
-        let (pitch, direction) = eyes(skeleton, pose);
+        let Eyes { pitch, direction } = eyes;
         self.gaze_blink(now, direction);
         let gone = now - (BLINK.0 + BLINK.1 + BLINK.2);
         self.started.retain(|&s| s > gone);
@@ -131,25 +149,11 @@ impl Blinker {
     }
 }
 
-/// The eyes' mean pitch (radians, up positive) and direction, in the head's frame.
-fn eyes(skeleton: &Skeleton, pose: &Pose) -> (f32, Vec3) {
-    let turn = |name: &str| {
-        (skeleton.joint(name))
-            .and_then(|j| pose.rotations.get(j).copied())
-            .unwrap_or(Quat::IDENTITY)
-    };
-    let d = (turn("l_eyeball_joint") * Vec3::Z + turn("r_eyeball_joint") * Vec3::Z)
-        .normalize_or(Vec3::Z);
-    (d.y.clamp(-1.0, 1.0).asin(), d)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn blinks(id: &str, seconds: f64) -> Vec<f64> {
-        let s = Skeleton::adult();
-        let pose = Pose::rest(&s);
         let mut b = Blinker::new(id);
         let m = FaceModel::default_model();
         let slot = m.slots(45, Side::Left).unwrap()[0];
@@ -158,7 +162,7 @@ mod tests {
         for k in 0..(seconds * 60.0) as usize {
             let t = k as f64 / 60.0;
             let mut face = Face::neutral(m);
-            b.apply(t, &s, &pose, &mut face);
+            b.apply(t, Eyes::default(), &mut face);
             let w = face.aus.0[slot];
             if w >= 0.99 && was < 0.99 {
                 closed_at.push(t);

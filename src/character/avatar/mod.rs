@@ -19,7 +19,7 @@ pub use morph::MorphMap;
 pub use retarget::{Posed, Retarget};
 
 /// The default avatar's GLB (`assets/avatar/default.glb`, CC0 data; notice beside it).
-pub const DEFAULT_GLB: &[u8] = include_bytes!("../../assets/avatar/default.glb");
+pub const DEFAULT_GLB: &[u8] = include_bytes!("../../../assets/avatar/default.glb");
 
 /// The default avatar, read.
 pub fn default_model() -> Model {

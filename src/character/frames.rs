@@ -10,22 +10,9 @@
 use indexmap::IndexMap;
 use serde::Serialize;
 
-use super::pose::Pose;
-use super::skeleton::Skeleton;
+use crate::body::Skeleton;
+use crate::engine::CharacterPose;
 use crate::face::{Face, FaceModel, ARKIT, VISEMES};
-use crate::sound::SoundEvent;
-
-/// One character in a frame: its id (`""` the default one), pose, the joints clamped into their
-/// limits, its face (if it has one), the sounds that started or stopped since the last frame
-/// and, once it has walked, which feet are on the ground (left, right).
-pub type Character<'a> = (
-    &'a str,
-    &'a Pose,
-    &'a [usize],
-    Option<&'a Face>,
-    &'a [SoundEvent],
-    Option<[bool; 2]>,
-);
 
 /// Feet on the ground, as a frame writes them.
 #[derive(Serialize)]
@@ -145,11 +132,21 @@ pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
     serde_json::to_string(&header).expect("a header always encodes")
 }
 
-/// One frame's line (without a newline): the time and each character's pose, in order, with the
-/// joints that were clamped into their limits and the face.
-pub fn line(skeleton: &Skeleton, time: f64, poses: &[Character<'_>]) -> String {
-    let characters = (poses.iter())
-        .map(|&(id, pose, clamped, face, events, contacts)| {
+/// One frame's line (without a newline): the time and each character (its id, `""` the default
+/// one) in order: its pose, the joints that were clamped into their limits, its face, the
+/// sounds that started or stopped since the last frame and, once it has walked, which feet are
+/// on the ground.
+pub fn line(skeleton: &Skeleton, time: f64, characters: &[(&str, &CharacterPose)]) -> String {
+    let characters = (characters.iter())
+        .map(|&(id, c)| {
+            let CharacterPose {
+                pose,
+                clamped,
+                face,
+                events,
+                contacts,
+                ..
+            } = c;
             let world = pose.world(skeleton);
             let joints = (skeleton.joints().iter().zip(&pose.rotations))
                 .map(|(j, &q)| (j.name.as_str(), quat(q)))
@@ -162,11 +159,9 @@ pub fn line(skeleton: &Skeleton, time: f64, poses: &[Character<'_>]) -> String {
                 clamped: (clamped.iter())
                     .map(|&j| skeleton.joints()[j].name.as_str())
                     .collect(),
-                face: face.map(action_units).unwrap_or_default(),
-                morphs: face.map(morphs).unwrap_or_default(),
-                viseme: face
-                    .and_then(|f| f.viseme)
-                    .and_then(|v| VISEMES.get(v).copied()),
+                face: action_units(face),
+                morphs: morphs(face),
+                viseme: face.viseme.and_then(|v| VISEMES.get(v).copied()),
                 events: (events.iter())
                     .map(|e| EventLine {
                         kind: if e.start { "audio-start" } else { "audio-stop" },
@@ -186,6 +181,19 @@ pub fn line(skeleton: &Skeleton, time: f64, poses: &[Character<'_>]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::body::Pose;
+
+    fn at_rest(pose: Pose, clamped: Vec<usize>, contacts: Option<[bool; 2]>) -> CharacterPose {
+        CharacterPose {
+            character: None,
+            pose,
+            clamped,
+            face: Face::neutral(FaceModel::default_model()),
+            sounds: Vec::new(),
+            events: Vec::new(),
+            contacts,
+        }
+    }
 
     #[test]
     fn the_header_names_every_joint_and_a_frame_every_rotation() {
@@ -203,8 +211,12 @@ mod tests {
             elbow,
             glam::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         );
-        let f: serde_json::Value =
-            serde_json::from_str(&line(&s, 0.5, &[("", &pose, &[], None, &[], None)])).unwrap();
+        let f: serde_json::Value = serde_json::from_str(&line(
+            &s,
+            0.5,
+            &[("", &at_rest(pose.clone(), vec![], None))],
+        ))
+        .unwrap();
         assert_eq!(f["time"], 0.5);
         let c = &f["characters"][""];
         assert_eq!(c["root"], serde_json::json!([0.0, 0.95, 0.0]));
@@ -219,7 +231,7 @@ mod tests {
         let f: serde_json::Value = serde_json::from_str(&line(
             &s,
             0.5,
-            &[("", &pose, &[elbow], None, &[], Some([true, false]))],
+            &[("", &at_rest(pose, vec![elbow], Some([true, false])))],
         ))
         .unwrap();
         assert_eq!(
