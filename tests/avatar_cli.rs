@@ -20,7 +20,7 @@ fn welcome_on(avatar: &std::path::Path, out: &std::path::Path) -> (i32, String) 
     ])
 }
 
-/// `bmlr run` with `args`: its exit code and stderr.
+/// `bmlr` with `args`: its exit code and stderr.
 fn bmlr(args: &[&str]) -> (i32, String) {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_bmlr"))
         .args(args)
@@ -126,6 +126,20 @@ fn bmlr_refuses_a_bad_avatar_with_exit_2_naming_the_file() {
     ]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--avatar shows the motion in --gltf"), "{err}");
+    // the live view: a bad avatar stops `serve` before it listens; no view, no avatar
+    let live = ["serve", "--tcp", "127.0.0.1:0", "--view", "127.0.0.1:0"];
+    let (code, err) = bmlr(&[&live[..], &["--avatar", bad.to_str().unwrap()]].concat());
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("broken.glb: not a valid GLB"), "{err}");
+    let (code, err) = bmlr(&[
+        "serve",
+        "--tcp",
+        "127.0.0.1:0",
+        "--avatar",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("give --view too"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

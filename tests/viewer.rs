@@ -292,6 +292,25 @@ fn the_live_view_streams_frames_and_feedback_as_blocks_arrive() {
     let d = data(&String::from_utf8(body).unwrap());
     assert_eq!(d["live"], true);
     let header = d["header"].clone();
+    // the default character is shown as the default avatar: its moving nodes by name
+    let wiring = &d["liveAvatars"][0];
+    assert_eq!(wiring["id"], "");
+    let glb = {
+        use base64::Engine as _;
+        let text = d["avatars"][0].as_str().unwrap();
+        base64::engine::general_purpose::STANDARD
+            .decode(text)
+            .unwrap()
+    };
+    let model = bml_realizer::avatar::Model::from_glb("live", &glb).unwrap();
+    let moving: Vec<String> = (wiring["moving"].as_array().unwrap().iter())
+        .map(|i| model.nodes[i.as_u64().unwrap() as usize].name.clone())
+        .collect();
+    let skeleton = bml_realizer::body::Skeleton::adult();
+    let retarget = bml_realizer::avatar::Retarget::new(&model, &skeleton, None).unwrap();
+    let targets: u64 = (wiring["morphs"].as_array().unwrap().iter())
+        .map(|m| m[1].as_u64().unwrap())
+        .sum();
     let (mut socket, _) = tungstenite::connect(format!("ws://{view}/live")).unwrap();
     let mut client = TcpStream::connect(&port).unwrap();
     let block = format!(
@@ -309,6 +328,33 @@ fn the_live_view_streams_frames_and_feedback_as_blocks_arrive() {
             frames += 1;
             let joints = world(&header, frame, "");
             highest = highest.max(at(&joints, "r_wrist").y - at(&joints, "r_shoulder").y);
+            // the avatar's nodes turn as their joints (its skeleton is the realizer's), its
+            // hips stand where the frame's root is, and every morph target has a weight
+            let avatar = &m["avatars"][""];
+            let r = avatar["r"].as_array().unwrap();
+            assert_eq!(r.len(), 4 * moving.len() + 3);
+            for (k, name) in moving.iter().enumerate() {
+                let node = quat(&Value::Array(r[4 * k..4 * k + 4].to_vec())).normalize();
+                let joint = quat(&frame["characters"][""]["joints"][name]).normalize();
+                assert!(
+                    node.angle_between(joint) < 1e-3,
+                    "{name}: {node} vs {joint}"
+                );
+            }
+            let c = &frame["characters"][""];
+            let pose = bml_realizer::body::Pose {
+                root: vec3(&c["root"]),
+                rotations: (skeleton.joints().iter())
+                    .map(|j| quat(&c["joints"][&j.name]).normalize())
+                    .collect(),
+            };
+            let hips = vec3(&Value::Array(r[r.len() - 3..].to_vec()));
+            let expected = retarget.pose(&pose).hips.1;
+            assert!(
+                hips.distance(expected) < 1e-4,
+                "hips {hips}, not {expected}"
+            );
+            assert_eq!(avatar["w"].as_array().unwrap().len() as u64, targets);
         }
         if let Some(f) = m.get("feedback") {
             let text = f["text"].as_str().unwrap().to_string();
@@ -638,4 +684,38 @@ fn headless_chromium_shows_the_avatar_s_mouth_speaking() {
     assert!(face > 0.6, "no face close up: {face:.2} of its box drawn");
     assert!(mouth > 0.1, "the mouth did not move: {mouth:.2} changed");
     assert!(eyes < 0.02, "the eyes moved: {eyes:.2} changed");
+}
+
+/// The live page of `bmlr serve --view` draws the default character as the default avatar (its
+/// light-blue shirt; the mannequin has none) while a block plays.
+#[test]
+#[ignore = "needs Debian's chromium; .ci/run installs it and runs this with --ignored"]
+fn headless_chromium_draws_the_live_view_s_avatar() {
+    let server = spawn(
+        &["serve", "--tcp", "127.0.0.1:0", "--view", "127.0.0.1:0"],
+        2,
+    );
+    let port = address(&server.lines, "bmlr serve: listening on ");
+    let view = address(&server.lines, "bmlr serve: live view on ");
+    let mut client = TcpStream::connect(&port).unwrap();
+    let block = format!(
+        r#"<bml {NS} id="hi"><gesture id="g" lexeme="WAVE" mode="RIGHT_HAND" start="0" end="30"/></bml>"#
+    );
+    writeln!(client, "{block}").unwrap();
+    let out = scratch("live-avatar").join("live.png");
+    let (_, console) = browse(
+        &format!("http://{view}/"),
+        &format!("--screenshot={}", out.display()),
+    );
+    assert!(console.is_empty(), "{console:?}");
+    let shot = Shot::load(&out);
+    let shirt = shot.share((0, 900, 0, 430), |x, y| {
+        let [r, g, b] = shot.px(x, y);
+        b > 180 && r < 150 && g > 120
+    });
+    eprintln!("shirt {shirt:.4} of the view");
+    assert!(
+        shirt > 0.004,
+        "no avatar drawn: {shirt:.4} of the view is its shirt"
+    );
 }

@@ -6,8 +6,9 @@
 // from disk) with its face (brows, lids and mouth moved by the frames' blendshapes), the world's
 // points, a cursor over the timeline and the feedback up to the cursor, with play / pause /
 // scrub / speed, and the run's sound (if it has any) played in step with the cursor. Characters
-// with an avatar in the page data are drawn as that avatar (GLTFLoader, an animation per
-// character; M toggles the mannequin). It opens paused at #t=SECONDS and sets the title to
+// with an avatar in the page data are drawn as that avatar (avatars.js: GLTFLoader, an animation
+// per character, or live the avatars' node rotations and morph weights with each frame; M
+// toggles the mannequin). It opens paused at #t=SECONDS and sets the title to
 // "bmlr view: ready" once the first frame is drawn with every avatar loaded.
 'use strict';
 
@@ -41,6 +42,8 @@
       this.clamped = [];
       // per frame, per character: the blendshapes that are not 0
       this.morphs = [];
+      // live, per frame: each avatar's node rotations and morph weights (by character id)
+      this.avatars = [];
       // the rest pose, for a character in the frames before it first appears
       this.rest = new Float32Array(7 + 4 * this.joints.length);
       this.rest.set(this.joints[0].offset, 0);
@@ -57,8 +60,9 @@
       return this.times.length ? this.times[0] : 0;
     }
 
-    /** Adds a frame line of the frames file (frames arrive in time order). */
-    push(frame) {
+    /** Adds a frame line of the frames file (frames arrive in time order), live with its
+     * avatars' data. */
+    push(frame, avatars) {
       for (const id of Object.keys(frame.characters)) {
         if (!this.characters.includes(id)) {
           this.characters.push(id);
@@ -78,12 +82,14 @@
       this.poses.push(poses);
       this.clamped.push(this.characters.map((id) => (frame.characters[id] || {}).clamped || []));
       this.morphs.push(this.characters.map((id) => (frame.characters[id] || {}).morphs || {}));
+      this.avatars.push(avatars || null);
       if (this.times.length > LIVE_FRAMES) {
         const drop = LIVE_FRAMES / 10;
         this.times.splice(0, drop);
         this.poses.splice(0, drop);
         this.clamped.splice(0, drop);
         this.morphs.splice(0, drop);
+        this.avatars.splice(0, drop);
       }
     }
 
@@ -184,7 +190,10 @@
     start() {
       this.scene3d();
       this.figures = this.clip.characters.map((id, k) => this.figure(k));
-      this.clip.added = (k) => this.figures.push(this.figure(k));
+      this.clip.added = (k) => {
+        this.figures.push(this.figure(k));
+        if (this.attachAvatar) this.attachAvatar(k);
+      };
       this.worldPoints();
       this.loadAvatars();
       this.controls();
@@ -286,59 +295,9 @@
       return { nodes, face, balance, pose: new Float32Array(7 + 4 * joints.length), k };
     }
 
-    /**
-     * Each character's avatar (a GLB in the page data, with its motion and face as an
-     * animation, made by the realizer as `bmlr run --gltf` makes it), loaded with three.js's
-     * GLTFLoader from the page's own text; the mannequin is hidden behind it (M shows it
-     * again).
-     */
+    /** Each character's avatar, drawn instead of its mannequin (avatars.js). */
     loadAvatars() {
-      const THREE = this.THREE;
-      const avatars = this.data.avatars || [];
-      if (!avatars.length) return;
-      const text = (id) => document.getElementById(id).textContent;
-      const module = (s) => URL.createObjectURL(new Blob([s], { type: 'text/javascript' }));
-      const three = (s) => s.replace(/from 'three'/g, `from '${this.threeURL}'`);
-      const utils = module(three(text('three-geometry-utils')));
-      const loader = module(
-        three(text('three-gltf')).replace("'../utils/BufferGeometryUtils.js'", `'${utils}'`),
-      );
-      this.avatarsLoading = avatars.length;
-      const done = () => {
-        this.avatarsLoading--;
-        this.draw();
-      };
-      import(loader).then(
-        ({ GLTFLoader }) => avatars.forEach((glb, k) => {
-          const bytes = Uint8Array.from(atob(glb), (c) => c.charCodeAt(0));
-          new GLTFLoader().parse(bytes.buffer, '', (gltf) => {
-            gltf.scene.traverse((o) => { if (o.isSkinnedMesh) o.frustumCulled = false; });
-            this.scene.add(gltf.scene);
-            const mixer = new THREE.AnimationMixer(gltf.scene);
-            if (gltf.animations.length) {
-              const action = mixer.clipAction(gltf.animations[0]);
-              action.setLoop(THREE.LoopOnce);
-              action.clampWhenFinished = true;
-              action.play();
-            }
-            if (k === 0) {
-              // the close look at the face at the first avatar's eyes (about 11 cm under the
-              // top of its head), not the mannequin's
-              const top = new THREE.Box3().setFromObject(gltf.scene).max.y;
-              if (Number.isFinite(top) && top > 0.5) {
-                const close = this.view.height === this.close.height;
-                this.close.height = top - 0.11;
-                if (close) this.view.height = this.close.height;
-              }
-            }
-            const f = this.figures[k];
-            f.avatar = { root: gltf.scene, mixer };
-            f.nodes[0].visible = false;
-            done();
-          }, (e) => { fail('an avatar did not load: ' + e); done(); });
-        }),
-        (e) => { fail("three.js's GLTFLoader did not load: " + e); this.avatarsLoading = 0; },
-      );
+      bmlrLoadAvatars(this, fail);
     }
 
     /**
@@ -668,7 +627,8 @@
           for (let j = 1; j < f.nodes.length; j++) f.nodes[j].quaternion.fromArray(pose, 7 + 4 * j);
           this.expression(f, this.t);
           this.balance(f);
-          if (f.avatar) f.avatar.mixer.setTime(this.t);
+          if (f.avatar && f.avatar.mixer) f.avatar.mixer.setTime(this.t);
+          if (f.avatar && f.avatar.live) bmlrDriveLive(THREE, f.avatar, this.clip, this.t, this.clip.characters[f.k]);
         }
       }
       for (const p of this.points) if (p.keys) p.ball.position.fromArray(along(p.keys, this.t));
@@ -780,7 +740,7 @@
       const socket = new WebSocket('ws://' + location.host + '/live');
       socket.onmessage = (e) => {
         const m = JSON.parse(e.data);
-        if (m.frame) this.clip.push(m.frame);
+        if (m.frame) this.clip.push(m.frame, m.avatars);
         if (m.feedback) this.addFeedback(m.feedback);
         if (m.timeline) this.setTimeline(m.timeline);
       };

@@ -1,5 +1,5 @@
-//! `--avatar FILE` and `--bone-map FILE` of `bmlr run` (and the viewer): the avatar a glTF
-//! export shows, read and recognised before anything runs, so that a bad one stops the command
+//! `--avatar FILE` and `--bone-map FILE` of `bmlr run`, `view` and `serve --view`: the avatar a
+//! glTF export, the viewer and the live view show, read and recognised before anything runs, so that a bad one stops the command
 //! with exit 2 and a sentence naming the file.
 
 use std::collections::BTreeMap;
@@ -13,7 +13,8 @@ use clap::Args;
 /// The avatar options.
 #[derive(Args, Clone, Default)]
 pub struct AvatarArgs {
-    /// The avatar --gltf shows (.glb, .gltf, or VRM 0.x/1.0 .vrm): the realized motion
+    /// The avatar the characters are shown as (in --gltf, the viewer, the live view) when the
+    /// world file gives them none (.glb, .gltf, or VRM 0.x/1.0 .vrm): the realized motion
     /// retargeted onto its skeleton, the face onto its morph targets by name. Without it, the
     /// default avatar (docs/avatars.md).
     #[arg(long, value_name = "FILE")]

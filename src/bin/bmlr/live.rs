@@ -3,10 +3,14 @@
 //! feedback message with the time it was sent, and the timeline of the last [`WINDOW`] seconds,
 //! redrawn at most twice a second while feedback arrives. A watcher who connects late first gets
 //! the last [`BACKLOG`] feedback messages and the latest timeline, then the frames from then on.
+//! Characters with an avatar (the default character and the world's, up to
+//! [`crate::view::MAX_VIEW_AVATARS`]) are shown as it: the page carries each avatar once, and
+//! each frame message its moving nodes' rotations and its morph weights (`avatar::Driver`).
 
 use std::collections::VecDeque;
 use std::sync::Arc;
 
+use bml_realizer::avatar::{animated_glb, Driver};
 use bml_realizer::body::Skeleton;
 use bml_realizer::character::frames;
 use bml_realizer::engine::CharacterPose;
@@ -35,15 +39,42 @@ pub struct LiveView {
     /// Feedback arrived since the last timeline, and when that was drawn.
     stale: bool,
     drawn_at: f64,
+    /// The characters shown as avatars, each with its driver.
+    avatars: Vec<(String, Driver)>,
+}
+
+/// Numbers in a frame's avatar data keep 6 decimals, as the frames file's.
+fn short(v: f32) -> f64 {
+    (f64::from(v) * 1e6).round() / 1e6 + 0.0
 }
 
 impl LiveView {
     /// Serves the live page on `addr` (loopback only; the address it got is printed on stderr)
-    /// for a realizer in `world`.
-    pub fn start(addr: &str, world: &World) -> Result<LiveView, String> {
+    /// for a realizer in `world`, its characters shown as their `avatars`.
+    pub fn start(
+        addr: &str,
+        world: &World,
+        avatars: &crate::avatar::Avatars,
+    ) -> Result<LiveView, String> {
         let (listener, at) = web::bind(addr)?;
         let skeleton = Skeleton::adult();
         let header = frames::header(&skeleton, FPS, &[""]);
+        let ids = std::iter::once("").chain(world.placements().map(|(id, _)| id));
+        let shown: Vec<&str> = ids.take(crate::view::MAX_VIEW_AVATARS).collect();
+        let glbs = (shown.iter())
+            .map(|id| animated_glb(&avatars.of(id).model, &avatars.of(id).retarget, &[], id))
+            .collect();
+        let drivers: Vec<(String, Driver)> = (shown.iter())
+            .map(|&id| {
+                let a = avatars.of(id);
+                (id.to_string(), Driver::new(&a.model, a.retarget.clone()))
+            })
+            .collect();
+        let wiring = (drivers.iter())
+            .map(|(id, d)| {
+                json!({"id": id, "moving": d.moving(), "hips": d.hips(), "morphs": d.morph_nodes()})
+            })
+            .collect();
         let data = crate::view::PageData {
             title: "bmlr serve",
             live: true,
@@ -52,8 +83,8 @@ impl LiveView {
             log: &[],
             world,
             audio: None,
-            // the live page shows mannequins: its frames arrive one by one
-            avatars: Vec::new(),
+            avatars: glbs,
+            live_avatars: wiring,
         }
         .to_json();
         let live = Live::new(BACKLOG);
@@ -68,6 +99,7 @@ impl LiveView {
             recent: VecDeque::new(),
             stale: false,
             drawn_at: f64::NEG_INFINITY,
+            avatars: drivers,
         })
     }
 
@@ -85,7 +117,20 @@ impl LiveView {
             .map(|p| (p.character.as_deref().unwrap_or(""), p))
             .collect();
         let line = frames::line(&self.skeleton, t, &poses);
-        self.live.send(format!("{{\"frame\":{line}}}"));
+        let (mut rotations, mut weights) = (Vec::new(), Vec::new());
+        let mut avatars = serde_json::Map::new();
+        for (id, p) in &poses {
+            let Some((_, driver)) = self.avatars.iter().find(|a| a.0 == *id) else {
+                continue;
+            };
+            driver.frame(&p.pose, &p.face, &mut rotations, &mut weights);
+            let r: Vec<f64> = rotations.iter().map(|&v| short(v)).collect();
+            let w: Vec<f64> = weights.iter().map(|&v| short(v)).collect();
+            avatars.insert(id.to_string(), json!({"r": r, "w": w}));
+        }
+        let avatars = serde_json::Value::Object(avatars);
+        self.live
+            .send(format!("{{\"frame\":{line},\"avatars\":{avatars}}}"));
     }
 
     /// A feedback message sent at time `t`.

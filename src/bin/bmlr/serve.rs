@@ -57,6 +57,8 @@ pub struct ServeArgs {
     /// gaze, pointing and headDirectionShift, added to the built-in scene.
     #[arg(long, value_name = "WORLD.json")]
     world: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    avatar: crate::avatar::AvatarArgs,
 }
 
 /// `bmlr serve --stdio` (runs until stdin closes and nothing more is scheduled) or `--tcp`.
@@ -95,11 +97,24 @@ pub fn serve(args: ServeArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if args.avatar.avatar.is_some() && args.view.is_none() {
+        eprintln!("bmlr serve: --avatar shows the characters in the live view; give --view too");
+        return ExitCode::from(2);
+    }
+    let avatars = match (args.view.is_some())
+        .then(|| (args.avatar).load(realizer.world(), args.world.as_deref()))
+        .transpose()
+    {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("bmlr serve: {e}");
+            return ExitCode::from(2);
+        }
+    };
     if let Some(addr) = &args.tcp {
-        let view = match args
-            .view
-            .as_deref()
-            .map(|v| crate::live::LiveView::start(v, realizer.world()))
+        let view = match (args.view.as_deref())
+            .zip(avatars.as_ref())
+            .map(|(v, a)| crate::live::LiveView::start(v, realizer.world(), a))
         {
             Some(Err(e)) => {
                 eprintln!("bmlr serve: --view {e}");

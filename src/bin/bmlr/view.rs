@@ -122,6 +122,7 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
         world: run.realizer.world(),
         audio,
         avatars,
+        live_avatars: Vec::new(),
     };
     let page = web::page(&data.to_json());
     let s = if characters.len() == 1 { "" } else { "s" };
@@ -160,8 +161,11 @@ pub struct PageData<'a> {
     /// The run's sound as a WAV file, if it made any.
     pub audio: Option<Vec<u8>>,
     /// Per character (in the header's order) its avatar with its motion, as GLB; none: the
-    /// mannequins.
+    /// mannequins. Live: the avatars without motion, in the order of `live_avatars`.
     pub avatars: Vec<Vec<u8>>,
+    /// Live: per avatar, the character it shows and how its frames' data sets its nodes
+    /// (`{"id", "moving": [node…], "hips": node, "morphs": [[node, targets]…]}`).
+    pub live_avatars: Vec<serde_json::Value>,
 }
 
 impl PageData<'_> {
@@ -187,6 +191,7 @@ impl PageData<'_> {
             .collect();
         let data = json!({
             "avatars": avatars,
+            "liveAvatars": self.live_avatars,
             "title": self.title,
             "live": self.live,
             "segments": mannequin::segments(&Skeleton::adult()),

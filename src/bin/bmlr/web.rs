@@ -13,6 +13,8 @@ use std::time::Duration;
 
 const TEMPLATE: &str = include_str!("../../../assets/viewer/index.html");
 const VIEWER: &str = include_str!("../../../assets/viewer/viewer.js");
+/// The avatars' part of the viewer (loading, and live driving).
+const AVATARS: &str = include_str!("../../../assets/viewer/avatars.js");
 const THREE: &str = include_str!("../../../assets/viewer/three/three.module.min.js");
 /// three.js's glTF loader and the geometry helpers it imports (the same release, same licence).
 const GLTF_LOADER: &str = include_str!("../../../assets/viewer/three/GLTFLoader.js");
@@ -42,6 +44,7 @@ pub fn page(data: &str) -> String {
             ("THREE", THREE),
             ("GLTF_LOADER", GLTF_LOADER),
             ("GEOMETRY_UTILS", GEOMETRY_UTILS),
+            ("AVATARS", AVATARS),
             ("VIEWER", VIEWER),
         ],
     )

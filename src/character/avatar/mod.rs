@@ -6,6 +6,7 @@
 //! data (`assets/avatar/NOTICE.md`), is compiled in: its skeleton is the realizer's own, its
 //! face has the 52 ARKit morph targets.
 
+mod drive;
 mod export;
 mod file;
 pub mod humanoid;
@@ -13,6 +14,7 @@ mod morph;
 mod retarget;
 mod twist;
 
+pub use drive::Driver;
 pub use export::{animated_glb, Frame};
 pub use file::{AvatarError, Model, Node, MAX_AVATAR_BYTES};
 pub use morph::MorphMap;
