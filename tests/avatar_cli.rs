@@ -238,23 +238,44 @@ fn a_character_takes_the_avatar_the_world_file_gives_it() {
     let (code, err) = run(&bob, "Bob", "fixtures/examples/two-bob.xml");
     assert_eq!(code, 0, "{err}");
     assert!(Model::read(&bob).unwrap().node("l_eyeball_joint").is_some());
-    // --avatar shows one character: two without --character is exit 1
+    // both without --character: one scene, Alice on hers (the world file's), Bob on the default
+    let both = dir.join("both.glb");
     let (code, err) = bmlr(&[
         "run",
         "--world",
         file.to_str().unwrap(),
         "--gltf",
-        bob.to_str().unwrap(),
-        "--avatar",
-        dir.join("mixamo.glb").to_str().unwrap(),
+        both.to_str().unwrap(),
         "fixtures/examples/two-alice.xml",
         "fixtures/examples/two-bob.xml",
     ]);
-    assert_eq!(code, 1, "{err}");
-    assert!(
-        err.contains("--avatar shows one character and 2 received blocks"),
-        "{err}"
+    assert_eq!(code, 0, "{err}");
+    let g = gltf::Gltf::from_slice(&std::fs::read(&both).unwrap()).unwrap();
+    assert_eq!(g.document.skins().count(), 2, "a skin per character");
+    assert_eq!(
+        g.document.animations().count(),
+        1,
+        "one animation plays both"
     );
+    let under = |who: &str| -> Vec<String> {
+        let top = g.document.nodes().find(|n| n.name() == Some(who)).unwrap();
+        let mut names = Vec::new();
+        let mut stack: Vec<_> = top.children().collect();
+        while let Some(n) = stack.pop() {
+            names.extend(n.name().map(str::to_string));
+            stack.extend(n.children());
+        }
+        names
+    };
+    assert!(under("Alice").iter().any(|n| n == "mixamorig:RightArm"));
+    assert!(under("Bob").iter().any(|n| n == "l_eyeball_joint"));
+    // every channel's node is one of the scene's, and both characters' bones are keyed
+    let animation = g.document.animations().next().unwrap();
+    let keyed: Vec<String> = (animation.channels())
+        .filter_map(|c| c.target().node().name().map(str::to_string))
+        .collect();
+    assert!(keyed.iter().any(|n| n == "mixamorig:RightArm"));
+    assert!(keyed.iter().any(|n| n == "r_shoulder"));
     // a world file naming an avatar that is not there: exit 2 naming the character and file
     world["characters"]["Bob"]["avatar"] = Value::from("missing.vrm");
     std::fs::write(&file, world.to_string()).unwrap();

@@ -542,8 +542,9 @@ fn run_gltf_writes_the_default_avatar_with_the_motion() {
     assert!(err.contains("--gltf records on the virtual clock"), "{err}");
 }
 
-/// Characters placed in the world make one glTF scene, each a mannequin of its own where it
-/// stands: Bob's root is keyed at his place in the example world (x 0.7 m, z 0.3 m).
+/// Characters placed in the world make one glTF scene, each on its avatar where it stands:
+/// Bob's hips are keyed at his place in the example world (x 0.7 m, z 0.3 m; not scaled by the
+/// avatar's shorter legs, which would put him 4 cm nearer the origin).
 #[test]
 fn run_gltf_of_several_characters_is_one_scene() {
     let path = std::env::temp_dir().join(format!("bmlr-{}-two.glb", std::process::id()));
@@ -557,16 +558,20 @@ fn run_gltf_of_several_characters_is_one_scene() {
         "fixtures/examples/two-bob.xml",
     ]);
     assert_eq!(code, 0, "{err}");
-    assert!(err.contains("57 joints, 2 characters,"), "{err}");
+    assert!(err.contains("2 characters on their avatars"), "{err}");
     let glb = std::fs::read(&path).unwrap();
     let (gltf, bin) = glb_json(&glb);
-    let n = bml_realizer::body::Skeleton::adult().len();
     assert_eq!(gltf["skins"].as_array().unwrap().len(), 2);
-    assert_eq!(gltf["nodes"][2 * n + 1]["name"], "Bob");
-    // Bob's root translation channel, its first key
+    let nodes = gltf["nodes"].as_array().unwrap();
+    let bob = nodes.iter().position(|n| n["name"] == "Bob").unwrap();
+    // Bob's HumanoidRoot, the root of his skeleton under his node
+    let hips = (nodes[bob]["children"].as_array().unwrap().iter())
+        .map(|c| c.as_u64().unwrap() as usize)
+        .find(|&c| nodes[c]["name"] == "HumanoidRoot")
+        .unwrap();
     let channels = gltf["animations"][0]["channels"].as_array().unwrap();
     let root = (channels.iter())
-        .find(|c| c["target"]["node"] == n + 1 && c["target"]["path"] == "translation")
+        .find(|c| c["target"]["node"] == hips && c["target"]["path"] == "translation")
         .unwrap();
     let sampler = &gltf["animations"][0]["samplers"][root["sampler"].as_u64().unwrap() as usize];
     let output = &gltf["accessors"][sampler["output"].as_u64().unwrap() as usize];
@@ -576,7 +581,7 @@ fn run_gltf_of_several_characters_is_one_scene() {
     let z = f32::from_le_bytes(glb[bin + 8..bin + 12].try_into().unwrap());
     assert!(
         (x - 0.7).abs() < 0.02 && (z - 0.3).abs() < 0.02,
-        "Bob's root at x {x}, z {z}"
+        "Bob's hips at x {x}, z {z}"
     );
     std::fs::remove_file(&path).ok();
 }

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use bml_realizer::avatar::{self, Model, Retarget};
-use bml_realizer::body::Skeleton;
+use bml_realizer::body::{Pose, Skeleton};
 use bml_realizer::world::World;
 use clap::Args;
 
@@ -42,6 +42,15 @@ impl Avatar {
         let retarget = Retarget::new(&model, &Skeleton::adult(), map).map_err(|e| e.to_string())?;
         Ok(Avatar { model, retarget })
     }
+
+    /// Its driving for character `id`, standing where `world` places it (its place kept, its
+    /// travel from there scaled by leg length).
+    pub fn placed(&self, world: &World, id: &str) -> Retarget {
+        let mut retarget = self.retarget.clone();
+        let rest = Pose::rest(&Skeleton::adult()).root;
+        retarget.anchor_at(world.placement(id).to_world(rest));
+        retarget
+    }
 }
 
 /// The avatar of every character: the world file's for those it gives one, else the one of
@@ -49,8 +58,6 @@ impl Avatar {
 pub struct Avatars {
     /// For characters the world file gives none.
     pub common: Avatar,
-    /// Whether `common` was asked for (`--avatar`) rather than the default one.
-    pub asked: bool,
     /// By character id, from the world file.
     pub own: BTreeMap<String, Avatar>,
 }
@@ -82,8 +89,7 @@ impl AvatarArgs {
                 own.insert(id.to_string(), avatar);
             }
         }
-        let asked = self.avatar.is_some();
-        Ok(Avatars { common, asked, own })
+        Ok(Avatars { common, own })
     }
 }
 

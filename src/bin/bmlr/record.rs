@@ -3,12 +3,13 @@
 
 use std::path::Path;
 
-use bml_realizer::avatar::{animated_glb, Frame};
+use bml_realizer::avatar::{animated_document, animated_glb, scene_glb, Frame};
 use bml_realizer::body::{Pose, Skeleton};
 use bml_realizer::character::frames;
 use bml_realizer::engine::CharacterPose;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::sound::{SoundEvent, Track};
+use bml_realizer::world::World;
 
 use crate::avatar::{Avatar, Avatars};
 
@@ -123,8 +124,8 @@ impl Recording {
     }
 
     /// Writes `avatar` with the motion and face of the character `asked` (or of the one that
-    /// received blocks); without one asked among several, a scene of mannequins, one per
-    /// character, each where it stands. An error has the exit code.
+    /// received blocks); without one asked among several, a scene of every character's avatar
+    /// (mannequins without avatars), each where it stands. An error has the exit code.
     pub fn write_gltf(
         &self,
         realizer: &Realizer,
@@ -139,16 +140,10 @@ impl Recording {
                 .map_err(|e| (1, format!("--gltf: {e}")))?],
         };
         if let ([id], Some(avatars)) = (ids.as_slice(), avatar) {
-            return self.write_avatar(path, id, avatars.of(id));
+            return self.write_avatar(path, id, avatars.of(id), realizer.world());
         }
-        if avatar.is_some_and(|a| a.asked) {
-            return Err((
-                1,
-                format!(
-                    "--avatar shows one character and {} received blocks: name one with --character",
-                    ids.len()
-                ),
-            ));
+        if let Some(avatars) = avatar {
+            return self.write_avatars(path, &ids, avatars, realizer.world());
         }
         let poses: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
         let frames: Vec<Vec<(f64, &Pose)>> = (poses.iter())
@@ -178,8 +173,14 @@ impl Recording {
     }
 
     /// Writes `avatar` moving as character `id` did.
-    fn write_avatar(&self, path: &Path, id: &str, avatar: &Avatar) -> Result<(), (u8, String)> {
-        let glb = self.avatar_glb(id, avatar);
+    fn write_avatar(
+        &self,
+        path: &Path,
+        id: &str,
+        avatar: &Avatar,
+        world: &World,
+    ) -> Result<(), (u8, String)> {
+        let glb = self.avatar_glb(id, avatar, world);
         write_file(path, &glb)?;
         eprintln!(
             "wrote {} ({} on {}, {} frames at {} fps, {} kB)",
@@ -193,18 +194,54 @@ impl Recording {
         Ok(())
     }
 
-    /// `avatar` moving as character `id` did, as GLB bytes.
-    pub fn avatar_glb(&self, id: &str, avatar: &Avatar) -> Vec<u8> {
-        let poses = self.poses_of(id);
-        let frames: Vec<Frame> = (self.frames.iter().zip(&poses))
+    /// Writes one scene of the characters `ids`, each on its avatar, moving as it did.
+    fn write_avatars(
+        &self,
+        path: &Path,
+        ids: &[String],
+        avatars: &Avatars,
+        world: &World,
+    ) -> Result<(), (u8, String)> {
+        let parts = (ids.iter())
+            .map(|id| {
+                let avatar = avatars.of(id);
+                let poses = self.poses_of(id);
+                let frames = self.avatar_frames(&poses);
+                let retarget = avatar.placed(world, id);
+                let (doc, bin) = animated_document(&avatar.model, &retarget, &frames, id);
+                (id.clone(), doc, bin)
+            })
+            .collect();
+        let glb = scene_glb(parts, "bml");
+        write_file(path, &glb)?;
+        eprintln!(
+            "wrote {} ({} characters on their avatars, {} frames at {} fps, {} kB)",
+            path.display(),
+            ids.len(),
+            self.frames.len(),
+            self.fps,
+            glb.len() / 1024
+        );
+        Ok(())
+    }
+
+    /// The avatar export's frames of one character's `poses`.
+    fn avatar_frames<'a>(&self, poses: &'a [CharacterPose]) -> Vec<Frame<'a>> {
+        (self.frames.iter().zip(poses))
             .map(|((t, _), p)| Frame {
                 time: *t,
                 pose: &p.pose,
                 face: &p.face,
             })
-            .collect();
+            .collect()
+    }
+
+    /// `avatar` moving as character `id` did, as GLB bytes.
+    pub fn avatar_glb(&self, id: &str, avatar: &Avatar, world: &World) -> Vec<u8> {
+        let poses = self.poses_of(id);
+        let frames = self.avatar_frames(&poses);
         let name = if id.is_empty() { "bml" } else { id };
-        animated_glb(&avatar.model, &avatar.retarget, &frames, name)
+        animated_glb(&avatar.model, &avatar.placed(world, id), &frames, name)
     }
 
     /// The frames of the one character a BVH or glTF file (`flag`) shows.

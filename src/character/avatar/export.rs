@@ -32,6 +32,18 @@ pub fn animated_glb(
     frames: &[Frame<'_>],
     name: &str,
 ) -> Vec<u8> {
+    let (json, bin) = animated_document(model, retarget, frames, name);
+    let text = serde_json::to_vec(&json).expect("a JSON value serialises");
+    glb(&text, bin)
+}
+
+/// The avatar `model` moving as `frames` say: its glTF JSON and binary buffer (buffer 0).
+pub fn animated_document(
+    model: &Model,
+    retarget: &Retarget,
+    frames: &[Frame<'_>],
+    name: &str,
+) -> (Value, Vec<u8>) {
     let mut json = model.json.clone();
     // the file's own buffer, views and accessors, the animation's appended to them
     let mut take = |key: &str| match json.as_object_mut().and_then(|o| o.remove(key)) {
@@ -68,8 +80,7 @@ pub fn animated_glb(
         json["bufferViews"] = Value::Array(buf.views);
         json["accessors"] = Value::Array(buf.accessors);
     }
-    let text = serde_json::to_vec(&json).expect("a JSON value serialises");
-    glb(&text, buf.bytes)
+    (json, buf.bytes)
 }
 
 /// The animation of `frames` on `model`, its keys appended to `buf`.

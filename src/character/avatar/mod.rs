@@ -12,13 +12,15 @@ mod file;
 pub mod humanoid;
 mod morph;
 mod retarget;
+mod scene;
 mod twist;
 
 pub use drive::Driver;
-pub use export::{animated_glb, Frame};
+pub use export::{animated_document, animated_glb, Frame};
 pub use file::{AvatarError, Model, Node, MAX_AVATAR_BYTES};
 pub use morph::MorphMap;
 pub use retarget::{Posed, Retarget};
+pub use scene::scene_glb;
 
 /// The default avatar's GLB (`assets/avatar/default.glb`, CC0 data; notice beside it).
 pub const DEFAULT_GLB: &[u8] = include_bytes!("../../../assets/avatar/default.glb");

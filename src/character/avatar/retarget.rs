@@ -89,6 +89,9 @@ pub struct Retarget {
     hips_parent: (Quat, Vec3, Vec3),
     /// The realizer's root at rest.
     root_rest: Vec3,
+    /// Where the character stands: the realizer's root at rest there. Its travel from here is
+    /// scaled by leg length; the way from the origin to here is not.
+    anchor: Vec3,
     /// Whether the avatar's skeleton is the realizer's (same hierarchy, same frame, every rest
     /// rotation and alignment the identity): then each node's local rotation is its joint's,
     /// with no arithmetic (the default avatar).
@@ -239,6 +242,7 @@ impl Retarget {
                 1.0
             },
             root_rest: rest.positions[0],
+            anchor: rest.positions[0],
             hips_parent: match model.nodes[hips].parent {
                 Some(p) => {
                     let (scale, rotation, place) = world[p].to_scale_rotation_translation();
@@ -253,7 +257,8 @@ impl Retarget {
     /// The avatar posed as the realizer's `pose` (of the skeleton it was made for).
     pub fn pose(&self, pose: &Pose) -> Posed {
         let mut rotations: Vec<Quat> = self.rest.iter().map(|r| r.1).collect();
-        let travel = self.frame * (pose.root - self.root_rest) * self.scale;
+        let travel =
+            self.frame * ((self.anchor - self.root_rest) + (pose.root - self.anchor) * self.scale);
         let turn = |j: usize| pose.rotations.get(j).copied().unwrap_or(Quat::IDENTITY);
         if self.direct {
             for (i, s) in self.source.iter().enumerate() {
@@ -319,6 +324,14 @@ impl Retarget {
             world[i] = parent * local;
         }
         world
+    }
+
+    /// Places the character where it stands in the world: `root` is the realizer's root there
+    /// at rest (its placement applied to the rest pose's root). The avatar stands there, and
+    /// only its travel from there is scaled by the ratio of leg lengths (so that its feet do
+    /// not slide), not its place.
+    pub fn anchor_at(&mut self, root: Vec3) {
+        self.anchor = root;
     }
 
     /// Whether the avatar's skeleton is the realizer's own (each node turns as its joint).
