@@ -315,6 +315,9 @@ impl crate::engine::Expression for SpeechEngine {
             let w = lipsync::weights(&u.phones, u.tts_time(now));
             let mut shapes = [0.0f32; 52];
             for (v, &wv) in w.iter().enumerate() {
+                if let Some(x) = face.visemes.get_mut(v) {
+                    *x = x.max(wv.clamp(0.0, 1.0));
+                }
                 for &(m, weight) in model.viseme(v) {
                     shapes[m] += wv * weight;
                 }

@@ -106,6 +106,9 @@ pub struct Face {
     pub morphs: Morphs,
     /// The viseme being articulated (an index into [`VISEMES`]), while speaking.
     pub viseme: Option<usize>,
+    /// Each viseme's weight (0–1, in the order of [`VISEMES`]) while speaking: coarticulated,
+    /// so that one blends into the next (for avatars with a target per viseme).
+    pub visemes: [f32; VISEMES.len()],
 }
 
 impl Face {
@@ -115,6 +118,7 @@ impl Face {
             aus: FaceState(vec![0.0; 2 * model.aus.len()]),
             morphs: Morphs::default(),
             viseme: None,
+            visemes: [0.0; VISEMES.len()],
         }
     }
 

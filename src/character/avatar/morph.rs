@@ -1,6 +1,7 @@
 //! The face on an avatar's morph targets, by name. A target named as one of the 52 ARKit
 //! blendshapes takes the frame's weight of it; a target named `viseme_X` (Ready Player Me, the
-//! Oculus set) takes 1 while the frame's viseme is X; VRM expressions (1.0 `expressions`, 0.x
+//! Oculus set) takes the frame's weight of viseme X (coarticulated: one blends into the next);
+//! VRM expressions (1.0 `expressions`, 0.x
 //! `blendShapeMaster`) are weighed from the face (visemes aa ih ou ee oh, blinks from the
 //! blink weights, happy/angry/sad/surprised from the smile, brow and frown weights) and spread
 //! onto the morph targets they bind, scaled by each bind's weight.
@@ -90,7 +91,7 @@ fn by_name(name: &str) -> Vec<Source> {
 fn weigh(source: &Source, face: &Face) -> f32 {
     match *source {
         Source::Arkit(i) => face.morphs.0[i],
-        Source::Viseme(v) => f32::from(face.viseme == Some(v)),
+        Source::Viseme(v) => face.visemes.get(v).copied().unwrap_or(0.0),
         Source::Expression(name, weight) => expression(name, face) * weight,
     }
 }
@@ -98,7 +99,7 @@ fn weigh(source: &Source, face: &Face) -> f32 {
 /// The weight of VRM 1.0 expression `name` in `face`.
 fn expression(name: &str, face: &Face) -> f32 {
     let m = |n: &str| face.morphs.get(n);
-    let viseme = |v: &str| f32::from(face.viseme.is_some_and(|i| VISEMES[i] == v));
+    let viseme = |v: &str| (VISEMES.iter().position(|x| *x == v)).map_or(0.0, |i| face.visemes[i]);
     match name {
         "aa" => viseme("aa"),
         "ih" => viseme("ih"),
@@ -221,9 +222,14 @@ mod tests {
         ] {
             morphs.0[morph_index(name).unwrap()] = w;
         }
+        let aa = VISEMES.iter().position(|v| *v == "aa").unwrap();
+        let mut visemes = [0.0; VISEMES.len()];
+        visemes[aa] = 1.0;
+        visemes[aa + 1] = 0.25; // coarticulation: the next one coming
         Face {
             morphs,
-            viseme: VISEMES.iter().position(|v| *v == "aa"),
+            viseme: Some(aa),
+            visemes,
             ..Face::default()
         }
     }
@@ -260,5 +266,38 @@ mod tests {
         let mut plain = model(json!({"nodes": [{"mesh": 0}]}));
         plain.morphs = vec![vec!["Key 1".into()]];
         assert!(MorphMap::new(&plain).is_empty());
+    }
+
+    /// Visemes blend into each other: over a spoken sentence at 60 frames a second, a
+    /// `viseme_*` target never jumps by more than half its range from one frame to the next,
+    /// and spends frames between off and on (a target that followed the strongest viseme alone
+    /// would jump from 0 to 1).
+    #[test]
+    fn viseme_targets_blend_from_frame_to_frame() {
+        let map = MorphMap::new(&model(json!({"nodes": [{"mesh": 0}]})));
+        let mut r = crate::realizer::Realizer::new().with_idle(false);
+        r.perform_bml(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><speech id="s">
+               <text>Hello and welcome to the realizer, a talking head.</text></speech></bml>"#,
+        )
+        .unwrap();
+        let (mut jump, mut between, mut w, mut was) = (0.0f32, 0, Vec::new(), None::<Vec<f32>>);
+        for k in 0..240 {
+            let frame = r.tick(f64::from(k) / 60.0);
+            map.weights(0, &frame.poses[0].face, &mut w);
+            let aa = w[1];
+            if aa > 0.05 && aa < 0.95 {
+                between += 1;
+            }
+            if let Some(p) = &was {
+                jump = jump.max((aa - p[1]).abs());
+            }
+            was = Some(w.clone());
+        }
+        assert!(
+            between >= 4,
+            "viseme_aa between off and on in {between} frames"
+        );
+        assert!(jump <= 0.5, "viseme_aa jumped {jump} in one frame");
     }
 }
