@@ -1,8 +1,19 @@
 //! `bmlr`: the command-line front end of the BML realizer.
 
+/// Like std's `eprintln!`, but a closed stderr (`bmlr validate *.xml 2>&1 | head -1`) loses the
+/// line instead of panicking, as a closed stdout loses what is written there. Defined before
+/// the modules, it is the `eprintln!` of the whole command line.
+macro_rules! eprintln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod avatar;
 mod diff;
 mod live;
+mod outcome;
 mod record;
 mod run;
 mod serve;

@@ -339,8 +339,8 @@ pub struct VirtualRun {
     pub motion: Option<Recording>,
     /// Every message with the time of the frame that sent it, when it is kept.
     pub log: Option<Vec<(f64, Feedback)>>,
-    /// Blocks that could not be parsed (the run goes on; it exits 1).
-    pub invalid: usize,
+    /// Blocks that could not be parsed or scheduled whole (the run goes on; it exits 1).
+    pub outcome: crate::outcome::Outcome,
 }
 
 impl VirtualRun {
@@ -354,7 +354,7 @@ impl VirtualRun {
             open: true,
             motion: Some(Recording::new(fps)),
             log: Some(Vec::new()),
-            invalid: 0,
+            outcome: Default::default(),
         }
     }
 
@@ -372,6 +372,7 @@ impl VirtualRun {
 
     /// Prints (or keeps) the feedback of a frame at time `at`.
     fn emit(&mut self, at: f64, feedback: Vec<Feedback>) {
+        self.outcome.note(&feedback);
         if let Some(out) = self.out.as_mut() {
             self.open &= print(out, self.format, &feedback);
         }
@@ -415,7 +416,7 @@ impl VirtualRun {
             return;
         }
         if self.realizer.perform_bml_from(text, Some(source)).is_err() {
-            self.invalid += 1;
+            self.outcome.unparsed += 1;
         }
         let now = self.realizer.now();
         let frame = self.realizer.tick(now);
@@ -438,7 +439,7 @@ impl VirtualRun {
                     }
                 }
                 Err(bad) => {
-                    self.invalid += 1;
+                    self.outcome.unparsed += 1;
                     self.realizer.refuse_line(STDIN, &bad);
                 }
             }
@@ -524,7 +525,7 @@ pub fn run(args: RunArgs) -> ExitCode {
         until: args.until.unwrap_or(f64::INFINITY),
         out: Some(std::io::stdout().lock()),
         open: true,
-        invalid: 0,
+        outcome: Default::default(),
         motion: (args.bvh.is_some()
             || args.frames.is_some()
             || args.gltf.is_some()
@@ -538,7 +539,7 @@ pub fn run(args: RunArgs) -> ExitCode {
         eprintln!("bmlr run: {e}");
         return ExitCode::from(code);
     }
-    exit_for(run.invalid, "run")
+    run.outcome.exit("run")
 }
 
 /// The items and the realizer of `bmlr run`, or what is wrong with the command line (exit 2).
@@ -611,7 +612,7 @@ fn run_realtime(realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> ExitCod
         until: args.until.unwrap_or(f64::INFINITY),
         period: 1.0 / args.fps,
         out: std::io::stdout().lock(),
-        invalid: 0,
+        outcome: Default::default(),
     };
     for item in items {
         let open = match item {
@@ -633,7 +634,7 @@ fn run_realtime(realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> ExitCod
         run.wait_until(run.until);
     }
     report_unfinished(&run.realizer);
-    exit_for(run.invalid, "run")
+    run.outcome.exit("run")
 }
 
 /// A realizer on the wall clock that prints its feedback as it goes. Its methods return false
@@ -645,14 +646,15 @@ struct RealtimeRun {
     until: f64,
     period: f64,
     out: std::io::StdoutLock<'static>,
-    /// Blocks that could not be parsed.
-    invalid: usize,
+    /// Blocks that could not be parsed or scheduled whole.
+    outcome: crate::outcome::Outcome,
 }
 
 impl RealtimeRun {
     /// A frame now (capped at `--until`), its feedback printed.
     fn tick(&mut self) -> bool {
         let frame = self.realizer.tick(self.clock.now().min(self.until));
+        self.outcome.note(&frame.feedback);
         print(&mut self.out, self.format, &frame.feedback)
     }
 
@@ -674,7 +676,7 @@ impl RealtimeRun {
     fn perform(&mut self, text: &str, source: &str) -> bool {
         let open = self.tick();
         let result = self.realizer.perform_bml_from(text, Some(source));
-        self.invalid += usize::from(result.is_err());
+        self.outcome.unparsed += usize::from(result.is_err());
         open
     }
 
@@ -700,7 +702,7 @@ impl RealtimeRun {
                     stream.push("\n");
                 }
                 Ok(Some(Err(bad))) => {
-                    self.invalid += 1;
+                    self.outcome.unparsed += 1;
                     self.realizer.refuse_line(STDIN, &bad);
                 }
                 Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => finished = true,
@@ -721,16 +723,6 @@ impl RealtimeRun {
         }
         true
     }
-}
-
-/// Success, or exit 1 (after a line on stderr) when `invalid` blocks could not be parsed.
-pub fn exit_for(invalid: usize, command: &str) -> ExitCode {
-    if invalid == 0 {
-        return ExitCode::SUCCESS;
-    }
-    let s = if invalid == 1 { "" } else { "s" };
-    eprintln!("bmlr {command}: {invalid} block{s} could not be parsed (see the warnings)");
-    ExitCode::from(1)
 }
 
 /// `bmlr plan`: submits the files at time 0 without running the clock and prints each block's
@@ -765,11 +757,12 @@ pub fn plan(args: PlanArgs) -> ExitCode {
     };
     let mut feedback = Vec::new();
     let mut blocks = Vec::new();
-    let mut invalid = 0;
+    let mut outcome = crate::outcome::Outcome::default();
     for item in items {
         match item {
             Item::Text(path, text) => {
-                invalid += usize::from(realizer.perform_bml_from(&text, Some(&path)).is_err());
+                let parsed = realizer.perform_bml_from(&text, Some(&path));
+                outcome.unparsed += usize::from(parsed.is_err());
                 feedback.extend(realizer.tick(0.0).feedback);
                 if let Ok(parsed) = bml_realizer::bml::load(&text) {
                     blocks.push(parsed.block);
@@ -797,7 +790,8 @@ pub fn plan(args: PlanArgs) -> ExitCode {
             break;
         }
     }
-    exit_for(invalid, "plan")
+    outcome.note(&feedback);
+    outcome.exit("plan")
 }
 
 /// The plan report: for each block's last full prediction, a header and one line per sync;

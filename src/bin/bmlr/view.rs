@@ -53,7 +53,7 @@ pub const MAX_VIEW_AVATARS: usize = 4;
 
 /// `bmlr view`.
 pub fn view(args: ViewArgs) -> ExitCode {
-    let (page, summary, invalid) = match realize(&args) {
+    let (page, summary, outcome) = match realize(&args) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("bmlr view: {e}");
@@ -66,7 +66,7 @@ pub fn view(args: ViewArgs) -> ExitCode {
         (None, None) => unreachable!("clap requires --out or --serve"),
     };
     match written {
-        Ok(()) => crate::run::exit_for(invalid, "view"),
+        Ok(()) => outcome.exit("view"),
         Err(e) => {
             eprintln!("bmlr view: {e}");
             ExitCode::from(2)
@@ -75,7 +75,7 @@ pub fn view(args: ViewArgs) -> ExitCode {
 }
 
 /// Runs the items and returns the page, a summary of it, and how many blocks could not be parsed.
-fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
+fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome), String> {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         return Err("--fps must be a positive number".into());
     }
@@ -133,7 +133,7 @@ fn realize(args: &ViewArgs) -> Result<(String, String, usize), String> {
         characters.len(),
         page.len() / 1024
     );
-    Ok((page, summary, run.invalid))
+    Ok((page, summary, run.outcome))
 }
 
 /// The page's heading: the items, shortened to their file names.

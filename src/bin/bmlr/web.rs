@@ -302,9 +302,9 @@ mod tests {
         let p = page(r#"{"text": "</script><script>alert(1)</script>"}"#);
         assert_eq!(
             p.matches("</script>").count(),
-            6,
-            "the six script elements only (the timing switch, data, three.js, its glTF loader \
-             and geometry helpers, the viewer)"
+            7,
+            "the seven script elements only (the timing switch, data, three.js, its glTF loader \
+             and geometry helpers, the avatars, the viewer)"
         );
         assert!(p.contains(r#""\u003c/script>\u003cscript>alert(1)\u003c/script>""#));
     }
