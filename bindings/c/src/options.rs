@@ -1,0 +1,61 @@
+//! `bmlr_new`'s options, as JSON: the command line's options for a realizer a host drives.
+//! `{"world": {…the world file's object…}, "tts": "builtin" | "flite", "idle": true,
+//! "character": "ID"}`; every key may be left out (the defaults of `bmlr run`). Unknown keys
+//! are refused, naming them, so that a typo does not silently change nothing.
+
+use bml_realizer::realizer::Realizer;
+use bml_realizer::timing::{SpeechTiming, Voice};
+use serde_json::Value;
+
+use crate::status::{bmlr_status, Failure};
+
+/// The realizer `options` (JSON, or empty for the defaults) describe.
+pub fn realizer(options: &str) -> Result<Realizer, Failure> {
+    let bad = |what: String| (bmlr_status::BMLR_ERR_OPTIONS, format!("options: {what}"));
+    let options: Value = if options.trim().is_empty() {
+        Value::Object(Default::default())
+    } else {
+        serde_json::from_str(options).map_err(|e| bad(format!("not JSON: {e}")))?
+    };
+    let Value::Object(o) = options else {
+        return Err(bad("not a JSON object".into()));
+    };
+    if let Some(k) = o
+        .keys()
+        .find(|k| !["world", "tts", "idle", "character"].contains(&k.as_str()))
+    {
+        return Err(bad(format!(
+            "unknown option '{k}' (known: world, tts, idle, character)"
+        )));
+    }
+    let mut realizer = Realizer::new();
+    match o.get("tts").map(|v| v.as_str()) {
+        None | Some(Some("builtin")) => {}
+        Some(Some("flite")) => {
+            bml_realizer::voice::flite::Flite::default()
+                .check()
+                .map_err(|e| bad(format!("tts flite: {e}")))?;
+            realizer = realizer.with_speech_timing(SpeechTiming {
+                voice: Voice::Flite,
+                ..SpeechTiming::default()
+            });
+        }
+        Some(_) => return Err(bad("tts is \"builtin\" or \"flite\"".into())),
+    }
+    match o.get("idle") {
+        None => {}
+        Some(Value::Bool(on)) => realizer = realizer.with_idle(*on),
+        Some(_) => return Err(bad("idle is true or false".into())),
+    }
+    match o.get("character") {
+        None | Some(Value::Null) => {}
+        Some(Value::String(id)) => realizer = realizer.with_default_character(Some(id.clone())),
+        Some(_) => return Err(bad("character is a string".into())),
+    }
+    if let Some(world) = o.get("world") {
+        let (world, _) = bml_realizer::world::World::from_json(&world.to_string())
+            .map_err(|e| bad(format!("world: {e}")))?;
+        *realizer.world_mut() = world;
+    }
+    Ok(realizer)
+}
