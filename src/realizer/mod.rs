@@ -6,6 +6,9 @@
 use std::collections::BTreeMap;
 use std::time::{SystemTime, UNIX_EPOCH};
 
+mod options;
+pub use options::from_options;
+
 use crate::blocks::BlockManager;
 use crate::bml::{self, BmlError, Diagnostic};
 use crate::body::Skeleton;

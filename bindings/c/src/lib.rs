@@ -14,7 +14,6 @@
 
 #![allow(non_camel_case_types)]
 
-mod options;
 mod status;
 
 use std::collections::VecDeque;
@@ -150,7 +149,8 @@ pub unsafe extern "C" fn bmlr_new(
             // SAFETY: the caller's contract
             unsafe { text(options_json, "the options")? }
         };
-        let realizer = options::realizer(options)?;
+        let realizer = bml_realizer::realizer::from_options(options)
+            .map_err(|e| (bmlr_status::BMLR_ERR_OPTIONS, e))?;
         let cstring = |s: &str| CString::new(s).unwrap_or_default();
         let handle = bmlr_realizer {
             realizer,

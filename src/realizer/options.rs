@@ -1,17 +1,18 @@
-//! `bmlr_new`'s options, as JSON: the command line's options for a realizer a host drives.
-//! `{"world": {…the world file's object…}, "tts": "builtin" | "flite", "idle": true,
-//! "character": "ID"}`; every key may be left out (the defaults of `bmlr run`). Unknown keys
-//! are refused, naming them, so that a typo does not silently change nothing.
+//! A realizer described by options as JSON, for hosts that speak neither Rust nor the command
+//! line (the C ABI, Python): `{"world": {…the world file's object…}, "tts": "builtin" |
+//! "flite", "idle": true, "character": "ID"}`; every key may be left out (the defaults of
+//! `bmlr run`). Unknown keys are refused, naming them, so that a typo does not silently change
+//! nothing.
 
-use bml_realizer::realizer::Realizer;
-use bml_realizer::timing::{SpeechTiming, Voice};
 use serde_json::Value;
 
-use crate::status::{bmlr_status, Failure};
+use super::Realizer;
+use crate::timing::{SpeechTiming, Voice};
 
-/// The realizer `options` (JSON, or empty for the defaults) describe.
-pub fn realizer(options: &str) -> Result<Realizer, Failure> {
-    let bad = |what: String| (bmlr_status::BMLR_ERR_OPTIONS, format!("options: {what}"));
+/// The realizer `options` (JSON, or empty for the defaults) describe, or a sentence saying
+/// what is wrong with them.
+pub fn from_options(options: &str) -> Result<Realizer, String> {
+    let bad = |what: String| format!("options: {what}");
     let options: Value = if options.trim().is_empty() {
         Value::Object(Default::default())
     } else {
@@ -32,7 +33,7 @@ pub fn realizer(options: &str) -> Result<Realizer, Failure> {
     match o.get("tts").map(|v| v.as_str()) {
         None | Some(Some("builtin")) => {}
         Some(Some("flite")) => {
-            bml_realizer::voice::flite::Flite::default()
+            crate::voice::flite::Flite::default()
                 .check()
                 .map_err(|e| bad(format!("tts flite: {e}")))?;
             realizer = realizer.with_speech_timing(SpeechTiming {
@@ -53,7 +54,7 @@ pub fn realizer(options: &str) -> Result<Realizer, Failure> {
         Some(_) => return Err(bad("character is a string".into())),
     }
     if let Some(world) = o.get("world") {
-        let (world, _) = bml_realizer::world::World::from_json(&world.to_string())
+        let (world, _) = crate::world::World::from_json(&world.to_string())
             .map_err(|e| bad(format!("world: {e}")))?;
         *realizer.world_mut() = world;
     }
