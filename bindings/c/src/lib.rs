@@ -211,6 +211,9 @@ pub unsafe extern "C" fn bmlr_tick(r: *mut bmlr_realizer, now: f64) -> bmlr_stat
         if !now.is_finite() {
             return Err((bmlr_status::BMLR_ERR_RANGE, format!("now is {now}")));
         }
+        // the last frame goes first: its memory is reused for the new one (kept alive, it
+        // made a C tick 9.4 µs against the Rust 6.5 µs: benches/tick.rs)
+        r.frame = None;
         let frame = r.realizer.tick(now);
         let format = bml_realizer::feedback::Format::Jsonl;
         r.feedback
