@@ -8,8 +8,8 @@
 
 use std::ffi::{c_char, CString};
 use std::hint::black_box;
-use std::time::{Duration, Instant};
 use std::ptr::{null, null_mut};
+use std::time::{Duration, Instant};
 
 use bml_realizer::realizer::Realizer;
 use bmlr::*;
