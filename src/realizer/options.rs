@@ -1,7 +1,8 @@
 //! A realizer described by options as JSON, for hosts that speak neither Rust nor the command
 //! line (the C ABI, Python): `{"world": {…the world file's object…}, "tts": "builtin" |
-//! "flite", "idle": true, "character": "ID"}`; every key may be left out (the defaults of
-//! `bmlr run`). Unknown keys are refused, naming them, so that a typo does not silently change
+//! "flite", "idle": true, "character": "ID", "fps": 60}`; every key may be left out (the
+//! defaults of `bmlr run`). `fps` is for hosts that step the realizer frame by frame instead
+//! of ticking it at times of their own. Unknown keys are refused, naming them, so that a typo does not silently change
 //! nothing.
 
 use serde_json::Value;
@@ -9,9 +10,9 @@ use serde_json::Value;
 use super::Realizer;
 use crate::timing::{SpeechTiming, Voice};
 
-/// The realizer `options` (JSON, or empty for the defaults) describe, or a sentence saying
-/// what is wrong with them.
-pub fn from_options(options: &str) -> Result<Realizer, String> {
+/// The realizer `options` (JSON, or empty for the defaults) describe and the frame rate they
+/// ask for (60 when they do not), or a sentence saying what is wrong with them.
+pub fn from_options(options: &str) -> Result<(Realizer, f64), String> {
     let bad = |what: String| format!("options: {what}");
     let options: Value = if options.trim().is_empty() {
         Value::Object(Default::default())
@@ -23,12 +24,21 @@ pub fn from_options(options: &str) -> Result<Realizer, String> {
     };
     if let Some(k) = o
         .keys()
-        .find(|k| !["world", "tts", "idle", "character"].contains(&k.as_str()))
+        .find(|k| !["world", "tts", "idle", "character", "fps"].contains(&k.as_str()))
     {
         return Err(bad(format!(
-            "unknown option '{k}' (known: world, tts, idle, character)"
+            "unknown option '{k}' (known: world, tts, idle, character, fps)"
         )));
     }
+    let fps = match o.get("fps") {
+        None => 60.0,
+        Some(v) => v
+            .as_f64()
+            .filter(|f| f.is_finite() && *f > 0.0 && *f <= 10_000.0)
+            .ok_or_else(|| {
+                bad("fps is a number of frames a second above 0, at most 10 000".into())
+            })?,
+    };
     let mut realizer = Realizer::new();
     match o.get("tts").map(|v| v.as_str()) {
         None | Some(Some("builtin")) => {}
@@ -58,5 +68,5 @@ pub fn from_options(options: &str) -> Result<Realizer, String> {
             .map_err(|e| bad(format!("world: {e}")))?;
         *realizer.world_mut() = world;
     }
-    Ok(realizer)
+    Ok((realizer, fps))
 }

@@ -64,6 +64,14 @@ enum bmlr_status bmlr_perform(struct bmlr_realizer *r, const char *bml);
 // `r` is a live realizer.
 enum bmlr_status bmlr_tick(struct bmlr_realizer *r, double now);
 
+// Advances the realizer by one frame at the options' `fps` (60 when not given): the first
+// step is at time 0, the k-th at k / fps; `*now` (if not NULL) is the step's time. For hosts
+// without a clock of their own; use either this or `bmlr_tick`.
+//
+// # Safety
+// `r` is a live realizer; `now` is NULL or points at a writable double.
+enum bmlr_status bmlr_step(struct bmlr_realizer *r, double *now);
+
 // When the next thing is due (`*has` 1 and `*at` its time), or `*has` 0 when nothing more is
 // scheduled: a host may stop ticking then.
 //

@@ -36,6 +36,9 @@ pub struct bmlr_realizer {
     sounds: VecDeque<String>,
     /// The last tick's frame.
     frame: Option<Frame>,
+    /// The frame rate of `bmlr_step` (option `fps`), and the steps taken.
+    fps: f64,
+    steps: u64,
     joint_names: Vec<CString>,
     morph_names: Vec<CString>,
 }
@@ -51,6 +54,30 @@ fn get<'a>(r: *mut bmlr_realizer) -> Result<&'a mut bmlr_realizer, Failure> {
 }
 
 impl bmlr_realizer {
+    /// Advances to `now` and queues the frame's feedback and sound events.
+    fn tick(&mut self, now: f64) {
+        let r = self;
+        // the last frame goes first: its memory is reused for the new one (kept alive, it
+        // made a C tick 9.4 µs against the Rust 6.5 µs: benches/tick.rs)
+        r.frame = None;
+        let frame = r.realizer.tick(now);
+        let format = bml_realizer::feedback::Format::Jsonl;
+        r.feedback
+            .extend(frame.feedback.iter().map(|f| format.encode(f)));
+        for p in &frame.poses {
+            for e in &p.events {
+                let event = serde_json::json!({
+                    "character": p.character.as_deref().unwrap_or(""),
+                    "kind": if e.start { "audio-start" } else { "audio-stop" },
+                    "id": e.id,
+                    "offset": e.offset,
+                });
+                r.sounds.push_back(event.to_string());
+            }
+        }
+        r.frame = Some(frame);
+    }
+
     /// Character `id`'s pose in the last frame (NULL or "": the default character).
     ///
     /// # Safety
@@ -149,7 +176,7 @@ pub unsafe extern "C" fn bmlr_new(
             // SAFETY: the caller's contract
             unsafe { text(options_json, "the options")? }
         };
-        let realizer = bml_realizer::realizer::from_options(options)
+        let (realizer, fps) = bml_realizer::realizer::from_options(options)
             .map_err(|e| (bmlr_status::BMLR_ERR_OPTIONS, e))?;
         let cstring = |s: &str| CString::new(s).unwrap_or_default();
         let handle = bmlr_realizer {
@@ -157,6 +184,8 @@ pub unsafe extern "C" fn bmlr_new(
             feedback: VecDeque::new(),
             sounds: VecDeque::new(),
             frame: None,
+            fps,
+            steps: 0,
             joint_names: skeleton()
                 .joints()
                 .iter()
@@ -211,25 +240,28 @@ pub unsafe extern "C" fn bmlr_tick(r: *mut bmlr_realizer, now: f64) -> bmlr_stat
         if !now.is_finite() {
             return Err((bmlr_status::BMLR_ERR_RANGE, format!("now is {now}")));
         }
-        // the last frame goes first: its memory is reused for the new one (kept alive, it
-        // made a C tick 9.4 µs against the Rust 6.5 µs: benches/tick.rs)
-        r.frame = None;
-        let frame = r.realizer.tick(now);
-        let format = bml_realizer::feedback::Format::Jsonl;
-        r.feedback
-            .extend(frame.feedback.iter().map(|f| format.encode(f)));
-        for p in &frame.poses {
-            for e in &p.events {
-                let event = serde_json::json!({
-                    "character": p.character.as_deref().unwrap_or(""),
-                    "kind": if e.start { "audio-start" } else { "audio-stop" },
-                    "id": e.id,
-                    "offset": e.offset,
-                });
-                r.sounds.push_back(event.to_string());
-            }
+        r.tick(now);
+        Ok(())
+    })
+}
+
+/// Advances the realizer by one frame at the options' `fps` (60 when not given): the first
+/// step is at time 0, the k-th at k / fps; `*now` (if not NULL) is the step's time. For hosts
+/// without a clock of their own; use either this or `bmlr_tick`.
+///
+/// # Safety
+/// `r` is a live realizer; `now` is NULL or points at a writable double.
+#[no_mangle]
+pub unsafe extern "C" fn bmlr_step(r: *mut bmlr_realizer, now: *mut f64) -> bmlr_status {
+    guard(|| {
+        let r = get(r)?;
+        let t = r.steps as f64 / r.fps;
+        r.steps += 1;
+        r.tick(t);
+        // SAFETY: NULL or a writable double by the caller's contract
+        if let Some(now) = unsafe { now.as_mut() } {
+            *now = t;
         }
-        r.frame = Some(frame);
         Ok(())
     })
 }

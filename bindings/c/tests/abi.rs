@@ -227,3 +227,22 @@ fn a_realizer_crosses_threads() {
     .join()
     .unwrap();
 }
+
+/// `bmlr_step` advances one frame at the options' fps: 0, 1/30, 2/30…
+#[test]
+fn steps_advance_a_frame_at_fps() {
+    let r = new(r#"{"fps": 30}"#);
+    let mut times = Vec::new();
+    for _ in 0..4 {
+        let mut now = -1.0;
+        // SAFETY: a live realizer, a writable double
+        assert_eq!(unsafe { bmlr_step(r, &mut now) }, bmlr_status::BMLR_OK);
+        times.push(now);
+    }
+    assert_eq!(times, [0.0, 1.0 / 30.0, 2.0 / 30.0, 3.0 / 30.0]);
+    // SAFETY: a live realizer; NULL is allowed for `now`
+    unsafe {
+        assert_eq!(bmlr_step(r, null_mut()), bmlr_status::BMLR_OK);
+        bmlr_free(r);
+    }
+}

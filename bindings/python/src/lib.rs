@@ -36,6 +36,9 @@ struct State {
     frame: Option<Frame>,
     /// Every tick's characters, when recording (for `write_glb`).
     recorded: Option<Vec<(f64, Vec<CharacterPose>)>>,
+    /// The frame rate of `step`, and the steps taken.
+    fps: f64,
+    steps: u64,
 }
 
 /// A realizer: `perform` BML blocks, `tick` it with your clock, read feedback and bodies.
@@ -43,6 +46,37 @@ struct State {
 struct Realizer {
     state: Mutex<State>,
     joint_names: Vec<String>,
+}
+
+impl State {
+    /// Advances to `now`: the frame kept (and recorded), its feedback as JSON lines.
+    fn tick(&mut self, now: f64) -> Vec<String> {
+        // the last frame goes first: its memory is reused for the new one (see bmlr-c)
+        self.frame = None;
+        let frame = self.realizer.tick(now);
+        let lines = frame
+            .feedback
+            .iter()
+            .map(|f| Format::Jsonl.encode(f))
+            .collect();
+        if let Some(r) = self.recorded.as_mut() {
+            r.push((now, frame.poses.clone()));
+        }
+        self.frame = Some(frame);
+        lines
+    }
+}
+
+/// Feedback lines as Python dicts.
+fn dicts<'py>(py: Python<'py>, lines: &[String]) -> PyResult<Bound<'py, PyList>> {
+    if lines.is_empty() {
+        return Ok(PyList::empty(py));
+    }
+    let loads = py.import("json")?.getattr("loads")?;
+    let dicts = (lines.iter())
+        .map(|l| loads.call1((l,)))
+        .collect::<PyResult<Vec<_>>>()?;
+    PyList::new(py, dicts)
 }
 
 /// Runs `f` on the realizer's state with the GIL released (waiting for another thread's call to
@@ -87,13 +121,14 @@ impl Realizer {
     /// ("builtin" or "flite"), alive between behaviours when `idle`, blocks without a
     /// characterId for `character`; `record=True` keeps every frame for `write_glb`.
     #[new]
-    #[pyo3(signature = (world=None, tts="builtin", idle=true, character=None, record=false))]
+    #[pyo3(signature = (world=None, tts="builtin", idle=true, character=None, record=false, fps=60.0))]
     fn new(
         world: Option<&Bound<'_, PyAny>>,
         tts: &str,
         idle: bool,
         character: Option<String>,
         record: bool,
+        fps: f64,
     ) -> PyResult<Realizer> {
         let world: Option<serde_json::Value> = match world {
             None => None,
@@ -115,17 +150,20 @@ impl Realizer {
                 })?)
             }
         };
-        let mut options = serde_json::json!({"tts": tts, "idle": idle, "character": character});
+        let mut options =
+            serde_json::json!({"tts": tts, "idle": idle, "character": character, "fps": fps});
         if let Some(w) = world {
             options["world"] = w;
         }
-        let realizer = bml_realizer::realizer::from_options(&options.to_string())
+        let (realizer, fps) = bml_realizer::realizer::from_options(&options.to_string())
             .map_err(PyValueError::new_err)?;
         Ok(Realizer {
             state: Mutex::new(State {
                 realizer,
                 frame: None,
                 recorded: record.then(Vec::new),
+                fps,
+                steps: 0,
             }),
             joint_names: Skeleton::adult()
                 .joints()
@@ -153,30 +191,20 @@ impl Realizer {
         if !now.is_finite() {
             return Err(PyValueError::new_err(format!("now is {now}")));
         }
-        let lines = with_state(py, &self.state, |s| {
-            // the last frame goes first: its memory is reused for the new one (see bmlr-c)
-            s.frame = None;
-            let frame = s.realizer.tick(now);
-            let lines: Vec<String> = frame
-                .feedback
-                .iter()
-                .map(|f| Format::Jsonl.encode(f))
-                .collect();
-            if let Some(r) = s.recorded.as_mut() {
-                r.push((now, frame.poses.clone()));
-            }
-            s.frame = Some(frame);
-            Ok(lines)
+        let lines = with_state(py, &self.state, |s| Ok(s.tick(now)))?;
+        dicts(py, &lines)
+    }
+
+    /// Advances by one frame at `fps` (the first step at time 0, the k-th at k / fps), for a
+    /// host without a clock of its own: (the step's time, its feedback as dicts). Use either
+    /// this or `tick`.
+    fn step<'py>(&self, py: Python<'py>) -> PyResult<(f64, Bound<'py, PyList>)> {
+        let (t, lines) = with_state(py, &self.state, |s| {
+            let t = s.steps as f64 / s.fps;
+            s.steps += 1;
+            Ok((t, s.tick(t)))
         })?;
-        if lines.is_empty() {
-            return Ok(PyList::empty(py));
-        }
-        let loads = py.import("json")?.getattr("loads")?;
-        let dicts = lines
-            .iter()
-            .map(|l| loads.call1((l,)))
-            .collect::<PyResult<Vec<_>>>()?;
-        PyList::new(py, dicts)
+        Ok((t, dicts(py, &lines)?))
     }
 
     /// For the overhead bench (`benches/tick.py`): `n` ticks from `start`, `dt` apart, made in

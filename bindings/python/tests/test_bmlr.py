@@ -149,3 +149,12 @@ def test_run_yields_frames_and_write_glb_writes_an_avatar(tmp_path):
     assert data[:4] == b"glTF" and len(data) > 1_000_000
     with pytest.raises(RuntimeError, match="record=True"):
         bmlr.Realizer().write_glb(out)
+
+
+def test_step_advances_a_frame_at_fps():
+    r = bmlr.Realizer(fps=30)
+    r.perform(WELCOME.read_text())
+    times = [r.step()[0] for _ in range(4)]
+    assert times == [0.0, 1 / 30, 2 / 30, 3 / 30]
+    with pytest.raises(ValueError, match="fps"):
+        bmlr.Realizer(fps=0)
