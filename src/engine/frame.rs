@@ -53,3 +53,10 @@ pub struct Frame {
     /// Feedback sent since the previous frame, in order.
     pub feedback: Vec<Feedback>,
 }
+
+impl Frame {
+    /// Character `id`'s body in this frame (`""` the default character).
+    pub fn character(&self, id: &str) -> Option<&CharacterPose> {
+        (self.poses.iter()).find(|p| p.character.as_deref().unwrap_or("") == id)
+    }
+}

@@ -93,17 +93,15 @@ impl bmlr_realizer {
             bmlr_status::BMLR_ERR_CHARACTER,
             "no frame yet: call bmlr_tick first".to_string(),
         ))?;
-        (frame.poses.iter())
-            .find(|p| p.character.as_deref().unwrap_or("") == id)
-            .ok_or_else(|| {
-                let known: Vec<&str> = (frame.poses.iter())
-                    .map(|p| p.character.as_deref().unwrap_or(""))
-                    .collect();
-                (
-                    bmlr_status::BMLR_ERR_CHARACTER,
-                    format!("no character '{id}' in the last frame (it has {known:?})"),
-                )
-            })
+        frame.character(id).ok_or_else(|| {
+            let known: Vec<&str> = (frame.poses.iter())
+                .map(|p| p.character.as_deref().unwrap_or(""))
+                .collect();
+            (
+                bmlr_status::BMLR_ERR_CHARACTER,
+                format!("no character '{id}' in the last frame (it has {known:?})"),
+            )
+        })
     }
 }
 
@@ -330,6 +328,19 @@ pub unsafe extern "C" fn bmlr_joint_count(r: *mut bmlr_realizer, n: *mut usize) 
     })
 }
 
+/// Name `i` of `names` (a `what`) into `*name`.
+fn name_at(
+    names: &[CString],
+    i: usize,
+    what: &str,
+    name: *mut *const c_char,
+) -> Result<(), Failure> {
+    let n = names.len();
+    let s = (names.get(i)).ok_or((bmlr_status::BMLR_ERR_RANGE, format!("{what} {i} of {n}")))?;
+    *out(name, "name")? = s.as_ptr();
+    Ok(())
+}
+
 /// Joint `i`'s H-Anim name into `*name` (valid while the realizer lives).
 ///
 /// # Safety
@@ -340,16 +351,7 @@ pub unsafe extern "C" fn bmlr_joint_name(
     i: usize,
     name: *mut *const c_char,
 ) -> bmlr_status {
-    guard(|| {
-        let r = get(r)?;
-        let n = r.joint_names.len();
-        let s = r
-            .joint_names
-            .get(i)
-            .ok_or((bmlr_status::BMLR_ERR_RANGE, format!("joint {i} of {n}")))?;
-        *out(name, "name")? = s.as_ptr();
-        Ok(())
-    })
+    guard(|| name_at(&get(r)?.joint_names, i, "joint", name))
 }
 
 /// Character `character`'s (NULL or "": the default one) local joint rotations in the last
@@ -427,16 +429,7 @@ pub unsafe extern "C" fn bmlr_morph_name(
     i: usize,
     name: *mut *const c_char,
 ) -> bmlr_status {
-    guard(|| {
-        let r = get(r)?;
-        let n = r.morph_names.len();
-        let s = r.morph_names.get(i).ok_or((
-            bmlr_status::BMLR_ERR_RANGE,
-            format!("blendshape {i} of {n}"),
-        ))?;
-        *out(name, "name")? = s.as_ptr();
-        Ok(())
-    })
+    guard(|| name_at(&get(r)?.morph_names, i, "blendshape", name))
 }
 
 /// Character `character`'s blendshape weights (0–1, `bmlr_morph_name` order) in the last frame

@@ -8,7 +8,7 @@
 use std::sync::{Mutex, MutexGuard};
 
 use bml_realizer::avatar::{animated_glb, default_model, Frame as AvatarFrame, Retarget};
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::body::Skeleton;
 use bml_realizer::engine::{CharacterPose, Frame};
 use bml_realizer::face::ARKIT;
 use bml_realizer::feedback::Format;
@@ -101,9 +101,7 @@ fn find_character<'a>(state: &'a State, id: &str) -> Result<&'a CharacterPose, S
         .frame
         .as_ref()
         .ok_or("no frame yet: call tick first")?;
-    (frame.poses.iter())
-        .find(|p| p.character.as_deref().unwrap_or("") == id)
-        .ok_or_else(|| format!("no character '{id}' in the last frame"))
+    (frame.character(id)).ok_or_else(|| format!("no character '{id}' in the last frame"))
 }
 
 /// A failure as a Python exception: a character that is not there is a KeyError.
@@ -301,10 +299,9 @@ impl Realizer {
                 .as_ref()
                 .ok_or("write_glb needs Realizer(record=True)")?;
             let model = default_model();
-            let skeleton = Skeleton::adult();
-            let mut retarget = Retarget::new(&model, &skeleton, None).map_err(|e| e.to_string())?;
-            let rest = Pose::rest(&skeleton).root;
-            retarget.anchor_at(s.realizer.world().placement(character).to_world(rest));
+            let mut retarget =
+                Retarget::new(&model, &Skeleton::adult(), None).map_err(|e| e.to_string())?;
+            retarget.place_in(s.realizer.world(), character);
             let poses: Vec<(f64, &CharacterPose)> = (recorded.iter())
                 .filter_map(|(t, ps)| {
                     let p = ps

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use bml_realizer::avatar::{self, Model, Retarget};
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::body::Skeleton;
 use bml_realizer::world::World;
 use clap::Args;
 
@@ -47,8 +47,7 @@ impl Avatar {
     /// travel from there scaled by leg length).
     pub fn placed(&self, world: &World, id: &str) -> Retarget {
         let mut retarget = self.retarget.clone();
-        let rest = Pose::rest(&Skeleton::adult()).root;
-        retarget.anchor_at(world.placement(id).to_world(rest));
+        retarget.place_in(world, id);
         retarget
     }
 }

@@ -326,12 +326,11 @@ impl Retarget {
         world
     }
 
-    /// Places the character where it stands in the world: `root` is the realizer's root there
-    /// at rest (its placement applied to the rest pose's root). The avatar stands there, and
-    /// only its travel from there is scaled by the ratio of leg lengths (so that its feet do
-    /// not slide), not its place.
-    pub fn anchor_at(&mut self, root: Vec3) {
-        self.anchor = root;
+    /// Places character `id` where `world` has it stand: the avatar stands there, and only
+    /// its travel from there is scaled by the ratio of leg lengths (so that its feet do not
+    /// slide), not its place.
+    pub fn place_in(&mut self, world: &crate::world::World, id: &str) {
+        self.anchor = world.placement(id).to_world(self.root_rest);
     }
 
     /// Whether the avatar's skeleton is the realizer's own (each node turns as its joint).

@@ -29,14 +29,13 @@ pub(super) fn drives(
         let name = model.nodes[i].name.to_lowercase();
         source[i].is_none() && (name.contains("twist") || name.contains("roll"))
     };
-    // nodes with a follower at or below them
+    // nodes with a follower at or below them: each follower and its ancestors, up to the
+    // first one already marked
     let mut carries = vec![false; model.nodes.len()];
     for i in (0..model.nodes.len()).filter(|&i| source[i].is_some()) {
-        let mut at = Some(i);
-        for _ in 0..model.nodes.len() {
-            let Some(k) = at.filter(|&k| !carries[k] || k == i) else {
-                break;
-            };
+        carries[i] = true;
+        let mut at = model.nodes[i].parent;
+        while let Some(k) = at.filter(|&k| !carries[k]) {
             carries[k] = true;
             at = model.nodes[k].parent;
         }
