@@ -452,6 +452,49 @@ fn run_frames_writes_the_skeleton_and_every_frame_without_changing_the_feedback(
 }
 
 #[test]
+fn run_frames_roots_writes_where_each_character_stands_and_nothing_else() {
+    let dir = std::env::temp_dir();
+    let full = dir.join(format!("bmlr-{}-full.jsonl", std::process::id()));
+    let roots = dir.join(format!("bmlr-{}-roots.jsonl", std::process::id()));
+    let file = "fixtures/examples/welcome.xml";
+    let (code, _, err) = bmlr(&["run", "--frames", full.to_str().unwrap(), file]);
+    assert_eq!(code, 0, "{err}");
+    let args = [
+        "run",
+        "--frames",
+        roots.to_str().unwrap(),
+        "--frames-roots",
+        file,
+    ];
+    let (code, _, err) = bmlr(&args);
+    assert_eq!(code, 0, "{err}");
+    let read = |p: &std::path::Path| -> Vec<serde_json::Value> {
+        (std::fs::read_to_string(p).unwrap().lines())
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let (full, roots) = (read(&full), read(&roots));
+    assert_eq!(roots[0]["roots_only"], true);
+    assert!(full[0].get("roots_only").is_none());
+    assert_eq!(roots.len(), full.len());
+    for (r, f) in roots.iter().zip(&full).skip(1) {
+        let (r, f) = (&r["characters"][""], &f["characters"][""]);
+        assert_eq!(
+            r.as_object().unwrap().len(),
+            2,
+            "root and rotation only: {r}"
+        );
+        assert_eq!((&r["root"], &r["rotation"]), (&f["root"], &f["rotation"]));
+    }
+    let (code, _, err) = bmlr(&["run", "--frames-roots", file]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--frames"), "{err}");
+    let (code, _, err) = bmlr(&["run", "--frames", "/no/such/dir/f.jsonl", file]);
+    assert_eq!(code, 2);
+    assert!(err.contains("/no/such/dir/f.jsonl: cannot write"), "{err}");
+}
+
+#[test]
 fn the_idle_layer_moves_the_body_and_never_the_feedback() {
     let dir = std::env::temp_dir();
     let (a, b) = (

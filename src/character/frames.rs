@@ -35,6 +35,9 @@ struct Header<'a> {
     skeleton: SkeletonLine<'a>,
     /// Character ids in the order of the frames' `characters` (the default character is `""`).
     characters: &'a [&'a str],
+    /// Present (true) when the frames carry only where each character stands.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    roots_only: bool,
 }
 
 #[derive(Serialize)]
@@ -47,13 +50,6 @@ struct JointLine<'a> {
     name: &'a str,
     parent: Option<&'a str>,
     offset: [f64; 3],
-}
-
-/// One frame.
-#[derive(Serialize)]
-struct FrameLine<'a> {
-    time: f64,
-    characters: IndexMap<&'a str, CharacterLine<'a>>,
 }
 
 #[derive(Serialize)]
@@ -113,8 +109,9 @@ fn quat(q: glam::Quat) -> [f64; 4] {
     [round(q.x), round(q.y), round(q.z), round(q.w)]
 }
 
-/// The header line (without a newline) for frames at `fps` of `characters` on `skeleton`.
-pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
+/// The header line (without a newline) for frames at `fps` of `characters` on `skeleton`, whose
+/// lines carry `detail`.
+pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str], detail: Detail) -> String {
     let joints = skeleton.joints();
     let header = Header {
         fps,
@@ -128,8 +125,29 @@ pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
                 .collect(),
         },
         characters,
+        roots_only: detail == Detail::Roots,
     };
     serde_json::to_string(&header).expect("a header always encodes")
+}
+
+/// What a frame line carries of each character.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Detail {
+    /// Pose, clamped joints, face, sound events and foot contacts.
+    #[default]
+    Full,
+    /// Only where each character stands (its root's position and rotation) and, once it has
+    /// walked, its foot contacts: for crowds too large to keep every joint.
+    Roots,
+}
+
+/// Where a character stands, for [`Detail::Roots`].
+#[derive(Serialize)]
+struct RootLine {
+    root: [f64; 3],
+    rotation: [f64; 4],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    contacts: Option<Contacts>,
 }
 
 /// One frame's line (without a newline): the time and each character (its id, `""` the default
@@ -137,45 +155,77 @@ pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str]) -> String {
 /// sounds that started or stopped since the last frame and, once it has walked, which feet are
 /// on the ground.
 pub fn line(skeleton: &Skeleton, time: f64, characters: &[(&str, &CharacterPose)]) -> String {
-    let characters = (characters.iter())
-        .map(|&(id, c)| {
-            let CharacterPose {
-                pose,
-                clamped,
-                face,
-                events,
-                contacts,
-                ..
-            } = c;
-            let world = pose.world(skeleton);
-            let joints = (skeleton.joints().iter().zip(&pose.rotations))
-                .map(|(j, &q)| (j.name.as_str(), quat(q)))
-                .collect();
-            let (root, rotation) = (world.positions[0], world.orientations[0]);
-            let character = CharacterLine {
-                root: [round(root.x), round(root.y), round(root.z)],
-                rotation: quat(rotation),
-                joints,
-                clamped: (clamped.iter())
-                    .map(|&j| skeleton.joints()[j].name.as_str())
-                    .collect(),
-                face: action_units(face),
-                morphs: morphs(face),
-                viseme: face.viseme.and_then(|v| VISEMES.get(v).copied()),
-                events: (events.iter())
-                    .map(|e| EventLine {
-                        kind: if e.start { "audio-start" } else { "audio-stop" },
-                        id: &e.id,
-                        offset: (e.offset * 1e6).round() / 1e6,
-                    })
-                    .collect(),
-                contacts: contacts.map(|[l, r]| Contacts { l, r }),
-            };
-            (id, character)
-        })
+    let parts: Vec<(&str, String)> = (characters.iter())
+        .map(|&(id, c)| (id, character(skeleton, c, Detail::Full)))
         .collect();
+    let parts: Vec<(&str, &str)> = parts.iter().map(|(id, p)| (*id, p.as_str())).collect();
+    line_of(time, &parts)
+}
+
+/// One frame's line (without a newline) from each character's id and its JSON object made by
+/// [`character`], in order. The same bytes as [`line`] for the same characters.
+pub fn line_of(time: f64, characters: &[(&str, &str)]) -> String {
     let time = (time * 1e6).round() / 1e6;
-    serde_json::to_string(&FrameLine { time, characters }).expect("a frame always encodes")
+    let mut out = format!("{{\"time\":{},\"characters\":{{", json(&time));
+    for (k, (id, part)) in characters.iter().enumerate() {
+        if k > 0 {
+            out.push(',');
+        }
+        out.push_str(&json(id));
+        out.push(':');
+        out.push_str(part);
+    }
+    out.push_str("}}");
+    out
+}
+
+fn json<T: Serialize + ?Sized>(value: &T) -> String {
+    serde_json::to_string(value).expect("numbers and strings always encode")
+}
+
+/// One character's JSON object in a frame line (see [`line`]), with the `detail` asked for.
+pub fn character(skeleton: &Skeleton, c: &CharacterPose, detail: Detail) -> String {
+    let CharacterPose {
+        pose,
+        clamped,
+        face,
+        events,
+        contacts,
+        ..
+    } = c;
+    let world = pose.world(skeleton);
+    let (root, rotation) = (world.positions[0], world.orientations[0]);
+    let root = [round(root.x), round(root.y), round(root.z)];
+    let contacts = contacts.map(|[l, r]| Contacts { l, r });
+    if detail == Detail::Roots {
+        return json(&RootLine {
+            root,
+            rotation: quat(rotation),
+            contacts,
+        });
+    }
+    let joints = (skeleton.joints().iter().zip(&pose.rotations))
+        .map(|(j, &q)| (j.name.as_str(), quat(q)))
+        .collect();
+    json(&CharacterLine {
+        root,
+        rotation: quat(rotation),
+        joints,
+        clamped: (clamped.iter())
+            .map(|&j| skeleton.joints()[j].name.as_str())
+            .collect(),
+        face: action_units(face),
+        morphs: morphs(face),
+        viseme: face.viseme.and_then(|v| VISEMES.get(v).copied()),
+        events: (events.iter())
+            .map(|e| EventLine {
+                kind: if e.start { "audio-start" } else { "audio-stop" },
+                id: &e.id,
+                offset: (e.offset * 1e6).round() / 1e6,
+            })
+            .collect(),
+        contacts,
+    })
 }
 
 #[cfg(test)]
@@ -198,7 +248,8 @@ mod tests {
     #[test]
     fn the_header_names_every_joint_and_a_frame_every_rotation() {
         let s = Skeleton::adult();
-        let h: serde_json::Value = serde_json::from_str(&header(&s, 60.0, &["", "anna"])).unwrap();
+        let h: serde_json::Value =
+            serde_json::from_str(&header(&s, 60.0, &["", "anna"], Detail::Full)).unwrap();
         assert_eq!(h["fps"], 60.0);
         assert_eq!(h["characters"], serde_json::json!(["", "anna"]));
         let joints = h["skeleton"]["joints"].as_array().unwrap();

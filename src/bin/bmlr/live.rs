@@ -58,7 +58,7 @@ impl LiveView {
     ) -> Result<LiveView, String> {
         let (listener, at) = web::bind(addr)?;
         let skeleton = Skeleton::adult();
-        let header = frames::header(&skeleton, FPS, &[""]);
+        let header = frames::header(&skeleton, FPS, &[""], frames::Detail::Full);
         let ids = std::iter::once("").chain(world.placements().map(|(id, _)| id));
         let shown: Vec<&str> = ids.take(crate::view::MAX_VIEW_AVATARS).collect();
         let glbs = (shown.iter())

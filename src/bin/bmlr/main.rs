@@ -17,6 +17,7 @@ mod outcome;
 mod record;
 mod run;
 mod serve;
+mod spool;
 mod tcp;
 mod view;
 mod web;

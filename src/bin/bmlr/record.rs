@@ -12,14 +12,21 @@ use bml_realizer::sound::{SoundEvent, Track};
 use bml_realizer::world::World;
 
 use crate::avatar::{Avatar, Avatars};
+use crate::spool::FrameSpool;
 
 /// The frame period, the next frame's time, and every character's pose in each frame so far
 /// (which characters a file shows is decided at the end).
 pub struct Recording {
     pub period: f64,
     pub next: f64,
-    /// (time, the poses of the characters that had one).
+    /// How many frames were recorded.
+    pub count: usize,
+    /// (time, the poses of the characters that had one), when they are kept (BVH, glTF, the
+    /// viewer).
     pub frames: Vec<(f64, Vec<CharacterPose>)>,
+    keep: bool,
+    /// The frames file being written as the run goes.
+    spool: Option<FrameSpool>,
     fps: f64,
     /// Every sound heard, from every tick (not only the recorded frames: an interrupt's cut
     /// falls between them), and whether it still plays.
@@ -35,10 +42,22 @@ impl Recording {
         Recording {
             period: 1.0 / fps,
             next: 0.0,
+            count: 0,
             frames: Vec::new(),
+            keep: true,
+            spool: None,
             fps,
             heard: Vec::new(),
             pending: Vec::new(),
+        }
+    }
+
+    /// Writes the frames to `spool` as they come; keeps them in memory too only when `keep`.
+    pub fn streaming(fps: f64, spool: Option<FrameSpool>, keep: bool) -> Recording {
+        Recording {
+            spool,
+            keep,
+            ..Recording::new(fps)
         }
     }
 
@@ -52,7 +71,13 @@ impl Recording {
             p.events = mine.into_iter().map(|(_, e)| e).collect();
             self.pending = rest;
         }
-        self.frames.push((time, poses));
+        self.count += 1;
+        if let Some(spool) = self.spool.as_mut() {
+            spool.push(time, &poses);
+        }
+        if self.keep {
+            self.frames.push((time, poses));
+        }
     }
 
     /// Notes the sounds playing at tick `t`: new ones, volume changes, and sounds gone before
@@ -256,22 +281,27 @@ impl Recording {
         Ok(self.poses_of(&character))
     }
 
-    /// Writes the frames of every character that received blocks (see [`Recording::lines`]).
-    /// An error has the exit code.
-    pub fn write_frames(&self, realizer: &Realizer, path: &Path) -> Result<(), (u8, String)> {
+    /// Writes the frames of every character that received blocks from the spool (see
+    /// [`FrameSpool`]); without one, from the frames kept. An error has the exit code.
+    pub fn write_frames(&mut self, realizer: &Realizer, path: &Path) -> Result<(), (u8, String)> {
         let ids = received(realizer);
-        let (header, lines) = self.lines(&ids);
-        let mut text = header;
-        text.push('\n');
-        for line in lines {
-            text.push_str(&line);
-            text.push('\n');
-        }
-        write_file(path, text.as_bytes())?;
+        let count = match self.spool.take() {
+            Some(spool) => spool.finish(path, self.fps, &ids).map_err(|e| (2, e))?,
+            None => {
+                let (header, lines) = self.lines(&ids);
+                let mut text = header;
+                text.push('\n');
+                for line in lines {
+                    text.push_str(&line);
+                    text.push('\n');
+                }
+                write_file(path, text.as_bytes())?;
+                self.frames.len()
+            }
+        };
         eprintln!(
-            "wrote {} ({} frames at {} fps, {} character(s))",
+            "wrote {} ({count} frames at {} fps, {} character(s))",
             path.display(),
-            self.frames.len(),
             self.fps,
             ids.len()
         );
@@ -282,7 +312,7 @@ impl Recording {
     /// default character is `""`).
     pub fn lines(&self, ids: &[&str]) -> (String, Vec<String>) {
         let skeleton = Skeleton::adult();
-        let header = frames::header(&skeleton, self.fps, ids);
+        let header = frames::header(&skeleton, self.fps, ids, frames::Detail::Full);
         let per_character: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
         let lines = (self.frames.iter().enumerate())
             .map(|(k, (time, _))| {

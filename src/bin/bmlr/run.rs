@@ -16,6 +16,8 @@ use bml_realizer::timing::{SpeechTiming, Voice};
 use clap::{Args, ValueEnum};
 
 use crate::record::Recording;
+use crate::spool::FrameSpool;
+use bml_realizer::character::frames;
 
 /// Feedback line format.
 #[derive(Clone, Copy, ValueEnum)]
@@ -73,6 +75,11 @@ pub struct RunArgs {
     /// a header with the skeleton, then one line every 1/--fps seconds (virtual clock only).
     #[arg(long, value_name = "OUT.jsonl")]
     frames: Option<std::path::PathBuf>,
+    /// With --frames: write only where each character stands (its root's position and
+    /// rotation, and its feet on the ground once it walked), for crowds too large for every
+    /// joint.
+    #[arg(long, requires = "frames")]
+    frames_roots: bool,
     /// BML files (one block each; a directory: its .xml files by name), '-' for a stream of
     /// blocks on stdin, '+SECS' to advance the clock before the next item.
     #[arg(required = true, value_name = "ITEM")]
@@ -387,7 +394,7 @@ impl VirtualRun {
         let t = t.min(self.until);
         while let Some(m) = self.motion.as_mut().filter(|m| m.next <= t) {
             let at = m.next;
-            m.next = (m.frames.len() + 1) as f64 * m.period;
+            m.next = (m.count + 1) as f64 * m.period;
             let frame = self.realizer.tick(at);
             self.emit(at, frame.feedback);
             self.hear(at, &frame.poses);
@@ -466,7 +473,7 @@ impl VirtualRun {
     pub fn take_motion(&mut self) -> Option<Recording> {
         let mut m = self.motion.take()?;
         let now = self.realizer.now();
-        if m.frames.is_empty() || m.next <= now + 1e-9 {
+        if m.count == 0 || m.next <= now + 1e-9 {
             let frame = self.realizer.tick(now);
             m.observe(now, &frame.poses);
             m.push_frame(now, frame.poses);
@@ -480,7 +487,7 @@ impl VirtualRun {
         args: &RunArgs,
         avatar: Option<&crate::avatar::Avatars>,
     ) -> Result<(), (u8, String)> {
-        let Some(m) = self.take_motion() else {
+        let Some(mut m) = self.take_motion() else {
             return Ok(());
         };
         if let Some(path) = &args.bvh {
@@ -519,6 +526,23 @@ pub fn run(args: RunArgs) -> ExitCode {
     if args.realtime {
         return run_realtime(realizer, items, &args);
     }
+    let detail = if args.frames_roots {
+        frames::Detail::Roots
+    } else {
+        frames::Detail::Full
+    };
+    let spool = match args
+        .frames
+        .as_deref()
+        .map(|f| FrameSpool::create(f, detail))
+    {
+        None => None,
+        Some(Ok(spool)) => Some(spool),
+        Some(Err(e)) => {
+            eprintln!("bmlr run: {e}");
+            return ExitCode::from(2);
+        }
+    };
     let mut run = VirtualRun {
         realizer,
         format: args.format.into(),
@@ -527,10 +551,10 @@ pub fn run(args: RunArgs) -> ExitCode {
         open: true,
         outcome: Default::default(),
         motion: (args.bvh.is_some()
-            || args.frames.is_some()
+            || spool.is_some()
             || args.gltf.is_some()
             || args.wav.is_some())
-        .then(|| Recording::new(args.fps)),
+        .then(|| Recording::streaming(args.fps, spool, args.bvh.is_some() || args.gltf.is_some())),
         log: None,
     };
     run.items(items);
