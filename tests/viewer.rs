@@ -4,11 +4,13 @@
 //! The browser test (headless Chromium draws the page) needs Debian's `chromium`: it is
 //! `#[ignore]`d here and `.ci/run` installs the browser and runs it with `--ignored`.
 
+mod browser;
 mod common;
+
+use browser::{browse, data, far, page, scratch, Shot};
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
-use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -17,34 +19,6 @@ use serde_json::Value;
 
 const WELCOME: &str = "fixtures/examples/welcome.xml";
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
-
-/// A fresh directory under the target directory.
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// The page of `bmlr view ARGS --out DIR` and its directory.
-fn page(name: &str, args: &[&str]) -> (String, PathBuf) {
-    let dir = scratch(name);
-    let mut all = vec!["view", "--out", dir.to_str().unwrap()];
-    all.extend_from_slice(args);
-    let (code, _, err) = common::bmlr(&all, "");
-    assert_eq!(code, 0, "{err}");
-    (
-        std::fs::read_to_string(dir.join("index.html")).unwrap(),
-        dir,
-    )
-}
-
-/// The run data in a page.
-fn data(page: &str) -> Value {
-    let start = page.find(r#"id="bmlr-data">"#).expect("the data element") + 15;
-    let end = start + page[start..].find("</script>").unwrap();
-    serde_json::from_str(&page[start..end]).expect("the data is JSON")
-}
 
 fn vec3(v: &Value) -> Vec3 {
     let f = |i: usize| v[i].as_f64().unwrap() as f32;
@@ -371,97 +345,6 @@ fn the_live_view_streams_frames_and_feedback_as_blocks_arrive() {
     assert!(feedback.iter().any(|t| t.contains(r#"id="hi:g:stroke""#)));
 }
 
-/// Where `chromium` is, if it is installed.
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|d| d.join("chromium"))
-        .find(|p| p.exists())
-}
-
-/// Headless Chromium on `url` with `what` (e.g. `--dump-dom` or `--screenshot=OUT.png`):
-/// (stdout, the page's console lines).
-fn browse(url: &str, what: &str) -> (String, Vec<String>) {
-    let chromium =
-        chromium().expect("Debian's chromium (apt-get install chromium; .ci/run installs it)");
-    // one profile per run: Chromium locks its profile, and the tests run browsers in parallel
-    // (a profile named by the arguments' lengths was shared, now and then, by two of them, and
-    // one wrote no screenshot)
-    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let profile = scratch(&format!("chromium-{run}"));
-    let out = Command::new(chromium)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--use-angle=swiftshader",
-            "--enable-unsafe-swiftshader",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--window-size=1280,720",
-            "--virtual-time-budget=5000",
-            "--enable-logging=stderr",
-            "--v=0",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg(what)
-        .arg(url)
-        .output()
-        .unwrap();
-    // (SwiftShader's notes on reading pixels back for the screenshot are the browser's, not the
-    // page's)
-    let console = String::from_utf8_lossy(&out.stderr)
-        .lines()
-        .filter(|l| l.contains(":CONSOLE") && !l.contains("GL Driver Message"))
-        .map(str::to_string)
-        .collect();
-    (String::from_utf8_lossy(&out.stdout).into_owned(), console)
-}
-
-/// An RGB screenshot: width, height, pixels.
-struct Shot(usize, usize, Vec<u8>);
-
-impl Shot {
-    fn load(path: &Path) -> Shot {
-        let decoder = png::Decoder::new(BufReader::new(std::fs::File::open(path).unwrap()));
-        let mut reader = decoder.read_info().unwrap();
-        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-        let info = reader.next_frame(&mut buf).unwrap();
-        let channels = info.color_type.samples();
-        let rgb = buf[..info.buffer_size()]
-            .chunks(channels)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect();
-        Shot(info.width as usize, info.height as usize, rgb)
-    }
-
-    fn px(&self, x: usize, y: usize) -> [u8; 3] {
-        let i = 3 * (y * self.0 + x);
-        [self.2[i], self.2[i + 1], self.2[i + 2]]
-    }
-
-    /// The share of pixels in the box (x0..x1, y0..y1) for which `differs` holds.
-    fn share(
-        &self,
-        (x0, x1, y0, y1): (usize, usize, usize, usize),
-        differs: impl Fn(usize, usize) -> bool,
-    ) -> f64 {
-        let hits = (y0..y1)
-            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
-            .filter(|&(x, y)| differs(x, y))
-            .count();
-        hits as f64 / ((x1 - x0) * (y1 - y0)) as f64
-    }
-}
-
-fn far([a, b, c]: [u8; 3], [x, y, z]: [u8; 3]) -> bool {
-    a.abs_diff(x).max(b.abs_diff(y)).max(c.abs_diff(z)) > 24
-}
-
 #[test]
 #[ignore = "needs Debian's chromium; .ci/run installs it and runs this with --ignored"]
 fn headless_chromium_draws_the_character_and_the_beat_moves_the_arm() {
@@ -565,16 +448,16 @@ fn headless_chromium_draws_the_centre_of_mass_when_asked() {
 #[test]
 #[ignore = "needs Debian's chromium; .ci/run installs it and runs this with --ignored"]
 fn headless_chromium_frames_characters_where_they_stand() {
-    let file = scratch("view-world").join("world.json");
-    std::fs::write(
-        &file,
-        r#"{"characters": {"Alice": {"position": [0, 0, 0]},
-            "Bob": {"position": [2.4, 0, 1.8], "facing": -120}}}"#,
-    )
-    .unwrap();
-    let world = file.to_str().unwrap();
+    // the page shows every character the world places: Bob alone is in a world of his own
+    let dir = scratch("view-world");
+    let (alone, both) = (dir.join("bob.json"), dir.join("world.json"));
+    let bob = r#""Bob": {"position": [2.4, 0, 1.8], "facing": -120}"#;
+    std::fs::write(&alone, format!(r#"{{"characters": {{{bob}}}}}"#)).unwrap();
+    let alice = r#""Alice": {"position": [0, 0, 0]}"#;
+    std::fs::write(&both, format!(r#"{{"characters": {{{alice}, {bob}}}}}"#)).unwrap();
     let shot = |name: &str, files: &[&str]| {
-        let mut args = vec!["--no-idle", "--world", world];
+        let world = if files.len() == 1 { &alone } else { &both };
+        let mut args = vec!["--no-idle", "--world", world.to_str().unwrap()];
         args.extend_from_slice(files);
         let (_, dir) = page(name, &args);
         let url = format!("file://{}#t=0", dir.join("index.html").display());

@@ -8,7 +8,8 @@
 // scrub / speed, and the run's sound (if it has any) played in step with the cursor. Characters
 // with an avatar in the page data are drawn as that avatar (avatars.js: GLTFLoader, an animation
 // per character, or live the avatars' node rotations and morph weights with each frame; M
-// toggles the mannequin). It opens paused at #t=SECONDS and sets the title to
+// toggles the mannequin). A crowd (more than 16 characters) comes packed and is drawn as one
+// (crowd.js: instanced mannequins, no faces). It opens paused at #t=SECONDS and sets the title to
 // "bmlr view: ready" once the first frame is drawn with every avatar loaded.
 'use strict';
 
@@ -49,6 +50,21 @@
       this.rest.set(this.joints[0].offset, 0);
       for (let q = 6; q < this.rest.length; q += 4) this.rest[q] = 1;
       this.added = () => {};
+      this.a = new Float32Array(this.rest.length);
+      this.b = new Float32Array(this.rest.length);
+    }
+
+    /** A crowd's packed frames (crowd.js) instead of frame lines. */
+    unpack(packed) {
+      this.packed = new BmlrPackedFrames(packed, this.joints);
+      this.characters = packed.characters.slice();
+      this.times = packed.times.slice();
+    }
+
+    /** Frame i of character k (`out` is scratch space for packed frames). */
+    frameOf(i, k, out) {
+      if (this.packed) return this.packed.pose(i, k, out);
+      return this.poses[i][k] || this.rest;
     }
 
     get duration() {
@@ -107,6 +123,7 @@
 
     /** Character `k`'s blendshape `name` at time `t`, interpolated between frames. */
     morph(t, k, name) {
+      if (this.packed) return 0;
       const i = this.index(t);
       const j = Math.min(i + 1, this.times.length - 1);
       const span = this.times[j] - this.times[i];
@@ -119,11 +136,11 @@
     /** Character `k`'s pose at time `t`, interpolated between frames, into `out`. */
     sample(THREE, t, k, out) {
       const i = this.index(t);
-      const a = this.poses[i][k] || this.rest;
+      const a = this.frameOf(i, k, this.a);
       const j = Math.min(i + 1, this.times.length - 1);
       const span = this.times[j] - this.times[i];
       const f = span > 0 ? Math.min(Math.max((t - this.times[i]) / span, 0), 1) : 0;
-      const b = this.poses[j][k] || this.rest;
+      const b = this.frameOf(j, k, this.b);
       for (let c = 0; c < 3; c++) out[c] = a[c] + (b[c] - a[c]) * f;
       for (let q = 3; q < out.length; q += 4) THREE.Quaternion.slerpFlat(out, q, a, q, b, q, f);
       return out;
@@ -173,6 +190,7 @@
       this.avatarsLoading = 0;
       this.data = data;
       this.clip = new Clip(data.header);
+      if (data.packed) this.clip.unpack(data.packed);
       data.frames.forEach((f) => this.clip.push(f));
       this.feedback = [];
       this.shown = 0;
@@ -189,7 +207,13 @@
 
     start() {
       this.scene3d();
-      this.figures = this.clip.characters.map((id, k) => this.figure(k));
+      if (this.clip.packed) {
+        const { joints, characters } = this.clip;
+        this.crowd = new BmlrCrowd(this.THREE, this.scene, joints, this.data.segments, this.materials, characters.length);
+        this.crowdPose = new Float32Array(this.clip.rest.length);
+      }
+      this.figures = this.crowd ? [] : this.clip.characters.map((id, k) => this.figure(k));
+      this.fitFloor();
       this.clip.added = (k) => {
         this.figures.push(this.figure(k));
         if (this.attachAvatar) this.attachAvatar(k);
@@ -230,13 +254,13 @@
       const sun = new THREE.DirectionalLight(0xffffff, 2.0);
       sun.position.set(2, 4, 3);
       this.scene.add(sun);
-      const floor = new THREE.Mesh(
+      const floor = (this.floor = new THREE.Mesh(
         new THREE.CircleGeometry(4, 48),
         new THREE.MeshLambertMaterial({ color: 0xc9ced6 }),
-      );
+      ));
       floor.rotation.x = -Math.PI / 2;
       this.scene.add(floor);
-      const grid = new THREE.GridHelper(8, 16, 0xaab1bc, 0xb8bec8);
+      const grid = (this.grid = new THREE.GridHelper(8, 16, 0xaab1bc, 0xb8bec8));
       grid.position.y = 0.001;
       this.scene.add(grid);
       this.materials = [
@@ -245,6 +269,18 @@
       ];
       this.resize();
       window.addEventListener('resize', () => this.resize());
+    }
+
+    /** A floor under everywhere the characters go (4 m round the middle, or more). */
+    fitFloor() {
+      const s = this.stage(false);
+      const scale = Math.max(1, (s.spread + 2) / 4);
+      for (const m of [this.floor, this.grid]) {
+        m.position.x = s.x;
+        m.position.z = s.z;
+      }
+      this.floor.scale.set(scale, scale, 1);
+      this.grid.scale.set(scale, 1, scale);
     }
 
     resize() {
@@ -501,15 +537,15 @@
     /** Where the camera looks: the middle of everywhere the characters stand during the clip and
      *  how far that spreads (walkers stay in view), or (`face`) the first character's place now. */
     stage(face) {
-      const first = this.clip.poses[0] || [];
-      if (!first.length) return { x: 0, z: 0, spread: 0, yaw: 0 };
+      if (!this.clip.times.length || !this.clip.characters.length) return { x: 0, z: 0, spread: 0, yaw: 0 };
       if (face) {
-        const now = this.clip.sample(this.THREE, this.t, 0, new Float32Array(first[0].length));
+        const now = this.clip.sample(this.THREE, this.t, 0, new Float32Array(this.clip.rest.length));
         // a close look comes from in front of the character, the way it faces (its root's
         // turn about +y)
         return { x: now[0], z: now[2], spread: 0, yaw: 2 * Math.atan2(now[4], now[6]) };
       }
-      if (!this.bounds || this.boundsFrames !== this.clip.poses.length) {
+      if (this.clip.packed && !this.bounds) this.bounds = this.clip.packed.bounds();
+      if (!this.clip.packed && (!this.bounds || this.boundsFrames !== this.clip.poses.length)) {
         this.boundsFrames = this.clip.poses.length;
         let [x0, z0, x1, z1] = [Infinity, Infinity, -Infinity, -Infinity];
         for (const frame of this.clip.poses) {
@@ -529,7 +565,7 @@
 
     orbit() {
       // the whole body, or (#face in the address, or the F key) a close look at the face
-      this.body = { azimuth: 0.35, elevation: 0.08, distance: 3.5, height: 0.92 };
+      this.body = { azimuth: 0.35, elevation: this.crowd ? 0.55 : 0.08, distance: 3.5, height: 0.92 };
       this.close = { azimuth: 0.25, elevation: 0.05, distance: 0.75, height: 1.64 };
       const face = /(?:^#|&)face(?:&|$)/.test(location.hash);
       this.view = { ...(face ? this.close : this.body) };
@@ -620,6 +656,12 @@
     draw() {
       const THREE = this.THREE;
       if (this.clip.times.length) {
+        if (this.crowd) {
+          for (let k = 0; k < this.clip.characters.length; k++) {
+            this.crowd.place(k, this.clip.sample(THREE, this.t, k, this.crowdPose));
+          }
+          this.crowd.placed();
+        }
         for (const f of this.figures) {
           const pose = this.clip.sample(THREE, this.t, f.k, f.pose);
           f.nodes[0].position.set(pose[0], pose[1], pose[2]);

@@ -85,6 +85,7 @@ impl LiveView {
             audio: None,
             avatars: glbs,
             live_avatars: wiring,
+            packed: None,
         }
         .to_json();
         let live = Live::new(BACKLOG);

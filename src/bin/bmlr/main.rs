@@ -14,6 +14,7 @@ mod avatar;
 mod diff;
 mod live;
 mod outcome;
+mod pack;
 mod record;
 mod run;
 mod serve;

@@ -27,6 +27,8 @@ pub struct Recording {
     keep: bool,
     /// The frames file being written as the run goes.
     spool: Option<FrameSpool>,
+    /// Where the world file places characters: one without a pose in a frame stands there.
+    places: std::collections::HashMap<String, bml_realizer::world::Placement>,
     fps: f64,
     /// Every sound heard, from every tick (not only the recorded frames: an interrupt's cut
     /// falls between them), and whether it still plays.
@@ -46,6 +48,7 @@ impl Recording {
             frames: Vec::new(),
             keep: true,
             spool: None,
+            places: Default::default(),
             fps,
             heard: Vec::new(),
             pending: Vec::new(),
@@ -59,6 +62,14 @@ impl Recording {
             keep,
             ..Recording::new(fps)
         }
+    }
+
+    /// Notes where `world` places characters (see [`Recording::standing`]).
+    pub fn placed(mut self, world: &World) -> Recording {
+        self.places = (world.placements())
+            .map(|(id, at)| (id.to_string(), at))
+            .collect();
+        self
     }
 
     /// Records a frame at `time`: the poses, each with the sound events heard since the last
@@ -286,7 +297,12 @@ impl Recording {
     pub fn write_frames(&mut self, realizer: &Realizer, path: &Path) -> Result<(), (u8, String)> {
         let ids = received(realizer);
         let count = match self.spool.take() {
-            Some(spool) => spool.finish(path, self.fps, &ids).map_err(|e| (2, e))?,
+            Some(spool) => {
+                let rest: Vec<CharacterPose> = ids.iter().map(|id| self.standing(id)).collect();
+                spool
+                    .finish(path, self.fps, &ids, &rest)
+                    .map_err(|e| (2, e))?
+            }
             None => {
                 let (header, lines) = self.lines(&ids);
                 let mut text = header;
@@ -365,18 +381,10 @@ impl Recording {
         !self.heard.is_empty()
     }
 
-    /// The poses of `character` ("" the default one), frame by frame (the rest pose where a
-    /// frame has none for it).
-    fn poses_of(&self, character: &str) -> Vec<CharacterPose> {
-        let rest = CharacterPose {
-            character: Some(character.to_string()),
-            pose: Pose::rest(&Skeleton::adult()),
-            clamped: Vec::new(),
-            face: bml_realizer::face::Face::neutral(bml_realizer::face::FaceModel::default_model()),
-            sounds: Vec::new(),
-            events: Vec::new(),
-            contacts: None,
-        };
+    /// The poses of `character` ("" the default one), frame by frame (standing where the
+    /// world places it, at rest, where a frame has none for it).
+    pub fn poses_of(&self, character: &str) -> Vec<CharacterPose> {
+        let rest = self.standing(character);
         self.frames
             .iter()
             .map(|(_, f)| {
@@ -385,6 +393,24 @@ impl Recording {
                     .map_or_else(|| rest.clone(), |p| p.clone())
             })
             .collect()
+    }
+
+    /// `character` at rest where the world places it, for a frame in which it has no pose.
+    pub fn standing(&self, character: &str) -> CharacterPose {
+        let mut pose = Pose::rest(&Skeleton::adult());
+        if let Some(at) = self.places.get(character) {
+            pose.root = at.to_world(pose.root);
+            pose.rotations[0] = at.rotation() * pose.rotations[0];
+        }
+        CharacterPose {
+            character: Some(character.to_string()),
+            pose,
+            clamped: Vec::new(),
+            face: bml_realizer::face::Face::neutral(bml_realizer::face::FaceModel::default_model()),
+            sounds: Vec::new(),
+            events: Vec::new(),
+            contacts: None,
+        }
     }
 }
 

@@ -353,13 +353,14 @@ pub struct VirtualRun {
 impl VirtualRun {
     /// A run that keeps its feedback and records frames at `fps` instead of printing.
     pub fn recording(realizer: Realizer, fps: f64, until: f64) -> VirtualRun {
+        let motion = Recording::new(fps).placed(realizer.world());
         VirtualRun {
             realizer,
             format: Format::Xml,
             until,
             out: None,
             open: true,
-            motion: Some(Recording::new(fps)),
+            motion: Some(motion),
             log: Some(Vec::new()),
             outcome: Default::default(),
         }
@@ -543,6 +544,9 @@ pub fn run(args: RunArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let keep = args.bvh.is_some() || args.gltf.is_some();
+    let motion = (keep || spool.is_some() || args.wav.is_some())
+        .then(|| Recording::streaming(args.fps, spool, keep).placed(realizer.world()));
     let mut run = VirtualRun {
         realizer,
         format: args.format.into(),
@@ -550,11 +554,7 @@ pub fn run(args: RunArgs) -> ExitCode {
         out: Some(std::io::stdout().lock()),
         open: true,
         outcome: Default::default(),
-        motion: (args.bvh.is_some()
-            || spool.is_some()
-            || args.gltf.is_some()
-            || args.wav.is_some())
-        .then(|| Recording::streaming(args.fps, spool, args.bvh.is_some() || args.gltf.is_some())),
+        motion,
         log: None,
     };
     run.items(items);
@@ -607,8 +607,13 @@ fn checked(
 /// Tells stderr which blocks did not finish (waiting for activation, persistent behaviour, or
 /// the clock stopped).
 pub fn report_unfinished(realizer: &Realizer) {
+    let mut told = 0;
     for (character, m) in realizer.characters() {
         for (id, status) in m.live_blocks() {
+            told += 1;
+            if told > MAX_UNFINISHED_TOLD {
+                continue;
+            }
             let why = match status {
                 BlockStatus::Pending => "pre-planned, never activated",
                 BlockStatus::Lurking => "still waiting for the blocks it is appended to",
@@ -625,7 +630,18 @@ pub fn report_unfinished(realizer: &Realizer) {
             );
         }
     }
+    if told > MAX_UNFINISHED_TOLD {
+        eprintln!(
+            "bmlr run: and {} more blocks did not finish at {:.3} s",
+            told - MAX_UNFINISHED_TOLD,
+            realizer.now()
+        );
+    }
 }
+
+/// Unfinished blocks named one by one at the end of a run (a crowd stopped by `--until` would
+/// fill the terminal); the rest are counted.
+const MAX_UNFINISHED_TOLD: usize = 10;
 
 /// `bmlr run --realtime`: the wall clock drives the realizer at `--fps`; `+SECS` waits.
 fn run_realtime(realizer: Realizer, items: Vec<Item>, args: &RunArgs) -> ExitCode {

@@ -10,10 +10,9 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::body::Skeleton;
 use bml_realizer::character::frames::{self, Detail};
 use bml_realizer::engine::CharacterPose;
-use bml_realizer::face::{Face, FaceModel};
 
 /// Frame lines on their way to a frames file.
 pub struct FrameSpool {
@@ -65,8 +64,15 @@ impl FrameSpool {
     }
 
     /// Writes the frames file `target` at `fps` showing `ids` (in that order) from the spool,
-    /// and removes the spool. Returns the number of frames.
-    pub fn finish(mut self, target: &Path, fps: f64, ids: &[&str]) -> Result<usize, String> {
+    /// each as `rest` has it (in the same order) in a frame in which it had no pose, and
+    /// removes the spool. Returns the number of frames.
+    pub fn finish(
+        mut self,
+        target: &Path,
+        fps: f64,
+        ids: &[&str],
+        rest: &[CharacterPose],
+    ) -> Result<usize, String> {
         let cannot = |e: &dyn std::fmt::Display| format!("{}: cannot write: {e}", target.display());
         let spooled = self.out.take().map(BufWriter::into_inner);
         if let Some(e) = &self.failed {
@@ -75,7 +81,9 @@ impl FrameSpool {
         let Some(Ok(_)) = spooled else {
             return Err(cannot(&"the spool could not be flushed"));
         };
-        let rest = self.rest(ids);
+        let rest: Vec<String> = (rest.iter())
+            .map(|p| frames::character(&self.skeleton, p, self.detail))
+            .collect();
         let file = File::create(target).map_err(|e| cannot(&e))?;
         let mut out = BufWriter::new(file);
         let reader = BufReader::new(File::open(&self.part).map_err(|e| cannot(&e))?);
@@ -112,24 +120,6 @@ impl FrameSpool {
         };
         copy().map_err(|e| cannot(&e))
     }
-
-    /// Each character's JSON object at rest, for a frame in which it had no pose.
-    fn rest(&self, ids: &[&str]) -> Vec<String> {
-        (ids.iter())
-            .map(|id| {
-                let still = CharacterPose {
-                    character: Some(id.to_string()),
-                    pose: Pose::rest(&self.skeleton),
-                    clamped: Vec::new(),
-                    face: Face::neutral(FaceModel::default_model()),
-                    sounds: Vec::new(),
-                    events: Vec::new(),
-                    contacts: None,
-                };
-                frames::character(&self.skeleton, &still, self.detail)
-            })
-            .collect()
-    }
 }
 
 impl Drop for FrameSpool {
@@ -150,6 +140,8 @@ fn assemble(time: f64, parts: &HashMap<String, String>, ids: &[&str], rest: &[St
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bml_realizer::body::Pose;
+    use bml_realizer::face::{Face, FaceModel};
 
     fn posed(id: &str, turn: f32, skeleton: &Skeleton) -> CharacterPose {
         let mut pose = Pose::rest(skeleton);
@@ -184,12 +176,9 @@ mod tests {
         for (t, poses) in &frames_in {
             spool.push(*t, poses);
         }
-        assert_eq!(spool.finish(&target, 60.0, &ids).unwrap(), 2);
-        let rest = posed("a\t\"x", 0.0, &skeleton);
-        let rest = CharacterPose {
-            contacts: None,
-            ..rest
-        };
+        let rest = posed("a\t\"x", -0.4, &skeleton);
+        let rests = [rest.clone(), posed("b", 0.0, &skeleton)];
+        assert_eq!(spool.finish(&target, 60.0, &ids, &rests).unwrap(), 2);
         let mut expected = frames::header(&skeleton, 60.0, &ids, Detail::Full) + "\n";
         for (t, poses) in &frames_in {
             let a = poses

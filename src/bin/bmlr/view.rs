@@ -51,6 +51,10 @@ pub struct ViewArgs {
 /// are shown as mannequins.
 pub const MAX_VIEW_AVATARS: usize = 4;
 
+/// Most characters whose frames the page carries as the frames file's lines, each drawn with
+/// its face; more are packed and drawn as one crowd (instanced, without faces).
+pub const CROWD_PAGE: usize = 16;
+
 /// `bmlr view`.
 pub fn view(args: ViewArgs) -> ExitCode {
     let (page, summary, outcome) = match realize(&args) {
@@ -91,11 +95,24 @@ fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome),
     crate::run::report_unfinished(&run.realizer);
     let motion = run.take_motion().expect("a recording run records");
     let log = run.log.take().unwrap_or_default();
+    // those that received blocks, and those the world file places standing by
     let mut characters = crate::record::received(&run.realizer);
+    characters.extend(run.realizer.world().placements().map(|(id, _)| id));
+    characters.sort_unstable();
+    characters.dedup();
     if characters.is_empty() {
         characters.push(""); // the default character, standing
     }
-    let (header, lines) = motion.lines(&characters);
+    // a crowd's page carries its frames packed and draws them without faces
+    let packed = (characters.len() > CROWD_PAGE).then(|| {
+        let times: Vec<f64> = motion.frames.iter().map(|(t, _)| *t).collect();
+        let poses: Vec<_> = characters.iter().map(|id| motion.poses_of(id)).collect();
+        crate::pack::packed(&times, &poses, &characters)
+    });
+    let (header, lines) = match packed {
+        Some(_) => (motion.lines(&[]).0, Vec::new()),
+        None => motion.lines(&characters),
+    };
     // the sound goes in as a WAV data: URL, played in step with the cursor
     let audio = match motion.heard_any() {
         true => Some(motion.wav(&run.realizer)?.0),
@@ -123,12 +140,13 @@ fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome),
         audio,
         avatars,
         live_avatars: Vec::new(),
+        packed,
     };
     let page = web::page(&data.to_json());
     let s = if characters.len() == 1 { "" } else { "s" };
     let summary = format!(
         "{} frames at {} fps, {} character{s}, {} kB",
-        lines.len(),
+        motion.count,
         args.fps,
         characters.len(),
         page.len() / 1024
@@ -166,6 +184,8 @@ pub struct PageData<'a> {
     /// Live: per avatar, the character it shows and how its frames' data sets its nodes
     /// (`{"id", "moving": [node…], "hips": node, "morphs": [[node, targets]…]}`).
     pub live_avatars: Vec<serde_json::Value>,
+    /// A crowd's frames, packed (see [`crate::pack`]) instead of `lines`.
+    pub packed: Option<Value>,
 }
 
 impl PageData<'_> {
@@ -201,6 +221,7 @@ impl PageData<'_> {
             "world": world_data(self.world),
             "header": raw(self.header),
             "frames": self.lines.iter().map(|l| raw(l)).collect::<Vec<_>>(),
+            "packed": self.packed,
             "audio": audio,
         });
         serde_json::to_string(&data).expect("the page data encodes")

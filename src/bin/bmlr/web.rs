@@ -15,6 +15,8 @@ const TEMPLATE: &str = include_str!("../../../assets/viewer/index.html");
 const VIEWER: &str = include_str!("../../../assets/viewer/viewer.js");
 /// The avatars' part of the viewer (loading, and live driving).
 const AVATARS: &str = include_str!("../../../assets/viewer/avatars.js");
+/// The crowds' part of the viewer (packed frames, instanced mannequins).
+const CROWD: &str = include_str!("../../../assets/viewer/crowd.js");
 const THREE: &str = include_str!("../../../assets/viewer/three/three.module.min.js");
 /// three.js's glTF loader and the geometry helpers it imports (the same release, same licence).
 const GLTF_LOADER: &str = include_str!("../../../assets/viewer/three/GLTFLoader.js");
@@ -45,6 +47,7 @@ pub fn page(data: &str) -> String {
             ("GLTF_LOADER", GLTF_LOADER),
             ("GEOMETRY_UTILS", GEOMETRY_UTILS),
             ("AVATARS", AVATARS),
+            ("CROWD", CROWD),
             ("VIEWER", VIEWER),
         ],
     )
@@ -302,9 +305,9 @@ mod tests {
         let p = page(r#"{"text": "</script><script>alert(1)</script>"}"#);
         assert_eq!(
             p.matches("</script>").count(),
-            7,
-            "the seven script elements only (the timing switch, data, three.js, its glTF loader \
-             and geometry helpers, the avatars, the viewer)"
+            8,
+            "the eight script elements only (the timing switch, data, three.js, its glTF loader \
+             and geometry helpers, the avatars, the crowd, the viewer)"
         );
         assert!(p.contains(r#""\u003c/script>\u003cscript>alert(1)\u003c/script>""#));
     }
