@@ -53,7 +53,7 @@ fn movers(walks: &[Walk]) -> Vec<Mover> {
         .collect()
 }
 
-/// Steps `crowd` until everyone has arrived or [`LIMIT`], recording everyone's track, and
+/// Steps `crowd` until everyone has arrived (or given up) or [`LIMIT`], recording everyone's track, and
 /// measures it in `scene`.
 fn walk(mut crowd: impl Stepped, scene: &Scene) -> Quality {
     let mut tracks: Vec<Track> = (crowd.movers().iter())
@@ -63,13 +63,15 @@ fn walk(mut crowd: impl Stepped, scene: &Scene) -> Quality {
             speed: m.speed,
             radius: m.radius,
             arrived: None,
+            gave_up: None,
         })
         .collect();
-    while crowd.movers().iter().any(|m| m.arrived.is_none()) && crowd.time() < LIMIT {
+    while !crowd.movers().iter().all(Mover::standing) && crowd.time() < LIMIT {
         crowd.step(DT);
         for (t, m) in tracks.iter_mut().zip(crowd.movers()) {
             t.at.push(m.at);
             t.arrived = m.arrived;
+            t.gave_up = m.gave_up;
         }
     }
     let walls = bml_realizer::locomotion::Obstacles::new(scene.walls.clone());
@@ -85,7 +87,7 @@ fn main() {
         let theirs = walk(orca::Orca::among(movers(&scene.walks), walls), &scene);
         for (who, q) in [("realizer", ours), ("ORCA", theirs)] {
             println!(
-                "| {} ({}) | {who} | {} | {:.1} | {} / {} | {} | {:.2}, {:.2} | {:.3} | {:.3} | {:.2} |",
+                "| {} ({}) | {who} | {} | {:.1} | {} / {} | {} ({} gave up) | {:.2}, {:.2} | {:.3} | {:.3} | {:.2} |",
                 scene.name,
                 scene.walks.len(),
                 q.collisions,
@@ -93,6 +95,7 @@ fn main() {
                 q.through_walls,
                 q.into_groups,
                 q.stranded,
+                q.gave_up,
                 q.time_ratio,
                 q.worst_time_ratio,
                 q.path_ratio,

@@ -33,6 +33,8 @@ pub struct Track {
     pub radius: f32,
     /// When it arrived.
     pub arrived: Option<f64>,
+    /// When it gave up (it said it could not reach its goal).
+    pub gave_up: Option<f64>,
 }
 
 /// The measures of one run (means over walkers unless named otherwise; time, energy and
@@ -45,6 +47,8 @@ pub struct Quality {
     pub deepest: f32,
     /// Walkers that did not arrive.
     pub stranded: usize,
+    /// Of those, the walkers that gave up, saying they could not reach their goal.
+    pub gave_up: usize,
     /// Arrival time over the straight line's time at the preferred speed (mean, and worst).
     pub time_ratio: f32,
     /// See `time_ratio`.
@@ -124,6 +128,7 @@ pub fn measure(tracks: &[Track], dt: f32, walls: &Obstacles, spaces: &[Space]) -
         q.path_ratio += path / straight / n;
         let Some(arrived) = t.arrived else {
             q.stranded += 1;
+            q.gave_up += usize::from(t.gave_up.is_some());
             continue;
         };
         let ratio = arrived as f32 / (straight / t.speed);
@@ -184,6 +189,7 @@ mod tests {
             speed: best,
             radius: 0.25,
             arrived: Some(10.0),
+            gave_up: None,
         };
         let q = measure(std::slice::from_ref(&t), dt, &Obstacles::default(), &[]);
         assert!((q.energy_ratio - 1.0).abs() < 1e-3, "{q:?}");

@@ -13,6 +13,7 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use super::avoid::{DECIDE_PERIOD, NEIGHBOUR_RADIUS};
+use super::negotiate::{self, Standing};
 use super::{Agent, Avoider, Crowd, Profile};
 use crate::locomotion::{path, Obstacles};
 
@@ -28,6 +29,12 @@ pub const ROUTE_MARGIN: f32 = 0.1;
 pub const REACH: f32 = 0.45;
 /// Shortest time between two plans of a mover's route (s).
 pub const REPLAN_PERIOD: f64 = 1.0;
+/// A walker that has come no nearer its goal by [`PROGRESS`] for this long gives up (s).
+pub const GIVE_UP: f64 = 60.0;
+/// What counts as coming nearer the goal (m).
+pub const PROGRESS: f32 = 0.1;
+/// One standing this far from its place goes back to it when nobody asks it for room (m).
+pub const DISPLACED: f32 = 0.1;
 /// Fewest movers stepped on several threads.
 const PARALLEL_MOVERS: usize = 64;
 
@@ -46,6 +53,16 @@ pub struct Mover {
     pub speed: f32,
     /// When it arrived.
     pub arrived: Option<f64>,
+    /// When it gave up: it came no nearer its goal for [`GIVE_UP`] seconds (it then stands).
+    pub gave_up: Option<f64>,
+    /// Walking: the standing person it asks to make room (looks at), while they shut its way.
+    pub looking_at: Option<usize>,
+    /// Standing: the spot it steps aside to while a walker asks for room, and whether it has
+    /// left its place (it goes back when nobody asks any more).
+    aside: Option<Vec2>,
+    stepped: bool,
+    /// Its least distance to its goal so far, and when that last shrank by [`PROGRESS`].
+    best: (f32, f64),
     avoider: Avoider,
     chosen: Option<Vec2>,
     /// The points to walk through (the last is the goal), and the one sought now.
@@ -66,6 +83,11 @@ impl Mover {
             speed,
             // one whose goal is where it stands has arrived (a group's member, standing)
             arrived: (at.distance(goal) < ARRIVED).then_some(0.0),
+            gave_up: None,
+            looking_at: None,
+            aside: None,
+            stepped: false,
+            best: (at.distance(goal), 0.0),
             avoider: Avoider::starting_at(at),
             chosen: None,
             route: vec![goal],
@@ -111,8 +133,19 @@ impl Mover {
     /// The velocity it wants: toward the point of its route it seeks, slowing in the last
     /// [`SLOW_RADIUS`] before its goal.
     pub fn desired(&self) -> Vec2 {
-        if self.arrived.is_some() {
-            return Vec2::ZERO;
+        if self.standing() {
+            // stepping aside for a walker, or back to its place
+            let spot = match (self.aside, self.stepped) {
+                (Some(spot), _) => spot,
+                (None, true) => self.goal,
+                (None, false) => return Vec2::ZERO,
+            };
+            let d = spot - self.at;
+            let l = d.length();
+            return match l < ARRIVED {
+                true => Vec2::ZERO,
+                false => d / l * negotiate::STEP_SPEED * (l / 0.3).min(1.0),
+            };
         }
         let aim = self.route.get(self.next).copied().unwrap_or(self.goal);
         let d = aim - self.at;
@@ -139,6 +172,23 @@ impl Mover {
         if self.arrived.is_none() && (d < ARRIVED || near_enough) {
             self.arrived = Some(time);
             self.velocity = Vec2::ZERO;
+            self.chosen = None;
+        }
+    }
+
+    /// Whether it stands: arrived, or given up.
+    pub fn standing(&self) -> bool {
+        self.arrived.is_some() || self.gave_up.is_some()
+    }
+
+    /// Gives up when it has come no nearer its goal for [`GIVE_UP`] seconds up to `time`.
+    fn keep_trying(&mut self, time: f64) {
+        let d = self.at.distance(self.goal);
+        if d < self.best.0 - PROGRESS {
+            self.best = (d, time);
+        } else if !self.standing() && time - self.best.1 > GIVE_UP {
+            self.gave_up = Some(time);
+            self.looking_at = None;
             self.chosen = None;
         }
     }
@@ -203,9 +253,20 @@ impl Sim {
         self.movers.iter().all(|m| m.arrived.is_some())
     }
 
+    /// Whether everyone stands: arrived, or given up.
+    pub fn all_standing(&self) -> bool {
+        self.movers.iter().all(Mover::standing)
+    }
+
     /// Moves everyone on by `dt` seconds, each choosing from where all were before the step.
     pub fn step(&mut self, dt: f32) {
         let crowd = Crowd::unnamed(self.time, self.movers.iter().map(Mover::agent).collect());
+        let standing: Vec<bool> = self.movers.iter().map(Mover::standing).collect();
+        // (asked, asking): who asks whom to make room
+        let mut asks: Vec<(usize, usize)> = (self.movers.iter().enumerate())
+            .filter_map(|(i, m)| m.looking_at.map(|t| (t, i)))
+            .collect();
+        asks.sort_unstable();
         let every = ((DECIDE_PERIOD / f64::from(dt)).round() as u64).max(1);
         let (steps, profile, time, all) = (self.steps, self.profile, self.time, self.decide_all);
         self.decide_all = false;
@@ -216,6 +277,8 @@ impl Sim {
                 crowd: &crowd,
                 walls,
                 profile: &profile,
+                standing: &standing,
+                asks: &asks,
             };
             step_one(m, i, world, decide, every as f32 * dt, dt, time);
         };
@@ -235,6 +298,10 @@ struct World<'a> {
     crowd: &'a Crowd,
     walls: &'a Obstacles,
     profile: &'a Profile,
+    /// Per mover, whether it stands.
+    standing: &'a [bool],
+    /// (asked, asking), sorted: who asks whom to make room.
+    asks: &'a [(usize, usize)],
 }
 
 /// One mover's step from the snapshot (where it is index `me`).
@@ -243,12 +310,16 @@ fn step_one(m: &mut Mover, me: usize, w: World, decide: bool, period: f32, dt: f
         crowd,
         walls,
         profile,
+        ..
     } = w;
     m.follow(walls, time);
+    if m.standing() {
+        make_room(m, me, w);
+    }
     let desired = m.desired();
     let mut near = Vec::new();
     // everyone within sight when choosing, only those it may touch otherwise
-    let decide = decide && m.arrived.is_none();
+    let decide = decide && !m.standing();
     let reach = if decide {
         NEIGHBOUR_RADIUS
     } else {
@@ -274,19 +345,156 @@ fn step_one(m: &mut Mover, me: usize, w: World, decide: bool, period: f32, dt: f
             profile,
         );
         m.chosen = m.avoider.avoiding.then_some(v);
+        ask_for_room(m, me, desired, w);
     }
     let target = m.chosen.filter(|_| m.arrived.is_none()).unwrap_or(desired);
     m.velocity += (target - m.velocity).clamp_length_max(MAX_ACCELERATION * dt);
     m.at = super::contact::pushed_out(m.at + m.velocity * dt, m.radius, others, dt);
-    if m.arrived.is_none() && !walls.is_empty() {
+    if (m.arrived.is_none() || m.stepped) && !walls.is_empty() {
         m.at = walls.push_out(m.at, m.radius);
     }
     m.arrive_if_there(time + f64::from(dt));
+    if m.stepped && m.aside.is_none() && m.at.distance(m.goal) < ARRIVED {
+        m.stepped = false;
+    }
+    m.keep_trying(time + f64::from(dt));
+}
+
+/// A walker held back (below half its speed) looks for someone standing who shuts its way,
+/// and asks them for room ([`negotiate::blocker`]).
+fn ask_for_room(m: &mut Mover, me: usize, desired: Vec2, w: World) {
+    m.looking_at = None;
+    if m.velocity.length() >= 0.5 * m.speed || desired.length() < 1e-3 {
+        return;
+    }
+    let mut near = Vec::new();
+    w.crowd.near(m.at, negotiate::LOOKAHEAD + 1.0, &mut near);
+    let standing: Vec<Standing> = (near.into_iter())
+        .filter(|&i| i != me && w.standing[i])
+        .map(|index| {
+            let a = w.crowd.agent(index);
+            Standing {
+                index,
+                at: a.at,
+                radius: a.radius,
+            }
+        })
+        .collect();
+    m.looking_at = negotiate::blocker(m.at, desired.normalize(), m.radius, &standing, w.walls);
+}
+
+/// One standing steps aside for a walker within [`negotiate::TRIGGER`] that asks it for room
+/// (to where [`negotiate::aside`] finds), and stays there while it is asked.
+fn make_room(m: &mut Mover, me: usize, w: World) {
+    let from = w.asks.partition_point(|&(t, _)| t < me);
+    let asking = (w.asks[from..].iter())
+        .take_while(|&&(t, _)| t == me)
+        .map(|&(_, i)| w.crowd.agent(i))
+        .find(|a| a.at.distance(m.at) <= negotiate::TRIGGER);
+    let Some(walker) = asking else {
+        if w.asks[from..].first().is_none_or(|&(t, _)| t != me) {
+            m.aside = None;
+            // pressed from its place (by one stepping aside, or passing): back when free
+            m.stepped |= m.arrived.is_some() && m.at.distance(m.goal) > DISPLACED;
+        }
+        return;
+    };
+    if m.aside.is_some() {
+        return;
+    }
+    let way = (m.at - walker.at).normalize_or_zero();
+    let mut near = Vec::new();
+    w.crowd.near(m.at, 2.0, &mut near);
+    let others: Vec<(Vec2, f32)> = (near.into_iter())
+        .filter(|&i| i != me)
+        .map(|i| w.crowd.agent(i))
+        .map(|a| (a.at, a.radius))
+        .collect();
+    let spot = negotiate::aside(
+        m.at,
+        m.radius,
+        walker.at,
+        way,
+        walker.radius,
+        &others,
+        w.walls,
+    );
+    if spot.is_some() {
+        m.aside = spot;
+        m.stepped = true;
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A walker whose place is ringed by eight people standing 0.8 m apart (gaps of 0.3 m).
+    fn hemmed_in() -> Sim {
+        let mut movers = vec![Mover::new(Vec2::new(0.0, -4.0), Vec2::ZERO, 0.25, 1.3)];
+        for (x, z) in [
+            (-1, -1),
+            (0, -1),
+            (1, -1),
+            (-1, 0),
+            (1, 0),
+            (-1, 1),
+            (0, 1),
+            (1, 1),
+        ] {
+            let at = Vec2::new(x as f32, z as f32) * 0.8;
+            movers.push(Mover::new(at, at, 0.25, 1.3));
+        }
+        Sim::new(movers)
+    }
+
+    #[test]
+    fn one_standing_in_the_way_steps_aside_when_asked_and_goes_back() {
+        let mut s = hemmed_in();
+        let (mut asked, mut deepest) = (None, 0f32);
+        while !(s.movers[0].standing() && s.movers.iter().all(|m| !m.stepped)) && s.time < 40.0 {
+            s.step(1.0 / 30.0);
+            asked = asked.or(s.movers[0].looking_at);
+            for (i, a) in s.movers.iter().enumerate() {
+                for b in &s.movers[i + 1..] {
+                    deepest = deepest.max(a.radius + b.radius - a.at.distance(b.at));
+                }
+            }
+        }
+        let walker = &s.movers[0];
+        assert!(walker.arrived.is_some(), "{walker:?}");
+        assert_eq!(
+            asked,
+            Some(2),
+            "it asks the one in front of its place, at (0, -0.8)"
+        );
+        assert!(deepest <= 0.01, "bodies {deepest} m into each other");
+        for m in &s.movers[1..] {
+            assert!(m.at.distance(m.goal) < 0.06, "{m:?} is not back");
+        }
+    }
+
+    #[test]
+    fn a_walker_that_cannot_reach_its_place_gives_up_and_says_so() {
+        let mut s = hemmed_in();
+        // the ring packed tight: nobody can step aside
+        for k in 0..16 {
+            let a = std::f32::consts::TAU * k as f32 / 16.0;
+            let at = Vec2::new(a.sin(), a.cos()) * 0.6;
+            s.movers.push(Mover::new(at * 1.9, at * 1.9, 0.25, 1.3));
+            s.movers.push(Mover::new(at, at, 0.25, 1.3));
+        }
+        s.movers.drain(1..9);
+        while !s.all_standing() && s.time < 100.0 {
+            s.step(1.0 / 30.0);
+        }
+        let walker = &s.movers[0];
+        assert!(
+            walker.arrived.is_none() && walker.gave_up.is_some(),
+            "{walker:?}"
+        );
+        assert!(walker.gave_up.unwrap() < 100.0);
+    }
 
     #[test]
     fn a_pair_head_on_passes_and_arrives_and_threads_change_nothing() {
