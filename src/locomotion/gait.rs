@@ -107,6 +107,11 @@ pub fn angle_diff(a: f32, b: f32) -> f32 {
     crate::body::limits::wrap(a - b)
 }
 
+/// Most the body turns away from a planted foot's heading while walking (rad): the hip's
+/// twist (45°) less the pelvis's own rotation in the stride and a margin (at 30° the body turned in
+/// jerks round a table: the head no longer led its turns).
+pub const MAX_STANCE_TWIST: f32 = 0.6;
+
 /// Side of each foot: +1 left (+x when facing +z), −1 right.
 const SIDE: [f32; 2] = [1.0, -1.0];
 /// Phase offset of each foot.
@@ -177,6 +182,24 @@ impl Gait {
             .stop_at
             .is_some_and(|at| at.distance(body.at) < 0.1 && self.settled(k, Body { at, ..body }));
         standing || stopping
+    }
+
+    /// `facing` turned back, if need be, to within [`MAX_STANCE_TWIST`] of every planted
+    /// foot's heading: a body turning in a tight curve turns over its planted foot only as far
+    /// as the hip twists, and the rest of the turn waits for the next step (beyond it the hip's
+    /// limit held the leg back and swung the planted foot round: seen in the plaza, a ball of
+    /// the foot sliding 10 cm).
+    pub fn within_stance_twist(&self, facing: f32) -> f32 {
+        let mut out = facing;
+        for foot in self.feet {
+            if let Foot::Planted { yaw, .. } = foot {
+                let off = angle_diff(out, yaw);
+                if off.abs() > MAX_STANCE_TWIST {
+                    out = yaw + off.signum() * MAX_STANCE_TWIST;
+                }
+            }
+        }
+        out
     }
 
     /// Whether the walker stands: both feet planted where they belong and no speed.

@@ -478,6 +478,7 @@ impl Walker {
         let v = self.velocity();
         if v.length() > 0.05 {
             turn_toward(&mut self.facing, v.x.atan2(v.y), TURN_RATE * dt);
+            self.facing = self.gait.within_stance_twist(self.facing);
             let f = forward(self.facing);
             if v.dot(f) < 0.0 {
                 let keep = v - f * v.dot(f);
