@@ -9,6 +9,7 @@ use super::obstacles::Obstacles;
 use super::steering::{flat, Vehicle};
 use super::walker::STEP;
 use crate::crowd::avoid::NEIGHBOUR_RADIUS;
+use crate::crowd::negotiate::{self, Standing};
 use crate::crowd::{Agent, Avoider, Crowd, Profile};
 
 /// The others a walker shares the ground with: the frame's crowd and its own place in it.
@@ -40,11 +41,12 @@ pub(super) struct Near<'a, 'b> {
 
 impl Near<'_, '_> {
     /// The force toward the velocity chosen among the others ([`DECIDE_EVERY`] steps), or
-    /// `None` when nobody is in the way (or the choice would lead into an obstacle).
+    /// `None` when nobody is in the way (or the choice would lead into an obstacle); with each
+    /// regular choice, whom it asks for room (`asking`, see [`Near::asks`]).
     pub(super) fn steer(
         &self,
         avoider: &mut Avoider,
-        chosen: &mut Option<Vec2>,
+        (chosen, asking): (&mut Option<Vec2>, &mut Option<Vec2>),
         vehicle: &Vehicle,
         facing: f32,
         desired: Vec2,
@@ -56,6 +58,7 @@ impl Near<'_, '_> {
         let regular = tick % DECIDE_EVERY == 0;
         if regular {
             avoider.wait(DECIDE_EVERY as f32 * STEP as f32, velocity.length(), pref);
+            *asking = self.asks(here, velocity, desired, pref);
         }
         // between the regular choices, a course about to touch someone is chosen again at once
         let urgent = !regular
@@ -92,6 +95,31 @@ impl Near<'_, '_> {
         chosen.map(|v| Vec3::new(v.x, 0.0, v.y) - flat(vehicle.velocity))
     }
 }
+
+impl Near<'_, '_> {
+    /// Where the person standing (not moving) in the way of a walker at `here`, held back
+    /// below half its preferred speed `pref`, stands, when they shut its way
+    /// ([`negotiate::blocker`]).
+    fn asks(&self, here: Vec2, velocity: Vec2, desired: Vec2, pref: f32) -> Option<Vec2> {
+        if velocity.length() >= 0.5 * pref || desired.length() < 1e-3 {
+            return None;
+        }
+        let near = neighbours(self.others, self.time, here, negotiate::LOOKAHEAD + 1.0);
+        let standing: Vec<Standing> = (near.iter().enumerate())
+            .filter(|(_, a)| a.velocity.length() < STANDING_SPEED)
+            .map(|(index, a)| Standing {
+                index,
+                at: a.at,
+                radius: a.radius,
+            })
+            .collect();
+        let way = desired.normalize();
+        negotiate::blocker(here, way, self.radius, &standing, self.obstacles).map(|i| near[i].at)
+    }
+}
+
+/// Slower than this (m/s), someone counts as standing.
+const STANDING_SPEED: f32 = 0.05;
 
 /// The others within `r` of `here` at `time` (their places moved on by their velocities).
 pub(super) fn neighbours(o: Others<'_>, time: f64, here: Vec2, r: f32) -> Vec<Agent> {

@@ -97,6 +97,13 @@ pub struct Walker {
     /// its way).
     avoider: Avoider,
     chosen: Option<Vec2>,
+    /// Where the person standing in its way stands, whom it asks for room by looking at them
+    /// (`crowd::negotiate`), while they shut its way.
+    pub asking: Option<Vec2>,
+    /// How much it attends to the one it asks (0 to 1, eased in and out over a quarter of a
+    /// second), and where that one last stood.
+    attention: f32,
+    asked_at: Vec2,
     active: Option<Active>,
 }
 
@@ -116,6 +123,9 @@ impl Walker {
             profile: Profile::default(),
             avoider: Avoider::starting_at(at),
             chosen: None,
+            asking: None,
+            attention: 0.0,
+            asked_at: at,
             active: None,
         }
     }
@@ -145,13 +155,31 @@ impl Walker {
             .map_or(0.0, |a| path::length(&a.route_from(self.body().at)))
     }
 
-    /// How far off its facing the way goes 1.5 m ahead along the route (rad, positive to the
-    /// left); 0 when not walking.
+    /// How far off its facing the way goes 1.5 m ahead along the route, or where the one it
+    /// asks for room stands (rad, positive to the left); 0 when not walking.
     pub fn look_ahead(&self) -> f32 {
-        let Some(a) = self.active.as_ref().filter(|a| !a.stopped) else {
+        if self.active.as_ref().is_none_or(|a| a.stopped) {
+            return 0.0;
+        }
+        let here = self.body().at;
+        let route = self.route_ahead(here);
+        // looking at the one it asks for room, as much as it attends to them
+        let to = self.asked_at - here;
+        let asked = angle_diff(to.x.atan2(to.y), self.facing);
+        route + (asked - route) * self.attention
+    }
+
+    /// How much its head attends to the one it asks for room (0 to 1): the head turns to them
+    /// whatever the gait's amount.
+    pub fn attention(&self) -> f32 {
+        self.attention
+    }
+
+    /// How far off its facing the way goes 1.5 m ahead along the route from `here` (rad).
+    fn route_ahead(&self, here: Vec2) -> f32 {
+        let Some(a) = self.active.as_ref() else {
             return 0.0;
         };
-        let here = self.body().at;
         let (mut left, mut at) = (1.5f32, here);
         for p in a.route_from(here).into_iter().skip(1) {
             let d = at.distance(p);
@@ -342,6 +370,9 @@ impl Walker {
         others: Option<Others<'_>>,
     ) -> Option<Moments> {
         let time = self.time;
+        if others.is_none() || self.active.as_ref().is_none_or(|a| a.stopped) {
+            self.asking = None;
+        }
         // among others, who may press it behind an obstacle: once a second on the global grid
         if others.is_some() && (time / STEP).round() as i64 % REPLAN_EVERY == 0 {
             self.replan_if_lost(obstacles);
@@ -412,7 +443,7 @@ impl Walker {
                             let desired = toward * a.walk.speed * slowing;
                             near.steer(
                                 &mut self.avoider,
-                                &mut self.chosen,
+                                (&mut self.chosen, &mut self.asking),
                                 &self.vehicle,
                                 self.facing,
                                 desired,
@@ -486,6 +517,11 @@ impl Walker {
             }
         }
         let body = self.body();
+        if let Some(p) = self.asking {
+            self.asked_at = p;
+        }
+        let attend = if self.asking.is_some() { 1.0 } else { 0.0 };
+        self.attention += (attend - self.attention) * (1.0 - (-dt / 0.25).exp());
         self.gait.turn_rate = angle_diff(self.facing, facing_before) / dt;
         self.gait.step(dt, body, self.velocity());
         if let Some(a) = self.active.as_mut() {

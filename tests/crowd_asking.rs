@@ -1,0 +1,90 @@
+//! Whole-body walkers ask for room (`crowd::negotiate`): in a corridor shut by a row of people
+//! standing shoulder to shoulder, a walker held back in front of them looks at the one in its
+//! way — its head turns to them — where a walker with an open way looks along its route.
+
+use bml_realizer::body::Skeleton;
+use bml_realizer::realizer::Realizer;
+use bml_realizer::world::World;
+use glam::Vec3;
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// Per frame in which the walker is within 2 m of the row at z = 3 (a row of people standing
+/// at `xs`): where it is (x, z), which way its head faces and which way its body faces (rad
+/// about +y from +z).
+fn heads(xs: &[f32]) -> Vec<(glam::Vec2, f32, f32)> {
+    let people: Vec<String> = (xs.iter().enumerate())
+        .map(|(k, x)| format!(r#""s{k}": {{"position": [{x}, 0, 3], "facing": 180}}"#))
+        .collect();
+    let world = format!(
+        r#"{{"obstacles": [{{"box": [-4, -1, -2.3, 8], "height": 2}}, {{"box": [2.3, -1, 4, 8], "height": 2}}],
+            "characters": {{"w": {{"position": [0.1, 0, 0]}}, {}}}}}"#,
+        people.join(", ")
+    );
+    let mut r = Realizer::new();
+    *r.world_mut() = World::from_json(&world).expect("a world").0;
+    let bml =
+        format!(r#"<bml {NS} id="b" characterId="w"><locomotion id="go" target="0.1,6"/></bml>"#);
+    r.perform_bml(&bml).unwrap();
+    let s = Skeleton::adult();
+    let skull = s.joint("skullbase").unwrap();
+    let mut out = Vec::new();
+    for i in 0..=(8.0 * 60.0) as u32 {
+        let frame = r.tick(f64::from(i) / 60.0);
+        let Some(p) = frame
+            .poses
+            .iter()
+            .find(|p| p.character.as_deref() == Some("w"))
+        else {
+            continue;
+        };
+        let world = p.pose.world(&s);
+        let at = world.positions[0];
+        if (1.0..2.9).contains(&at.z) {
+            let yaw = |q: glam::Quat| {
+                let f = q * Vec3::Z;
+                f.x.atan2(f.z)
+            };
+            let (head, body) = (yaw(world.orientations[skull]), yaw(world.orientations[0]));
+            out.push((glam::Vec2::new(at.x, at.z), head, body));
+        }
+    }
+    out
+}
+
+/// Frames in which the head, turned more than 0.15 rad from the body, faces one of `people`
+/// (within 0.12 rad).
+fn looking_at(frames: &[(glam::Vec2, f32, f32)], people: &[glam::Vec2]) -> usize {
+    (frames.iter())
+        .filter(|(at, head, body)| {
+            (head - body).abs() > 0.15
+                && people.iter().any(|p| {
+                    let to = *p - *at;
+                    (to.x.atan2(to.y) - head).abs() < 0.12
+                })
+        })
+        .count()
+}
+
+#[test]
+fn a_walker_whose_way_is_shut_looks_at_the_one_in_its_way() {
+    let at =
+        |xs: &[f32]| -> Vec<glam::Vec2> { xs.iter().map(|&x| glam::Vec2::new(x, 3.0)).collect() };
+    // gaps of 0.3 m between bodies 0.5 m wide, 0.1 m to the walls: no way through; the walker
+    // stops in front of a gap and looks at one beside it
+    let row = [-1.95, -1.15, -0.35, 0.45, 1.25, 2.05];
+    let shut = heads(&row);
+    let looking = looking_at(&shut, &at(&row));
+    eprintln!(
+        "way shut: the head on someone for {looking} of {} frames",
+        shut.len()
+    );
+    // (52 frames without asking: the body itself turns toward someone as it stops)
+    assert!(looking >= 100, "{looking} of {} frames", shut.len());
+    // a gap of a metre in the middle: it walks through, looking along its way
+    let row = [-1.95, -1.15, 1.25, 2.05];
+    let open = heads(&row);
+    let looking = looking_at(&open, &at(&row));
+    eprintln!("way open: {looking} of {} frames", open.len());
+    assert!(looking <= 3, "{looking} of {} frames", open.len());
+}
