@@ -49,16 +49,14 @@ pub fn blocker(
         })
         .min_by(|a, b| a.1.total_cmp(&b.1))?;
     let (s, _, _) = ahead;
-    let fits = |spot: Vec2| {
-        let clear_of_people = (standing.iter())
-            .filter(|o| o.index != s.index)
-            .all(|o| o.at.distance(spot) >= radius + o.radius + ROOM);
-        clear_of_people && walls.clearance(spot, radius + 0.01) >= radius
-    };
+    let others: Vec<(Vec2, f32)> = (standing.iter())
+        .filter(|o| o.index != s.index)
+        .map(|o| (o.at, o.radius))
+        .collect();
     let beside = s.radius + radius + ROOM;
     let open = [1.0, -1.0]
         .iter()
-        .any(|&sign| fits(s.at + side * sign * beside));
+        .any(|&sign| free(s.at + side * sign * beside, radius, ROOM, &others, walls));
     (!open).then_some(s.index)
 }
 
@@ -81,10 +79,6 @@ pub fn aside(
     // walker keeps to its right)
     let first = if across < -0.01 { -1.0 } else { 1.0 };
     let clear = radius + walker_radius + ROOM;
-    let fits = |spot: Vec2| {
-        (others.iter()).all(|&(o, r)| o.distance(spot) >= radius + r + 0.02)
-            && walls.clearance(spot, radius + 0.01) >= radius
-    };
     let mut spots: Vec<Vec2> = Vec::new();
     for sign in [first, -first] {
         let shift = (clear - across * sign).max(0.0);
@@ -93,7 +87,15 @@ pub fn aside(
         }
     }
     spots.sort_by(|a, b| a.distance(home).total_cmp(&b.distance(home)));
-    (spots.into_iter()).find(|&spot| spot.distance(home) <= 1.0 && fits(spot))
+    (spots.into_iter())
+        .find(|&spot| spot.distance(home) <= 1.0 && free(spot, radius, 0.02, others, walls))
+}
+
+/// Whether a body of `radius` at `spot` keeps `room` from each of `others` (place, radius) and
+/// does not touch a wall.
+fn free(spot: Vec2, radius: f32, room: f32, others: &[(Vec2, f32)], walls: &Obstacles) -> bool {
+    (others.iter()).all(|&(o, r)| o.distance(spot) >= radius + r + room)
+        && walls.clearance(spot, radius + 0.01) >= radius
 }
 
 #[cfg(test)]

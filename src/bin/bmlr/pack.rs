@@ -5,19 +5,18 @@
 //! character is written once per character. The page draws such crowds without faces.
 
 use base64::Engine as _;
-use bml_realizer::body::Skeleton;
-use bml_realizer::engine::CharacterPose;
+use bml_realizer::body::{Pose, Skeleton};
 use serde_json::{json, Value};
 
-/// Frame times and each character's poses (per frame, in the order of `ids`).
-pub fn packed(times: &[f64], poses: &[Vec<CharacterPose>], ids: &[&str]) -> Value {
+/// Frame times and each character's body in every frame (in the order of `ids`).
+pub fn packed(times: &[f64], poses: &[Vec<&Pose>], ids: &[&str]) -> Value {
     let skeleton = Skeleton::adult();
     let joints = skeleton.len();
     let moving: Vec<usize> = (0..joints)
         .filter(|&j| {
             (poses.iter()).any(|frames| {
-                let first = frames.first().map(|p| p.pose.rotations[j]);
-                (frames.iter()).any(|p| Some(p.pose.rotations[j]) != first)
+                let first = frames.first().map(|p| p.rotations[j]);
+                (frames.iter()).any(|p| Some(p.rotations[j]) != first)
             })
         })
         .collect();
@@ -25,7 +24,7 @@ pub fn packed(times: &[f64], poses: &[Vec<CharacterPose>], ids: &[&str]) -> Valu
         .map(|frames| {
             let first = frames.first();
             (0..joints)
-                .map(|j| first.map_or([0.0, 0.0, 0.0, 1.0], |p| rounded(p.pose.rotations[j])))
+                .map(|j| first.map_or([0.0, 0.0, 0.0, 1.0], |p| rounded(p.rotations[j])))
                 .collect()
         })
         .collect();
@@ -33,7 +32,7 @@ pub fn packed(times: &[f64], poses: &[Vec<CharacterPose>], ids: &[&str]) -> Valu
     let mut rotations: Vec<u8> = Vec::with_capacity(times.len() * ids.len() * moving.len() * 8);
     for k in 0..times.len() {
         for frames in poses {
-            let p = &frames[k].pose;
+            let p = frames[k];
             let world = p.world(&skeleton);
             let (at, turn) = (world.positions[0], world.orientations[0].normalize());
             for v in [at.x, at.y, at.z, turn.x, turn.y, turn.z, turn.w] {
@@ -66,10 +65,8 @@ fn rounded(q: glam::Quat) -> [f32; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use bml_realizer::body::Pose;
-    use bml_realizer::face::{Face, FaceModel};
 
-    fn at(turn: f32, x: f32) -> CharacterPose {
+    fn at(turn: f32, x: f32) -> Pose {
         let s = Skeleton::adult();
         let mut pose = Pose::rest(&s);
         pose.rotate(
@@ -77,24 +74,14 @@ mod tests {
             glam::Quat::from_rotation_x(turn),
         );
         pose.root.x = x;
-        CharacterPose {
-            character: None,
-            pose,
-            clamped: Vec::new(),
-            face: Face::neutral(FaceModel::default_model()),
-            sounds: Vec::new(),
-            events: Vec::new(),
-            contacts: None,
-        }
+        pose
     }
 
     #[test]
     fn only_moving_joints_go_in_every_frame_and_they_come_back_within_a_hundredth_of_a_degree() {
-        let poses = vec![
-            vec![at(0.0, 0.0), at(0.5, 0.3)],
-            vec![at(0.2, 1.0), at(0.2, 1.0)],
-        ];
-        let v = packed(&[0.0, 0.5], &poses, &["a", "b"]);
+        let poses = [[at(0.0, 0.0), at(0.5, 0.3)], [at(0.2, 1.0), at(0.2, 1.0)]];
+        let borrowed: Vec<Vec<&Pose>> = poses.iter().map(|f| f.iter().collect()).collect();
+        let v = packed(&[0.0, 0.5], &borrowed, &["a", "b"]);
         let knee = Skeleton::adult().joint("l_knee").unwrap();
         assert_eq!(v["moving"], json!([knee]));
         let b64 = |k: &str| {
@@ -116,7 +103,7 @@ mod tests {
             f32::from(i(11)) / 32767.0,
         );
         // component by component (acos is too coarse this near 0): 1e-4 is 0.01°
-        let want = poses[0][1].pose.rotations[knee];
+        let want = poses[0][1].rotations[knee];
         let off = (glam::Vec4::from(q.normalize()) - glam::Vec4::from(want))
             .abs()
             .max_element();

@@ -395,6 +395,21 @@ impl Recording {
             .collect()
     }
 
+    /// Per character of `ids`, its body in every frame, borrowed (`rests`, in the order of
+    /// `ids`, where a frame has none for it): for a crowd, whose poses are too many to copy.
+    pub fn bodies<'a>(&'a self, ids: &[&str], rests: &'a [CharacterPose]) -> Vec<Vec<&'a Pose>> {
+        let mut out: Vec<Vec<&Pose>> = vec![Vec::with_capacity(self.frames.len()); ids.len()];
+        for (_, poses) in &self.frames {
+            let by_id: std::collections::HashMap<&str, &Pose> = (poses.iter())
+                .map(|p| (p.character.as_deref().unwrap_or(""), &p.pose))
+                .collect();
+            for ((id, rest), list) in ids.iter().zip(rests).zip(&mut out) {
+                list.push(by_id.get(id).copied().unwrap_or(&rest.pose));
+            }
+        }
+        out
+    }
+
     /// `character` at rest where the world places it, for a frame in which it has no pose.
     pub fn standing(&self, character: &str) -> CharacterPose {
         let mut pose = Pose::rest(&Skeleton::adult());

@@ -106,11 +106,19 @@ fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome),
     // a crowd's page carries its frames packed and draws them without faces
     let packed = (characters.len() > CROWD_PAGE).then(|| {
         let times: Vec<f64> = motion.frames.iter().map(|(t, _)| *t).collect();
-        let poses: Vec<_> = characters.iter().map(|id| motion.poses_of(id)).collect();
-        crate::pack::packed(&times, &poses, &characters)
+        let rests: Vec<_> = characters.iter().map(|id| motion.standing(id)).collect();
+        crate::pack::packed(&times, &motion.bodies(&characters, &rests), &characters)
     });
     let (header, lines) = match packed {
-        Some(_) => (motion.lines(&[]).0, Vec::new()),
+        Some(_) => {
+            let header = bml_realizer::character::frames::header(
+                &Skeleton::adult(),
+                args.fps,
+                &[],
+                bml_realizer::character::frames::Detail::Full,
+            );
+            (header, Vec::new())
+        }
         None => motion.lines(&characters),
     };
     // the sound goes in as a WAV data: URL, played in step with the cursor
