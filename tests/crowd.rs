@@ -497,6 +497,20 @@ fn through_doors_halls_and_a_bottleneck_and_round_a_group_nobody_meets_a_wall_or
     }
 }
 
+#[test]
+fn in_every_scene_of_the_quality_table_everyone_arrives_untouched() {
+    // the open scenes too: head-on, crossing, overtaking, confusion, oncoming groups and the
+    // circles of 24 and 250 (in the circle of 250, 57 walkers used to be left going to and fro
+    // past their places along the ring of those already standing, or stuck face to face)
+    for scene in scenes::all() {
+        let q = walk_scene(&scene);
+        assert_eq!(q.stranded, 0, "{}: {q:?}", scene.name);
+        assert_eq!(q.gave_up, 0, "{}: {q:?}", scene.name);
+        let tolerance = if scene.walks.len() > 100 { 0.025 } else { 0.01 };
+        assert!(q.deepest <= tolerance, "{}: {q:?}", scene.name);
+    }
+}
+
 /// Places on a grid of 20 × 20 cells 0.8 m apart (every two at least 0.7 m apart): `n` of
 /// them, in a random order.
 fn cells(n: usize) -> impl Strategy<Value = Vec<Vec2>> {

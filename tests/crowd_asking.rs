@@ -71,7 +71,7 @@ fn a_walker_whose_way_is_shut_looks_at_the_one_in_its_way() {
     let at =
         |xs: &[f32]| -> Vec<glam::Vec2> { xs.iter().map(|&x| glam::Vec2::new(x, 3.0)).collect() };
     // gaps of 0.3 m between bodies 0.5 m wide, 0.1 m to the walls: no way through; the walker
-    // stops in front of a gap and looks at one beside it
+    // stops in front of a gap and looks at one beside it, then tries along the row
     let row = [-1.95, -1.15, -0.35, 0.45, 1.25, 2.05];
     let shut = heads(&row);
     let looking = looking_at(&shut, &at(&row));
@@ -79,8 +79,9 @@ fn a_walker_whose_way_is_shut_looks_at_the_one_in_its_way() {
         "way shut: the head on someone for {looking} of {} frames",
         shut.len()
     );
-    // (52 frames without asking: the body itself turns toward someone as it stops)
-    assert!(looking >= 100, "{looking} of {} frames", shut.len());
+    // (72 frames without asking: the body itself turns toward someone as it stops, and the
+    // head leads the body's turn as it goes along the row to try the next gap)
+    assert!(looking >= 88, "{looking} of {} frames", shut.len());
     // a gap of a metre in the middle: it walks through, looking along its way
     let row = [-1.95, -1.15, 1.25, 2.05];
     let open = heads(&row);

@@ -4,8 +4,10 @@
 //! steadily (the thesis' alertHumanObstacle: a passer-by asking for room gazes at the one in its
 //! way). A standing person so looked at steps aside once the walker is near (its
 //! clearHumanObstacle: not earlier, as an early move can close the space again) to the nearest
-//! free spot that opens the way, and goes back when nobody asks any more. Only standing people
-//! and walls are weighed, as in the thesis: walkers make way for each other by avoidance.
+//! free spot that opens the way, and goes back when nobody asks any more. Only people standing
+//! still and walls are weighed, as in the thesis: walkers make way for each other by avoidance,
+//! except one stuck still (held back until fully impatient), whom others may ask like someone
+//! standing, and who asks whoever stands on its line whether there is room beside them or not.
 
 use glam::Vec2;
 
@@ -33,13 +35,15 @@ pub struct Standing {
 
 /// The standing person who shuts the way of a walker at `at` of radius `radius` going along
 /// `way` (a unit vector), among `standing`, if there is one: the nearest ahead within
-/// [`LOOKAHEAD`] whose body is on the walker's line, beside whom the walker fits on neither side.
+/// [`LOOKAHEAD`] whose body is on the walker's line, beside whom the walker fits on neither side
+/// (or, when it `insist`s, whether it fits or not: a walker stuck behind someone asks them).
 pub fn blocker(
     at: Vec2,
     way: Vec2,
     radius: f32,
     standing: &[Standing],
     walls: &Obstacles,
+    insist: bool,
 ) -> Option<usize> {
     let side = way.perp();
     let ahead = (standing.iter())
@@ -49,6 +53,9 @@ pub fn blocker(
         })
         .min_by(|a, b| a.1.total_cmp(&b.1))?;
     let (s, _, _) = ahead;
+    if insist {
+        return Some(s.index);
+    }
     let others: Vec<(Vec2, f32)> = (standing.iter())
         .filter(|o| o.index != s.index)
         .map(|o| (o.at, o.radius))
@@ -117,13 +124,15 @@ mod tests {
         let walls = Obstacles::default();
         let (at, way) = (Vec2::ZERO, Vec2::Y);
         let one = standing(&[(0.1, 1.5)]);
-        assert_eq!(blocker(at, way, 0.25, &one, &walls), None);
+        assert_eq!(blocker(at, way, 0.25, &one, &walls, false), None);
+        // … unless the walker is stuck behind them: it asks all the same
+        assert_eq!(blocker(at, way, 0.25, &one, &walls, true), Some(0));
         // a gap of 0.3 m on either side of the middle one: too narrow for a body 0.5 m wide
         let row = standing(&[(-0.8, 1.5), (0.0, 1.5), (0.8, 1.5)]);
-        assert_eq!(blocker(at, way, 0.25, &row, &walls), Some(1));
+        assert_eq!(blocker(at, way, 0.25, &row, &walls, false), Some(1));
         // beyond the lookahead, or off the line: nobody
         let far = standing(&[(-0.8, 2.5), (0.0, 2.5), (0.8, 2.5)]);
-        assert_eq!(blocker(at, way, 0.25, &far, &walls), None);
+        assert_eq!(blocker(at, way, 0.25, &far, &walls, false), None);
         // a wall beside one person shuts the way too
         let wall = Obstacles::new(vec![crate::locomotion::Obstacle {
             shape: crate::locomotion::Shape::Box {
@@ -133,9 +142,9 @@ mod tests {
             height: 1.0,
         }]);
         let lone = standing(&[(-0.7, 1.5)]);
-        assert_eq!(blocker(at, way, 0.25, &lone, &wall), None);
+        assert_eq!(blocker(at, way, 0.25, &lone, &wall, false), None);
         let middle = standing(&[(-0.2, 1.5), (-1.0, 1.5)]);
-        assert_eq!(blocker(at, way, 0.25, &middle, &wall), Some(0));
+        assert_eq!(blocker(at, way, 0.25, &middle, &wall, false), Some(0));
     }
 
     #[test]

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use glam::Vec2;
 use rayon::prelude::*;
 
-use super::avoid::{DECIDE_PERIOD, NEIGHBOUR_RADIUS};
+use super::avoid::{progress, DECIDE_PERIOD, NEIGHBOUR_RADIUS};
 use super::negotiate::{self, Standing};
 use super::{Agent, Avoider, Crowd, Profile};
 use crate::locomotion::{path, Obstacles};
@@ -34,7 +34,9 @@ pub const GIVE_UP: f64 = 60.0;
 /// What counts as coming nearer the goal (m).
 pub const PROGRESS: f32 = 0.1;
 /// One standing this far from its place goes back to it when nobody asks it for room (m).
-pub const DISPLACED: f32 = 0.1;
+pub const DISPLACED: f32 = 0.06;
+/// Below this fraction of its preferred speed a fully impatient walker is stuck.
+pub const STILL: f32 = 0.1;
 /// Fewest movers stepped on several threads.
 const PARALLEL_MOVERS: usize = 64;
 
@@ -55,10 +57,11 @@ pub struct Mover {
     pub arrived: Option<f64>,
     /// When it gave up: it came no nearer its goal for [`GIVE_UP`] seconds (it then stands).
     pub gave_up: Option<f64>,
-    /// Walking: the standing person it asks to make room (looks at), while they shut its way.
+    /// Walking: the standing (or stuck) person it asks to make room (looks at), while they
+    /// shut its way.
     pub looking_at: Option<usize>,
-    /// Standing: the spot it steps aside to while a walker asks for room, and whether it has
-    /// left its place (it goes back when nobody asks any more).
+    /// Standing or stuck: the spot it steps aside to while a walker asks for room, and (standing)
+    /// whether it has left its place (it goes back when nobody asks any more).
     aside: Option<Vec2>,
     stepped: bool,
     /// Its least distance to its goal so far, and when that last shrank by [`PROGRESS`].
@@ -133,7 +136,7 @@ impl Mover {
     /// The velocity it wants: toward the point of its route it seeks, slowing in the last
     /// [`SLOW_RADIUS`] before its goal.
     pub fn desired(&self) -> Vec2 {
-        if self.standing() {
+        if self.standing() || self.aside.is_some() {
             // stepping aside for a walker, or back to its place
             let spot = match (self.aside, self.stepped) {
                 (Some(spot), _) => spot,
@@ -173,12 +176,22 @@ impl Mover {
             self.arrived = Some(time);
             self.velocity = Vec2::ZERO;
             self.chosen = None;
+            self.looking_at = None;
         }
     }
 
     /// Whether it stands: arrived, or given up.
     pub fn standing(&self) -> bool {
         self.arrived.is_some() || self.gave_up.is_some()
+    }
+
+    /// Whether it is stuck: walking, but held back so long that it is fully impatient, and
+    /// standing still. Others may then ask it for room as they ask those standing.
+    pub fn stuck(&self) -> bool {
+        !self.standing()
+            && self.aside.is_none()
+            && self.avoider.impatience() >= 1.0
+            && self.velocity.length() < STILL * self.speed
     }
 
     /// Gives up when it has come no nearer its goal for [`GIVE_UP`] seconds up to `time`.
@@ -261,9 +274,12 @@ impl Sim {
     /// Moves everyone on by `dt` seconds, each choosing from where all were before the step.
     pub fn step(&mut self, dt: f32) {
         let crowd = Crowd::unnamed(self.time, self.movers.iter().map(Mover::agent).collect());
-        let standing: Vec<bool> = self.movers.iter().map(Mover::standing).collect();
+        let still: Vec<bool> = (self.movers.iter())
+            .map(|m| m.standing() || m.stuck())
+            .collect();
         // (asked, asking): who asks whom to make room
         let mut asks: Vec<(usize, usize)> = (self.movers.iter().enumerate())
+            .filter(|(_, m)| !m.standing())
             .filter_map(|(i, m)| m.looking_at.map(|t| (t, i)))
             .collect();
         asks.sort_unstable();
@@ -277,7 +293,7 @@ impl Sim {
                 crowd: &crowd,
                 walls,
                 profile: &profile,
-                standing: &standing,
+                still: &still,
                 asks: &asks,
             };
             step_one(m, i, world, decide, every as f32 * dt, dt, time);
@@ -298,8 +314,8 @@ struct World<'a> {
     crowd: &'a Crowd,
     walls: &'a Obstacles,
     profile: &'a Profile,
-    /// Per mover, whether it stands.
-    standing: &'a [bool],
+    /// Per mover, whether it stands or is stuck (may be asked for room).
+    still: &'a [bool],
     /// (asked, asking), sorted: who asks whom to make room.
     asks: &'a [(usize, usize)],
 }
@@ -313,7 +329,7 @@ fn step_one(m: &mut Mover, me: usize, w: World, decide: bool, period: f32, dt: f
         ..
     } = w;
     m.follow(walls, time);
-    if m.standing() {
+    if w.still[me] || m.aside.is_some() {
         make_room(m, me, w);
     }
     let desired = m.desired();
@@ -328,7 +344,7 @@ fn step_one(m: &mut Mover, me: usize, w: World, decide: bool, period: f32, dt: f
     crowd.near(m.at, reach, &mut near);
     let others = near.iter().filter(|&&i| i != me).map(|&i| crowd.agent(i));
     if decide {
-        m.avoider.wait(period, m.velocity.length(), m.speed);
+        m.avoider.wait(period, m.velocity, desired, m.speed);
         let heading = if m.velocity.length() > 0.05 {
             m.velocity.x.atan2(m.velocity.y)
         } else {
@@ -351,7 +367,13 @@ fn step_one(m: &mut Mover, me: usize, w: World, decide: bool, period: f32, dt: f
     m.velocity += (target - m.velocity).clamp_length_max(MAX_ACCELERATION * dt);
     m.at = super::contact::pushed_out(m.at + m.velocity * dt, m.radius, others, dt);
     if (m.arrived.is_none() || m.stepped) && !walls.is_empty() {
-        m.at = walls.push_out(m.at, m.radius);
+        let free = walls.push_out(m.at, m.radius);
+        // a wall stops what goes into it: the velocity others see slides along the wall
+        // (kept, walkers pressed against a wall seemed to their neighbours to move on through
+        // it, and were squeezed into them)
+        let normal = (free - m.at).normalize_or_zero();
+        m.velocity -= normal * m.velocity.dot(normal).min(0.0);
+        m.at = free;
     }
     m.arrive_if_there(time + f64::from(dt));
     if m.stepped && m.aside.is_none() && m.at.distance(m.goal) < ARRIVED {
@@ -360,17 +382,18 @@ fn step_one(m: &mut Mover, me: usize, w: World, decide: bool, period: f32, dt: f
     m.keep_trying(time + f64::from(dt));
 }
 
-/// A walker held back (below half its speed) looks for someone standing who shuts its way,
-/// and asks them for room ([`negotiate::blocker`]).
+/// A walker held back (going its way at below half its speed) looks for someone standing (or
+/// stuck) who shuts its way, and asks them for room ([`negotiate::blocker`]).
 fn ask_for_room(m: &mut Mover, me: usize, desired: Vec2, w: World) {
     m.looking_at = None;
-    if m.velocity.length() >= 0.5 * m.speed || desired.length() < 1e-3 {
+    let held = progress(m.velocity, desired) < 0.5 * m.speed;
+    if !held || desired.length() < 1e-3 || m.aside.is_some() {
         return;
     }
     let mut near = Vec::new();
     w.crowd.near(m.at, negotiate::LOOKAHEAD + 1.0, &mut near);
     let standing: Vec<Standing> = (near.into_iter())
-        .filter(|&i| i != me && w.standing[i])
+        .filter(|&i| i != me && w.still[i])
         .map(|index| {
             let a = w.crowd.agent(index);
             Standing {
@@ -380,7 +403,11 @@ fn ask_for_room(m: &mut Mover, me: usize, desired: Vec2, w: World) {
             }
         })
         .collect();
-    m.looking_at = negotiate::blocker(m.at, desired.normalize(), m.radius, &standing, w.walls);
+    // stuck itself, it asks whoever stands on its line, room beside them or not: its
+    // avoidance found no way round them
+    let insist = m.stuck();
+    let way = desired.normalize();
+    m.looking_at = negotiate::blocker(m.at, way, m.radius, &standing, w.walls, insist);
 }
 
 /// One standing steps aside for a walker within [`negotiate::TRIGGER`] that asks it for room
@@ -389,6 +416,8 @@ fn make_room(m: &mut Mover, me: usize, w: World) {
     let from = w.asks.partition_point(|&(t, _)| t < me);
     let asking = (w.asks[from..].iter())
         .take_while(|&&(t, _)| t == me)
+        // of two stuck walkers who ask each other, the later in the crowd's order makes room
+        .filter(|&&(_, i)| !(m.looking_at == Some(i) && me < i))
         .map(|&(_, i)| w.crowd.agent(i))
         .find(|a| a.at.distance(m.at) <= negotiate::TRIGGER);
     let Some(walker) = asking else {

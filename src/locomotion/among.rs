@@ -25,10 +25,8 @@ pub struct Others<'a> {
 /// [`DECIDE_PERIOD`](crate::crowd::avoid::DECIDE_PERIOD).
 pub const DECIDE_EVERY: i64 = (crate::crowd::avoid::DECIDE_PERIOD / STEP + 0.5) as i64;
 /// How often a walker checks that its course does not touch someone within
-/// [`URGENT_HORIZON`] (steps: 40 times a second).
+/// [`URGENT_HORIZON`](crate::crowd::avoid::URGENT_HORIZON) (steps: 40 times a second).
 pub const WATCH_EVERY: i64 = 6;
-/// A course that touches someone sooner than this (s) is chosen again at once.
-pub const URGENT_HORIZON: f32 = 0.4;
 
 /// What a walker among others needs to steer round them.
 pub(super) struct Near<'a, 'b> {
@@ -57,23 +55,22 @@ impl Near<'_, '_> {
         let tick = (self.time / STEP).round() as i64;
         let regular = tick % DECIDE_EVERY == 0;
         if regular {
-            avoider.wait(DECIDE_EVERY as f32 * STEP as f32, velocity.length(), pref);
+            avoider.wait(DECIDE_EVERY as f32 * STEP as f32, velocity, desired, pref);
             *asking = self.asks(here, velocity, desired, pref);
         }
         // between the regular choices, a course about to touch someone is chosen again at once
+        let me = Agent {
+            at: here,
+            velocity,
+            radius: self.radius,
+        };
         let urgent = !regular
             && tick % WATCH_EVERY == 0
-            && (neighbours(self.others, self.time, here, 2.0).iter()).any(|o| {
-                let reach = self.radius + o.radius + crate::crowd::avoid::BODY_MARGIN;
-                crate::crowd::contact::time_to_contact(o.at - here, o.velocity - velocity, reach)
-                    .is_some_and(|t| t < URGENT_HORIZON)
-            });
+            && crate::crowd::avoid::about_to_touch(
+                me,
+                neighbours(self.others, self.time, here, 2.0).into_iter(),
+            );
         if regular || urgent {
-            let me = Agent {
-                at: here,
-                velocity,
-                radius: self.radius,
-            };
             let near = neighbours(self.others, self.time, here, NEIGHBOUR_RADIUS);
             // the walls are left to the route and the obstacle steering: a walker going round a
             // group's space at its clearance found every forward candidate "into a wall" and
@@ -114,7 +111,8 @@ impl Near<'_, '_> {
             })
             .collect();
         let way = desired.normalize();
-        negotiate::blocker(here, way, self.radius, &standing, self.obstacles).map(|i| near[i].at)
+        negotiate::blocker(here, way, self.radius, &standing, self.obstacles, false)
+            .map(|i| near[i].at)
     }
 }
 
