@@ -106,6 +106,7 @@ fn gait(c: &mut Criterion) {
         speed: 1.3,
         running: false,
         face: None,
+        stepping: false,
     };
     w.start(walk, &o).unwrap();
     w.advance(3.0, &o);

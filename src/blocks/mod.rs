@@ -104,6 +104,8 @@ pub struct BlockManager {
     world: std::sync::Arc<World>,
     /// Where it stands in the world: its frames' root is placed there.
     placement: crate::world::Placement,
+    /// Whether an engine has moved the character from where it was first placed.
+    moved: bool,
     now: f64,
     seq: u64,
     out: Vec<Feedback>,
@@ -139,6 +141,7 @@ impl BlockManager {
             shared: std::sync::Arc::new(World::default()),
             world: std::sync::Arc::new(World::default()),
             placement: crate::world::Placement::default(),
+            moved: false,
             now: 0.0,
             seq: 0,
             out: Vec::new(),
@@ -233,6 +236,12 @@ impl BlockManager {
     /// id does not count).
     pub fn received_blocks(&self) -> bool {
         self.seq > 0
+    }
+
+    /// Whether an engine has moved the character about (it walked, or stepped aside for
+    /// someone without a block of its own).
+    pub fn moved(&self) -> bool {
+        self.moved
     }
 
     /// Ids and statuses of the blocks not yet finished, in arrival order.

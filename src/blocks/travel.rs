@@ -26,6 +26,8 @@ impl BlockManager {
             }
         }
         if at != self.placement {
+            // (the first placement, from the world, is no move)
+            self.moved |= self.placement != crate::world::Placement::default();
             self.placement = at;
             self.world = std::sync::Arc::new(self.shared.seen_from_at(at));
         }
@@ -37,6 +39,11 @@ impl BlockManager {
     /// Whether an engine moves the character about now.
     pub fn moving(&mut self) -> bool {
         (self.registry.engines_mut()).any(|e| e.as_travel().is_some_and(|t| t.moving()))
+    }
+
+    /// Where the person stands whom the character asks to make room, if anyone.
+    pub fn asking(&mut self) -> Option<glam::Vec2> {
+        (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.asking()))
     }
 
     /// Whether each foot is on the ground, if an engine moves the character's feet.

@@ -38,6 +38,8 @@ pub struct Crowd {
     cells: Vec<(u64, u32)>,
     /// The agents' places in the order of `cells` (read together when searching a cell).
     placed: Vec<Vec2>,
+    /// (asked, asking), sorted: who asks whom to make room (`crowd::negotiate`).
+    asks: Vec<(u32, u32)>,
 }
 
 fn cell_of(p: Vec2) -> (i32, i32) {
@@ -91,7 +93,36 @@ impl Crowd {
             agents,
             cells,
             placed,
+            asks: Vec::new(),
         }
+    }
+
+    /// Notes who asks whom to make room: for each asking character (index), the place of the
+    /// one it asks, taken to be whoever stands within 0.15 m of it (the nearest; nobody else).
+    pub fn set_asks(&mut self, asking: impl IntoIterator<Item = (usize, Vec2)>) {
+        let mut near = Vec::new();
+        self.asks.clear();
+        for (who, place) in asking {
+            self.near(place, 0.15, &mut near);
+            let asked = (near.iter().copied())
+                .filter(|&i| i != who)
+                .min_by(|&a, &b| {
+                    let d = |i: usize| self.agents[i].at.distance_squared(place);
+                    d(a).total_cmp(&d(b)).then(a.cmp(&b))
+                });
+            if let Some(asked) = asked {
+                self.asks.push((asked as u32, who as u32));
+            }
+        }
+        self.asks.sort_unstable();
+    }
+
+    /// Who asks character `i` to make room (indices, in order).
+    pub fn askers(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        let from = self.asks.partition_point(|&(t, _)| (t as usize) < i);
+        (self.asks[from..].iter())
+            .take_while(move |&&(t, _)| t as usize == i)
+            .map(|&(_, w)| w as usize)
     }
 
     /// How many characters it holds.
@@ -195,5 +226,28 @@ mod tests {
             assert_eq!(got, want, "{p} {r}");
         }
         assert_eq!(crowd.index("a0021"), Some(21));
+    }
+
+    #[test]
+    fn an_ask_goes_to_whoever_stands_at_the_place_asked() {
+        let at = |x: f32| Agent {
+            at: Vec2::new(x, 0.0),
+            velocity: Vec2::ZERO,
+            radius: 0.25,
+        };
+        let mut crowd = Crowd::unnamed(0.0, vec![at(0.0), at(1.0), at(2.0), at(3.0)]);
+        // 0 and 2 ask the one at x = 1 (2 from a place 10 cm off); 3 asks an empty place
+        crowd.set_asks([
+            (0, Vec2::new(1.0, 0.0)),
+            (2, Vec2::new(1.1, 0.0)),
+            (3, Vec2::new(5.0, 0.0)),
+        ]);
+        assert_eq!(crowd.askers(1).collect::<Vec<_>>(), vec![0, 2]);
+        for nobody in [0, 2, 3] {
+            assert_eq!(crowd.askers(nobody).count(), 0);
+        }
+        // asking the place where it stands itself asks nobody
+        crowd.set_asks([(1, Vec2::new(1.0, 0.0))]);
+        assert_eq!((0..4).map(|i| crowd.askers(i).count()).sum::<usize>(), 0);
     }
 }

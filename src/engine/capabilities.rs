@@ -140,6 +140,12 @@ pub trait Travel {
     fn moving(&self) -> bool {
         false
     }
+
+    /// Where the person stands whom the character, held back, asks to make room (world x, z),
+    /// if it asks anyone (`crowd::negotiate`).
+    fn asking(&self) -> Option<glam::Vec2> {
+        None
+    }
 }
 
 /// New sync times for a unit of a [`Travel`] engine.

@@ -27,6 +27,7 @@ use crate::body::{Pose, Skeleton};
 use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitKey, Units};
 use crate::feedback::KnownWarning;
 use crate::locomotion::posing::{lead_the_turn, pose_gait, GaitJoints};
+use crate::locomotion::room::{make_room, Room};
 use crate::locomotion::targets::{resolve, Pursuit};
 use crate::locomotion::{walker, Moments, Obstacles, Walk, Walker};
 use crate::timing::{SyncName, TimingModel, TimingModels};
@@ -81,6 +82,8 @@ pub struct LocomotionEngine {
     pursuit: Pursuit,
     /// What the walk under way goes round (see [`LocomotionEngine::round`]).
     obstacles: Arc<Obstacles>,
+    /// Standing, whether it made room for a walker and where it stood before.
+    room: Option<Room>,
 }
 
 /// Reads a locomotion behaviour's order.
@@ -203,6 +206,7 @@ impl LocomotionEngine {
                 speed: u.order.speed,
                 running: u.order.running,
                 face,
+                stepping: false,
             },
             None => {
                 self.fail(&key, world.unknown_target(&u.order.target));
@@ -367,6 +371,7 @@ impl Engine for LocomotionEngine {
             speed: o.speed,
             running: o.running,
             face,
+            stepping: false,
         };
         let m = match self.rehearse(walker, &walk, &self.round(world, walker, &walk)) {
             Ok(m) => m,
@@ -499,6 +504,7 @@ impl Travel for LocomotionEngine {
         }
         // (shared, not copied: the world changes every frame someone walks)
         self.world = Some(world.clone());
+        self.make_room(now, world, id, at);
         // a character that never walked and has no walk to start stands where it is placed
         if !self.walked && self.units.is_empty() {
             self.walker = None;
@@ -571,6 +577,10 @@ impl Travel for LocomotionEngine {
         self.current.is_some() || (self.walker.as_ref()).is_some_and(|w| !w.gait.at_rest(w.body()))
     }
 
+    fn asking(&self) -> Option<Vec2> {
+        self.walker.as_ref().and_then(|w| w.asking)
+    }
+
     fn contacts(&self) -> Option<[bool; 2]> {
         let w = self.walker.as_ref().filter(|_| self.walked)?;
         Some(
@@ -582,6 +592,38 @@ impl Travel for LocomotionEngine {
 }
 
 impl LocomotionEngine {
+    /// Standing (no walk of its own under way), makes room for a walker who asks it, or goes
+    /// back once nobody asks (`locomotion::room`); such a walk sends no feedback.
+    fn make_room(&mut self, now: f64, world: &World, id: &str, at: Placement) {
+        if self.current.is_some() {
+            self.room = None;
+            return;
+        }
+        let crowd = world.crowd();
+        let Some(me) = crowd.index(id) else {
+            return;
+        };
+        if self.room.is_none() && crowd.askers(me).next().is_none() {
+            return;
+        }
+        let obstacles = world.obstacles_for(id);
+        let w = self.walker(at, world, now);
+        let (body, radius, walking) = (w.body(), w.radius, w.moments().is_some());
+        if self.room.as_ref().is_some_and(|r| !r.aside) && !walking {
+            // back at its place
+            self.room = None;
+            return;
+        }
+        let me = (me, body, radius);
+        if let Some(walk) = make_room(&mut self.room, now, me, crowd, &obstacles) {
+            let w = self.walker.as_mut().expect("made above");
+            if w.start(walk, &obstacles).is_ok() {
+                self.obstacles = obstacles;
+                self.walked = true;
+            }
+        }
+    }
+
     /// The key of the unstarted unit starting at `start` (the first added of several).
     fn unit_starting_at(&self, start: f64) -> Option<UnitKey> {
         (self.units.keyed())

@@ -13,6 +13,7 @@ pub mod gait;
 pub mod obstacles;
 pub mod path;
 pub mod posing;
+pub mod room;
 pub mod steering;
 pub mod targets;
 pub mod walker;

@@ -46,6 +46,9 @@ pub struct Walk {
     pub running: bool,
     /// A point to turn to once arrived.
     pub face: Option<Vec2>,
+    /// A few steps to one side or back, keeping the facing (making room: `locomotion::room`),
+    /// rather than turning to walk the way.
+    pub stepping: bool,
 }
 
 /// When a walk's sync points happened (global times).
@@ -388,6 +391,7 @@ impl Walker {
             let next = ahead.get(1).copied().unwrap_or(a.walk.goal);
             let wanted = (next - here).normalize_or_zero();
             let behind = wanted != Vec2::ZERO
+                && !a.walk.stepping
                 && angle_diff(wanted.x.atan2(wanted.y), self.facing).abs() > TURN_FIRST;
             // arriving, the floor speed is braked away where the arrival would stop dead (a
             // person does not stop from 0.12 m/s in a step; this takes about 0.1 s and 5 mm)
@@ -429,7 +433,8 @@ impl Walker {
                         },
                     );
                     let f = match others {
-                        Some(o) if o.crowd.len() > 1 => {
+                        // (stepping aside for someone, it does not avoid them)
+                        Some(o) if o.crowd.len() > 1 && !a.walk.stepping => {
                             let toward = (route.get(1).copied().unwrap_or(a.walk.goal) - here)
                                 .normalize_or_zero();
                             let slowing = (left / a.slow_radius()).clamp(0.1, 1.0);
@@ -505,9 +510,10 @@ impl Walker {
         if out != here {
             self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
         }
-        // face the way of travel, never walk backwards
+        // face the way of travel, never walk backwards (unless stepping aside)
         let v = self.velocity();
-        if v.length() > 0.05 {
+        let stepping = self.active.as_ref().is_some_and(|a| a.walk.stepping);
+        if v.length() > 0.05 && !stepping {
             turn_toward(&mut self.facing, v.x.atan2(v.y), TURN_RATE * dt);
             self.facing = self.gait.within_stance_twist(self.facing);
             let f = forward(self.facing);
@@ -615,6 +621,7 @@ mod tests {
             speed: 1.3,
             running: false,
             face: None,
+            stepping: false,
         };
         let o = Obstacles::default();
         w.start(walk.clone(), &o).unwrap();

@@ -548,8 +548,22 @@ impl Realizer {
                 .filter(|id| !self.world.is_placed(id))
                 .map(|id| agent(id, crate::world::Placement::default())),
         );
-        let crowd = crate::crowd::Crowd::new(now, agents);
+        let mut crowd = crate::crowd::Crowd::new(now, agents);
+        let asking: Vec<(usize, glam::Vec2)> = (self.characters.iter_mut())
+            .filter_map(|(id, m)| Some((crowd.index(id)?, m.asking()?)))
+            .collect();
+        crowd.set_asks(asking);
+        // one placed by the world file alone, asked to make room, becomes a character here
+        // (standing, with the engines that can move it aside)
+        let asked: Vec<String> = (0..crowd.len())
+            .filter(|&i| crowd.askers(i).next().is_some())
+            .map(|i| crowd.id(i).to_string())
+            .filter(|id| !self.characters.contains_key(id))
+            .collect();
         std::sync::Arc::make_mut(&mut self.world).set_crowd(crowd);
+        for id in asked {
+            self.manager(Some(id));
+        }
     }
 }
 

@@ -429,10 +429,11 @@ impl Recording {
     }
 }
 
-/// Every character that received blocks, sorted by id (the default character is `""`).
+/// Every character that received blocks, or moved without (a character placed by the world
+/// file that stepped aside for a walker), sorted by id (the default character is `""`).
 pub fn received(realizer: &Realizer) -> Vec<&str> {
     let mut ids: Vec<&str> = (realizer.characters())
-        .filter(|(_, m)| m.received_blocks())
+        .filter(|(_, m)| m.received_blocks() || m.moved())
         .map(|(c, _)| c)
         .collect();
     ids.sort_unstable();

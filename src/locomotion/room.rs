@@ -1,0 +1,100 @@
+//! A whole-body character standing in someone's way makes room when asked ("Social Path
+//! Following" §5.2.3, the clearHumanObstacle half of the negotiation of space; the walker's half,
+//! looking at the one in its way, is `crowd::negotiate::blocker` and [`Walker::asking`]). The
+//! crowd snapshot says who asks whom; a character standing (no walk of its own under way) that
+//! is asked by a walker within [`TRIGGER`] walks, at the negotiation's stepping speed, to the
+//! nearest free spot that opens the walker's way (`crowd::negotiate::aside`), turned as it
+//! stood, and walks back to its place, turned as before, once nobody asks any more. These walks
+//! are the character's own: they send no feedback.
+//!
+//! [`Walker::asking`]: super::Walker::asking
+
+use glam::Vec2;
+
+use super::gait::{forward, Body};
+use super::{Obstacles, Walk};
+use crate::crowd::negotiate::{self, STEP_SPEED, TRIGGER};
+use crate::crowd::Crowd;
+
+/// How long after the last ask one who stepped aside stays there at least (s): a walker's ask
+/// comes and goes as it judges its way, and one that went back at each lapse never got aside.
+pub const HOLD: f64 = 1.0;
+
+/// Where a character that made room stood, whether it is aside now, for whom.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Room {
+    /// Its place (and facing) before it was first asked.
+    pub home: Body,
+    /// Whether it stands (or walks) aside; false once it walks back.
+    pub aside: bool,
+    /// The walker it made room for (its id), and when that one last asked.
+    pub walker: String,
+    /// When it was last asked (s).
+    pub asked: f64,
+}
+
+/// The walk a standing character at `body` (index `me` in `crowd`, radius `radius`, among
+/// `obstacles`) sets off on at `now` to make room or to go back, given what it did so far
+/// (`room`, updated); `None` when it keeps doing what it does. It goes back once nobody has
+/// asked it for [`HOLD`] and the walker it made room for is more than [`TRIGGER`] from its
+/// place.
+pub fn make_room(
+    room: &mut Option<Room>,
+    now: f64,
+    (me, body, radius): (usize, Body, f32),
+    crowd: &Crowd,
+    obstacles: &Obstacles,
+) -> Option<Walk> {
+    let near = (crowd.askers(me)).find(|&i| crowd.agent(i).at.distance(body.at) <= TRIGGER);
+    if let Some(r) = room.as_mut() {
+        if crowd.askers(me).next().is_some() {
+            r.asked = now;
+        }
+        if r.aside {
+            let walker_near = (crowd.index(&r.walker))
+                .is_some_and(|i| crowd.agent(i).at.distance(r.home.at) <= TRIGGER);
+            if now - r.asked < HOLD || walker_near {
+                return None;
+            }
+            r.aside = false;
+            return Some(walk_to(r.home.at, r.home));
+        }
+    }
+    let walker = crowd.agent(near?);
+    let home = room.as_ref().map_or(body, |r| r.home);
+    let way = (body.at - walker.at).normalize_or_zero();
+    let mut around = Vec::new();
+    crowd.near(body.at, 2.0, &mut around);
+    let others: Vec<(Vec2, f32)> = (around.into_iter())
+        .filter(|&i| i != me)
+        .map(|i| crowd.agent(i))
+        .map(|a| (a.at, a.radius))
+        .collect();
+    let spot = negotiate::aside(
+        body.at,
+        radius,
+        walker.at,
+        way,
+        walker.radius,
+        &others,
+        obstacles,
+    )?;
+    *room = Some(Room {
+        home,
+        aside: true,
+        walker: crowd.id(near?).to_string(),
+        asked: now,
+    });
+    Some(walk_to(spot, home))
+}
+
+/// A walk at the stepping speed to `spot`, ending turned as `home` faced.
+fn walk_to(spot: Vec2, home: Body) -> Walk {
+    Walk {
+        goal: spot,
+        speed: STEP_SPEED,
+        running: false,
+        face: Some(spot + forward(home.facing)),
+        stepping: true,
+    }
+}
