@@ -6,6 +6,7 @@ use bml_realizer::body::Skeleton;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
 use glam::Vec3;
+use std::f32::consts::PI;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 
@@ -95,8 +96,11 @@ fn a_walker_whose_way_is_shut_looks_at_the_one_in_its_way() {
     assert!(looking <= 3, "{looking} of {} frames", open.len());
 }
 
-/// The corridor of [`heads`] shut by `xs`, walked for `seconds`: per frame, everyone's place.
-fn corridor(xs: &[f32], seconds: f64) -> (Realizer, Vec<Vec<(String, glam::Vec2)>>) {
+/// Per frame: everyone's place, and the head's and the body's heading of everyone posed.
+type Places = Vec<(Vec<(String, glam::Vec2)>, Vec<(String, f32, f32)>)>;
+
+/// The corridor of [`heads`] shut by `xs`, walked for `seconds`.
+fn corridor(xs: &[f32], seconds: f64) -> (Realizer, Places) {
     let people: Vec<String> = (xs.iter().enumerate())
         .map(|(k, x)| format!(r#""s{k}": {{"position": [{x}, 0, 3], "facing": 180}}"#))
         .collect();
@@ -110,13 +114,30 @@ fn corridor(xs: &[f32], seconds: f64) -> (Realizer, Vec<Vec<(String, glam::Vec2)
     let bml =
         format!(r#"<bml {NS} id="b" characterId="w"><locomotion id="go" target="0.1,6"/></bml>"#);
     r.perform_bml(&bml).unwrap();
+    let s = Skeleton::adult();
+    let skull = s.joint("skullbase").unwrap();
+    let yaw = |q: glam::Quat| {
+        let f = q * Vec3::Z;
+        f.x.atan2(f.z)
+    };
     let mut places = Vec::new();
     for i in 0..=(seconds * 60.0) as u32 {
-        r.tick(f64::from(i) / 60.0);
+        let frame = r.tick(f64::from(i) / 60.0);
         let at = (r.world().placements())
             .map(|(id, p)| (id.to_string(), glam::Vec2::new(p.position.x, p.position.z)))
             .collect();
-        places.push(at);
+        let heads = (frame.poses.iter())
+            .map(|p| {
+                let world = p.pose.world(&s);
+                let id = p.character.clone().unwrap_or_default();
+                (
+                    id,
+                    yaw(world.orientations[skull]),
+                    yaw(world.orientations[0]),
+                )
+            })
+            .collect();
+        places.push((at, heads));
     }
     (r, places)
 }
@@ -126,7 +147,7 @@ fn one_standing_in_the_way_steps_aside_for_the_walker_and_goes_back() {
     // the row of the test above: no way through until one of them makes room
     let row = [-1.95, -1.15, -0.35, 0.45, 1.25, 2.05];
     let (mut r, places) = corridor(&row, 14.0);
-    let last = places.last().unwrap();
+    let last = &places.last().unwrap().0;
     let w = last.iter().find(|(id, _)| id == "w").unwrap().1;
     assert!(
         w.distance(glam::Vec2::new(0.1, 6.0)) < 0.15,
@@ -140,10 +161,28 @@ fn one_standing_in_the_way_steps_aside_for_the_walker_and_goes_back() {
     // someone stepped aside (more than 0.2 m) and everyone is back within 5 cm of their place
     let mut farthest = 0f32;
     let mut closest = f32::INFINITY;
-    for frame in &places {
+    let (mut watching, mut aside) = (0, 0);
+    for (frame, heads) in &places {
+        let w = frame.iter().find(|(id, _)| id == "w").unwrap().1;
         for (id, at) in frame {
             if let Some(k) = id.strip_prefix('s').and_then(|k| k.parse::<usize>().ok()) {
-                farthest = farthest.max(at.distance(glam::Vec2::new(row[k], 3.0)));
+                let off = at.distance(glam::Vec2::new(row[k], 3.0));
+                farthest = farthest.max(off);
+                // aside with the walker near: does its head, turned from its body, face it?
+                if off > 0.2 && at.distance(w) < 1.5 {
+                    aside += 1;
+                    let to = w - *at;
+                    // toward it: facing it (within 0.35 rad), or turned its way from the body
+                    // by 0.3 rad or more where it is further round than that
+                    let faces = heads.iter().any(|(h, head, body)| {
+                        let wrap = |a: f32| (a + PI).rem_euclid(2.0 * PI) - PI;
+                        let (want, turned) = (wrap(to.x.atan2(to.y) - body), wrap(head - body));
+                        h == id
+                            && ((want - turned).abs() < 0.35
+                                || (want.abs() > 0.35 && turned * want.signum() >= 0.3))
+                    });
+                    watching += usize::from(faces);
+                }
             }
         }
         for (i, (_, a)) in frame.iter().enumerate() {
@@ -153,6 +192,13 @@ fn one_standing_in_the_way_steps_aside_for_the_walker_and_goes_back() {
         }
     }
     assert!(farthest > 0.2, "nobody stepped aside ({farthest} m)");
+    // the one who made room watches the walker (the seed's clearHumanObstacle)
+    eprintln!("watching the walker in {watching} of {aside} frames aside with it near");
+    // (275 of 275 frames; 65 without the watching, when the walker was in front anyway)
+    assert!(
+        aside > 30 && watching * 10 >= aside * 8,
+        "{watching} of {aside}"
+    );
     for (id, at) in last {
         if let Some(k) = id.strip_prefix('s').and_then(|k| k.parse::<usize>().ok()) {
             let home = glam::Vec2::new(row[k], 3.0);

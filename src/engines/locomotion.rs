@@ -595,6 +595,9 @@ impl LocomotionEngine {
     /// Standing (no walk of its own under way), makes room for a walker who asks it, or goes
     /// back once nobody asks (`locomotion::room`); such a walk sends no feedback.
     fn make_room(&mut self, now: f64, world: &World, id: &str, at: Placement) {
+        if let Some(w) = self.walker.as_mut() {
+            w.watching = None;
+        }
         if self.current.is_some() {
             self.room = None;
             return;
@@ -603,6 +606,15 @@ impl LocomotionEngine {
         let Some(me) = crowd.index(id) else {
             return;
         };
+        // (making room, it watches the walker it makes room for while that one is near)
+        let watched = (self.room.as_ref())
+            .and_then(|r| crowd.index(&r.walker))
+            .map(|i| crowd.agent(i).at)
+            .filter(|p| {
+                self.room
+                    .as_ref()
+                    .is_some_and(|r| p.distance(r.home.at) < 2.5)
+            });
         if self.room.is_none() && crowd.askers(me).next().is_none() {
             return;
         }
@@ -615,8 +627,10 @@ impl LocomotionEngine {
             return;
         }
         let me = (me, body, radius);
-        if let Some(walk) = make_room(&mut self.room, now, me, crowd, &obstacles) {
-            let w = self.walker.as_mut().expect("made above");
+        let walk = make_room(&mut self.room, now, me, crowd, &obstacles);
+        let w = self.walker.as_mut().expect("made above");
+        w.watching = watched;
+        if let Some(walk) = walk {
             if w.start(walk, &obstacles).is_ok() {
                 self.obstacles = obstacles;
                 self.walked = true;

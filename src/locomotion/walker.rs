@@ -103,6 +103,8 @@ pub struct Walker {
     /// Where the person standing in its way stands, whom it asks for room by looking at them
     /// (`crowd::negotiate`), while they shut its way.
     pub asking: Option<Vec2>,
+    /// Where the walker stands for whom it makes room (`locomotion::room`), whom it watches.
+    pub watching: Option<Vec2>,
     /// How much it attends to the one it asks (0 to 1, eased in and out over a quarter of a
     /// second), and where that one last stood.
     attention: f32,
@@ -127,6 +129,7 @@ impl Walker {
             avoider: Avoider::starting_at(at),
             chosen: None,
             asking: None,
+            watching: None,
             attention: 0.0,
             asked_at: at,
             active: None,
@@ -158,14 +161,12 @@ impl Walker {
             .map_or(0.0, |a| path::length(&a.route_from(self.body().at)))
     }
 
-    /// How far off its facing the way goes 1.5 m ahead along the route, or where the one it
-    /// asks for room stands (rad, positive to the left); 0 when not walking.
+    /// How far off its facing the way goes 1.5 m ahead along the route (0 when not walking),
+    /// or where the one it asks for room, or watches, stands (rad, positive to the left).
     pub fn look_ahead(&self) -> f32 {
-        if self.active.as_ref().is_none_or(|a| a.stopped) {
-            return 0.0;
-        }
         let here = self.body().at;
-        let route = self.route_ahead(here);
+        let walking = self.active.as_ref().is_some_and(|a| !a.stopped);
+        let route = if walking { self.route_ahead(here) } else { 0.0 };
         // looking at the one it asks for room, as much as it attends to them
         let to = self.asked_at - here;
         let asked = angle_diff(to.x.atan2(to.y), self.facing);
@@ -346,7 +347,12 @@ impl Walker {
     ) -> Option<Moments> {
         let mut ended = None;
         while self.time + STEP <= t + 1e-9 {
-            if self.active.is_none() && self.gait.at_rest(self.body()) && self.gait.amount < 1e-3 {
+            let attending = self.watching.is_some() || self.attention > 1e-3;
+            if self.active.is_none()
+                && self.gait.at_rest(self.body())
+                && self.gait.amount < 1e-3
+                && !attending
+            {
                 self.count(((t + 1e-9 - self.time) / STEP).floor() as u64);
                 self.gait.amount = 0.0;
                 break;
@@ -523,10 +529,14 @@ impl Walker {
             }
         }
         let body = self.body();
-        if let Some(p) = self.asking {
+        if let Some(p) = self.asking.or(self.watching) {
             self.asked_at = p;
         }
-        let attend = if self.asking.is_some() { 1.0 } else { 0.0 };
+        let attend = if self.asking.or(self.watching).is_some() {
+            1.0
+        } else {
+            0.0
+        };
         self.attention += (attend - self.attention) * (1.0 - (-dt / 0.25).exp());
         self.gait.turn_rate = angle_diff(self.facing, facing_before) / dt;
         self.gait.step(dt, body, self.velocity());
