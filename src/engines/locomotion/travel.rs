@@ -1,0 +1,167 @@
+//! The locomotion engine's travel: stepping the walker to each frame's time among the others
+//! (starting the walks that are due, following their moments, pursuing a moving target), and,
+//! standing, making room for a walker that asks (`locomotion::room`).
+
+use glam::{Vec2, Vec3};
+
+use super::LocomotionEngine;
+use crate::engine::{Revision, Travel, UnitKey};
+use crate::locomotion::room::make_room;
+use crate::locomotion::targets::resolve;
+use crate::locomotion::walker;
+use crate::world::{Placement, World};
+
+impl Travel for LocomotionEngine {
+    fn travel(
+        &mut self,
+        now: f64,
+        world: &std::sync::Arc<World>,
+        id: &str,
+        at: Placement,
+    ) -> Placement {
+        if self.id != id {
+            self.id = id.to_string();
+        }
+        // (shared, not copied: the world changes every frame someone walks)
+        self.world = Some(world.clone());
+        self.make_room(now, world, id, at);
+        // a character that never walked and has no walk to start stands where it is placed
+        if !self.walked && self.units.is_empty() {
+            self.walker = None;
+            self.at = at;
+            return at;
+        }
+        // a new walker starts no later than the first walk
+        let first = (self.units.all())
+            .filter_map(|(syncs, u)| (!u.started).then(|| syncs.first().map(|s| s.1)).flatten())
+            .fold(now, f64::min);
+        self.walker(at, world, first);
+        loop {
+            // the next walk to start by now
+            let next = (self.units.all())
+                .filter(|(syncs, u)| !u.started && syncs.first().is_some_and(|s| s.1 <= now))
+                .map(|(syncs, _)| syncs[0].1)
+                .reduce(f64::min);
+            let until = next.unwrap_or(now).min(now);
+            // a walk is stepped no further than its deadline at a time: a huge jump of the
+            // clock ends it there instead of simulating all of it
+            let deadline = (self.current.as_ref())
+                .and_then(|k| self.units.get(k))
+                .map_or(f64::INFINITY, |u| u.deadline);
+            let stop = until.min(deadline + walker::STEP);
+            let others = walker::Others {
+                crowd: world.crowd(),
+                me: world.crowd().index(id),
+            };
+            let ended = self
+                .walker
+                .as_mut()
+                .and_then(|w| w.advance_among(stop, &self.obstacles, Some(others)));
+            self.follow_moments(stop, ended);
+            if stop < until {
+                continue;
+            }
+            let Some(start) = next else { break };
+            match self.unit_starting_at(start) {
+                Some(k) => self.start_walk(k, world),
+                None => break,
+            }
+        }
+        // a moving target: pursue it
+        let order =
+            (self.current.as_ref()).and_then(|k| self.units.get(k).map(|u| u.order.clone()));
+        if let (Some(o), Some(w)) = (order, self.walker.as_mut()) {
+            let from = w.body().at;
+            if let Some((goal, face)) = resolve(world, id, &o.target, from) {
+                self.pursuit.observe(now, face.unwrap_or(goal));
+                let aim = self.pursuit.aim(goal, from, o.speed);
+                w.retarget(aim, face, &self.obstacles);
+            }
+        }
+        let body = self.walker.as_ref().map(|w| w.body());
+        self.at = match body {
+            Some(b) => Placement {
+                position: Vec3::new(b.at.x, at.position.y, b.at.y),
+                facing: b.facing,
+            },
+            None => at,
+        };
+        self.at
+    }
+
+    fn take_revisions(&mut self) -> Vec<Revision> {
+        std::mem::take(&mut self.revisions)
+    }
+
+    fn moving(&self) -> bool {
+        self.current.is_some() || (self.walker.as_ref()).is_some_and(|w| !w.gait.at_rest(w.body()))
+    }
+
+    fn asking(&self) -> Option<Vec2> {
+        self.walker.as_ref().and_then(|w| w.asking)
+    }
+
+    fn contacts(&self) -> Option<[bool; 2]> {
+        let w = self.walker.as_ref().filter(|_| self.walked)?;
+        Some(
+            w.gait
+                .feet
+                .map(|f| matches!(f, crate::locomotion::gait::Foot::Planted { .. })),
+        )
+    }
+}
+
+impl LocomotionEngine {
+    /// Standing (no walk of its own under way), makes room for a walker who asks it, or goes
+    /// back once nobody asks (`locomotion::room`); such a walk sends no feedback.
+    fn make_room(&mut self, now: f64, world: &World, id: &str, at: Placement) {
+        if let Some(w) = self.walker.as_mut() {
+            w.watching = None;
+        }
+        if self.current.is_some() {
+            self.room = None;
+            return;
+        }
+        let crowd = world.crowd();
+        let Some(me) = crowd.index(id) else {
+            return;
+        };
+        // (making room, it watches the walker it makes room for while that one is near)
+        let watched = (self.room.as_ref())
+            .and_then(|r| crowd.index(&r.walker))
+            .map(|i| crowd.agent(i).at)
+            .filter(|p| {
+                self.room
+                    .as_ref()
+                    .is_some_and(|r| p.distance(r.home.at) < 2.5)
+            });
+        if self.room.is_none() && crowd.askers(me).next().is_none() {
+            return;
+        }
+        let obstacles = world.obstacles_for(id);
+        let w = self.walker(at, world, now);
+        let (body, radius, walking) = (w.body(), w.radius, w.moments().is_some());
+        if self.room.as_ref().is_some_and(|r| !r.aside) && !walking {
+            // back at its place
+            self.room = None;
+            return;
+        }
+        let me = (me, body, radius);
+        let walk = make_room(&mut self.room, now, me, crowd, &obstacles);
+        let w = self.walker.as_mut().expect("made above");
+        w.watching = watched;
+        if let Some(walk) = walk {
+            if w.start(walk, &obstacles).is_ok() {
+                self.obstacles = obstacles;
+                self.walked = true;
+            }
+        }
+    }
+
+    /// The key of the unstarted unit starting at `start` (the first added of several).
+    fn unit_starting_at(&self, start: f64) -> Option<UnitKey> {
+        (self.units.keyed())
+            .find(|(syncs, u, _)| !u.started && syncs.first().is_some_and(|s| s.1 == start))
+            .map(|(_, _, k)| k.clone())
+    }
+}
