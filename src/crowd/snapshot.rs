@@ -10,6 +10,17 @@
 
 use glam::Vec2;
 
+/// How often walkers among others see where the others are (s): the realizer builds the crowd
+/// every this much global time, on a grid of its multiples, so that no result depends on the
+/// host's frames.
+pub const PERIOD: f64 = 0.05;
+
+/// Whether `t` is a time of the crowd's grid (within a millionth of a period).
+pub fn on_grid(t: f64) -> bool {
+    let k = t / PERIOD;
+    (k - k.round()).abs() < 1e-6
+}
+
 /// Side of a grid cell (m).
 pub const CELL: f32 = 2.0;
 /// Most characters a crowd holds (beyond, the rest are not seen by walkers, with a warning

@@ -22,7 +22,13 @@ use glam::{Quat, Vec2, Vec3};
 pub const STRAIN_BEHIND: f32 = 0.45;
 /// … and turned against it by more than this (rad) strains the hip.
 pub const STRAIN_TWIST: f32 = 0.3;
-/// Each this much strain (m × rad beyond both) adds one cadence to the stepping.
+/// Slowest walk that hurries its steps (m/s).
+pub const HURRY_SPEED: f32 = 0.6;
+/// Strain (m × rad beyond both) a step bears at its own pace: rounding the table of the
+/// example room at 1.27 m/s reaches up to about 0.01 (hurried there, the walk ended 0.3 s
+/// later and the head led the turns less); the plaza's dragged foot bore 0.013–0.016.
+pub const STRAIN_FREE: f32 = 0.011;
+/// Each this much strain beyond [`STRAIN_FREE`] adds one cadence to the stepping.
 pub const STRAIN_PER_CADENCE: f32 = 0.003;
 /// The walk ratio (m per step/min).
 pub const WALK_RATIO: f32 = 0.0061;
@@ -215,6 +221,10 @@ impl Gait {
     /// turns 34° over it; a walker speeding up out of a 30° turn over a foot 0.55 m behind
     /// could no longer reach it, and dragged it 8 cm (seen in the plaza).
     fn hurry(&self, body: Body) -> f32 {
+        // (only walking on: stopping and turning on the spot the feet close at their own pace)
+        if self.speed < HURRY_SPEED {
+            return 1.0;
+        }
         let strain = (self.feet.iter())
             .filter_map(|foot| match *foot {
                 Foot::Planted { at, yaw } => {
@@ -225,7 +235,7 @@ impl Gait {
                 Foot::Swing { .. } => None,
             })
             .fold(0.0f32, f32::max);
-        1.0 + strain / STRAIN_PER_CADENCE
+        1.0 + (strain - STRAIN_FREE).max(0.0) / STRAIN_PER_CADENCE
     }
 
     /// Whether the walker stands: both feet planted where they belong and no speed.

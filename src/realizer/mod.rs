@@ -179,13 +179,17 @@ impl Realizer {
     }
 
     fn manager(&mut self, character: Option<String>) -> &mut BlockManager {
+        self.manager_at(character, self.now)
+    }
+
+    /// [`manager`](Self::manager), a new one made as of time `now`.
+    fn manager_at(&mut self, character: Option<String>, now: f64) -> &mut BlockManager {
         let character = character.or_else(|| self.default_character.clone());
         let key = character.clone().unwrap_or_default();
         if self.characters.contains_key(&key) {
             // the usual case: no entry to build
             return self.characters.get_mut(&key).expect("just found");
         }
-        let now = self.now;
         let (engines, strategy, skeleton, world, idle) = (
             &self.engines,
             &self.strategy,
@@ -443,7 +447,7 @@ pub const PARALLEL_CHARACTERS: usize = 4;
 
 /// How often walkers among others see where the others are (s): every 0.05 s of global time,
 /// on a grid of its multiples, so that no result depends on the host's frames.
-pub const CROWD_PERIOD: f64 = 0.05;
+pub const CROWD_PERIOD: f64 = crate::crowd::snapshot::PERIOD;
 
 /// The index of the crowd grid time at or before `t` (a time within a millionth of a period
 /// of a grid time counts as on it: `k * 0.1 / 0.1` may fall just short of `k`).
@@ -561,8 +565,9 @@ impl Realizer {
             .filter(|id| !self.characters.contains_key(id))
             .collect();
         std::sync::Arc::make_mut(&mut self.world).set_crowd(crowd);
+        // (as of the crowd's time, not the frame's: the same whatever the host's frames)
         for id in asked {
-            self.manager(Some(id));
+            self.manager_at(Some(id), now);
         }
     }
 }

@@ -115,6 +115,11 @@ impl LocomotionEngine {
     /// Standing (no walk of its own under way), makes room for a walker who asks it, or goes
     /// back once nobody asks (`locomotion::room`); such a walk sends no feedback.
     fn make_room(&mut self, now: f64, world: &World, id: &str, at: Placement) {
+        // (decided on the crowd's grid of times only, as the asks are: the same whatever the
+        // host's frames)
+        if !crate::crowd::snapshot::on_grid(now) {
+            return;
+        }
         if let Some(w) = self.walker.as_mut() {
             w.watching = None;
         }

@@ -32,6 +32,8 @@ pub const TURN_FIRST: f32 = 0.8;
 pub const HALT_DECELERATION: f32 = 1.6;
 /// Within this distance of its goal (m) a walk has arrived: it brakes to a stop there.
 pub const STOP_RADIUS: f32 = 0.04;
+/// Held still this near its goal, a walker has arrived (m).
+pub const NEAR_ENOUGH: f32 = 0.1;
 /// Margin kept from obstacles beyond the body's radius when planning (m).
 pub const PLAN_MARGIN: f32 = 0.08;
 
@@ -403,7 +405,13 @@ impl Walker {
             // person does not stop from 0.12 m/s in a step; this takes about 0.1 s and 5 mm)
             let speed = self.vehicle.speed();
             let braking = speed * speed / (2.0 * HALT_DECELERATION);
-            if !a.halting && speed < 0.3 && to_goal.length() <= STOP_RADIUS + braking {
+            // (held still within a hand of its goal, it has arrived: a walker 7 cm from its
+            // place, stopped for someone standing a metre beyond it, stood there for half a
+            // minute)
+            let held_near = speed < 0.05 && to_goal.length() < NEAR_ENOUGH;
+            if !a.halting
+                && ((speed < 0.3 && to_goal.length() <= STOP_RADIUS + braking) || held_near)
+            {
                 a.halting = ahead.len() <= 2;
             }
             if a.halting && !a.stopped {
