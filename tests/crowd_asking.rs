@@ -11,46 +11,17 @@ use std::f32::consts::PI;
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 
 /// Per frame in which the walker is within 2 m of the row at z = 3 (a row of people standing
-/// at `xs`): where it is (x, z), which way its head faces and which way its body faces (rad
-/// about +y from +z).
+/// at `xs`, [`corridor`]): where it is (x, z), which way its head faces and which way its body
+/// faces (rad about +y from +z).
 fn heads(xs: &[f32]) -> Vec<(glam::Vec2, f32, f32)> {
-    let people: Vec<String> = (xs.iter().enumerate())
-        .map(|(k, x)| format!(r#""s{k}": {{"position": [{x}, 0, 3], "facing": 180}}"#))
-        .collect();
-    let world = format!(
-        r#"{{"obstacles": [{{"box": [-4, -1, -2.3, 8], "height": 2}}, {{"box": [2.3, -1, 4, 8], "height": 2}}],
-            "characters": {{"w": {{"position": [0.1, 0, 0]}}, {}}}}}"#,
-        people.join(", ")
-    );
-    let mut r = Realizer::new();
-    *r.world_mut() = World::from_json(&world).expect("a world").0;
-    let bml =
-        format!(r#"<bml {NS} id="b" characterId="w"><locomotion id="go" target="0.1,6"/></bml>"#);
-    r.perform_bml(&bml).unwrap();
-    let s = Skeleton::adult();
-    let skull = s.joint("skullbase").unwrap();
-    let mut out = Vec::new();
-    for i in 0..=(8.0 * 60.0) as u32 {
-        let frame = r.tick(f64::from(i) / 60.0);
-        let Some(p) = frame
-            .poses
-            .iter()
-            .find(|p| p.character.as_deref() == Some("w"))
-        else {
-            continue;
-        };
-        let world = p.pose.world(&s);
-        let at = world.positions[0];
-        if (1.0..2.9).contains(&at.z) {
-            let yaw = |q: glam::Quat| {
-                let f = q * Vec3::Z;
-                f.x.atan2(f.z)
-            };
-            let (head, body) = (yaw(world.orientations[skull]), yaw(world.orientations[0]));
-            out.push((glam::Vec2::new(at.x, at.z), head, body));
-        }
-    }
-    out
+    let (_, places) = corridor(xs, 8.0);
+    (places.iter())
+        .filter_map(|(at, heads)| {
+            let at = at.iter().find(|(id, _)| id == "w")?.1;
+            let &(_, head, body) = heads.iter().find(|(id, _, _)| id == "w")?;
+            (1.0..2.9).contains(&at.y).then_some((at, head, body))
+        })
+        .collect()
 }
 
 /// Frames in which the head, turned more than 0.15 rad from the body, faces one of `people`
@@ -99,7 +70,8 @@ fn a_walker_whose_way_is_shut_looks_at_the_one_in_its_way() {
 /// Per frame: everyone's place, and the head's and the body's heading of everyone posed.
 type Places = Vec<(Vec<(String, glam::Vec2)>, Vec<(String, f32, f32)>)>;
 
-/// The corridor of [`heads`] shut by `xs`, walked for `seconds`.
+/// A corridor 4.6 m wide shut at z = 3 by people standing at `xs` (facing the walker), walked
+/// for `seconds` by "w" from (0.1, 0) to (0.1, 6).
 fn corridor(xs: &[f32], seconds: f64) -> (Realizer, Places) {
     let people: Vec<String> = (xs.iter().enumerate())
         .map(|(k, x)| format!(r#""s{k}": {{"position": [{x}, 0, 3], "facing": 180}}"#))

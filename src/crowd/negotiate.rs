@@ -11,6 +11,7 @@
 
 use glam::Vec2;
 
+use super::{Agent, Crowd};
 use crate::locomotion::Obstacles;
 
 /// How far ahead along its way a walker looks for someone standing in it (m).
@@ -96,6 +97,25 @@ pub fn aside(
     spots.sort_by(|a, b| a.distance(home).total_cmp(&b.distance(home)));
     (spots.into_iter())
         .find(|&spot| spot.distance(home) <= 1.0 && free(spot, radius, 0.02, others, walls))
+}
+
+/// [`aside`] for the one at index `me` of `crowd` (standing at `home`, radius `radius`) and the
+/// `walker` asking it, among everyone else of the crowd within 2 m.
+pub fn aside_in(
+    crowd: &Crowd,
+    (me, home, radius): (usize, Vec2, f32),
+    walker: Agent,
+    walls: &Obstacles,
+) -> Option<Vec2> {
+    let way = (home - walker.at).normalize_or_zero();
+    let mut near = Vec::new();
+    crowd.near(home, 2.0, &mut near);
+    let others: Vec<(Vec2, f32)> = (near.into_iter())
+        .filter(|&i| i != me)
+        .map(|i| crowd.agent(i))
+        .map(|a| (a.at, a.radius))
+        .collect();
+    aside(home, radius, walker.at, way, walker.radius, &others, walls)
 }
 
 /// Whether a body of `radius` at `spot` keeps `room` from each of `others` (place, radius) and

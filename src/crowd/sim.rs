@@ -273,16 +273,16 @@ impl Sim {
 
     /// Moves everyone on by `dt` seconds, each choosing from where all were before the step.
     pub fn step(&mut self, dt: f32) {
-        let crowd = Crowd::unnamed(self.time, self.movers.iter().map(Mover::agent).collect());
+        let mut crowd = Crowd::unnamed(self.time, self.movers.iter().map(Mover::agent).collect());
         let still: Vec<bool> = (self.movers.iter())
             .map(|m| m.standing() || m.stuck())
             .collect();
-        // (asked, asking): who asks whom to make room
-        let mut asks: Vec<(usize, usize)> = (self.movers.iter().enumerate())
-            .filter(|(_, m)| !m.standing())
-            .filter_map(|(i, m)| m.looking_at.map(|t| (t, i)))
-            .collect();
-        asks.sort_unstable();
+        // who asks whom to make room
+        crowd.set_ask_pairs(
+            (self.movers.iter().enumerate())
+                .filter(|(_, m)| !m.standing())
+                .filter_map(|(i, m)| m.looking_at.map(|t| (t, i))),
+        );
         let every = ((DECIDE_PERIOD / f64::from(dt)).round() as u64).max(1);
         let (steps, profile, time, all) = (self.steps, self.profile, self.time, self.decide_all);
         self.decide_all = false;
@@ -294,7 +294,6 @@ impl Sim {
                 walls,
                 profile: &profile,
                 still: &still,
-                asks: &asks,
             };
             step_one(m, i, world, decide, every as f32 * dt, dt, time);
         };
@@ -316,8 +315,6 @@ struct World<'a> {
     profile: &'a Profile,
     /// Per mover, whether it stands or is stuck (may be asked for room).
     still: &'a [bool],
-    /// (asked, asking), sorted: who asks whom to make room.
-    asks: &'a [(usize, usize)],
 }
 
 /// One mover's step from the snapshot (where it is index `me`).
@@ -413,15 +410,13 @@ fn ask_for_room(m: &mut Mover, me: usize, desired: Vec2, w: World) {
 /// One standing steps aside for a walker within [`negotiate::TRIGGER`] that asks it for room
 /// (to where [`negotiate::aside`] finds), and stays there while it is asked.
 fn make_room(m: &mut Mover, me: usize, w: World) {
-    let from = w.asks.partition_point(|&(t, _)| t < me);
-    let asking = (w.asks[from..].iter())
-        .take_while(|&&(t, _)| t == me)
+    let asking = (w.crowd.askers(me))
         // of two stuck walkers who ask each other, the later in the crowd's order makes room
-        .filter(|&&(_, i)| !(m.looking_at == Some(i) && me < i))
-        .map(|&(_, i)| w.crowd.agent(i))
+        .filter(|&i| !(m.looking_at == Some(i) && me < i))
+        .map(|i| w.crowd.agent(i))
         .find(|a| a.at.distance(m.at) <= negotiate::TRIGGER);
     let Some(walker) = asking else {
-        if w.asks[from..].first().is_none_or(|&(t, _)| t != me) {
+        if w.crowd.askers(me).next().is_none() {
             m.aside = None;
             // pressed from its place (by one stepping aside, or passing): back when free
             m.stepped |= m.arrived.is_some() && m.at.distance(m.goal) > DISPLACED;
@@ -431,23 +426,7 @@ fn make_room(m: &mut Mover, me: usize, w: World) {
     if m.aside.is_some() {
         return;
     }
-    let way = (m.at - walker.at).normalize_or_zero();
-    let mut near = Vec::new();
-    w.crowd.near(m.at, 2.0, &mut near);
-    let others: Vec<(Vec2, f32)> = (near.into_iter())
-        .filter(|&i| i != me)
-        .map(|i| w.crowd.agent(i))
-        .map(|a| (a.at, a.radius))
-        .collect();
-    let spot = negotiate::aside(
-        m.at,
-        m.radius,
-        walker.at,
-        way,
-        walker.radius,
-        &others,
-        w.walls,
-    );
+    let spot = negotiate::aside_in(w.crowd, (me, m.at, m.radius), walker, w.walls);
     if spot.is_some() {
         m.aside = spot;
         m.stepped = true;

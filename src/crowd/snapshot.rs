@@ -112,7 +112,7 @@ impl Crowd {
     /// one it asks, taken to be whoever stands within 0.15 m of it (the nearest; nobody else).
     pub fn set_asks(&mut self, asking: impl IntoIterator<Item = (usize, Vec2)>) {
         let mut near = Vec::new();
-        self.asks.clear();
+        let mut pairs = Vec::new();
         for (who, place) in asking {
             self.near(place, 0.15, &mut near);
             let asked = (near.iter().copied())
@@ -122,9 +122,17 @@ impl Crowd {
                     d(a).total_cmp(&d(b)).then(a.cmp(&b))
                 });
             if let Some(asked) = asked {
-                self.asks.push((asked as u32, who as u32));
+                pairs.push((asked, who));
             }
         }
+        self.set_ask_pairs(pairs);
+    }
+
+    /// Notes who asks whom to make room, as (asked, asking) indices.
+    pub fn set_ask_pairs(&mut self, pairs: impl IntoIterator<Item = (usize, usize)>) {
+        self.asks = (pairs.into_iter())
+            .map(|(asked, who)| (asked as u32, who as u32))
+            .collect();
         self.asks.sort_unstable();
     }
 

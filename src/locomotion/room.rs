@@ -62,23 +62,7 @@ pub fn make_room(
     }
     let walker = crowd.agent(near?);
     let home = room.as_ref().map_or(body, |r| r.home);
-    let way = (body.at - walker.at).normalize_or_zero();
-    let mut around = Vec::new();
-    crowd.near(body.at, 2.0, &mut around);
-    let others: Vec<(Vec2, f32)> = (around.into_iter())
-        .filter(|&i| i != me)
-        .map(|i| crowd.agent(i))
-        .map(|a| (a.at, a.radius))
-        .collect();
-    let spot = negotiate::aside(
-        body.at,
-        radius,
-        walker.at,
-        way,
-        walker.radius,
-        &others,
-        obstacles,
-    )?;
+    let spot = negotiate::aside_in(crowd, (me, body.at, radius), walker, obstacles)?;
     *room = Some(Room {
         home,
         aside: true,
