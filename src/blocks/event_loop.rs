@@ -144,6 +144,7 @@ impl BlockManager {
         self.update_anticipators(to);
         self.apply_changes(to);
         self.predict_poses(to);
+        self.attend();
         let mut pose = self.base_pose(to);
         let mut face = crate::face::Face::neutral(crate::face::FaceModel::default_model());
         let mut warnings = Vec::new();

@@ -2,7 +2,8 @@
 //! move the whole character (locomotion) step it to the frame's time. Where it then stands is
 //! its placement (its engines see the world from there), and the sync times those engines
 //! revise are taken into the plan: through the block's pegs, so that what is tied to them
-//! follows, or, for an interrupted unit, for that unit alone.
+//! follows, or, for an interrupted unit, for that unit alone. Whom the walk attends to (the one
+//! it asks for room, the walker it makes room for) is passed on to the engines that look.
 
 use super::live::Phase;
 use super::BlockManager;
@@ -44,6 +45,26 @@ impl BlockManager {
     /// Where the person stands whom the character asks to make room, if anyone.
     pub fn asking(&mut self) -> Option<glam::Vec2> {
         (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.asking()))
+    }
+
+    /// Tells the engines that look ([`Attend`](crate::engine::Attend)) whom the character's
+    /// travel attends to now, at their eyes in the character's frame.
+    pub(super) fn attend(&mut self) {
+        let cue = (self.registry.engines_mut())
+            .find_map(|e| e.as_travel().and_then(|t| t.attending()))
+            .map(|(at, weight)| crate::engine::Attention {
+                at: (self.placement).to_local(glam::Vec3::new(
+                    at.x,
+                    crate::world::CHARACTER_EYES.y,
+                    at.y,
+                )),
+                weight,
+            });
+        for e in self.registry.engines_mut() {
+            if let Some(a) = e.as_attend() {
+                a.attend(cue);
+            }
+        }
     }
 
     /// Whether each foot is on the ground, if an engine moves the character's feet.

@@ -1,7 +1,8 @@
 //! What only some engines do, one trait per capability: moving the body ([`Motion`]), taking
 //! part in animation prediction ([`Prediction`]), parameters that change while a unit runs
-//! ([`Parameters`]), body resources and exclusive groups ([`Resources`]) and actions on the plan
-//! ([`Control`]). An engine offers one by returning itself from the matching `as_…` method of
+//! ([`Parameters`]), body resources and exclusive groups ([`Resources`]), actions on the plan
+//! ([`Control`]), moving about the world ([`Travel`]) and looking at whom the walk attends to
+//! ([`Attend`]). An engine offers one by returning itself from the matching `as_…` method of
 //! [`Engine`](super::Engine).
 
 use super::{EngineError, ParameterChange, UnitKey};
@@ -146,6 +147,31 @@ pub trait Travel {
     fn asking(&self) -> Option<glam::Vec2> {
         None
     }
+
+    /// Whom the character attends to as it moves (the one it asks for room, the walker it
+    /// makes room for): where they stand (world x, z) and how much (0 to 1, eased). Engines that
+    /// [`Attend`] look there.
+    fn attending(&self) -> Option<(glam::Vec2, f32)> {
+        None
+    }
+}
+
+/// Someone the character attends to: where their eyes are in the character's own frame (the
+/// origin facing +z), and how much it attends (0 to 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Attention {
+    /// Their eyes, in the character's frame (m).
+    pub at: glam::Vec3,
+    /// How much it attends (0 to 1).
+    pub weight: f32,
+}
+
+/// An engine that looks at whom the character attends to ([`Travel::attending`]) when nothing
+/// else directs its gaze: the gaze engine, under any running BML gaze.
+pub trait Attend {
+    /// Whom the character attends to this frame, if anyone (called before the frame's
+    /// [`Motion::animate`]).
+    fn attend(&mut self, cue: Option<Attention>);
 }
 
 /// New sync times for a unit of a [`Travel`] engine.

@@ -16,8 +16,8 @@ mod units;
 use std::fmt;
 
 pub use capabilities::{
-    Action, BalanceReading, Control, Expression, Motion, MotionKind, Parameters, Physics,
-    Prediction, Resources, Revision, Sound, Steering, Travel,
+    Action, Attend, Attention, BalanceReading, Control, Expression, Motion, MotionKind, Parameters,
+    Physics, Prediction, Resources, Revision, Sound, Steering, Travel,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};
@@ -214,6 +214,11 @@ pub trait Engine: Send {
 
     /// Its travel about the world, if it moves the whole character (locomotion).
     fn as_travel(&mut self) -> Option<&mut dyn Travel> {
+        None
+    }
+
+    /// Its look at whom the character's travel attends to, if it directs the eyes (gaze).
+    fn as_attend(&mut self) -> Option<&mut dyn Attend> {
         None
     }
 

@@ -18,6 +18,9 @@
 //!   until `relax`, then returns to the rest aim by `end`. A `gazeShift` moves over its whole span
 //!   and makes its target the new rest aim, kept after it ends (`engines::motion`).
 //! - Of several gazes running at once the one that started last wins.
+//! - Whom the character's walk attends to (the one it asks for room, the walker it makes room
+//!   for: `engine::Attend`) is looked at with the neck and head influence under any BML gaze,
+//!   as much as the walk attends to them, the eyes leading.
 //! - `offsetAngle` in `offsetDirection` turns the aim away from the target (LEFT, RIGHT, UP, DOWN
 //!   and the diagonals; POLAR gives no offset).
 //! - A target the world does not have is refused when the behaviour starts (the runtime reports
@@ -27,7 +30,7 @@ use glam::{Quat, Vec3};
 
 use crate::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
 use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, UnitKey, Units};
+use crate::engine::{Attend, Attention, Engine, EngineError, Steering, Unit, UnitKey, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
 use crate::timing::SyncName;
 use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
@@ -133,10 +136,16 @@ pub struct GazeEngine {
     /// under the gazes that follow until one has turned fully, then faded out over [`HAND_OVER`]
     /// s (since when, once fading).
     ghost: Option<(BodyAim, Option<f64>)>,
+    /// Whom the character's walk attends to this frame (`engine::Attend`).
+    attention: Option<Attention>,
 }
 
 /// A body aim: (joint, yaw, pitch) per joint the gaze turns.
 type BodyAim = Vec<(usize, f32, f32)>;
+
+/// How much faster than the head the eyes go to whom the walk attends to (the eyes are on them
+/// once the attention is a third grown: 80 ms of its quarter-second easing).
+pub const ATTENTION_EYES: f32 = 3.0;
 
 /// How long the aim a removed gaze left takes to fade once nothing turns over it (s).
 pub const HAND_OVER: f64 = 0.4;
@@ -243,6 +252,16 @@ impl Engine for GazeEngine {
     fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
         Some(self)
     }
+
+    fn as_attend(&mut self) -> Option<&mut dyn Attend> {
+        Some(self)
+    }
+}
+
+impl Attend for GazeEngine {
+    fn attend(&mut self, cue: Option<Attention>) {
+        self.attention = cue.filter(|a| a.weight > 0.0 && a.at.is_finite());
+    }
 }
 
 impl crate::engine::Motion for GazeEngine {
@@ -329,7 +348,18 @@ impl GazeEngine {
             .filter(|a| a.2.body_weight > 0.0 || a.2.eye_weight > 0.0)
             .collect();
         active.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
-        let layers: Vec<Target> = active.into_iter().map(|a| a.2).collect();
+        // whom the walk attends to lies under the BML gazes: the eyes go there at once, the
+        // head as the attention grows
+        let attended = self.attention.map(|a| Target {
+            point: a.at,
+            influence: Influence::Neck,
+            body_weight: a.weight.min(1.0),
+            eye_weight: (ATTENTION_EYES * a.weight).min(1.0),
+            offset: (0.0, 0.0),
+        });
+        let layers: Vec<Target> = (attended.into_iter())
+            .chain(active.into_iter().map(|a| a.2))
+            .collect();
         // the aim a removed gaze left holds until a gaze over it has turned fully, then fades
         let turned = layers.last().is_none_or(|t| t.body_weight >= 0.999);
         let ghost = match self.ghost.as_mut() {
@@ -477,6 +507,7 @@ impl crate::engine::Resources for GazeEngine {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::Motion;
 
     #[test]
     fn yaw_is_toward_the_left_and_pitch_down() {
@@ -488,6 +519,78 @@ mod tests {
         let d = donders(0.3, 0.2) * Vec3::Z;
         let (y, p) = yaw_pitch(d);
         assert!((y - 0.3).abs() < 1e-5 && (p - 0.2).abs() < 1e-5);
+    }
+
+    /// The mean line of sight of the eyes and the head's yaw (world, rad) of `pose`.
+    fn sight(s: &Skeleton, pose: &Pose) -> (Vec3, f32) {
+        let w = pose.world(s);
+        let eyes = ["l_eyeball_joint", "r_eyeball_joint"].map(|e| s.joint(e).unwrap());
+        let sight: Vec3 = eyes.iter().map(|&e| w.orientations[e] * Vec3::Z).sum();
+        let head = w.orientations[s.joint("skullbase").unwrap()] * Vec3::Z;
+        (sight.normalize(), head.x.atan2(head.z))
+    }
+
+    /// Whom the walk attends to is looked at (eyes on them, the head turned part of the way,
+    /// as much as attended), under a BML gaze, which wins while it runs.
+    #[test]
+    fn it_looks_at_whom_the_walk_attends_to_unless_a_bml_gaze_runs() {
+        let s = Skeleton::adult();
+        let mut world = World::default();
+        let (left, right) = (Vec3::new(1.5, 1.64, 1.5), Vec3::new(-2.0, 1.64, 1.0));
+        world.set("right", right);
+        let eyes = eyes_at_rest(&s);
+        let mut e = GazeEngine::default();
+        let look = |e: &mut GazeEngine, t: f64| {
+            let mut pose = Pose::rest(&s);
+            e.animate(t, &s, &world, &mut pose);
+            sight(&s, &pose)
+        };
+        e.attend(Some(Attention {
+            at: left,
+            weight: 1.0,
+        }));
+        let (sight_full, head_full) = look(&mut e, 0.0);
+        let off = sight_full.angle_between(left - eyes).to_degrees();
+        assert!(off < 3.0, "the eyes are {off}° off whom it attends to");
+        // the neck and head take 60 % of the 45° turn
+        assert!((head_full.to_degrees() - 27.0).abs() < 3.0, "{head_full}");
+        e.attend(Some(Attention {
+            at: left,
+            weight: 0.5,
+        }));
+        let (_, head_half) = look(&mut e, 0.0);
+        assert!((head_half - head_full / 2.0).abs() < 0.02, "{head_half}");
+        // nobody attended to: the rest pose
+        e.attend(None);
+        assert!(look(&mut e, 0.0).1.abs() < 1e-4);
+        // a BML gaze at someone on the right, once it has turned, wins over the attention
+        let block = crate::bml::load(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gaze id="g" target="right"/></bml>"#,
+        )
+        .unwrap()
+        .block;
+        let key = UnitKey::new("b", "g");
+        let syncs = [("start", 0.0), ("ready", 0.5), ("relax", 3.0), ("end", 4.0)];
+        e.add(Unit {
+            key: &key,
+            behaviour: &block.behaviours[0],
+            syncs: syncs.map(|(n, t)| (SyncName::new_static(n), t)).to_vec(),
+            world: &world,
+        })
+        .unwrap();
+        e.attend(Some(Attention {
+            at: left,
+            weight: 1.0,
+        }));
+        let (sight, head) = look(&mut e, 1.0);
+        let off = sight.angle_between(right - eyes).to_degrees();
+        assert!(
+            off < 3.0 && head < -0.3,
+            "{off}° off the gaze's target, head {head}"
+        );
+        // and once it has ended, the eyes go back to whom the walk attends to
+        let (sight, _) = look(&mut e, 4.5);
+        assert!(sight.angle_between(left - eyes).to_degrees() < 3.0);
     }
 
     /// A placed character as a target is where the default adult's eyes are.

@@ -513,7 +513,7 @@ impl crate::engine::Motion for LocomotionEngine {
         let joints = self.joints.get_or_insert_with(|| GaitJoints::of(skeleton));
         if let Some(j) = joints {
             pose_gait(skeleton, j, &w.gait, w.body(), pose);
-            lead_the_turn(j, w.look_ahead(), w.gait.amount.max(w.attention()), pose);
+            lead_the_turn(j, w.look_ahead(), w.gait.amount, pose);
         }
     }
 }

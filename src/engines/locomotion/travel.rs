@@ -101,6 +101,10 @@ impl Travel for LocomotionEngine {
         self.walker.as_ref().and_then(|w| w.asking)
     }
 
+    fn attending(&self) -> Option<(Vec2, f32)> {
+        self.walker.as_ref().and_then(|w| w.attending())
+    }
+
     fn contacts(&self) -> Option<[bool; 2]> {
         let w = self.walker.as_ref().filter(|_| self.walked)?;
         Some(

@@ -114,6 +114,9 @@ pub struct Walker {
     active: Option<Active>,
 }
 
+/// How far the one it looks at may have moved between two steps for it to be followed (m).
+const FOLLOW: f32 = 0.2;
+
 impl Walker {
     /// Standing at `at` facing `facing`, at time `time`.
     pub fn new(at: Vec2, facing: f32, radius: f32, time: f64) -> Walker {
@@ -163,22 +166,38 @@ impl Walker {
             .map_or(0.0, |a| path::length(&a.route_from(self.body().at)))
     }
 
-    /// How far off its facing the way goes 1.5 m ahead along the route (0 when not walking),
-    /// or where the one it asks for room, or watches, stands (rad, positive to the left).
+    /// How far off its facing the way goes 1.5 m ahead along the route (0 when not walking;
+    /// rad, positive to the left): where the head leads the turn.
     pub fn look_ahead(&self) -> f32 {
-        let here = self.body().at;
         let walking = self.active.as_ref().is_some_and(|a| !a.stopped);
-        let route = if walking { self.route_ahead(here) } else { 0.0 };
-        // looking at the one it asks for room, as much as it attends to them
-        let to = self.asked_at - here;
-        let asked = angle_diff(to.x.atan2(to.y), self.facing);
-        route + (asked - route) * self.attention
+        if walking {
+            self.route_ahead(self.body().at)
+        } else {
+            0.0
+        }
     }
 
-    /// How much its head attends to the one it asks for room (0 to 1): the head turns to them
-    /// whatever the gait's amount.
-    pub fn attention(&self) -> f32 {
-        self.attention
+    /// Whom it attends to: where the one it asks for room, or the walker it makes room for,
+    /// stands (world x, z), and how much (0 to 1, eased in and out over a quarter of a
+    /// second). The gaze engine looks there (`engine::Attend`).
+    pub fn attending(&self) -> Option<(Vec2, f32)> {
+        (self.attention > 1e-3).then_some((self.asked_at, self.attention))
+    }
+
+    /// Where the one it asked for room stands now, while it is still held back (below half its
+    /// speed) after it stopped asking (they began to make room): it keeps looking at them,
+    /// following them as they step aside, until its way is clear (the seed's walker gazes at the
+    /// one in its way for as long as the way lacks clearance).
+    fn held_back_by(&self, others: Option<Others<'_>>) -> Option<Vec2> {
+        let o = others?;
+        let a = self.active.as_ref().filter(|a| !a.stopped)?;
+        if self.attention < 1e-3 || self.velocity().length() >= 0.5 * a.walk.speed {
+            return None;
+        }
+        let near = neighbours(o, self.time, self.asked_at, FOLLOW);
+        (near.iter())
+            .map(|n| n.at)
+            .min_by(|p, q| (p.distance(self.asked_at)).total_cmp(&q.distance(self.asked_at)))
     }
 
     /// How far off its facing the way goes 1.5 m ahead along the route from `here` (rad).
@@ -537,14 +556,15 @@ impl Walker {
             }
         }
         let body = self.body();
-        if let Some(p) = self.asking.or(self.watching) {
+        let held = match self.asking.or(self.watching) {
+            Some(_) => None,
+            None => self.held_back_by(others),
+        };
+        let attended = self.asking.or(self.watching).or(held);
+        if let Some(p) = attended {
             self.asked_at = p;
         }
-        let attend = if self.asking.or(self.watching).is_some() {
-            1.0
-        } else {
-            0.0
-        };
+        let attend = if attended.is_some() { 1.0 } else { 0.0 };
         self.attention += (attend - self.attention) * (1.0 - (-dt / 0.25).exp());
         self.gait.turn_rate = angle_diff(self.facing, facing_before) / dt;
         self.gait.step(dt, body, self.velocity());
