@@ -278,6 +278,28 @@ fn the_crowd_is_the_same_whatever_the_frame_rate() {
 }
 
 #[test]
+fn a_host_ticking_twice_at_one_time_or_jumping_changes_nothing() {
+    // (a crowd made again at the same time once took everyone for standing still: the plaza's
+    // feedback depended on whether `bmlr run` recorded frames)
+    let walkers = circle(8, 4.0);
+    let places = |times: &[f64]| {
+        let mut r = prepared(&walkers, true);
+        for &t in times {
+            r.tick(t);
+        }
+        (0..walkers.len())
+            .map(|k| r.world().placement(&id(k)).position)
+            .collect::<Vec<_>>()
+    };
+    let frames: Vec<f64> = (0..=300).map(|i| f64::from(i) / 30.0).collect();
+    let twice: Vec<f64> = frames.iter().flat_map(|&t| [t, t]).collect();
+    let jumps: Vec<f64> = (0..=7).map(|i| f64::from(i) * 10.0 / 7.0).collect();
+    let once = places(&frames);
+    assert_eq!(once, places(&twice), "ticking twice at each time");
+    assert_eq!(once, places(&jumps), "jumping 1.43 s at a time");
+}
+
+#[test]
 fn characters_stepped_in_parallel_give_exactly_what_one_thread_gives() {
     let walkers = circle(8, 4.0);
     let (_, sequential) = realize_with(&walkers, 12.0, 30.0, false);

@@ -293,9 +293,41 @@ fn the_same_walk_at_20_and_90_frames_a_second_ends_alike() {
     let a = run_in(Some(world.clone()), &[&bml], 10.0, 20.0);
     let b = run_in(Some(world), &[&bml], 10.0, 90.0);
     let (ea, eb) = (a.sync("b1:w:end"), b.sync("b1:w:end"));
-    assert!((ea - eb).abs() < 0.1, "{ea} {eb}");
+    assert!((ea - eb).abs() < 1e-9, "{ea} {eb}");
     let (pa, pb) = (a.root(a.frames.len() - 1), b.root(b.frames.len() - 1));
-    assert!(pa.distance(pb) < 0.05, "{pa} {pb}");
+    assert!(pa.distance(pb) < 1e-5, "{pa} {pb}");
+}
+
+#[test]
+fn a_walk_started_between_frames_begins_when_it_is_due_whatever_the_frames() {
+    // the second block waits for the first, which ends between frames — at a planned time,
+    // or when the first walk really arrives: the second walk begins then, not at the next
+    // frame, so it ends at the same time at any frame rate
+    let mut world = World::default();
+    world.set("door", Vec3::new(-2.0, 1.0, 5.0));
+    world.set("corner", Vec3::new(1.0, 1.0, 2.0));
+    let nod =
+        format!(r#"<bml {NS} id="b0"><head id="h" lexeme="NOD" start="0" end="1.013"/></bml>"#);
+    let walk = format!(r#"<bml {NS} id="b0"><locomotion id="w" target="corner"/></bml>"#);
+    let then = format!(
+        r#"<bml {NS} id="b1" composition="APPEND"><locomotion id="w" target="door"/></bml>"#
+    );
+    for (first, end) in [(nod, "b0:h:end"), (walk, "b0:w:end")] {
+        let syncs: Vec<(f64, f64, f64)> = [7.0, 20.0, 60.0, 90.0]
+            .iter()
+            .map(|&fps| {
+                let run = run_in(Some(world.clone()), &[&first, &then], 14.0, fps);
+                (run.sync(end), run.sync("b1:w:start"), run.sync("b1:w:end"))
+            })
+            .collect();
+        let same = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        assert!(
+            syncs
+                .iter()
+                .all(|s| same(s.0, s.1) && same(s.2, syncs[0].2)),
+            "(first ends, second starts, second ends): {syncs:?}"
+        );
+    }
 }
 
 fn obstacle_world(json: &str) -> World {

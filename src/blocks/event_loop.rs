@@ -105,12 +105,19 @@ impl BlockManager {
     pub fn advance(&mut self, to: f64, world: &std::sync::Arc<World>, frame: &mut Frame) {
         self.set_world(world);
         let to = to.max(self.now);
-        // a walking character moves first: its walk's sync points follow what happens
-        self.travel(to);
         // changes made from outside since the last frame (e.g. a new tempo)
         self.update_anticipators(self.now);
         let mut last_change = f64::NEG_INFINITY;
+        // a walking character moves up to each sync point before it passes (its walk's sync
+        // points follow what happens, and a walk that a sync point starts begins then, whatever
+        // the host's frames), and on to `to` at the end
+        let mut traveled = f64::NEG_INFINITY;
         loop {
+            if let Some((t, _, _)) = self.next_sync().filter(|s| s.0 <= to && s.0 > traveled) {
+                traveled = t.max(self.now);
+                self.travel(traveled);
+                continue;
+            }
             let sync = self.next_sync().filter(|s| s.0 <= to);
             // an anticipator that keeps announcing the same change is not asked again
             let change = self
@@ -136,6 +143,12 @@ impl BlockManager {
                     } else if self.blocks.get(bi).is_some() {
                         self.queue_next(bi, xi);
                     }
+                }
+                // (and on to `to`, where a walk may turn out to have ended earlier than
+                // predicted: its end then passes in this frame)
+                (None, None) if traveled < to => {
+                    traveled = to;
+                    self.travel(to);
                 }
                 (None, None) => break,
             }

@@ -529,14 +529,20 @@ impl Realizer {
             }
             return;
         }
-        // velocities over the time since the last crowd
+        // velocities over the time since the last crowd (the crowd made again at the same
+        // time — a host ticking twice at one time — keeps them)
         let last = self.world.crowd().clone();
         let dt = (now - last.time) as f32;
         let agent = |id: &str, at: crate::world::Placement| {
             let here = glam::Vec2::new(at.position.x, at.position.z);
-            let velocity = (last.index(id))
-                .filter(|_| dt > 1e-6)
-                .map_or(glam::Vec2::ZERO, |i| (here - last.agent(i).at) / dt);
+            let velocity = (last.index(id)).map_or(glam::Vec2::ZERO, |i| {
+                let before = last.agent(i);
+                if dt > 1e-6 {
+                    (here - before.at) / dt
+                } else {
+                    before.velocity
+                }
+            });
             let agent = crate::crowd::Agent {
                 at: here,
                 velocity,
