@@ -25,6 +25,8 @@ pub use character::avatar;
 pub mod blocks;
 pub mod bml;
 pub mod body;
+#[cfg(feature = "broker")]
+pub mod broker;
 pub mod character;
 pub mod clock;
 #[cfg(feature = "conformance")]

@@ -13,6 +13,7 @@ macro_rules! eprintln {
 mod avatar;
 mod diff;
 mod live;
+mod mqtt;
 mod outcome;
 mod pack;
 mod record;

@@ -20,15 +20,36 @@ use realizer_tests::{run, Outcome, ProcessPort, TestPort};
 
 /// Arguments of `bmlr serve`.
 #[derive(Args)]
-#[command(group(clap::ArgGroup::new("port").required(true).args(["stdio", "tcp"])))]
+#[command(group(clap::ArgGroup::new("port").required(true).args(["stdio", "tcp", "mqtt"])))]
 pub struct ServeArgs {
     /// Serve on stdin/stdout.
-    #[arg(long, conflicts_with = "tcp")]
+    #[arg(long, conflicts_with_all = ["tcp", "mqtt"])]
     stdio: bool,
     /// Serve several clients on a TCP address (e.g. 127.0.0.1:7700; port 0 picks one, printed
     /// on stderr).
     #[arg(long, value_name = "ADDR")]
     tcp: Option<String>,
+    /// Serve on an MQTT broker (mqtt://HOST[:PORT]): blocks in on PREFIX/CHARACTER/bml, feedback
+    /// out on PREFIX/CHARACTER/feedback, presence on PREFIX/realizers/NAME (docs/broker.md).
+    #[arg(long, value_name = "URL", conflicts_with = "tcp")]
+    mqtt: Option<String>,
+    /// With --mqtt: the topics' first level(s) (bml by default).
+    #[arg(long, value_name = "PREFIX", requires = "mqtt")]
+    prefix: Option<String>,
+    /// With --mqtt: this realizer's name on the broker (its presence topic and client id;
+    /// bmlr-PID by default).
+    #[arg(long, value_name = "NAME", requires = "mqtt")]
+    name: Option<String>,
+    /// With --mqtt: serve only these characters (comma-separated; '_' is the default
+    /// character); all by default.
+    #[arg(long, value_name = "A,B", value_delimiter = ',', requires = "mqtt")]
+    characters: Vec<String>,
+    /// With --mqtt: the feedback's encoding (xml by default).
+    #[arg(long, value_enum, requires = "mqtt")]
+    format: Option<crate::run::FormatArg>,
+    /// With --mqtt: stop after this many seconds.
+    #[arg(long, value_name = "SECS", requires = "mqtt")]
+    until: Option<f64>,
     /// With --tcp: also serve the viewer's page on this loopback address (e.g. 127.0.0.1:8080;
     /// port 0 picks one, printed on stderr); it shows the character move as blocks arrive.
     #[arg(long, value_name = "ADDR", requires = "tcp")]
@@ -65,6 +86,30 @@ pub struct ServeArgs {
 pub fn serve(args: ServeArgs) -> ExitCode {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         eprintln!("bmlr serve: --fps must be a positive number");
+        return ExitCode::from(2);
+    }
+    // (clap's `requires` is not checked beside the port group: said here)
+    let mqtt_only = [
+        ("--prefix", args.prefix.is_some()),
+        ("--name", args.name.is_some()),
+        ("--characters", !args.characters.is_empty()),
+        ("--format", args.format.is_some()),
+        ("--until", args.until.is_some()),
+    ];
+    let tcp_only = [
+        ("--view", args.view.is_some()),
+        ("--per-client", args.per_client),
+    ];
+    let misplaced = (mqtt_only.iter().filter(|_| args.mqtt.is_none()))
+        .chain(tcp_only.iter().filter(|_| args.tcp.is_none()))
+        .find(|(_, given)| *given);
+    if let Some((flag, _)) = misplaced {
+        let port = if mqtt_only.iter().any(|m| m.0 == *flag) {
+            "--mqtt"
+        } else {
+            "--tcp"
+        };
+        eprintln!("bmlr serve: {flag} goes with {port}");
         return ExitCode::from(2);
     }
     let voice = match args.tts.timing() {
@@ -124,7 +169,64 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         };
         return crate::tcp::serve(addr, args.per_client, args.fps, realizer, view);
     }
+    if let Some(url) = &args.mqtt {
+        return match mqtt_args(&args, url) {
+            Ok(m) => crate::mqtt::serve(m, realizer),
+            Err(e) => {
+                eprintln!("bmlr serve: {e}");
+                ExitCode::from(2)
+            }
+        };
+    }
     serve_stdio(realizer, Duration::from_secs_f64(1.0 / args.fps))
+}
+
+/// What `serve --mqtt URL` needs, checked.
+fn mqtt_args(args: &ServeArgs, url: &str) -> Result<crate::mqtt::MqttServe, String> {
+    use bml_realizer::broker::{BrokerUrl, LinkOptions, Topics};
+    let url = BrokerUrl::parse(url).map_err(|e| format!("--mqtt {e}"))?;
+    let prefix = args.prefix.as_deref().unwrap_or("bml");
+    let topics = Topics::new(prefix).map_err(|e| format!("--prefix {e}"))?;
+    let name = (args.name.clone()).unwrap_or_else(|| format!("bmlr-{}", std::process::id()));
+    if !bml_realizer::broker::level_ok(&name) {
+        return Err(format!(
+            "--name '{name}' is not a topic level (no '/', '+', '#')"
+        ));
+    }
+    if let Some(bad) = args
+        .characters
+        .iter()
+        .find(|c| !bml_realizer::broker::level_ok(c))
+    {
+        return Err(format!(
+            "--characters '{bad}' is not a topic level (no '/', '+', '#')"
+        ));
+    }
+    let until = args.until.unwrap_or(f64::INFINITY);
+    if until.is_nan() || until < 0.0 {
+        return Err("--until must be a number of seconds".into());
+    }
+    // one subscription per character served, or the wildcard
+    let subscriptions = if args.characters.is_empty() {
+        vec![topics.all_bml()]
+    } else {
+        args.characters.iter().map(|c| topics.bml(c)).collect()
+    };
+    Ok(crate::mqtt::MqttServe {
+        link: LinkOptions {
+            url,
+            client_id: name.clone(),
+            subscriptions,
+            presence: Some(topics.presence(&name)),
+            inbox: 4_096,
+            start_tries: 6,
+        },
+        topics,
+        characters: args.characters.iter().cloned().collect(),
+        format: args.format.unwrap_or(crate::run::FormatArg::Xml).into(),
+        period: Duration::from_secs_f64(1.0 / args.fps),
+        until,
+    })
 }
 
 /// `bmlr serve --stdio`: one block per line, read and checked on a thread of its own (parsing

@@ -1,0 +1,195 @@
+//! `bmlr serve --mqtt URL`: the realizer on an MQTT broker (`docs/broker.md`). Blocks arrive on
+//! `PREFIX/CHARACTER/bml` (one block a message; the topic names the character, `_` the default
+//! one), feedback leaves on `PREFIX/CHARACTER/feedback` (one element a message), presence is
+//! `PREFIX/realizers/NAME`. The link to the broker (`bml_realizer::broker::Link`) keeps itself
+//! connected; this loop owns the realizer, ticks it on the wall clock and routes the feedback.
+//! A payload that is not a block for that topic's character is answered with a warning on the
+//! character's feedback topic; a block for a character this realizer does not serve is left to
+//! the realizer that does.
+
+use std::collections::BTreeSet;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use bml_realizer::bml::Checked;
+use bml_realizer::broker::{Inbound, Link, LinkOptions, Topics, DEFAULT_CHARACTER};
+use bml_realizer::clock::{Clock, WallClock};
+use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
+use bml_realizer::realizer::{Realizer, NO_ID};
+
+/// Messages handled in one frame at most (the rest wait for the next frames, so that a flood
+/// cannot hold the clock up).
+const PER_FRAME: usize = 1_024;
+
+/// What `serve --mqtt` was given.
+pub struct MqttServe {
+    /// The link's options (broker, client id, subscriptions, presence).
+    pub link: LinkOptions,
+    /// The topics.
+    pub topics: Topics,
+    /// The characters served (all when empty).
+    pub characters: BTreeSet<String>,
+    /// Feedback encoding.
+    pub format: Format,
+    /// Engine loop period.
+    pub period: Duration,
+    /// Stop after this many seconds (on the realizer's clock).
+    pub until: f64,
+}
+
+/// Serves until `until` (or for ever). Exit 2 when the broker cannot be reached at the start.
+pub fn serve(args: MqttServe, realizer: Realizer) -> ExitCode {
+    let url = args.link.url.clone();
+    let link = match Link::connect(args.link.clone()) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("bmlr serve: --mqtt {e}");
+            return ExitCode::from(2);
+        }
+    };
+    eprintln!("bmlr serve: on the broker at {url}");
+    let mut s = Server {
+        realizer,
+        clock: WallClock::new(),
+        link,
+        args,
+    };
+    s.run();
+    let Server { link, .. } = s;
+    link.close(Duration::from_secs(2));
+    ExitCode::SUCCESS
+}
+
+struct Server {
+    realizer: Realizer,
+    clock: WallClock,
+    link: Link,
+    args: MqttServe,
+}
+
+impl Server {
+    fn run(&mut self) {
+        loop {
+            let mut heard = Vec::new();
+            if let Some(first) = self.link.recv_timeout(self.args.period) {
+                heard.push(first);
+                while heard.len() < PER_FRAME {
+                    match self.link.try_recv() {
+                        Some(i) => heard.push(i),
+                        None => break,
+                    }
+                }
+            }
+            for inbound in heard {
+                self.hear(inbound);
+            }
+            self.tick();
+            if self.realizer.now() >= self.args.until {
+                return;
+            }
+        }
+    }
+
+    fn tick(&mut self) {
+        let now = self.clock.now().min(self.args.until);
+        let frame = self.realizer.tick(now);
+        self.send(frame.feedback, None);
+        let dropped = self.link.take_dropped();
+        if dropped > 0 {
+            eprintln!("bmlr serve: the broker was away too long: {dropped} feedback messages were dropped");
+        }
+    }
+
+    fn hear(&mut self, inbound: Inbound) {
+        match inbound {
+            Inbound::Lost(why) => eprintln!("bmlr serve: lost the broker ({why}); trying again"),
+            Inbound::Reconnected => eprintln!("bmlr serve: back on the broker; characters kept"),
+            Inbound::Message { topic, payload } => {
+                let Some(character) = self.args.topics.bml_character(&topic).map(str::to_string)
+                else {
+                    return;
+                };
+                let served =
+                    self.args.characters.is_empty() || self.args.characters.contains(&character);
+                if served {
+                    self.perform(&character, payload);
+                }
+            }
+        }
+    }
+
+    /// Performs a block from `character`'s topic; what it produces at once without a character
+    /// (a block that could not be read) is that topic's.
+    fn perform(&mut self, character: &str, payload: Vec<u8>) {
+        // the clock up to date first: the block is planned at this time
+        self.tick();
+        let limits = *self.realizer.limits();
+        let topic_character = (character != DEFAULT_CHARACTER).then(|| character.to_string());
+        let text = match String::from_utf8(payload) {
+            Ok(t) => t,
+            Err(_) => return self.refuse(character, "the payload is not UTF-8 text".into()),
+        };
+        let mut checked = Checked::new(&text, &limits);
+        if let Some(block) = checked.block.as_mut() {
+            if block.character_id.is_none() {
+                block.character_id = topic_character.clone();
+            }
+            if block.character_id != topic_character {
+                let named = block.character_id.as_deref().unwrap_or(DEFAULT_CHARACTER);
+                let id = block.id.to_string();
+                return self.refuse(
+                    character,
+                    format!("block {id} is for character '{named}' but came on the topic of '{character}'"),
+                );
+            }
+        }
+        let source = self.args.topics.bml(character);
+        let _ = self.realizer.perform_checked(checked, Some(&source));
+        let mut feedback = self
+            .realizer
+            .tick(self.clock.now().min(self.args.until))
+            .feedback;
+        // (a block that could not be read names no character: the topic's is meant)
+        for fb in &mut feedback {
+            if let Feedback::Warning(w) = fb {
+                w.character_id = w.character_id.take().or_else(|| topic_character.clone());
+            }
+        }
+        self.send(feedback, Some(character));
+    }
+
+    fn refuse(&mut self, character: &str, text: String) {
+        let warning = Feedback::Warning(WarningFeedback {
+            id: NO_ID.into(),
+            kind: KnownWarning::ParsingFailure.into(),
+            character_id: (character != DEFAULT_CHARACTER).then(|| character.to_string()),
+            text: format!("{}: {text}", self.args.topics.bml(character)),
+        });
+        self.send(vec![warning], Some(character));
+    }
+
+    /// Publishes each message on its character's feedback topic (one without a character on
+    /// `fallback`'s, or the default character's).
+    fn send(&mut self, feedback: Vec<Feedback>, fallback: Option<&str>) {
+        for fb in feedback {
+            let character = character_of(&fb)
+                .or(fallback)
+                .unwrap_or(DEFAULT_CHARACTER)
+                .to_string();
+            let topic = self.args.topics.feedback(&character);
+            self.link
+                .publish(&topic, self.args.format.encode(&fb).into_bytes(), false);
+        }
+        self.link.flush();
+    }
+}
+
+/// The character a feedback message is about, if it names one.
+fn character_of(fb: &Feedback) -> Option<&str> {
+    match fb {
+        Feedback::BlockProgress(p) => p.character_id.as_deref(),
+        Feedback::SyncPointProgress(p) => p.character_id.as_deref(),
+        Feedback::Prediction(p) => p.character_id.as_deref(),
+        Feedback::Warning(w) => w.character_id.as_deref(),
+    }
+}

@@ -1,0 +1,158 @@
+//! Topic names and the broker's address. With prefix `bml` (the default): blocks come in on
+//! `bml/CHARACTER/bml`, feedback goes out on `bml/CHARACTER/feedback`, a realizer's presence is
+//! `bml/realizers/NAME` and a character's root state `bml/world/CHARACTER`. The character `_`
+//! is the realizer's default character (blocks without a `characterId`).
+
+use std::fmt;
+
+/// The character name in topics of the default character.
+pub const DEFAULT_CHARACTER: &str = "_";
+
+/// A broker's address: `mqtt://HOST[:PORT]` (port 1883 when not given).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BrokerUrl {
+    /// Host name or address.
+    pub host: String,
+    /// TCP port.
+    pub port: u16,
+}
+
+impl BrokerUrl {
+    /// Reads `mqtt://HOST[:PORT]` (also `tcp://`); anything else is an error saying why.
+    pub fn parse(url: &str) -> Result<BrokerUrl, String> {
+        let rest = (url.strip_prefix("mqtt://"))
+            .or_else(|| url.strip_prefix("tcp://"))
+            .ok_or_else(|| format!("'{url}' is not a broker address (mqtt://HOST[:PORT])"))?;
+        let rest = rest.trim_end_matches('/');
+        let (host, port) = match rest.rsplit_once(':') {
+            // (an IPv6 address in brackets keeps its colons)
+            Some((h, p)) if !h.is_empty() && !p.contains(']') => {
+                let port = p
+                    .parse::<u16>()
+                    .ok()
+                    .filter(|&p| p > 0)
+                    .ok_or_else(|| format!("'{url}': '{p}' is not a port (1 to 65535)"))?;
+                (h, port)
+            }
+            _ => (rest, 1883),
+        };
+        let host = host.trim_start_matches('[').trim_end_matches(']');
+        if host.is_empty() || host.contains('/') {
+            return Err(format!("'{url}' names no host (mqtt://HOST[:PORT])"));
+        }
+        Ok(BrokerUrl {
+            host: host.to_string(),
+            port,
+        })
+    }
+}
+
+impl fmt::Display for BrokerUrl {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "mqtt://{}:{}", self.host, self.port)
+    }
+}
+
+/// The topics under one prefix.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Topics {
+    prefix: String,
+}
+
+impl Topics {
+    /// Topics under `prefix` (a topic level or several, without wildcards; `bml` by default).
+    pub fn new(prefix: &str) -> Result<Topics, String> {
+        let prefix = prefix.trim_matches('/');
+        if prefix.is_empty() || prefix.split('/').any(|l| !level_ok(l)) {
+            return Err(format!(
+                "'{prefix}' is not a topic prefix (levels without '+', '#' or empty ones)"
+            ));
+        }
+        Ok(Topics {
+            prefix: prefix.to_string(),
+        })
+    }
+
+    /// Where blocks for `character` come in.
+    pub fn bml(&self, character: &str) -> String {
+        format!("{}/{character}/bml", self.prefix)
+    }
+
+    /// Where `character`'s feedback goes out.
+    pub fn feedback(&self, character: &str) -> String {
+        format!("{}/{character}/feedback", self.prefix)
+    }
+
+    /// A realizer's presence (retained `online`; `offline` as its last will).
+    pub fn presence(&self, realizer: &str) -> String {
+        format!("{}/realizers/{realizer}", self.prefix)
+    }
+
+    /// Every realizer's presence (a subscription).
+    pub fn all_presence(&self) -> String {
+        format!("{}/realizers/+", self.prefix)
+    }
+
+    /// Blocks for every character (a subscription).
+    pub fn all_bml(&self) -> String {
+        format!("{}/+/bml", self.prefix)
+    }
+
+    /// The character a block topic is for, if `topic` is one.
+    pub fn bml_character<'t>(&self, topic: &'t str) -> Option<&'t str> {
+        let rest = topic.strip_prefix(&self.prefix)?.strip_prefix('/')?;
+        let character = rest.strip_suffix("/bml")?;
+        (level_ok(character) && character != "realizers" && character != "world")
+            .then_some(character)
+    }
+
+    /// The character name in topics of `character` (`None`: the default character).
+    pub fn character_level(character: Option<&str>) -> &str {
+        character.unwrap_or(DEFAULT_CHARACTER)
+    }
+}
+
+/// Whether `level` may be a character's or the prefix's topic level.
+pub fn level_ok(level: &str) -> bool {
+    !level.is_empty() && !level.contains(['/', '+', '#', '\0'])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn broker_addresses_are_read_or_refused_with_the_reason() {
+        let u = BrokerUrl::parse("mqtt://127.0.0.1:1884").unwrap();
+        assert_eq!((u.host.as_str(), u.port), ("127.0.0.1", 1884));
+        assert_eq!(BrokerUrl::parse("mqtt://broker").unwrap().port, 1883);
+        assert_eq!(BrokerUrl::parse("tcp://[::1]:7").unwrap().host, "::1");
+        assert!(BrokerUrl::parse("http://x")
+            .unwrap_err()
+            .contains("not a broker"));
+        assert!(BrokerUrl::parse("mqtt://x:0")
+            .unwrap_err()
+            .contains("not a port"));
+        assert!(BrokerUrl::parse("mqtt://x:99999")
+            .unwrap_err()
+            .contains("not a port"));
+        assert!(BrokerUrl::parse("mqtt://").unwrap_err().contains("no host"));
+    }
+
+    #[test]
+    fn topics_name_characters_and_refuse_wildcards() {
+        let t = Topics::new("bml").unwrap();
+        assert_eq!(t.bml("alice"), "bml/alice/bml");
+        assert_eq!(t.feedback("_"), "bml/_/feedback");
+        assert_eq!(t.presence("r1"), "bml/realizers/r1");
+        assert_eq!(t.bml_character("bml/alice/bml"), Some("alice"));
+        assert_eq!(t.bml_character("bml/alice/feedback"), None);
+        assert_eq!(t.bml_character("bml/a/b/bml"), None);
+        assert_eq!(t.bml_character("bmlx/alice/bml"), None);
+        assert_eq!(t.bml_character("bml/realizers/bml"), None);
+        let deep = Topics::new("/site/one/").unwrap();
+        assert_eq!(deep.bml("bob"), "site/one/bob/bml");
+        assert!(Topics::new("a/+/b").is_err());
+        assert!(Topics::new("").is_err());
+    }
+}

@@ -1,0 +1,318 @@
+//! `bmlr serve --mqtt` on a real broker: Debian's `mosquitto`, started here on a loopback port
+//! for each test. Without `mosquitto` on the PATH these tests say so and pass (`.ci/run`
+//! installs it). The planner's side is `bml_realizer::broker::Link`, as a host would use it.
+
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use bml_realizer::broker::{BrokerUrl, Inbound, Link, LinkOptions};
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// A mosquitto on a free loopback port, stopped when dropped.
+struct Broker {
+    child: Child,
+    port: u16,
+}
+
+impl Broker {
+    /// Starts one, or `None` (with a line saying why) when mosquitto is not installed.
+    fn start() -> Option<Broker> {
+        let port = free_port();
+        Broker::on(port)
+    }
+
+    fn on(port: u16) -> Option<Broker> {
+        // (Debian installs it in /usr/sbin, which a user's PATH may lack)
+        let spawn = |program: &str| {
+            Command::new(program)
+                .args(["-p", &port.to_string()])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+        };
+        let child = spawn("mosquitto").or_else(|_| spawn("/usr/sbin/mosquitto"));
+        let Ok(child) = child else {
+            eprintln!("skipped: mosquitto is not installed (Debian package mosquitto; .ci/run installs it)");
+            return None;
+        };
+        let until = Instant::now() + Duration::from_secs(5);
+        while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+            assert!(
+                Instant::now() < until,
+                "mosquitto did not start on port {port}"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        Some(Broker { child, port })
+    }
+
+    fn url(&self) -> String {
+        format!("mqtt://127.0.0.1:{}", self.port)
+    }
+}
+
+impl Drop for Broker {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn free_port() -> u16 {
+    let l = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    l.local_addr().unwrap().port()
+}
+
+/// A realizer serving `characters` (all when empty) on the broker, as `name`.
+fn realizer(broker: &Broker, name: &str, characters: &[&str], extra: &[&str]) -> Child {
+    let url = broker.url();
+    let mut args = vec!["serve", "--mqtt", &url, "--name", name];
+    let list = characters.join(",");
+    if !characters.is_empty() {
+        args.extend(["--characters", &list]);
+    }
+    args.extend(extra);
+    Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(&args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("bmlr runs")
+}
+
+/// A planner: a link subscribed to every feedback and presence topic.
+fn planner(broker: &Broker, id: &str) -> Link {
+    Link::connect(LinkOptions {
+        url: BrokerUrl::parse(&broker.url()).unwrap(),
+        client_id: id.into(),
+        subscriptions: vec!["bml/+/feedback".into(), "bml/realizers/+".into()],
+        presence: None,
+        inbox: 100_000,
+        start_tries: 3,
+    })
+    .expect("the planner connects")
+}
+
+/// Everything `link` hears for `secs`, or until `done` says so.
+fn hear(
+    link: &Link,
+    secs: f64,
+    done: impl Fn(&[(String, String)]) -> bool,
+) -> Vec<(String, String)> {
+    let until = Instant::now() + Duration::from_secs_f64(secs);
+    let mut heard = Vec::new();
+    while Instant::now() < until && !done(&heard) {
+        if let Some(Inbound::Message { topic, payload }) =
+            link.recv_timeout(Duration::from_millis(20))
+        {
+            heard.push((topic, String::from_utf8_lossy(&payload).into_owned()));
+        }
+    }
+    heard
+}
+
+fn online(heard: &[(String, String)], name: &str, state: &str) -> bool {
+    let topic = format!("bml/realizers/{name}");
+    heard.iter().any(|(t, p)| *t == topic && p == state)
+}
+
+fn ended(heard: &[(String, String)], character: &str, block: &str) -> bool {
+    let topic = format!("bml/{character}/feedback");
+    let id = format!(r#"id="{block}:end""#);
+    heard
+        .iter()
+        .any(|(t, p)| *t == topic && p.contains("blockProgress") && p.contains(&id))
+}
+
+fn block(id: &str) -> String {
+    format!(r#"<bml {NS} id="{id}"><head id="h" lexeme="NOD" start="0" end="0.3"/></bml>"#)
+}
+
+#[test]
+fn feedback_reaches_only_its_character_s_topic_across_two_realizers_and_two_planners() {
+    let Some(broker) = Broker::start() else {
+        return;
+    };
+    let mut p1 = planner(&broker, "planner1");
+    let mut p2 = planner(&broker, "planner2");
+    let mut r1 = realizer(&broker, "r1", &["a", "b", "c"], &[]);
+    let mut r2 = realizer(&broker, "r2", &["d", "e", "f"], &[]);
+    let heard = hear(&p1, 10.0, |h| {
+        online(h, "r1", "online") && online(h, "r2", "online")
+    });
+    assert!(
+        online(&heard, "r1", "online") && online(&heard, "r2", "online"),
+        "{heard:?}"
+    );
+    // each planner sends a block to each of three characters, spread over both realizers
+    for (p, chars) in [(&mut p1, ["a", "d", "e"]), (&mut p2, ["b", "c", "f"])] {
+        for c in chars {
+            p.publish(
+                &format!("bml/{c}/bml"),
+                block(&format!("blk_{c}")).into_bytes(),
+                false,
+            );
+        }
+    }
+    let all = ["a", "b", "c", "d", "e", "f"];
+    let heard = hear(&p1, 10.0, |h| {
+        all.iter().all(|c| ended(h, c, &format!("blk_{c}")))
+    });
+    for c in all {
+        assert!(
+            ended(&heard, c, &format!("blk_{c}")),
+            "no end of blk_{c}: {heard:?}"
+        );
+    }
+    // every message on a character's topic is about that character's block
+    for (topic, payload) in heard.iter().filter(|(t, _)| t.ends_with("/feedback")) {
+        let c = topic.split('/').nth(1).unwrap();
+        assert!(payload.contains(&format!("blk_{c}")), "{topic}: {payload}");
+        assert!(
+            payload.contains(&format!(r#"characterId="{c}""#)),
+            "{topic}: {payload}"
+        );
+    }
+    // r2 killed: its presence goes offline (its last will); r1 still serves
+    let _ = r2.kill();
+    let _ = r2.wait();
+    let heard = hear(&p2, 10.0, |h| online(h, "r2", "offline"));
+    assert!(online(&heard, "r2", "offline"), "{heard:?}");
+    p2.publish("bml/a/bml", block("again").into_bytes(), false);
+    let heard = hear(&p2, 10.0, |h| ended(h, "a", "again"));
+    assert!(ended(&heard, "a", "again"), "{heard:?}");
+    let _ = r1.kill();
+    let _ = r1.wait();
+}
+
+#[test]
+fn bad_payloads_are_answered_on_the_character_s_topic() {
+    let Some(broker) = Broker::start() else {
+        return;
+    };
+    let mut p = planner(&broker, "planner");
+    let mut r = realizer(&broker, "r", &[], &[]);
+    assert!(online(
+        &hear(&p, 10.0, |h| online(h, "r", "online")),
+        "r",
+        "online"
+    ));
+    p.publish("bml/bob/bml", vec![0xff, 0xfe, b'<'], false);
+    p.publish("bml/bob/bml", b"not a block".to_vec(), false);
+    let other = format!(r#"<bml {NS} id="x" characterId="alice"/>"#);
+    p.publish("bml/bob/bml", other.into_bytes(), false);
+    // far beyond a block's size limit
+    p.publish("bml/bob/bml", vec![b' '; 3 << 20], false);
+    p.publish("bml/bob/bml", block("fine").into_bytes(), false);
+    let heard = hear(&p, 10.0, |h| ended(h, "bob", "fine"));
+    let warnings: Vec<&String> = (heard.iter())
+        .filter(|(t, m)| t == "bml/bob/feedback" && m.contains("warningFeedback"))
+        .map(|(_, m)| m)
+        .collect();
+    assert!(
+        warnings.iter().any(|w| w.contains("not UTF-8")),
+        "{warnings:?}"
+    );
+    assert!(
+        warnings.iter().any(|w| w.contains("expected &lt;bml&gt;")),
+        "{warnings:?}"
+    );
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("is for character &apos;alice&apos;")),
+        "{warnings:?}"
+    );
+    assert_eq!(warnings.len(), 4, "{warnings:?}");
+    assert!(
+        warnings.iter().all(|w| w.contains(r#"characterId="bob""#)),
+        "{warnings:?}"
+    );
+    assert!(ended(&heard, "bob", "fine"), "{heard:?}");
+    let _ = r.kill();
+    let _ = r.wait();
+}
+
+#[test]
+fn after_a_broker_restart_the_realizer_reconnects_and_the_next_block_runs() {
+    let Some(broker) = Broker::start() else {
+        return;
+    };
+    let port = broker.port;
+    let mut r = realizer(&broker, "r", &[], &[]);
+    {
+        let p = planner(&broker, "planner");
+        assert!(online(
+            &hear(&p, 10.0, |h| online(h, "r", "online")),
+            "r",
+            "online"
+        ));
+    }
+    drop(broker);
+    std::thread::sleep(Duration::from_millis(500));
+    let broker = Broker::on(port).expect("mosquitto again");
+    let mut p = planner(&broker, "planner");
+    // (the restarted broker has forgotten everything: the realizer says it is online again)
+    let heard = hear(&p, 15.0, |h| online(h, "r", "online"));
+    assert!(online(&heard, "r", "online"), "{heard:?}");
+    p.publish("bml/_/bml", block("after").into_bytes(), false);
+    let heard = hear(&p, 10.0, |h| ended(h, "_", "after"));
+    assert!(ended(&heard, "_", "after"), "{heard:?}");
+    let _ = r.kill();
+    let _ = r.wait();
+}
+
+#[test]
+fn no_broker_at_the_start_is_a_clear_error_and_exit_2() {
+    // (nothing listens on the port: no broker needed)
+    let port = free_port();
+    let started = Instant::now();
+    let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(["serve", "--mqtt", &format!("mqtt://127.0.0.1:{port}")])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cannot reach the broker at mqtt://127.0.0.1:"),
+        "{err}"
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "{:?}",
+        started.elapsed()
+    );
+}
+
+#[test]
+fn bad_broker_flags_are_named_with_the_reason() {
+    for (args, says) in [
+        (
+            &["serve", "--mqtt", "http://x"][..],
+            "is not a broker address",
+        ),
+        (&["serve", "--mqtt", "mqtt://x:0"][..], "is not a port"),
+        (
+            &["serve", "--mqtt", "mqtt://x", "--prefix", "a/+"][..],
+            "is not a topic prefix",
+        ),
+        (
+            &["serve", "--mqtt", "mqtt://x", "--characters", "a/b"][..],
+            "is not a topic level",
+        ),
+        (
+            &["serve", "--stdio", "--prefix", "x"][..],
+            "--prefix goes with --mqtt",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+            .args(args)
+            .stdin(Stdio::null())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+}
