@@ -14,6 +14,7 @@ mod avatar;
 mod diff;
 mod live;
 mod mqtt;
+mod mqtt_port;
 mod outcome;
 mod pack;
 mod record;

@@ -318,6 +318,20 @@ pub struct ConformanceArgs {
     /// defaults to --realizer (with --retimable-speech added if that is `bmlr serve`).
     #[arg(long, value_name = "CMD")]
     incremental_realizer: Option<String>,
+    /// Test a realizer reached only through an MQTT broker (mqtt://HOST[:PORT]; `bmlr serve
+    /// --mqtt`), in real time.
+    #[arg(long, value_name = "URL", conflicts_with = "realizer")]
+    mqtt: Option<String>,
+    /// With --mqtt: the topics' first level(s).
+    #[arg(long, value_name = "PREFIX", default_value = "bml")]
+    prefix: String,
+    /// With --mqtt: the character the tests address ('_': the realizer's default character).
+    #[arg(long, value_name = "ID", default_value = "_")]
+    character: String,
+    /// With --mqtt: the character of the incremental-speech tests, served by a realizer with
+    /// retimable speech (by default --character).
+    #[arg(long, value_name = "ID")]
+    incremental_character: Option<String>,
     /// Run only the tests whose name contains PAT.
     #[arg(long, value_name = "PAT", default_value = "")]
     filter: String,
@@ -386,15 +400,27 @@ fn started(port: std::io::Result<ProcessPort>) -> Result<ProcessPort, String> {
 
 /// `bmlr conformance`.
 pub fn conformance(args: ConformanceArgs) -> ExitCode {
-    let mut port: Box<dyn TestPort> = match &args.realizer {
-        None => match args.tts.timing() {
+    let mut port: Box<dyn TestPort> = match (&args.realizer, &args.mqtt) {
+        (None, Some(url)) => {
+            let incremental =
+                (args.incremental_character.clone()).unwrap_or_else(|| args.character.clone());
+            let characters = [args.character.clone(), incremental];
+            match crate::mqtt_port::MqttPort::connect(url, &args.prefix, characters) {
+                Ok(p) => Box::new(p),
+                Err(e) => {
+                    eprintln!("bmlr conformance: --mqtt {e}");
+                    return ExitCode::from(2);
+                }
+            }
+        }
+        (None, None) => match args.tts.timing() {
             Ok(t) => Box::new(InProcess::new().with_voice(t.voice)),
             Err(e) => {
                 eprintln!("bmlr conformance: --tts flite: {e}");
                 return ExitCode::from(2);
             }
         },
-        Some(cmd) => {
+        (Some(cmd), _) => {
             let incremental = incremental_command(cmd, args.incremental_realizer.as_deref());
             if incremental != *cmd {
                 eprintln!("bmlr conformance: incremental-speech tests run on '{incremental}'");
@@ -409,7 +435,7 @@ pub fn conformance(args: ConformanceArgs) -> ExitCode {
             }
         }
     };
-    let external = args.realizer.is_some();
+    let external = args.realizer.is_some() || args.mqtt.is_some();
     let mut out = std::io::stdout().lock();
     let outcomes = run(port.as_mut(), &args.filter, |i, n, o: &Outcome| {
         let line = match &o.failure {
