@@ -64,8 +64,28 @@ fn free_port() -> u16 {
     l.local_addr().unwrap().port()
 }
 
+/// A realizer process, killed when dropped (also when a test fails).
+struct Served(Child);
+
+impl Served {
+    fn kill(&mut self) -> std::io::Result<()> {
+        self.0.kill()
+    }
+
+    fn wait(&mut self) -> std::io::Result<std::process::ExitStatus> {
+        self.0.wait()
+    }
+}
+
+impl Drop for Served {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
 /// A realizer serving `characters` (all when empty) on the broker, as `name`.
-fn realizer(broker: &Broker, name: &str, characters: &[&str], extra: &[&str]) -> Child {
+fn realizer(broker: &Broker, name: &str, characters: &[&str], extra: &[&str]) -> Served {
     let url = broker.url();
     let mut args = vec!["serve", "--mqtt", &url, "--name", name];
     let list = characters.join(",");
@@ -73,12 +93,14 @@ fn realizer(broker: &Broker, name: &str, characters: &[&str], extra: &[&str]) ->
         args.extend(["--characters", &list]);
     }
     args.extend(extra);
-    Command::new(env!("CARGO_BIN_EXE_bmlr"))
-        .args(&args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .expect("bmlr runs")
+    Served(
+        Command::new(env!("CARGO_BIN_EXE_bmlr"))
+            .args(&args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("bmlr runs"),
+    )
 }
 
 /// A planner: a link subscribed to every feedback and presence topic.
@@ -349,4 +371,103 @@ fn conformance_tests_pass_through_the_broker_on_both_fixtures() {
         let _ = r.kill();
         let _ = r.wait();
     }
+}
+
+/// The last state of each character heard on `bml/world/+`, per arrival: (character, x, z).
+fn states(heard: &[(String, String)]) -> Vec<(String, f32, f32)> {
+    (heard.iter())
+        .filter_map(|(t, p)| {
+            let c = t.strip_prefix("bml/world/")?;
+            let s = bml_realizer::broker::RootState::from_json(p.as_bytes()).ok()?;
+            Some((c.to_string(), s.position[0], s.position[2]))
+        })
+        .collect()
+}
+
+#[test]
+fn walkers_served_by_two_realizers_go_round_each_other_and_both_arrive() {
+    let Some(broker) = Broker::start() else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("bmlr-broker-world-{}", broker.port));
+    std::fs::create_dir_all(&dir).unwrap();
+    let world = dir.join("world.json");
+    std::fs::write(
+        &world,
+        r#"{"characters": {"a": {"position": [-4, 0, 0], "facing": 90}, "b": {"position": [0, 0, -4], "facing": 0}}}"#,
+    )
+    .unwrap();
+    let w = world.to_str().unwrap();
+    let ra = realizer(&broker, "ra", &["a"], &["--world", w]);
+    let rb = realizer(&broker, "rb", &["b"], &["--world", w]);
+    let mut p = Link::connect(LinkOptions {
+        url: BrokerUrl::parse(&broker.url()).unwrap(),
+        client_id: "planner".into(),
+        subscriptions: vec![
+            "bml/+/feedback".into(),
+            "bml/realizers/+".into(),
+            "bml/world/+".into(),
+        ],
+        presence: None,
+        inbox: 100_000,
+        start_tries: 3,
+    })
+    .unwrap();
+    hear(&p, 10.0, |h| {
+        online(h, "ra", "online") && online(h, "rb", "online")
+    });
+    // crossing at the origin at the same moment, unless they see each other
+    for (c, target) in [("a", "4,0"), ("b", "0,4")] {
+        let bml =
+            format!(r#"<bml {NS} id="walk_{c}"><locomotion id="w" target="{target}"/></bml>"#);
+        p.publish(&format!("bml/{c}/bml"), bml.into_bytes(), false);
+    }
+    let heard = hear(&p, 30.0, |h| {
+        ended(h, "a", "walk_a") && ended(h, "b", "walk_b")
+    });
+    for c in ["a", "b"] {
+        assert!(
+            ended(&heard, c, &format!("walk_{c}")),
+            "walk_{c} did not end: {heard:?}"
+        );
+    }
+    let failed: Vec<_> = heard
+        .iter()
+        .filter(|(_, m)| m.contains("warningFeedback"))
+        .collect();
+    assert!(failed.is_empty(), "{failed:?}");
+    // the closest the two came, between the latest states heard of each
+    let (mut last, mut closest) = ([None, None], f32::INFINITY);
+    for (c, x, z) in states(&heard) {
+        last[usize::from(c == "b")] = Some(glam::Vec2::new(x, z));
+        if let [Some(a), Some(b)] = last {
+            closest = closest.min(a.distance(b));
+        }
+    }
+    eprintln!("closest: {closest} m");
+    // bodies of 0.25 m: never closer than their radii less 2 cm
+    assert!(closest >= 0.48, "the walkers came {closest} m apart");
+    let end = states(&heard);
+    let at = |c: &str| {
+        end.iter()
+            .rev()
+            .find(|s| s.0 == c)
+            .map(|s| glam::Vec2::new(s.1, s.2))
+            .unwrap()
+    };
+    assert!(
+        at("a").distance(glam::Vec2::new(4.0, 0.0)) < 0.15,
+        "a at {}",
+        at("a")
+    );
+    assert!(
+        at("b").distance(glam::Vec2::new(0.0, 4.0)) < 0.15,
+        "b at {}",
+        at("b")
+    );
+    for mut r in [ra, rb] {
+        let _ = r.kill();
+        let _ = r.wait();
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -98,6 +98,23 @@ impl Topics {
         format!("{}/+/bml", self.prefix)
     }
 
+    /// Where `character`'s root state goes (realizers sharing one world).
+    pub fn world(&self, character: &str) -> String {
+        format!("{}/world/{character}", self.prefix)
+    }
+
+    /// Every character's root state (a subscription).
+    pub fn all_world(&self) -> String {
+        format!("{}/world/+", self.prefix)
+    }
+
+    /// The character a root-state topic is about, if `topic` is one.
+    pub fn world_character<'t>(&self, topic: &'t str) -> Option<&'t str> {
+        let rest = topic.strip_prefix(&self.prefix)?.strip_prefix('/')?;
+        let character = rest.strip_prefix("world/")?;
+        level_ok(character).then_some(character)
+    }
+
     /// The character a block topic is for, if `topic` is one.
     pub fn bml_character<'t>(&self, topic: &'t str) -> Option<&'t str> {
         let rest = topic.strip_prefix(&self.prefix)?.strip_prefix('/')?;
@@ -150,6 +167,10 @@ mod tests {
         assert_eq!(t.bml_character("bml/a/b/bml"), None);
         assert_eq!(t.bml_character("bmlx/alice/bml"), None);
         assert_eq!(t.bml_character("bml/realizers/bml"), None);
+        assert_eq!(t.world("a"), "bml/world/a");
+        assert_eq!(t.world_character("bml/world/a"), Some("a"));
+        assert_eq!(t.world_character("bml/world/a/b"), None);
+        assert_eq!(t.world_character("bml/a/bml"), None);
         let deep = Topics::new("/site/one/").unwrap();
         assert_eq!(deep.bml("bob"), "site/one/bob/bml");
         assert!(Topics::new("a/+/b").is_err());

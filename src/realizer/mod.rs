@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 mod options;
+mod remote;
 pub use options::from_options;
 
 use crate::blocks::BlockManager;
@@ -56,6 +57,8 @@ pub struct Realizer {
     unframed: Vec<Feedback>,
     /// Whether characters are stepped on several threads.
     parallel: bool,
+    /// Characters another realizer moves (`remote.rs`): placed here, never made characters.
+    remote: std::collections::BTreeSet<String>,
 }
 
 impl Default for Realizer {
@@ -78,6 +81,7 @@ impl Realizer {
             skeleton: Skeleton::adult(),
             idle: true,
             world: std::sync::Arc::new(World::default()),
+            remote: Default::default(),
             parallel: true,
             now: 0.0,
             unframed: Vec::new(),
@@ -568,7 +572,7 @@ impl Realizer {
         let asked: Vec<String> = (0..crowd.len())
             .filter(|&i| crowd.askers(i).next().is_some())
             .map(|i| crowd.id(i).to_string())
-            .filter(|id| !self.characters.contains_key(id))
+            .filter(|id| !self.characters.contains_key(id) && !self.remote.contains(id))
             .collect();
         std::sync::Arc::make_mut(&mut self.world).set_crowd(crowd);
         // (as of the crowd's time, not the frame's: the same whatever the host's frames)

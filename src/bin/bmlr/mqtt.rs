@@ -5,14 +5,18 @@
 //! connected; this loop owns the realizer, ticks it on the wall clock and routes the feedback.
 //! A payload that is not a block for that topic's character is answered with a warning on the
 //! character's feedback topic; a block for a character this realizer does not serve is left to
-//! the realizer that does.
+//! the realizer that does. Realizers on one broker share one world: each publishes where its
+//! characters stand on `PREFIX/world/CHARACTER` (20 Hz) and places the others' characters in
+//! its own world (`Realizer::place_remote`), so that its walkers go round them.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::process::ExitCode;
 use std::time::Duration;
 
 use bml_realizer::bml::Checked;
-use bml_realizer::broker::{Inbound, Link, LinkOptions, Topics, DEFAULT_CHARACTER};
+use bml_realizer::broker::{
+    Inbound, Link, LinkOptions, RootState, Topics, DEFAULT_CHARACTER, PUBLISH_PERIOD,
+};
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
 use bml_realizer::realizer::{Realizer, NO_ID};
@@ -53,6 +57,9 @@ pub fn serve(args: MqttServe, realizer: Realizer) -> ExitCode {
         clock: WallClock::new(),
         link,
         args,
+        others: BTreeMap::new(),
+        published: f64::NEG_INFINITY,
+        bad_states: BTreeSet::new(),
     };
     s.run();
     let Server { link, .. } = s;
@@ -65,6 +72,12 @@ struct Server {
     clock: WallClock,
     link: Link,
     args: MqttServe,
+    /// The other realizers' characters: their last state and when it arrived (local clock).
+    others: BTreeMap<String, (RootState, f64)>,
+    /// When this realizer last published its characters' states.
+    published: f64,
+    /// Characters whose state could not be read (said once each on stderr).
+    bad_states: BTreeSet<String>,
 }
 
 impl Server {
@@ -92,8 +105,18 @@ impl Server {
 
     fn tick(&mut self) {
         let now = self.clock.now().min(self.args.until);
+        // the others' characters where they are now, as far as their states tell
+        for (id, (state, heard)) in &self.others {
+            let _ = self
+                .realizer
+                .place_remote(id, state.placement_after(now - heard));
+        }
         let frame = self.realizer.tick(now);
         self.send(frame.feedback, None);
+        if now - self.published >= PUBLISH_PERIOD {
+            self.published = now;
+            self.publish_states(now);
+        }
         let dropped = self.link.take_dropped();
         if dropped > 0 {
             eprintln!("bmlr serve: the broker was away too long: {dropped} feedback messages were dropped");
@@ -105,16 +128,86 @@ impl Server {
             Inbound::Lost(why) => eprintln!("bmlr serve: lost the broker ({why}); trying again"),
             Inbound::Reconnected => eprintln!("bmlr serve: back on the broker; characters kept"),
             Inbound::Message { topic, payload } => {
+                if let Some(character) = self.args.topics.world_character(&topic) {
+                    let character = character.to_string();
+                    return self.hear_state(character, &payload);
+                }
                 let Some(character) = self.args.topics.bml_character(&topic).map(str::to_string)
                 else {
                     return;
                 };
-                let served =
-                    self.args.characters.is_empty() || self.args.characters.contains(&character);
-                if served {
+                if self.serves(&character) {
                     self.perform(&character, payload);
                 }
             }
+        }
+    }
+
+    /// Whether this realizer serves `character` (a topic level): one of `--characters`, or,
+    /// without them, any character no other realizer moves.
+    fn serves(&self, character: &str) -> bool {
+        if self.args.characters.is_empty() {
+            !self.others.contains_key(character)
+        } else {
+            self.args.characters.contains(character)
+        }
+    }
+
+    /// Keeps another realizer's state of `character` (not one served here).
+    fn hear_state(&mut self, character: String, payload: &[u8]) {
+        if self.args.characters.contains(&character) || self.is_ours(&character) {
+            return;
+        }
+        match RootState::from_json(payload) {
+            Ok(state) => {
+                self.others.insert(character, (state, self.clock.now()));
+            }
+            Err(e) => {
+                if self.bad_states.insert(character.clone()) {
+                    let topic = self.args.topics.world(&character);
+                    eprintln!("bmlr serve: {topic}: not a root state ({e}); ignored");
+                }
+            }
+        }
+    }
+
+    /// Whether `character` (a topic level) is one this realizer has made.
+    fn is_ours(&self, character: &str) -> bool {
+        let id = if character == DEFAULT_CHARACTER {
+            ""
+        } else {
+            character
+        };
+        self.realizer.character(id).is_some() && !self.realizer.is_remote(id)
+    }
+
+    /// Publishes where this realizer's characters stand: those it has made, and the
+    /// `--characters` the world places.
+    fn publish_states(&mut self, now: f64) {
+        let world = self.realizer.world();
+        let mut ours: BTreeSet<String> = (self.realizer.characters())
+            .map(|(id, _)| id.to_string())
+            .filter(|id| !id.is_empty() && !self.realizer.is_remote(id))
+            .collect();
+        ours.extend(
+            (self.args.characters.iter())
+                .filter(|c| world.is_placed(c))
+                .cloned(),
+        );
+        let crowd = world.crowd();
+        let states: Vec<(String, String)> = (ours.into_iter())
+            .filter(|id| world.is_placed(id))
+            .map(|id| {
+                let velocity = crowd.index(&id).map_or(glam::Vec3::ZERO, |i| {
+                    let v = crowd.agent(i).velocity;
+                    glam::Vec3::new(v.x, 0.0, v.y)
+                });
+                let state = RootState::new(now, world.placement(&id), velocity);
+                (self.args.topics.world(&id), state.to_json())
+            })
+            .collect();
+        for (topic, json) in states {
+            self.link.publish(&topic, json.into_bytes(), false);
         }
     }
 

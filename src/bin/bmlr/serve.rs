@@ -207,11 +207,13 @@ fn mqtt_args(args: &ServeArgs, url: &str) -> Result<crate::mqtt::MqttServe, Stri
         return Err("--until must be a number of seconds".into());
     }
     // one subscription per character served, or the wildcard
-    let subscriptions = if args.characters.is_empty() {
+    let mut subscriptions = if args.characters.is_empty() {
         vec![topics.all_bml()]
     } else {
         args.characters.iter().map(|c| topics.bml(c)).collect()
     };
+    // (the world the realizers on the broker share)
+    subscriptions.push(topics.all_world());
     Ok(crate::mqtt::MqttServe {
         link: LinkOptions {
             url,

@@ -1,0 +1,89 @@
+//! A character's root state as realizers sharing one world publish it on `PREFIX/world/ID`:
+//! JSON `{"time": s, "position": [x, y, z], "velocity": [x, y, z], "facing": degrees}` (world
+//! frame, metres, y up; `facing` about +y from +z, as in the world file; `time` is the sender's
+//! clock, for reading only: clocks of different realizers have different origins, so a
+//! receiver ages a state from when it arrived). A state is moved on along its velocity for at
+//! most [`EXTRAPOLATE`] seconds; older, the character stands where that left it.
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::world::Placement;
+
+/// The longest a state is moved on along its velocity (s).
+pub const EXTRAPOLATE: f64 = 0.5;
+
+/// How often a realizer publishes its characters' states (s): 20 Hz.
+pub const PUBLISH_PERIOD: f64 = 0.05;
+
+/// One character's root state.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RootState {
+    /// The sender's clock (s).
+    pub time: f64,
+    /// Where its root stands (m).
+    pub position: [f32; 3],
+    /// How fast it moves (m/s).
+    pub velocity: [f32; 3],
+    /// Its heading (degrees about +y from +z).
+    pub facing: f32,
+}
+
+impl RootState {
+    /// The state of a character placed at `at` moving at `velocity`, at `time`.
+    pub fn new(time: f64, at: Placement, velocity: Vec3) -> RootState {
+        RootState {
+            time,
+            position: at.position.to_array(),
+            velocity: velocity.to_array(),
+            facing: at.facing.to_degrees(),
+        }
+    }
+
+    /// Reads a payload; `Err` says why it is not a state.
+    pub fn from_json(payload: &[u8]) -> Result<RootState, String> {
+        let s: RootState = serde_json::from_slice(payload).map_err(|e| e.to_string())?;
+        let finite = s.time.is_finite()
+            && s.position.iter().chain(&s.velocity).all(|v| v.is_finite())
+            && s.facing.is_finite();
+        if !finite {
+            return Err("a number is not finite".into());
+        }
+        Ok(s)
+    }
+
+    /// The payload.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).expect("numbers are finite")
+    }
+
+    /// Where it stands `age` seconds after it was sent (moved on along its velocity for at
+    /// most [`EXTRAPOLATE`] s).
+    pub fn placement_after(&self, age: f64) -> Placement {
+        let t = age.clamp(0.0, EXTRAPOLATE) as f32;
+        Placement {
+            position: Vec3::from(self.position) + Vec3::from(self.velocity) * t,
+            facing: self.facing.to_radians(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_state_round_trips_and_is_moved_on_for_half_a_second_at_most() {
+        let at = Placement::new(Vec3::new(1.0, 0.0, 2.0), 90.0);
+        let s = RootState::new(3.5, at, Vec3::new(1.0, 0.0, 0.0));
+        let back = RootState::from_json(s.to_json().as_bytes()).unwrap();
+        assert_eq!(back, s);
+        assert!((back.placement_after(0.2).position.x - 1.2).abs() < 1e-6);
+        assert!((back.placement_after(9.0).position.x - 1.5).abs() < 1e-6);
+        assert!((back.placement_after(0.0).facing - at.facing).abs() < 1e-6);
+        assert!(RootState::from_json(br#"{"time": 1}"#).is_err());
+        assert!(RootState::from_json(b"not json").is_err());
+        let nan = br#"{"time": 0, "position": [0, 0, 0], "velocity": [0, 0, 0], "facing": 1e999}"#;
+        assert!(RootState::from_json(nan).is_err());
+    }
+}

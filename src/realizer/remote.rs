@@ -1,0 +1,29 @@
+//! Characters that another realizer moves — over a broker, realizers that share one world each
+//! publish where their characters stand and place the others' here. Such a character is placed
+//! in this realizer's world (walkers here see it in the crowd, gaze and pointing can aim at it),
+//! but it is never made a character of this realizer when a walker asks it for room (the host
+//! sends its blocks to the realizer that moves it).
+
+use super::Realizer;
+use crate::world::Placement;
+
+impl Realizer {
+    /// Places character `id`, which another realizer moves, at `at` (world frame). Refused for
+    /// a character this realizer has (it moves that one itself) and for a place that is not
+    /// finite.
+    pub fn place_remote(&mut self, id: &str, at: Placement) -> Result<(), String> {
+        if self.characters.contains_key(id) {
+            return Err(format!(
+                "character '{id}' is one of this realizer's: another cannot move it"
+            ));
+        }
+        self.world_mut().place(id, at)?;
+        self.remote.insert(id.to_string());
+        Ok(())
+    }
+
+    /// Whether character `id` is moved by another realizer ([`place_remote`](Self::place_remote)).
+    pub fn is_remote(&self, id: &str) -> bool {
+        self.remote.contains(id)
+    }
+}
