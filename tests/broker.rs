@@ -105,10 +105,15 @@ fn realizer(broker: &Broker, name: &str, characters: &[&str], extra: &[&str]) ->
 
 /// A planner: a link subscribed to every feedback and presence topic.
 fn planner(broker: &Broker, id: &str) -> Link {
+    planner_on(broker, id, &["bml/+/feedback", "bml/realizers/+"])
+}
+
+/// A planner subscribed to `topics`.
+fn planner_on(broker: &Broker, id: &str, topics: &[&str]) -> Link {
     Link::connect(LinkOptions {
         url: BrokerUrl::parse(&broker.url()).unwrap(),
         client_id: id.into(),
-        subscriptions: vec!["bml/+/feedback".into(), "bml/realizers/+".into()],
+        subscriptions: topics.iter().map(|t| t.to_string()).collect(),
         presence: None,
         inbox: 100_000,
         start_tries: 3,
@@ -470,4 +475,49 @@ fn walkers_served_by_two_realizers_go_round_each_other_and_both_arrive() {
         let _ = r.wait();
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_flood_for_one_character_does_not_hold_up_another_s_block() {
+    let Some(broker) = Broker::start() else {
+        return;
+    };
+    let _r = realizer(&broker, "r", &[], &["--no-idle"]);
+    let mut flood = planner(&broker, "flooder");
+    // (the other planner listens to its own character)
+    let mut other = planner_on(&broker, "other", &["bml/y/feedback", "bml/realizers/+"]);
+    hear(&other, 10.0, |h| online(h, "r", "online"));
+    // more than a character's queue holds: the rest is dropped, and said
+    for k in 0..12_000 {
+        flood.publish("bml/x/bml", block(&format!("f{k}")).into_bytes(), false);
+    }
+    flood.flush();
+    while flood.waiting() > 0 {
+        flood.flush();
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let sent = Instant::now();
+    other.publish("bml/y/bml", block("mine").into_bytes(), false);
+    let started = |h: &[(String, String)]| {
+        h.iter()
+            .any(|(t, m)| t == "bml/y/feedback" && m.contains(r#"id="mine:start""#))
+    };
+    let heard = hear(&other, 20.0, started);
+    let waited = sent.elapsed();
+    assert!(
+        started(&heard),
+        "{:?}",
+        &heard[heard.len().saturating_sub(5)..]
+    );
+    eprintln!("the other character's block started {waited:?} after it was sent");
+    assert!(waited < Duration::from_millis(250), "{waited:?}");
+    let heard = hear(&flood, 30.0, |h| {
+        h.iter()
+            .any(|(t, m)| t == "bml/x/feedback" && m.contains("blocks dropped"))
+    });
+    let said = heard.iter().find(|(_, m)| m.contains("blocks dropped"));
+    assert!(
+        said.is_some_and(|s| s.1.contains("more than 10000 waited")),
+        "{said:?}"
+    );
 }

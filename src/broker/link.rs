@@ -3,12 +3,13 @@
 //! the presence (retained `online`, with `offline` as the last will), since a broker that
 //! restarted has forgotten both. What arrives waits in a bounded inbox (the polling thread
 //! waits when it is full, and the broker holds back: backpressure); what is sent goes at QoS 1
-//! through rumqttc's bounded request queue, and, while that is full (a broker away), into an
-//! outbox of at most [`OUTBOX_LIMIT`] messages, beyond which the oldest are dropped and counted
-//! ([`Link::take_dropped`]). TCP_NODELAY is set: without it small messages wait for the
+//! through an outbox of one lane per topic, handed to rumqttc's small request queue a message
+//! of each lane in turn (so that one character's flood of feedback does not hold up another's),
+//! at most [`OUTBOX_LIMIT`] messages in all, beyond which the oldest of the longest lane are
+//! dropped and counted ([`Link::take_dropped`]). TCP_NODELAY is set: without it small messages wait for the
 //! previous one's acknowledgement (Nagle's algorithm, ~40 ms stalls).
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::sync::mpsc::{self, Receiver, SyncSender};
 use std::time::{Duration, Instant};
 
@@ -19,8 +20,9 @@ use super::BrokerUrl;
 /// Messages kept while the broker is away, beyond rumqttc's own queue.
 pub const OUTBOX_LIMIT: usize = 100_000;
 
-/// rumqttc's request queue (messages handed to its event loop, not yet written).
-const REQUESTS: usize = 4_096;
+/// rumqttc's request queue (messages handed to its event loop, not yet written): small, so
+/// that the lanes of the outbox decide the order.
+const REQUESTS: usize = 256;
 
 /// The largest packet taken from the broker (bytes); a larger one ends the connection (which
 /// is then made again).
@@ -65,7 +67,11 @@ pub enum Inbound {
 pub struct Link {
     client: Client,
     inbox: Receiver<Inbound>,
-    outbox: VecDeque<(String, Vec<u8>, bool)>,
+    /// Per topic, what waits to be handed to rumqttc (payload, retain), and the lanes' order
+    /// of turns.
+    outbox: BTreeMap<String, VecDeque<(Vec<u8>, bool)>>,
+    turns: VecDeque<String>,
+    waiting: usize,
     dropped: u64,
     presence: Option<String>,
 }
@@ -99,7 +105,9 @@ impl Link {
             Ok(Ok(())) => Ok(Link {
                 client,
                 inbox,
-                outbox: VecDeque::new(),
+                outbox: BTreeMap::new(),
+                turns: VecDeque::new(),
+                waiting: 0,
                 dropped: 0,
                 presence: options.presence,
             }),
@@ -118,45 +126,80 @@ impl Link {
         self.inbox.try_recv().ok()
     }
 
-    /// Sends `payload` on `topic` at QoS 1 (retained if `retain`): now, or once rumqttc's queue
-    /// has room ([`flush`](Self::flush)).
+    /// Sends `payload` on `topic` at QoS 1 (retained if `retain`), after what waits on the same
+    /// topic; hands what it can to rumqttc ([`flush`](Self::flush)).
     pub fn publish(&mut self, topic: &str, payload: Vec<u8>, retain: bool) {
-        self.flush();
-        if self.outbox.is_empty() {
-            match self
-                .client
-                .try_publish(topic, QoS::AtLeastOnce, retain, payload)
-            {
-                Ok(()) => return,
-                Err(e) => {
-                    if let Some(m) = unsent(e) {
-                        self.keep(m);
-                    }
-                    return;
+        if self.waiting >= OUTBOX_LIMIT {
+            self.drop_oldest();
+        }
+        match self.outbox.get_mut(topic) {
+            Some(lane) => lane.push_back((payload, retain)),
+            None => {
+                self.outbox
+                    .insert(topic.to_string(), VecDeque::from([(payload, retain)]));
+                // (a lane emptied by a drop may still have its turn)
+                if !self.turns.iter().any(|t| t == topic) {
+                    self.turns.push_back(topic.to_string());
                 }
             }
         }
-        self.keep((topic.to_string(), payload, retain));
+        self.waiting += 1;
+        self.flush();
     }
 
-    /// Hands what waits in the outbox to rumqttc, as far as its queue has room.
+    /// Hands waiting messages to rumqttc, a message of each topic in turn, as far as its queue
+    /// has room.
     pub fn flush(&mut self) {
-        while let Some((topic, payload, retain)) = self.outbox.pop_front() {
-            if let Err(e) = self
-                .client
-                .try_publish(topic, QoS::AtLeastOnce, retain, payload)
-            {
-                if let Some(m) = unsent(e) {
-                    self.outbox.push_front(m);
+        while let Some(topic) = self.turns.pop_front() {
+            let Some(lane) = self.outbox.get_mut(&topic) else {
+                continue;
+            };
+            let Some((payload, retain)) = lane.pop_front() else {
+                self.outbox.remove(&topic);
+                continue;
+            };
+            match (self.client).try_publish(topic.clone(), QoS::AtLeastOnce, retain, payload) {
+                Ok(()) => {
+                    self.waiting -= 1;
+                    if lane.is_empty() {
+                        self.outbox.remove(&topic);
+                    } else {
+                        self.turns.push_back(topic);
+                    }
                 }
-                return;
+                Err(e) => {
+                    // full: it goes first next time
+                    match unsent(e) {
+                        Some((_, payload, retain)) => lane.push_front((payload, retain)),
+                        None => self.waiting -= 1,
+                    }
+                    if lane.is_empty() {
+                        self.outbox.remove(&topic);
+                    } else {
+                        self.turns.push_front(topic);
+                    }
+                    return;
+                }
             }
         }
     }
 
     /// Messages waiting in the outbox.
     pub fn waiting(&self) -> usize {
-        self.outbox.len()
+        self.waiting
+    }
+
+    /// Drops the oldest message of the longest lane (the outbox is full).
+    fn drop_oldest(&mut self) {
+        let longest = (self.outbox.iter())
+            .max_by_key(|(_, lane)| lane.len())
+            .map(|(t, _)| t.clone());
+        if let Some(lane) = longest.and_then(|t| self.outbox.get_mut(&t)) {
+            if lane.pop_front().is_some() {
+                self.waiting -= 1;
+                self.dropped += 1;
+            }
+        }
     }
 
     /// How many messages were dropped since last asked (the outbox was full).
@@ -170,21 +213,13 @@ impl Link {
             self.publish(&p, b"offline".to_vec(), true);
         }
         let until = Instant::now() + linger;
-        while !self.outbox.is_empty() && Instant::now() < until {
+        while self.waiting > 0 && Instant::now() < until {
             self.flush();
             std::thread::sleep(Duration::from_millis(5));
         }
         // (what rumqttc still holds goes before the disconnect: its queue is in order)
         let _ = self.client.disconnect();
         std::thread::sleep(linger.min(Duration::from_millis(200)));
-    }
-
-    fn keep(&mut self, m: (String, Vec<u8>, bool)) {
-        if self.outbox.len() >= OUTBOX_LIMIT {
-            self.outbox.pop_front();
-            self.dropped += 1;
-        }
-        self.outbox.push_back(m);
     }
 }
 

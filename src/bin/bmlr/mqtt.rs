@@ -9,7 +9,7 @@
 //! characters stand on `PREFIX/world/CHARACTER` (20 Hz) and places the others' characters in
 //! its own world (`Realizer::place_remote`), so that its walkers go round them.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -21,9 +21,16 @@ use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
 use bml_realizer::realizer::{Realizer, NO_ID};
 
-/// Messages handled in one frame at most (the rest wait for the next frames, so that a flood
+/// Blocks performed in one frame at most (the rest wait for the next frames, so that a flood
 /// cannot hold the clock up).
 const PER_FRAME: usize = 1_024;
+
+/// Messages taken from the link in one frame at most (into the characters' queues).
+const TAKEN_PER_FRAME: usize = 65_536;
+
+/// Blocks that may wait for one character; beyond, the newest are dropped with a warning on
+/// its feedback topic.
+pub const QUEUE_LIMIT: usize = 10_000;
 
 /// What `serve --mqtt` was given.
 pub struct MqttServe {
@@ -60,6 +67,7 @@ pub fn serve(args: MqttServe, realizer: Realizer) -> ExitCode {
         others: BTreeMap::new(),
         published: f64::NEG_INFINITY,
         bad_states: BTreeSet::new(),
+        waiting: BTreeMap::new(),
     };
     s.run();
     let Server { link, .. } = s;
@@ -78,27 +86,63 @@ struct Server {
     published: f64,
     /// Characters whose state could not be read (said once each on stderr).
     bad_states: BTreeSet<String>,
+    /// Blocks waiting, per character served (taken in turns: one character's flood does not
+    /// hold up the others), and how many were dropped since last said.
+    waiting: BTreeMap<String, (VecDeque<Vec<u8>>, usize)>,
 }
 
 impl Server {
     fn run(&mut self) {
         loop {
-            let mut heard = Vec::new();
-            if let Some(first) = self.link.recv_timeout(self.args.period) {
-                heard.push(first);
-                while heard.len() < PER_FRAME {
+            // wait for something only when nothing waits
+            let idle = self.waiting.values().all(|q| q.0.is_empty());
+            let wait = if idle {
+                self.args.period
+            } else {
+                Duration::ZERO
+            };
+            if let Some(first) = self.link.recv_timeout(wait) {
+                self.hear(first);
+                for _ in 1..TAKEN_PER_FRAME {
                     match self.link.try_recv() {
-                        Some(i) => heard.push(i),
+                        Some(i) => self.hear(i),
                         None => break,
                     }
                 }
             }
-            for inbound in heard {
-                self.hear(inbound);
-            }
+            self.perform_waiting();
             self.tick();
             if self.realizer.now() >= self.args.until {
                 return;
+            }
+        }
+    }
+
+    /// Performs waiting blocks, one per character in turn, [`PER_FRAME`] at most and for no
+    /// longer than a frame; says what was dropped.
+    fn perform_waiting(&mut self) {
+        let dropped: Vec<(String, usize)> = (self.waiting.iter_mut())
+            .filter(|(_, q)| q.1 > 0)
+            .map(|(c, q)| (c.clone(), std::mem::take(&mut q.1)))
+            .collect();
+        for (c, n) in dropped {
+            let text =
+                format!("{n} blocks dropped: more than {QUEUE_LIMIT} waited for this character");
+            self.refuse(&c, text);
+        }
+        let (mut done, start) = (0, self.clock.now());
+        // (within a frame: the clock and the other messages are not held up)
+        while done < PER_FRAME && self.clock.now() - start < self.args.period.as_secs_f64() {
+            let next: Vec<(String, Vec<u8>)> = (self.waiting.iter_mut())
+                .filter_map(|(c, q)| Some((c.clone(), q.0.pop_front()?)))
+                .take(PER_FRAME - done)
+                .collect();
+            if next.is_empty() {
+                break;
+            }
+            done += next.len();
+            for (c, payload) in next {
+                self.perform(&c, payload);
             }
         }
     }
@@ -137,7 +181,12 @@ impl Server {
                     return;
                 };
                 if self.serves(&character) {
-                    self.perform(&character, payload);
+                    let q = self.waiting.entry(character).or_default();
+                    if q.0.len() < QUEUE_LIMIT {
+                        q.0.push_back(payload);
+                    } else {
+                        q.1 += 1;
+                    }
                 }
             }
         }
