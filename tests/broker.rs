@@ -521,3 +521,58 @@ fn a_flood_for_one_character_does_not_hold_up_another_s_block() {
         "{said:?}"
     );
 }
+
+#[test]
+fn ipaaca_messages_round_trip_as_the_contract_gives_them() {
+    let Some(broker) = Broker::start() else {
+        return;
+    };
+    let _r = realizer(&broker, "asap", &[], &["--ipaaca", "asapcomp"]);
+    let mut p = planner_on(
+        &broker,
+        "ipaaca",
+        &["asapcomp/bmlfeedback/+", "bml/realizers/+"],
+    );
+    hear(&p, 10.0, |h| online(h, "asap", "online"));
+    let message = serde_json::json!({"bml": block("ib"), "character": "alice"});
+    p.publish("asapcomp/bml/m1", message.to_string().into_bytes(), false);
+    p.publish("asapcomp/bml/m2", b"<bml/>".to_vec(), false);
+    let feedback = |h: &[(String, String)]| -> Vec<(String, String)> {
+        (h.iter())
+            .filter_map(|(t, m)| {
+                let v: serde_json::Value = serde_json::from_str(m).ok()?;
+                Some((t.clone(), v.get("bmlfeedback")?.as_str()?.to_string()))
+            })
+            .collect()
+    };
+    let heard = hear(&p, 10.0, |h| {
+        let f = feedback(h);
+        f.iter().any(|(_, x)| x.contains(r#"id="ib:end""#))
+            && f.iter().any(|(_, x)| x.contains("warningFeedback"))
+    });
+    let f = feedback(&heard);
+    // every message is {"bmlfeedback": XML}, on the character's topic
+    assert_eq!(
+        f.len(),
+        heard
+            .iter()
+            .filter(|(t, _)| t.starts_with("asapcomp/"))
+            .count()
+    );
+    let end = f
+        .iter()
+        .find(|(_, x)| x.contains(r#"id="ib:end""#))
+        .expect("the block's end");
+    assert_eq!(end.0, "asapcomp/bmlfeedback/alice");
+    assert!(end.1.starts_with("<blockProgress") && end.1.contains(r#"characterId="alice""#));
+    let warning = f
+        .iter()
+        .find(|(_, x)| x.contains("warningFeedback"))
+        .unwrap();
+    assert_eq!(warning.0, "asapcomp/bmlfeedback/_");
+    assert!(
+        warning.1.contains("not an ipaaca BML message"),
+        "{}",
+        warning.1
+    );
+}

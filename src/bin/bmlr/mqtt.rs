@@ -15,7 +15,7 @@ use std::time::Duration;
 
 use bml_realizer::bml::Checked;
 use bml_realizer::broker::{
-    Inbound, Link, LinkOptions, RootState, Topics, DEFAULT_CHARACTER, PUBLISH_PERIOD,
+    Inbound, Ipaaca, Link, LinkOptions, RootState, Topics, DEFAULT_CHARACTER, PUBLISH_PERIOD,
 };
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
@@ -46,6 +46,8 @@ pub struct MqttServe {
     pub period: Duration,
     /// Stop after this many seconds (on the realizer's clock).
     pub until: f64,
+    /// ipaaca's messages instead of the block and feedback topics (`--ipaaca COMPONENT`).
+    pub ipaaca: Option<Ipaaca>,
 }
 
 /// Serves until `until` (or for ever). Exit 2 when the broker cannot be reached at the start.
@@ -176,9 +178,10 @@ impl Server {
                     let character = character.to_string();
                     return self.hear_state(character, &payload);
                 }
-                let Some(character) = self.args.topics.bml_character(&topic).map(str::to_string)
-                else {
-                    return;
+                let (character, payload) = match self.block_of(&topic, payload) {
+                    Some(Ok(c)) => c,
+                    Some(Err((character, why))) => return self.refuse(&character, why),
+                    None => return,
                 };
                 if self.serves(&character) {
                     let q = self.waiting.entry(character).or_default();
@@ -189,6 +192,40 @@ impl Server {
                     }
                 }
             }
+        }
+    }
+
+    /// The character (a topic level) and the block text of a message on `topic`: `None` when
+    /// it is no block topic; an error (with the character to tell) when it is an ipaaca
+    /// message that cannot be read.
+    #[allow(clippy::type_complexity)]
+    fn block_of(
+        &self,
+        topic: &str,
+        payload: Vec<u8>,
+    ) -> Option<Result<(String, Vec<u8>), (String, String)>> {
+        let Some(ip) = &self.args.ipaaca else {
+            let character = self.args.topics.bml_character(topic)?;
+            return Some(Ok((character.to_string(), payload)));
+        };
+        Some(match ip.read(topic, &payload)? {
+            Ok((character, text)) => {
+                let character = character.unwrap_or_else(|| DEFAULT_CHARACTER.to_string());
+                if !bml_realizer::broker::level_ok(&character) {
+                    let why = format!("'{character}' is not a character name");
+                    return Some(Err((DEFAULT_CHARACTER.to_string(), why)));
+                }
+                Ok((character, text.into_bytes()))
+            }
+            Err(why) => Err((DEFAULT_CHARACTER.to_string(), why)),
+        })
+    }
+
+    /// Where blocks for `character` come from (named in warnings).
+    fn source(&self, character: &str) -> String {
+        match &self.args.ipaaca {
+            Some(ip) => format!("{} ({character})", ip.subscription()),
+            None => self.args.topics.bml(character),
         }
     }
 
@@ -285,7 +322,7 @@ impl Server {
                 );
             }
         }
-        let source = self.args.topics.bml(character);
+        let source = self.source(character);
         let _ = self.realizer.perform_checked(checked, Some(&source));
         let mut feedback = self
             .realizer
@@ -305,7 +342,7 @@ impl Server {
             id: NO_ID.into(),
             kind: KnownWarning::ParsingFailure.into(),
             character_id: (character != DEFAULT_CHARACTER).then(|| character.to_string()),
-            text: format!("{}: {text}", self.args.topics.bml(character)),
+            text: format!("{}: {text}", self.source(character)),
         });
         self.send(vec![warning], Some(character));
     }
@@ -318,9 +355,14 @@ impl Server {
                 .or(fallback)
                 .unwrap_or(DEFAULT_CHARACTER)
                 .to_string();
-            let topic = self.args.topics.feedback(&character);
-            self.link
-                .publish(&topic, self.args.format.encode(&fb).into_bytes(), false);
+            let (topic, payload) = match &self.args.ipaaca {
+                Some(ip) => ip.feedback(&character, &Format::Xml.encode(&fb)),
+                None => (
+                    self.args.topics.feedback(&character),
+                    self.args.format.encode(&fb).into_bytes(),
+                ),
+            };
+            self.link.publish(&topic, payload, false);
         }
         self.link.flush();
     }

@@ -47,6 +47,11 @@ pub struct ServeArgs {
     /// With --mqtt: the feedback's encoding (xml by default).
     #[arg(long, value_enum, requires = "mqtt")]
     format: Option<crate::run::FormatArg>,
+    /// With --mqtt: speak ipaaca's messages as component COMPONENT (BML in on
+    /// COMPONENT/bml/M as {"bml": TEXT}, feedback out on COMPONENT/bmlfeedback/CHARACTER as
+    /// {"bmlfeedback": XML}) instead of the block and feedback topics.
+    #[arg(long, value_name = "COMPONENT")]
+    ipaaca: Option<String>,
     /// With --mqtt: stop after this many seconds.
     #[arg(long, value_name = "SECS", requires = "mqtt")]
     until: Option<f64>,
@@ -95,6 +100,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         ("--characters", !args.characters.is_empty()),
         ("--format", args.format.is_some()),
         ("--until", args.until.is_some()),
+        ("--ipaaca", args.ipaaca.is_some()),
     ];
     let tcp_only = [
         ("--view", args.view.is_some()),
@@ -207,10 +213,14 @@ fn mqtt_args(args: &ServeArgs, url: &str) -> Result<crate::mqtt::MqttServe, Stri
         return Err("--until must be a number of seconds".into());
     }
     // one subscription per character served, or the wildcard
-    let mut subscriptions = if args.characters.is_empty() {
-        vec![topics.all_bml()]
-    } else {
-        args.characters.iter().map(|c| topics.bml(c)).collect()
+    let ipaaca = (args.ipaaca.as_deref())
+        .map(bml_realizer::broker::Ipaaca::new)
+        .transpose()
+        .map_err(|e| format!("--ipaaca {e}"))?;
+    let mut subscriptions = match (&ipaaca, args.characters.is_empty()) {
+        (Some(ip), _) => vec![ip.subscription()],
+        (None, true) => vec![topics.all_bml()],
+        (None, false) => args.characters.iter().map(|c| topics.bml(c)).collect(),
     };
     // (the world the realizers on the broker share)
     subscriptions.push(topics.all_world());
@@ -228,6 +238,7 @@ fn mqtt_args(args: &ServeArgs, url: &str) -> Result<crate::mqtt::MqttServe, Stri
         format: args.format.unwrap_or(crate::run::FormatArg::Xml).into(),
         period: Duration::from_secs_f64(1.0 / args.fps),
         until,
+        ipaaca,
     })
 }
 
