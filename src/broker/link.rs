@@ -252,7 +252,13 @@ impl Poller {
         let mut ready = Some(ready);
         let (mut failures, mut lost) = (0u32, false);
         let mut wait = Duration::from_millis(100);
+        // (renewed at each connection; tried again while rumqttc's queue is full of what
+        // waited to be sent)
+        let mut renewing = false;
         loop {
+            if renewing {
+                renewing = !self.renew();
+            }
             let event = match connection.recv() {
                 Ok(e) => e,
                 Err(_) => return, // the client is gone
@@ -260,7 +266,7 @@ impl Poller {
             match event {
                 Ok(Event::Incoming(Packet::ConnAck(_))) => {
                     (failures, wait) = (0, Duration::from_millis(100));
-                    self.renew();
+                    renewing = !self.renew();
                     if let Some(r) = ready.take() {
                         let _ = r.send(Ok(()));
                     } else if lost {
@@ -300,13 +306,16 @@ impl Poller {
         }
     }
 
-    /// Subscribes and says it is online (on every connection).
-    fn renew(&self) {
-        for s in &self.subscriptions {
-            let _ = self.client.try_subscribe(s, QoS::AtLeastOnce);
-        }
-        if let Some(p) = &self.presence {
-            let _ = (self.client).try_publish(p, QoS::AtLeastOnce, true, "online");
-        }
+    /// Subscribes and says it is online (on every connection); false when rumqttc's queue
+    /// had no room for all of it (subscribing again to a topic is harmless).
+    fn renew(&self) -> bool {
+        let subscribed = (self.subscriptions.iter())
+            .all(|s| self.client.try_subscribe(s, QoS::AtLeastOnce).is_ok());
+        let online = self.presence.as_ref().is_none_or(|p| {
+            (self.client)
+                .try_publish(p, QoS::AtLeastOnce, true, "online")
+                .is_ok()
+        });
+        subscribed && online
     }
 }
