@@ -139,6 +139,14 @@ fn hear(
     heard
 }
 
+/// Waits until every realizer of `names` has said it is online (fails the test if one does not
+/// within 10 s).
+fn until_online(link: &Link, names: &[&str]) {
+    let all = |h: &[(String, String)]| names.iter().all(|n| online(h, n, "online"));
+    let heard = hear(link, 10.0, all);
+    assert!(all(&heard), "not all of {names:?} online: {heard:?}");
+}
+
 fn online(heard: &[(String, String)], name: &str, state: &str) -> bool {
     let topic = format!("bml/realizers/{name}");
     heard.iter().any(|(t, p)| *t == topic && p == state)
@@ -163,15 +171,9 @@ fn feedback_reaches_only_its_character_s_topic_across_two_realizers_and_two_plan
     };
     let mut p1 = planner(&broker, "planner1");
     let mut p2 = planner(&broker, "planner2");
-    let mut r1 = realizer(&broker, "r1", &["a", "b", "c"], &[]);
+    let _r1 = realizer(&broker, "r1", &["a", "b", "c"], &[]);
     let mut r2 = realizer(&broker, "r2", &["d", "e", "f"], &[]);
-    let heard = hear(&p1, 10.0, |h| {
-        online(h, "r1", "online") && online(h, "r2", "online")
-    });
-    assert!(
-        online(&heard, "r1", "online") && online(&heard, "r2", "online"),
-        "{heard:?}"
-    );
+    until_online(&p1, &["r1", "r2"]);
     // each planner sends a block to each of three characters, spread over both realizers
     for (p, chars) in [(&mut p1, ["a", "d", "e"]), (&mut p2, ["b", "c", "f"])] {
         for c in chars {
@@ -209,8 +211,6 @@ fn feedback_reaches_only_its_character_s_topic_across_two_realizers_and_two_plan
     p2.publish("bml/a/bml", block("again").into_bytes(), false);
     let heard = hear(&p2, 10.0, |h| ended(h, "a", "again"));
     assert!(ended(&heard, "a", "again"), "{heard:?}");
-    let _ = r1.kill();
-    let _ = r1.wait();
 }
 
 #[test]
@@ -219,12 +219,8 @@ fn bad_payloads_are_answered_on_the_character_s_topic() {
         return;
     };
     let mut p = planner(&broker, "planner");
-    let mut r = realizer(&broker, "r", &[], &[]);
-    assert!(online(
-        &hear(&p, 10.0, |h| online(h, "r", "online")),
-        "r",
-        "online"
-    ));
+    let _r = realizer(&broker, "r", &[], &[]);
+    until_online(&p, &["r"]);
     p.publish("bml/bob/bml", vec![0xff, 0xfe, b'<'], false);
     p.publish("bml/bob/bml", b"not a block".to_vec(), false);
     let other = format!(r#"<bml {NS} id="x" characterId="alice"/>"#);
@@ -257,8 +253,6 @@ fn bad_payloads_are_answered_on_the_character_s_topic() {
         "{warnings:?}"
     );
     assert!(ended(&heard, "bob", "fine"), "{heard:?}");
-    let _ = r.kill();
-    let _ = r.wait();
 }
 
 #[test]
@@ -267,14 +261,9 @@ fn after_a_broker_restart_the_realizer_reconnects_and_the_next_block_runs() {
         return;
     };
     let port = broker.port;
-    let mut r = realizer(&broker, "r", &[], &[]);
+    let _r = realizer(&broker, "r", &[], &[]);
     {
-        let p = planner(&broker, "planner");
-        assert!(online(
-            &hear(&p, 10.0, |h| online(h, "r", "online")),
-            "r",
-            "online"
-        ));
+        until_online(&planner(&broker, "planner"), &["r"]);
     }
     drop(broker);
     std::thread::sleep(Duration::from_millis(500));
@@ -286,8 +275,6 @@ fn after_a_broker_restart_the_realizer_reconnects_and_the_next_block_runs() {
     p.publish("bml/_/bml", block("after").into_bytes(), false);
     let heard = hear(&p, 10.0, |h| ended(h, "_", "after"));
     assert!(ended(&heard, "_", "after"), "{heard:?}");
-    let _ = r.kill();
-    let _ = r.wait();
 }
 
 #[test]
@@ -351,14 +338,9 @@ fn conformance_tests_pass_through_the_broker_on_both_fixtures() {
     let Some(broker) = Broker::start() else {
         return;
     };
-    let std = realizer(&broker, "std", &["std"], &[]);
-    let inc = realizer(&broker, "inc", &["inc"], &["--retimable-speech"]);
-    {
-        let p = planner(&broker, "watch");
-        hear(&p, 10.0, |h| {
-            online(h, "std", "online") && online(h, "inc", "online")
-        });
-    }
+    let _std = realizer(&broker, "std", &["std"], &[]);
+    let _inc = realizer(&broker, "inc", &["inc"], &["--retimable-speech"]);
+    until_online(&planner(&broker, "watch"), &["std", "inc"]);
     for (filter, n) in [("Shift", 2), ("Retime", 1)] {
         let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
             .args(["conformance", "--mqtt", &broker.url(), "--character", "std"])
@@ -371,10 +353,6 @@ fn conformance_tests_pass_through_the_broker_on_both_fixtures() {
             "{text}\n{}",
             String::from_utf8_lossy(&out.stderr)
         );
-    }
-    for mut r in [std, inc] {
-        let _ = r.kill();
-        let _ = r.wait();
     }
 }
 
@@ -403,24 +381,14 @@ fn walkers_served_by_two_realizers_go_round_each_other_and_both_arrive() {
     )
     .unwrap();
     let w = world.to_str().unwrap();
-    let ra = realizer(&broker, "ra", &["a"], &["--world", w]);
-    let rb = realizer(&broker, "rb", &["b"], &["--world", w]);
-    let mut p = Link::connect(LinkOptions {
-        url: BrokerUrl::parse(&broker.url()).unwrap(),
-        client_id: "planner".into(),
-        subscriptions: vec![
-            "bml/+/feedback".into(),
-            "bml/realizers/+".into(),
-            "bml/world/+".into(),
-        ],
-        presence: None,
-        inbox: 100_000,
-        start_tries: 3,
-    })
-    .unwrap();
-    hear(&p, 10.0, |h| {
-        online(h, "ra", "online") && online(h, "rb", "online")
-    });
+    let _ra = realizer(&broker, "ra", &["a"], &["--world", w]);
+    let _rb = realizer(&broker, "rb", &["b"], &["--world", w]);
+    let mut p = planner_on(
+        &broker,
+        "planner",
+        &["bml/+/feedback", "bml/realizers/+", "bml/world/+"],
+    );
+    until_online(&p, &["ra", "rb"]);
     // crossing at the origin at the same moment, unless they see each other
     for (c, target) in [("a", "4,0"), ("b", "0,4")] {
         let bml =
@@ -470,10 +438,6 @@ fn walkers_served_by_two_realizers_go_round_each_other_and_both_arrive() {
         "b at {}",
         at("b")
     );
-    for mut r in [ra, rb] {
-        let _ = r.kill();
-        let _ = r.wait();
-    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -486,7 +450,7 @@ fn a_flood_for_one_character_does_not_hold_up_another_s_block() {
     let mut flood = planner(&broker, "flooder");
     // (the other planner listens to its own character)
     let mut other = planner_on(&broker, "other", &["bml/y/feedback", "bml/realizers/+"]);
-    hear(&other, 10.0, |h| online(h, "r", "online"));
+    until_online(&other, &["r"]);
     // a flood for x
     for k in 0..12_000 {
         flood.publish("bml/x/bml", block(&format!("f{k}")).into_bytes(), false);
@@ -527,7 +491,7 @@ fn ipaaca_messages_round_trip_as_the_contract_gives_them() {
         "ipaaca",
         &["asapcomp/bmlfeedback/+", "bml/realizers/+"],
     );
-    hear(&p, 10.0, |h| online(h, "asap", "online"));
+    until_online(&p, &["asap"]);
     let message = serde_json::json!({"bml": block("ib"), "character": "alice"});
     p.publish("asapcomp/bml/m1", message.to_string().into_bytes(), false);
     p.publish("asapcomp/bml/m2", b"<bml/>".to_vec(), false);

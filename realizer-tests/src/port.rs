@@ -150,6 +150,23 @@ impl<'a> Ctx<'a> {
     }
 }
 
+/// Sends [`REPLACE_SETUP`] on a real-time `port` and waits (up to [`REAL_TIME_WAIT`]) until its
+/// end is reported: whether it was. What a real-time port's [`TestPort::reset`] does.
+pub fn replace_setup(port: &mut dyn TestPort) -> bool {
+    port.perform_bml(REPLACE_SETUP);
+    let deadline = Instant::now() + REAL_TIME_WAIT;
+    while Instant::now() < deadline {
+        let lines = port.sleep(0.01);
+        if lines
+            .iter()
+            .any(|l| l.contains("blockProgress") && l.contains("\"replacesetup:end\""))
+        {
+            return true;
+        }
+    }
+    false
+}
+
 /// The empty REPLACE block the original fixture sends before every test.
 pub const REPLACE_SETUP: &str = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="replacesetup" composition="REPLACE"/>"#;
 
@@ -264,18 +281,11 @@ impl TestPort for ProcessPort {
             (self.child, self.stdin, self.lines) = (child, stdin, lines);
         }
         self.running = fixture;
-        self.perform_bml(REPLACE_SETUP);
-        let deadline = Instant::now() + REAL_TIME_WAIT;
-        while Instant::now() < deadline {
-            let lines = self.sleep(0.01);
-            if lines
-                .iter()
-                .any(|l| l.contains("blockProgress") && l.contains("\"replacesetup:end\""))
-            {
-                return Ok(());
-            }
+        if replace_setup(self) {
+            Ok(())
+        } else {
+            Err("the realizer did not end the REPLACE setup block".into())
         }
-        Err("the realizer did not end the REPLACE setup block".into())
     }
 }
 

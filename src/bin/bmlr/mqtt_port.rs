@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use bml_realizer::broker::{BrokerUrl, Inbound, Link, LinkOptions, Topics};
-use realizer_tests::port::{REAL_TIME_WAIT, REPLACE_SETUP};
+use realizer_tests::port::replace_setup;
 use realizer_tests::{Fixture, TestPort};
 
 /// The suite's port on a broker.
@@ -95,16 +95,8 @@ impl TestPort for MqttPort {
 
     fn reset(&mut self, fixture: Fixture) -> Result<(), String> {
         self.running = fixture;
-        self.perform_bml(REPLACE_SETUP);
-        let deadline = Instant::now() + REAL_TIME_WAIT;
-        while Instant::now() < deadline {
-            let lines = self.sleep(0.01);
-            if lines
-                .iter()
-                .any(|l| l.contains("blockProgress") && l.contains("\"replacesetup:end\""))
-            {
-                return Ok(());
-            }
+        if replace_setup(self) {
+            return Ok(());
         }
         Err(format!(
             "the realizer of '{}' did not end the REPLACE setup block (is one serving it on the broker?)",
