@@ -39,6 +39,7 @@ pub mod engines;
 pub mod face;
 pub mod feedback;
 pub mod locomotion;
+pub mod perception;
 pub mod plan;
 pub mod realizer;
 pub mod rng;

@@ -93,6 +93,7 @@ impl Timeline {
                 Feedback::BlockProgress(p) => t.block_progress(p, &mut started),
                 Feedback::SyncPointProgress(p) => t.sync_progress(p),
                 Feedback::Warning(w) => t.warnings.push((w.id.clone(), w.text.clone())),
+                Feedback::World(_) => {}
             }
         }
         for (id, _) in &t.warnings {

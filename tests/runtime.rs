@@ -520,12 +520,14 @@ fn an_appended_block_reports_in_the_order_of_design_section_4() {
             Feedback::BlockProgress(p) => p.block == "bml2",
             Feedback::SyncPointProgress(p) => p.block == "bml2",
             Feedback::Warning(_) => true,
+            Feedback::World(_) => false,
         })
         .map(|f| match f {
             Feedback::Prediction(p) => format!("prediction {}", p.blocks[0].status.unwrap()),
             Feedback::BlockProgress(p) => format!("{} {}", p.sync, p.global_time),
             Feedback::SyncPointProgress(p) => format!("{} {}", p.sync, p.global_time),
             Feedback::Warning(w) => format!("warning {}", w.text),
+            Feedback::World(w) => w.to_json(),
         })
         .collect();
     assert_eq!(

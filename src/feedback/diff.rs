@@ -45,12 +45,7 @@ impl Log {
 
 /// What a message is, for alignment: kind and id (and character, if any).
 fn identity(fb: &Feedback) -> String {
-    let character = match fb {
-        Feedback::BlockProgress(p) => p.character_id.as_deref(),
-        Feedback::SyncPointProgress(p) => p.character_id.as_deref(),
-        Feedback::Prediction(p) => p.character_id.as_deref(),
-        Feedback::Warning(w) => w.character_id.as_deref(),
-    };
+    let character = fb.character_id();
     let id = kind_and_id(fb);
     match character {
         Some(c) => format!("{id} (character {c})"),
@@ -73,6 +68,7 @@ fn kind_and_id(fb: &Feedback) -> String {
             )
         }
         Feedback::Warning(w) => format!("warningFeedback {} {}", w.id, w.kind.as_str()),
+        Feedback::World(w) => w.kind().to_string(),
     }
 }
 
@@ -160,7 +156,7 @@ fn measure(fb: &Feedback, origin: f64) -> Option<(&'static str, f64)> {
             let b = p.blocks.first()?;
             Some(("predicted length", b.global_end? - b.global_start?))
         }
-        Feedback::Warning(_) => None,
+        Feedback::Warning(_) | Feedback::World(_) => None,
     }
 }
 

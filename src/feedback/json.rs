@@ -153,6 +153,9 @@ fn syncs_ms<S: Serializer>(syncs: &IndexMap<String, f64>, s: S) -> Result<S::Ok,
 
 /// Encodes one message as one JSON line (no trailing newline).
 pub fn to_json(fb: &Feedback) -> String {
+    if let Feedback::World(w) = fb {
+        return w.to_json();
+    }
     serde_json::to_string(&Line::of(fb)).expect("feedback always encodes")
 }
 
@@ -168,6 +171,12 @@ pub fn from_json(line: &str) -> Result<Feedback, FeedbackError> {
         Some("syncPointProgress") => Line::SyncPointProgress(field_checked(value)?),
         Some("predictionFeedback") => Line::Prediction(field_checked(value)?),
         Some("warningFeedback") => Line::Warning(field_checked(value)?),
+        Some(k @ ("perception" | "net" | "var")) => {
+            let k = k.to_string();
+            return WorldFeedback::from_json(&k, value)
+                .expect("one of the world's kinds")
+                .map(Feedback::World);
+        }
         _ => return Err(FeedbackError(format!("unknown feedback {kind}"))),
     };
     line.feedback()
@@ -212,6 +221,7 @@ impl Line {
                 bml: p.blocks.iter().map(BlockLine::of).collect(),
                 behaviors: p.behaviours.iter().map(BehaviourLine::of).collect(),
             }),
+            Feedback::World(_) => unreachable!("written by to_json"),
             Feedback::Warning(w) => Line::Warning(WarningLine {
                 feedback: fb.element_name().into(),
                 id: w.id.clone(),

@@ -4,7 +4,9 @@
 
 pub mod diff;
 mod json;
+pub mod world;
 mod xml;
+pub use world::WorldFeedback;
 
 use std::fmt;
 
@@ -215,6 +217,8 @@ pub enum Feedback {
     Prediction(PredictionFeedback),
     /// Something was dropped, changed or failed.
     Warning(WarningFeedback),
+    /// About the world, not a block: perception, nets, world variables (see [`world`]).
+    World(WorldFeedback),
 }
 
 impl Feedback {
@@ -226,6 +230,18 @@ impl Feedback {
             Feedback::SyncPointProgress(_) => "syncPointProgress",
             Feedback::Prediction(_) => "predictionFeedback",
             Feedback::Warning(_) => "warningFeedback",
+            Feedback::World(w) => w.element_name(),
+        }
+    }
+
+    /// The character it names, if any.
+    pub fn character_id(&self) -> Option<&str> {
+        match self {
+            Feedback::BlockProgress(p) => p.character_id.as_deref(),
+            Feedback::SyncPointProgress(p) => p.character_id.as_deref(),
+            Feedback::Prediction(p) => p.character_id.as_deref(),
+            Feedback::Warning(w) => w.character_id.as_deref(),
+            Feedback::World(w) => w.character_id(),
         }
     }
 }

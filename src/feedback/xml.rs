@@ -111,6 +111,7 @@ pub fn to_xml(fb: &Feedback) -> String {
             }
             o.push_str("</predictionFeedback>");
         }
+        Feedback::World(w) => return w.to_xml(),
         Feedback::Warning(w) => {
             open(&mut o, "warningFeedback", false);
             attr(&mut o, "id", &w.id);
@@ -215,10 +216,21 @@ pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
             Event::Decl(_) | Event::Comment(_) | Event::PI(_) | Event::DocType(_) => continue,
             _ => return Err(FeedbackError("expected a feedback element".into())),
         };
+        let ns = match &res {
+            ResolveResult::Bound(ns) => Some(ns.as_ref().to_vec()),
+            _ => None,
+        };
         if !is_feedback_ns(&res) {
-            return Err(FeedbackError(
-                "feedback element is not in the BML 1.0 namespace".into(),
-            ));
+            let local = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+            let plain: Vec<(String, String)> = (attrs(&r, &e)?.into_iter())
+                .map(|(_, n, v)| (n, v))
+                .collect();
+            return match WorldFeedback::from_xml(ns.as_deref().unwrap_or(b""), &local, &plain) {
+                Some(w) => w.map(Feedback::World),
+                None => Err(FeedbackError(
+                    "feedback element is not in the BML 1.0 namespace".into(),
+                )),
+            };
         }
         let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
         let a = attrs(&r, &e)?;

@@ -8,6 +8,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 mod options;
 mod remote;
+mod sensing;
 pub use options::from_options;
 
 use crate::blocks::BlockManager;
@@ -59,6 +60,8 @@ pub struct Realizer {
     parallel: bool,
     /// Characters another realizer moves (`remote.rs`): placed here, never made characters.
     remote: std::collections::BTreeSet<String>,
+    /// Synthetic vision, when on (`sensing.rs`).
+    sensing: Option<Box<sensing::Sensing>>,
 }
 
 impl Default for Realizer {
@@ -82,6 +85,7 @@ impl Realizer {
             idle: true,
             world: std::sync::Arc::new(World::default()),
             remote: Default::default(),
+            sensing: None,
             parallel: true,
             now: 0.0,
             unframed: Vec::new(),
@@ -175,7 +179,16 @@ impl Realizer {
 
     /// The time of the next scheduled event of any character, if any (see
     /// [`BlockManager::next_event`]).
+    /// With sight on, a character's next look is an event too while sync points are still
+    /// to come (looks alone do not keep a run going).
     pub fn next_event(&self) -> Option<f64> {
+        let sync = self.next_sync()?;
+        let look = self.perception().and_then(|p| p.next_look_of_any());
+        Some(look.map_or(sync, |l| l.min(sync)))
+    }
+
+    /// The time of the next sync point of any character.
+    fn next_sync(&self) -> Option<f64> {
         self.characters
             .values()
             .filter_map(BlockManager::next_event)
@@ -402,7 +415,7 @@ impl Realizer {
         };
         // on the wall clock, the realizer may fall behind (a stalled host, a paused process)
         let due = self
-            .next_event()
+            .next_sync()
             .filter(|t| self.posix_time && now - t > LATE);
         self.now = now;
         // (the world is shared with every character: copied only when a point moves)
@@ -414,6 +427,8 @@ impl Realizer {
             ..Frame::default()
         };
         let from = self.unframed.len();
+        // sensing reads the world as the previous frame left it
+        self.sense(now);
         // walkers among others see the crowd on a fixed grid of times, whatever the frames:
         // the characters are stepped to each grid time passed since the last frame
         while self.among_others_moving() {
@@ -442,6 +457,7 @@ impl Realizer {
         }
         self.deliver(from);
         frame.feedback = std::mem::take(&mut self.unframed);
+        self.keep_poses(&frame);
         frame
     }
 }

@@ -29,6 +29,9 @@ struct WorldFile {
     profiles: BTreeMap<String, crate::crowd::Profile>,
     #[serde(default)]
     groups: Vec<crate::crowd::group::GroupFile>,
+    /// How characters see (when sight is on).
+    #[serde(default)]
+    vision: Option<crate::perception::Vision>,
 }
 
 #[derive(Deserialize)]
@@ -154,6 +157,10 @@ impl World {
         let list = (file.obstacles.iter().enumerate())
             .map(|(i, o)| o.obstacle(i))
             .collect::<Result<Vec<_>, String>>()?;
+        if let Some(v) = file.vision {
+            v.check()?;
+            w.vision = Some(Arc::new(v));
+        }
         let n = list.len();
         w.set_obstacles(crate::locomotion::Obstacles::new(list));
         w.add_groups(file.groups)?;

@@ -84,6 +84,8 @@ pub struct World {
     groups: Arc<Vec<crate::crowd::group::Group>>,
     /// Every character as walkers see it this frame, in world coordinates (a view has none).
     crowd: Arc<crate::crowd::Crowd>,
+    /// How characters see, if the world file says (`"vision"`).
+    vision: Option<Arc<crate::perception::Vision>>,
     /// The frame things are read and written in: the origin for the world itself, where a
     /// character stands for its view.
     frame: Placement,
@@ -132,8 +134,14 @@ impl World {
             avatars: Default::default(),
             groups: Default::default(),
             crowd: Default::default(),
+            vision: None,
             frame: Placement::default(),
         }
+    }
+
+    /// How characters see: the world file's `"vision"`, else the defaults.
+    pub fn vision(&self) -> crate::perception::Vision {
+        self.vision.as_deref().cloned().unwrap_or_default()
     }
 
     /// Character `id`'s avoidance profile (the defaults unless the world file names one).
@@ -283,6 +291,7 @@ impl World {
             avatars: self.avatars.clone(),
             groups: self.groups.clone(),
             crowd: Default::default(),
+            vision: self.vision.clone(),
             characters: self.characters.clone(),
             // `from` is given in this world's frame
             frame: Placement {

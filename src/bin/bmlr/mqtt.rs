@@ -351,7 +351,8 @@ impl Server {
     /// `fallback`'s, or the default character's).
     fn send(&mut self, feedback: Vec<Feedback>, fallback: Option<&str>) {
         for fb in feedback {
-            let character = character_of(&fb)
+            let character = fb
+                .character_id()
                 .or(fallback)
                 .unwrap_or(DEFAULT_CHARACTER)
                 .to_string();
@@ -365,15 +366,5 @@ impl Server {
             self.link.publish(&topic, payload, false);
         }
         self.link.flush();
-    }
-}
-
-/// The character a feedback message is about, if it names one.
-fn character_of(fb: &Feedback) -> Option<&str> {
-    match fb {
-        Feedback::BlockProgress(p) => p.character_id.as_deref(),
-        Feedback::SyncPointProgress(p) => p.character_id.as_deref(),
-        Feedback::Prediction(p) => p.character_id.as_deref(),
-        Feedback::Warning(w) => w.character_id.as_deref(),
     }
 }

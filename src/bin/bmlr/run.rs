@@ -109,6 +109,10 @@ pub struct SetupArgs {
     /// The voice that says speech: the built-in TTS, or flite (Debian package `flite`).
     #[arg(long, value_enum, default_value = "builtin")]
     pub tts: TtsArg,
+    /// Characters see (synthetic vision, settings from the world file's "vision") and
+    /// perception feedback reports what each sees when it changes.
+    #[arg(long)]
+    pub perception: bool,
     #[command(flatten)]
     pub limits: LimitArgs,
 }
@@ -120,12 +124,17 @@ impl SetupArgs {
         let speech = self.tts.timing().map_err(|e| format!("--tts flite: {e}"))?;
         let realizer = with_assets(Realizer::new(), self.assets.as_deref(), speech)
             .map_err(|e| format!("--assets {e}"))?;
-        Ok(with_world(realizer, self.world.as_deref())
+        let mut realizer = with_world(realizer, self.world.as_deref())
             .map_err(|e| format!("--world {e}"))?
             .with_default_character(self.character.clone())
             .with_posix_time(posix_time)
             .with_idle(!self.no_idle)
-            .with_limits(self.limits.limits()))
+            .with_limits(self.limits.limits());
+        if self.perception {
+            let vision = realizer.world().vision();
+            realizer.set_perception(Some(vision), true)?;
+        }
+        Ok(realizer)
     }
 }
 

@@ -110,6 +110,7 @@ fn block_of(fb: &Feedback) -> Option<&str> {
         Feedback::SyncPointProgress(p) => Some(&p.block),
         Feedback::Prediction(p) => p.blocks.first().map(|b| b.id.as_str()),
         Feedback::Warning(w) => Some(w.id.split(':').next().unwrap_or(&w.id)),
+        Feedback::World(_) => None,
     }
 }
 

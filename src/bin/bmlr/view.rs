@@ -253,12 +253,7 @@ fn balance_parts(skeleton: &Skeleton) -> Value {
 
 /// A feedback message for the page: when it was sent, its element name and its XML.
 pub fn message(time: f64, f: &Feedback) -> Value {
-    let kind = match f {
-        Feedback::BlockProgress(_) => "blockProgress",
-        Feedback::SyncPointProgress(_) => "syncPointProgress",
-        Feedback::Prediction(_) => "predictionFeedback",
-        Feedback::Warning(_) => "warningFeedback",
-    };
+    let kind = f.element_name();
     json!({"time": (time * 1e6).round() / 1e6, "kind": kind, "text": Format::Xml.encode(f)})
 }
 

@@ -1,0 +1,166 @@
+//! What the broker tests share: a mosquitto started on a free loopback port, realizer
+//! processes killed when dropped, and planners built on `bml_realizer::broker::Link`.
+#![allow(dead_code)]
+
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use bml_realizer::broker::{BrokerUrl, Inbound, Link, LinkOptions};
+
+pub const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// A mosquitto on a free loopback port, stopped when dropped.
+pub struct Broker {
+    child: Child,
+    /// Its loopback port.
+    pub port: u16,
+}
+
+impl Broker {
+    /// Starts one, or `None` (with a line saying why) when mosquitto is not installed.
+    pub fn start() -> Option<Broker> {
+        let port = free_port();
+        Broker::on(port)
+    }
+
+    pub fn on(port: u16) -> Option<Broker> {
+        // (Debian installs it in /usr/sbin, which a user's PATH may lack)
+        let spawn = |program: &str| {
+            Command::new(program)
+                .args(["-p", &port.to_string()])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+        };
+        let child = spawn("mosquitto").or_else(|_| spawn("/usr/sbin/mosquitto"));
+        let Ok(child) = child else {
+            eprintln!("skipped: mosquitto is not installed (Debian package mosquitto; .ci/run installs it)");
+            return None;
+        };
+        let until = Instant::now() + Duration::from_secs(5);
+        while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+            assert!(
+                Instant::now() < until,
+                "mosquitto did not start on port {port}"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        Some(Broker { child, port })
+    }
+
+    pub fn url(&self) -> String {
+        format!("mqtt://127.0.0.1:{}", self.port)
+    }
+}
+
+impl Drop for Broker {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+pub fn free_port() -> u16 {
+    let l = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    l.local_addr().unwrap().port()
+}
+
+/// A realizer process, killed when dropped (also when a test fails).
+pub struct Served(pub Child);
+
+impl Served {
+    pub fn kill(&mut self) -> std::io::Result<()> {
+        self.0.kill()
+    }
+
+    pub fn wait(&mut self) -> std::io::Result<std::process::ExitStatus> {
+        self.0.wait()
+    }
+}
+
+impl Drop for Served {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// A realizer serving `characters` (all when empty) on the broker, as `name`.
+pub fn realizer(broker: &Broker, name: &str, characters: &[&str], extra: &[&str]) -> Served {
+    let url = broker.url();
+    let mut args = vec!["serve", "--mqtt", &url, "--name", name];
+    let list = characters.join(",");
+    if !characters.is_empty() {
+        args.extend(["--characters", &list]);
+    }
+    args.extend(extra);
+    Served(
+        Command::new(env!("CARGO_BIN_EXE_bmlr"))
+            .args(&args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("bmlr runs"),
+    )
+}
+
+/// A planner: a link subscribed to every feedback and presence topic.
+pub fn planner(broker: &Broker, id: &str) -> Link {
+    planner_on(broker, id, &["bml/+/feedback", "bml/realizers/+"])
+}
+
+/// A planner subscribed to `topics`.
+pub fn planner_on(broker: &Broker, id: &str, topics: &[&str]) -> Link {
+    Link::connect(LinkOptions {
+        url: BrokerUrl::parse(&broker.url()).unwrap(),
+        client_id: id.into(),
+        subscriptions: topics.iter().map(|t| t.to_string()).collect(),
+        presence: None,
+        inbox: 100_000,
+        start_tries: 3,
+    })
+    .expect("the planner connects")
+}
+
+/// Everything `link` hears for `secs`, or until `done` says so.
+pub fn hear(
+    link: &Link,
+    secs: f64,
+    done: impl Fn(&[(String, String)]) -> bool,
+) -> Vec<(String, String)> {
+    let until = Instant::now() + Duration::from_secs_f64(secs);
+    let mut heard = Vec::new();
+    while Instant::now() < until && !done(&heard) {
+        if let Some(Inbound::Message { topic, payload }) =
+            link.recv_timeout(Duration::from_millis(20))
+        {
+            heard.push((topic, String::from_utf8_lossy(&payload).into_owned()));
+        }
+    }
+    heard
+}
+
+/// Waits until every realizer of `names` has said it is online (fails the test if one does not
+/// within 10 s).
+pub fn until_online(link: &Link, names: &[&str]) {
+    let all = |h: &[(String, String)]| names.iter().all(|n| online(h, n, "online"));
+    let heard = hear(link, 10.0, all);
+    assert!(all(&heard), "not all of {names:?} online: {heard:?}");
+}
+
+pub fn online(heard: &[(String, String)], name: &str, state: &str) -> bool {
+    let topic = format!("bml/realizers/{name}");
+    heard.iter().any(|(t, p)| *t == topic && p == state)
+}
+
+pub fn ended(heard: &[(String, String)], character: &str, block: &str) -> bool {
+    let topic = format!("bml/{character}/feedback");
+    let id = format!(r#"id="{block}:end""#);
+    heard
+        .iter()
+        .any(|(t, p)| *t == topic && p.contains("blockProgress") && p.contains(&id))
+}
+
+pub fn block(id: &str) -> String {
+    format!(r#"<bml {NS} id="{id}"><head id="h" lexeme="NOD" start="0" end="0.3"/></bml>"#)
+}
