@@ -140,6 +140,12 @@ impl Perception {
         self.viewers.get(id).map(|v| v.next)
     }
 
+    /// Whether [`sense`](Self::sense) at `now` has anything to do for a scene of `viewers`
+    /// characters: someone's look is due, or not all of them have been met.
+    pub fn due(&self, now: f64, viewers: usize) -> bool {
+        self.viewers.len() != viewers || self.next_look_of_any().is_some_and(|t| t <= now + 1e-9)
+    }
+
     /// When the next look of any character met so far is due.
     pub fn next_look_of_any(&self) -> Option<f64> {
         self.viewers.values().map(|v| v.next).reduce(f64::min)

@@ -93,6 +93,15 @@ impl Realizer {
         let Some(mut s) = self.sensing.take() else {
             return;
         };
+        // (the scene is made only when someone looks or someone new is to be met)
+        let everyone = self.world.placements().count()
+            + (self.characters.keys())
+                .filter(|id| !self.world.is_placed(id))
+                .count();
+        if !s.perception.due(now, everyone) {
+            self.sensing = Some(s);
+            return;
+        }
         let scene = self.scene(&s.poses);
         let mut changes = Vec::new();
         s.perception.sense(now, &scene, &mut changes);
