@@ -39,6 +39,7 @@ pub mod engines;
 pub mod face;
 pub mod feedback;
 pub mod locomotion;
+pub mod nets;
 pub mod perception;
 pub mod plan;
 pub mod realizer;
