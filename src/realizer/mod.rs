@@ -6,9 +6,11 @@
 use std::collections::BTreeMap;
 use std::time::{SystemTime, UNIX_EPOCH};
 
+mod netting;
 mod options;
 mod remote;
 mod sensing;
+pub use netting::NET_RATE;
 pub use options::from_options;
 
 use crate::blocks::BlockManager;
@@ -62,6 +64,8 @@ pub struct Realizer {
     remote: std::collections::BTreeSet<String>,
     /// Synthetic vision, when on (`sensing.rs`).
     sensing: Option<Box<sensing::Sensing>>,
+    /// PaT-Nets, when given (`netting.rs`).
+    netting: Option<Box<netting::Netting>>,
 }
 
 impl Default for Realizer {
@@ -86,6 +90,7 @@ impl Realizer {
             world: std::sync::Arc::new(World::default()),
             remote: Default::default(),
             sensing: None,
+            netting: None,
             parallel: true,
             now: 0.0,
             unframed: Vec::new(),
@@ -180,11 +185,14 @@ impl Realizer {
     /// The time of the next scheduled event of any character, if any (see
     /// [`BlockManager::next_event`]).
     /// With sight on, a character's next look is an event too while sync points are still
-    /// to come (looks alone do not keep a run going).
+    /// to come or nets run (looks alone do not keep a run going).
+    /// Nets that can still change state want a step every frame ([`NET_RATE`]), and keep a
+    /// run going.
     pub fn next_event(&self) -> Option<f64> {
-        let sync = self.next_sync()?;
+        let (sync, nets) = (self.next_sync(), self.nets_wake());
+        sync.or(nets)?;
         let look = self.perception().and_then(|p| p.next_look_of_any());
-        Some(look.map_or(sync, |l| l.min(sync)))
+        [sync, nets, look].into_iter().flatten().reduce(f64::min)
     }
 
     /// The time of the next sync point of any character.
@@ -426,9 +434,10 @@ impl Realizer {
             time: now,
             ..Frame::default()
         };
-        let from = self.unframed.len();
-        // sensing reads the world as the previous frame left it
+        // sensing reads the world as the previous frame left it; then the nets act on it
         self.sense(now);
+        self.run_nets(now);
+        let from = self.unframed.len();
         // walkers among others see the crowd on a fixed grid of times, whatever the frames:
         // the characters are stepped to each grid time passed since the last frame
         while self.among_others_moving() {
@@ -456,8 +465,11 @@ impl Realizer {
             }));
         }
         self.deliver(from);
+        // (its feedback is delivered as it is performed)
+        self.perform_nets_bml();
         frame.feedback = std::mem::take(&mut self.unframed);
         self.keep_poses(&frame);
+        self.note_progress(&frame.feedback);
         frame
     }
 }

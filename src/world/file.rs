@@ -32,6 +32,9 @@ struct WorldFile {
     /// How characters see (when sight is on).
     #[serde(default)]
     vision: Option<crate::perception::Vision>,
+    /// Named world values that nets read and write, with their first values.
+    #[serde(default)]
+    variables: BTreeMap<String, crate::feedback::world::VarValue>,
 }
 
 #[derive(Deserialize)]
@@ -157,6 +160,7 @@ impl World {
         let list = (file.obstacles.iter().enumerate())
             .map(|(i, o)| o.obstacle(i))
             .collect::<Result<Vec<_>, String>>()?;
+        w.variables = Arc::new(file.variables);
         if let Some(v) = file.vision {
             v.check()?;
             w.vision = Some(Arc::new(v));

@@ -86,6 +86,8 @@ pub struct World {
     crowd: Arc<crate::crowd::Crowd>,
     /// How characters see, if the world file says (`"vision"`).
     vision: Option<Arc<crate::perception::Vision>>,
+    /// World variables' first values (the world file's `"variables"`).
+    variables: Arc<BTreeMap<String, crate::feedback::world::VarValue>>,
     /// The frame things are read and written in: the origin for the world itself, where a
     /// character stands for its view.
     frame: Placement,
@@ -135,8 +137,14 @@ impl World {
             groups: Default::default(),
             crowd: Default::default(),
             vision: None,
+            variables: Default::default(),
             frame: Placement::default(),
         }
+    }
+
+    /// The world variables' first values (the world file's `"variables"`).
+    pub fn variables(&self) -> &BTreeMap<String, crate::feedback::world::VarValue> {
+        &self.variables
     }
 
     /// How characters see: the world file's `"vision"`, else the defaults.
@@ -292,6 +300,7 @@ impl World {
             groups: self.groups.clone(),
             crowd: Default::default(),
             vision: self.vision.clone(),
+            variables: self.variables.clone(),
             characters: self.characters.clone(),
             // `from` is given in this world's frame
             frame: Placement {

@@ -113,6 +113,11 @@ pub struct SetupArgs {
     /// perception feedback reports what each sees when it changes.
     #[arg(long)]
     pub perception: bool,
+    /// PaT-Nets (JSON, docs/nets.md) run with the behaviours; their transitions and the
+    /// world variables' changes are reported. Nets that can go on changing keep a run going:
+    /// give --until.
+    #[arg(long, value_name = "NETS.json")]
+    pub nets: Option<std::path::PathBuf>,
     #[command(flatten)]
     pub limits: LimitArgs,
 }
@@ -133,6 +138,15 @@ impl SetupArgs {
         if self.perception {
             let vision = realizer.world().vision();
             realizer.set_perception(Some(vision), true)?;
+        }
+        if let Some(path) = &self.nets {
+            let at = path.display();
+            let text = std::fs::read_to_string(path).map_err(|e| format!("--nets {at}: {e}"))?;
+            let nets = bml_realizer::nets::file::read(&text, realizer.limits())
+                .map_err(|e| format!("--nets {at}: {e}"))?;
+            let variables = realizer.world().variables().clone();
+            let nets = bml_realizer::nets::Nets::new(nets, variables);
+            realizer.set_nets(Some(nets), true)?;
         }
         Ok(realizer)
     }
@@ -601,6 +615,9 @@ fn checked(
     }
     if args.gltf.is_none() && args.avatar.avatar.is_some() {
         return Err("--avatar shows the motion in --gltf OUT.glb; give it too".into());
+    }
+    if args.setup.nets.is_some() && args.until.is_none() {
+        return Err("--nets: nets may go on changing for ever; give --until SECS".into());
     }
     let realizer = args.setup.realizer(args.realtime)?;
     let avatar = match &args.gltf {

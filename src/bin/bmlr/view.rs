@@ -87,6 +87,9 @@ fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome),
         return Err("--until must be a number of seconds >= 0".into());
     }
     let items = crate::run::read_items(&args.items)?;
+    if args.setup.nets.is_some() && args.until.is_none() {
+        return Err("--nets: nets may go on changing for ever; give --until SECS".into());
+    }
     let until = args.until.unwrap_or(f64::INFINITY);
     let realizer = args.setup.realizer(false)?;
     let avatars = (args.avatar).load(realizer.world(), args.setup.world.as_deref())?;
