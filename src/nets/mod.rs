@@ -9,6 +9,7 @@
 //! actions take effect together after every net was tried, so that no result depends on the
 //! order nets are tried in. The file format is read in [`file`].
 
+pub mod behaviour;
 pub mod file;
 
 use std::collections::BTreeMap;
