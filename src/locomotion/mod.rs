@@ -9,6 +9,7 @@
 //! the whole.
 
 pub mod among;
+pub mod footsteps;
 pub mod gait;
 pub mod obstacles;
 pub mod path;
