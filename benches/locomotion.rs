@@ -107,6 +107,7 @@ fn gait(c: &mut Criterion) {
         running: false,
         face: None,
         stepping: false,
+        footsteps: false,
     };
     w.start(walk, &o).unwrap();
     w.advance(3.0, &o);

@@ -80,5 +80,6 @@ fn walk_to(spot: Vec2, home: Body) -> Walk {
         running: false,
         face: Some(spot + forward(home.facing)),
         stepping: true,
+        footsteps: false,
     }
 }

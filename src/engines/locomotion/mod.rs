@@ -3,7 +3,8 @@
 //! - The target is a point of the world, a point moving along a path (followed as it moves), a
 //!   placed character (the walker stops 1.2 m from them, turned to face them) or `x,z` in world
 //!   metres. `manner` is WALK (1.3 m/s), STROLL (0.8 m/s) or RUN (3.0 m/s, with a flight
-//!   phase); `bmlt:speed` (m/s) overrides the speed.
+//!   phase); `bmlt:speed` (m/s) overrides the speed; `bmlt:planner="footsteps"` walks by
+//!   footsteps chosen one at a time (`locomotion::footsteps`) instead of steering.
 //! - Timing: when the block is scheduled the engine rehearses the walk from where the character
 //!   stands (the same fixed-step simulation it will run), which gives the preferred times of
 //!   `start` (first weight shift), `ready` (cruising speed), `relax` (final deceleration begins)
@@ -47,7 +48,9 @@ struct Order {
     target: String,
     speed: f32,
     running: bool,
-    /// Why the speed or manner written was not taken.
+    /// Walks by footsteps (`bmlt:planner="footsteps"`).
+    footsteps: bool,
+    /// Why the speed, manner or planner written was not taken.
     note: Option<String>,
 }
 
@@ -120,10 +123,25 @@ fn order(b: &Behaviour) -> Option<Order> {
             }
         }
     }
+    let planner = b
+        .foreign_attrs
+        .iter()
+        .find(|a| a.ns == NS_BMLT && a.name == "planner");
+    let footsteps = match planner.map(|a| a.value.trim()) {
+        None | Some("steering") => false,
+        Some("footsteps") => true,
+        Some(other) => {
+            note = Some(format!(
+                "bmlt:planner '{other}' is not one of steering, footsteps: it steers"
+            ));
+            false
+        }
+    };
     Some(Order {
         target: l.target.clone(),
         speed,
         running,
+        footsteps,
         note,
     })
 }
@@ -209,6 +227,7 @@ impl LocomotionEngine {
                 running: u.order.running,
                 face,
                 stepping: false,
+                footsteps: u.order.footsteps,
             },
             None => {
                 self.fail(&key, world.unknown_target(&u.order.target));
@@ -334,6 +353,12 @@ impl LocomotionEngine {
         }
         if ended.is_some() {
             self.current = None;
+            if let Some(short) = self.walker.as_mut().and_then(|w| w.stuck.take()) {
+                self.warnings.push((
+                    key.clone(),
+                    format!("{key}: the footstep walk stopped {short:.2} m short of its goal: no step led anywhere better (a local minimum of its behaviour net)"),
+                ));
+            }
         }
         if changed {
             let follow = !self.units.get(&key).is_some_and(|u| u.halted);
@@ -374,6 +399,7 @@ impl Engine for LocomotionEngine {
             running: o.running,
             face,
             stepping: false,
+            footsteps: o.footsteps,
         };
         let m = match self.rehearse(walker, &walk, &self.round(world, walker, &walk)) {
             Ok(m) => m,
@@ -401,7 +427,7 @@ impl Engine for LocomotionEngine {
     }
 
     fn interprets(&self, ns: &str, name: &str) -> bool {
-        ns == NS_BMLT && name == "speed"
+        ns == NS_BMLT && (name == "speed" || name == "planner")
     }
 
     fn refusal(&self, error: &EngineError) -> KnownWarning {

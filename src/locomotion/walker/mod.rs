@@ -51,6 +51,8 @@ pub struct Walk {
     /// A few steps to one side or back, keeping the facing (making room: `locomotion::room`),
     /// rather than turning to walk the way.
     pub stepping: bool,
+    /// Walks by footsteps chosen one at a time (`locomotion::footsteps`) instead of steering.
+    pub footsteps: bool,
 }
 
 /// When a walk's sync points happened (global times).
@@ -76,6 +78,8 @@ struct Active {
     stopped: bool,
     /// Whether it is halting where it is (interrupted, or braking at its goal).
     halting: bool,
+    /// The footsteps of a footstep walk.
+    plan: Option<Box<footstep_mode::Plan>>,
 }
 
 /// A walking character (see the module documentation).
@@ -112,6 +116,9 @@ pub struct Walker {
     attention: f32,
     asked_at: Vec2,
     active: Option<Active>,
+    /// How far short of its goal the last footstep walk stopped, when no step led anywhere
+    /// better (taken by whoever reports it).
+    pub stuck: Option<f32>,
 }
 
 /// How far the one it looks at may have moved between two steps for it to be followed (m).
@@ -138,6 +145,7 @@ impl Walker {
             attention: 0.0,
             asked_at: at,
             active: None,
+            stuck: None,
         }
     }
 
@@ -264,6 +272,18 @@ impl Walker {
         // to about 2.3 m/s² walking, more running
         self.vehicle.max_force = self.vehicle.mass * (1.6 + 0.6 * walk.speed);
         self.gait.running = walk.running;
+        let body = self.body();
+        let plan = walk.footsteps.then(|| {
+            let p = footstep_mode::Plan::new(
+                body.at,
+                self.facing,
+                walk.goal,
+                walk.speed,
+                walk.running,
+                self.radius,
+            );
+            Box::new(p)
+        });
         let moments = Moments {
             start: Some(self.time),
             ..Moments::default()
@@ -275,6 +295,7 @@ impl Walker {
             moments,
             stopped: false,
             halting: false,
+            plan,
         });
         Ok(())
     }
@@ -445,7 +466,35 @@ impl Walker {
             } else if !a.stopped {
                 let route = ahead;
                 let left = path::length(&route);
-                if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
+                if let Some(plan) = a.plan.as_mut() {
+                    let walkers: Vec<Vec2> = others
+                        .map(|o| {
+                            neighbours(o, time, here, 3.0)
+                                .iter()
+                                .map(|n| n.at)
+                                .collect()
+                        })
+                        .unwrap_or_default();
+                    match plan.velocity(time, here, obstacles, &walkers, self.radius) {
+                        Some(v) => {
+                            // speeding up and braking as a person does
+                            let now = Vec2::new(self.vehicle.velocity.x, self.vehicle.velocity.z);
+                            let v =
+                                now + (v - now).clamp_length_max(footstep_mode::ACCELERATION * dt);
+                            self.vehicle.velocity = Vec3::new(v.x, 0.0, v.y);
+                            self.vehicle.position += self.vehicle.velocity * dt;
+                        }
+                        // arrived (the last step closed the feet) or stuck: it stands
+                        None => {
+                            if plan.stuck {
+                                self.stuck = Some(to_goal.length());
+                            }
+                            a.halting = true;
+                            a.stopped = true;
+                            self.vehicle.velocity = Vec3::ZERO;
+                        }
+                    }
+                } else if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
                     // turn on the spot before setting off
                     let brake = Behaviour::Stop.force(
                         &mut self.vehicle,
@@ -646,6 +695,8 @@ fn turn_toward(facing: &mut f32, to: f32, max: f32) {
     let d = angle_diff(to, *facing);
     *facing = (*facing + d.clamp(-max, max)).rem_euclid(std::f32::consts::TAU);
 }
+
+mod footstep_mode;
 
 #[cfg(test)]
 mod tests;

@@ -12,6 +12,7 @@ fn a_walk_reaches_its_goal_and_reports_its_moments_in_order() {
         running: false,
         face: None,
         stepping: false,
+        footsteps: false,
     };
     let o = Obstacles::default();
     w.start(walk.clone(), &o).unwrap();

@@ -1,0 +1,146 @@
+//! A walker's footstep mode (`bmlt:planner="footsteps"`): instead of steering, the walk is a
+//! sequence of footsteps chosen one at a time by [`crate::locomotion::footsteps`]. At each
+//! footfall the next placement is chosen from where the feet are; the body then moves to
+//! stand midway between the feet over one step's time (the cadence of the walk's speed),
+//! turning with it, and the gait plays the steps. When the trailing foot can close within
+//! [`ARRIVE`] of the goal, the walk closes its feet there; when no step lowers the energy, it
+//! stops where it is (a local minimum: stuck).
+
+use glam::Vec2;
+
+use crate::locomotion::footsteps::{self, Fan, Feet, Footstep};
+use crate::locomotion::gait;
+use crate::locomotion::Obstacles;
+use crate::nets::behaviour::{BehaviourNet, Surroundings};
+
+/// A footstep walk arrives when its body can stand within this of the goal (m).
+pub const ARRIVE: f32 = 0.3;
+
+/// How far from obstacles the walk keeps (m), beyond the body's radius.
+pub const CLEAR: f32 = 1.0;
+
+/// How far from other walkers (m).
+pub const PERSONAL: f32 = 1.0;
+
+/// The fastest the body moves, as a multiple of the walk's speed.
+pub const TOP_SPEED: f32 = 1.25;
+
+/// How fast the body's velocity changes at most (m/s²), as a walker's steering lets it.
+pub const ACCELERATION: f32 = 2.5;
+
+/// Most turn of one step (rad).
+pub const MAX_TURN: f32 = 0.8;
+
+/// A footstep walk under way.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Plan {
+    feet: Feet,
+    net: BehaviourNet,
+    walk_node: usize,
+    fan: Fan,
+    goal: Vec2,
+    /// Where the body is headed now, its heading there, and when it gets there.
+    next: Option<(Vec2, f32, f64)>,
+    /// Where the body stood after the last step, and its heading.
+    last: (Vec2, f32),
+    step_time: f64,
+    /// Whether the last step closed the feet at the goal.
+    closing: bool,
+    /// The fastest the body moves (m/s).
+    top_speed: f32,
+    /// Whether the walk stopped short of its goal: no step led anywhere better.
+    pub stuck: bool,
+}
+
+impl Plan {
+    /// A walk from `body` facing `facing` to `goal` at `speed`.
+    pub fn new(
+        body: Vec2,
+        facing: f32,
+        goal: Vec2,
+        speed: f32,
+        running: bool,
+        radius: f32,
+    ) -> Plan {
+        let (net, walk_node) = footsteps::walking_net(goal, ARRIVE, radius + CLEAR, PERSONAL);
+        let step = gait::step_length(speed, running).max(0.2);
+        Plan {
+            feet: Feet::standing(body, facing),
+            net,
+            walk_node,
+            fan: Fan::new(step, MAX_TURN, 9),
+            goal,
+            next: None,
+            last: (body, facing),
+            step_time: 60.0 / gait::cadence(speed, running) as f64,
+            closing: false,
+            top_speed: speed * TOP_SPEED,
+            stuck: false,
+        }
+    }
+
+    /// The velocity to walk at `time` from `here`, or `None` when the walk is over (arrived,
+    /// or no step leads anywhere better).
+    pub fn velocity(
+        &mut self,
+        time: f64,
+        here: Vec2,
+        obstacles: &Obstacles,
+        walkers: &[Vec2],
+        radius: f32,
+    ) -> Option<Vec2> {
+        if self.next.is_none_or(|(_, _, due)| time >= due - 1e-9) {
+            if self.closing {
+                // the body stands midway between the closed feet
+                let (target, ..) = self.next?;
+                if here.distance(target) <= 0.02 {
+                    return None;
+                }
+                let v = (target - here) / self.step_time as f32;
+                return Some(v.clamp_length_max(self.top_speed));
+            }
+            let Some(step) = self.choose(obstacles, walkers, radius) else {
+                self.stuck = true;
+                return None;
+            };
+            self.feet = self.feet.after(&step);
+            self.last = (step.body, step.heading);
+            let (target, heading) = if self.feet.body().distance(self.goal) <= ARRIVE {
+                // the trailing foot closes beside the one just planted
+                self.closing = true;
+                (self.feet.body(), step.heading)
+            } else {
+                (step.body, step.heading)
+            };
+            self.next = Some((target, heading, time + self.step_time));
+        }
+        let (target, _, due) = self.next?;
+        let left = (due - time).max(1e-3) as f32;
+        // (never faster than a brisk version of the walk: a foot left behind would drag)
+        Some(((target - here) / left).clamp_length_max(self.top_speed))
+    }
+
+    /// The next step: the least energy of the fan, if it is less than standing where the
+    /// last step left the body.
+    fn choose(&mut self, obstacles: &Obstacles, walkers: &[Vec2], radius: f32) -> Option<Footstep> {
+        let here = Surroundings {
+            at: self.last.0,
+            heading: self.last.1,
+            obstacles,
+            walkers,
+        };
+        let now = self.net.energy(self.walk_node, &here);
+        let full = self.fan.len();
+        let step = footsteps::choose(
+            &mut self.net,
+            self.walk_node,
+            &self.feet,
+            &self.fan,
+            full,
+            obstacles,
+            walkers,
+            radius,
+        )?;
+        (step.energy < now - 1e-6).then_some(step)
+    }
+}

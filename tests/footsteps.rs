@@ -1,0 +1,139 @@
+//! `<locomotion bmlt:planner="footsteps">`: the seed's wall-and-goal scene walked by footsteps
+//! chosen one at a time, through the realizer: round the wall's end without zig-zag, arriving
+//! within 0.3 m, with the gait's planted feet staying where they were put down.
+
+use std::collections::HashMap;
+
+use bml_realizer::body::Skeleton;
+use bml_realizer::feedback::Feedback;
+use bml_realizer::realizer::Realizer;
+use bml_realizer::world::World;
+use glam::Vec2;
+
+const WORLD: &str = r#"{"characters": {"w": {"position": [0, 0, 0], "facing": 0}},
+                       "obstacles": [{"segment": [-4, 5, 3, 5], "height": 2.0}]}"#;
+
+fn block(planner: &str) -> String {
+    format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="fw" characterId="w"><locomotion id="l" target="4,10" bmlt:planner="{planner}"/></bml>"#
+    )
+}
+
+/// The walk at 60 fps: the root's ground positions, the worst slide of a planted foot point
+/// (m), and the feedback.
+fn walk(planner: &str) -> (Vec<Vec2>, f32, Vec<Feedback>) {
+    let s = Skeleton::adult();
+    let mut r = Realizer::new().with_idle(false);
+    *r.world_mut() = World::from_json(WORLD).unwrap().0;
+    r.perform_bml(&block(planner)).unwrap();
+    let points: Vec<(usize, usize)> = [
+        "l_talocrural",
+        "r_talocrural",
+        "l_metatarsal",
+        "r_metatarsal",
+    ]
+    .iter()
+    .enumerate()
+    .map(|(k, n)| (k % 2, s.joint(n).unwrap()))
+    .collect();
+    let (mut rest, mut down) = (HashMap::new(), HashMap::new());
+    let (mut roots, mut worst, mut feedback) = (Vec::new(), 0f32, Vec::new());
+    for i in 1..=(20 * 60) {
+        let frame = r.tick(f64::from(i) / 60.0);
+        feedback.extend(frame.feedback.iter().cloned());
+        let Some(p) = frame.character("w") else {
+            continue;
+        };
+        roots.push(Vec2::new(p.pose.root.x, p.pose.root.z));
+        let Some(contacts) = p.contacts else { continue };
+        let world = p.pose.world(&s);
+        for &(side, joint) in &points {
+            let at = world.positions[joint];
+            let ground = *rest.entry(joint).or_insert(at.y);
+            if contacts[side] && at.y - ground < 0.005 {
+                let from = *down.entry(joint).or_insert(Vec2::new(at.x, at.z));
+                let d = from.distance(Vec2::new(at.x, at.z));
+                if d > worst && std::env::var_os("SLIDE_AT").is_some() {
+                    eprintln!(
+                        "slide {d:.4} at {:.3} joint {joint} root {}",
+                        f64::from(i) / 60.0,
+                        p.pose.root
+                    );
+                }
+                worst = worst.max(d);
+            } else {
+                down.remove(&joint);
+            }
+        }
+        if r.next_event().is_none() {
+            break;
+        }
+    }
+    (roots, worst, feedback)
+}
+
+/// Changes of direction of the root's sideways motion (across the straight line to the goal),
+/// over the path averaged across a gait cycle (the pelvis sways with every step), ignoring
+/// sideways speeds under 5 cm/s.
+fn reversals(roots: &[Vec2]) -> usize {
+    let across = Vec2::new(10.0, -4.0).normalize();
+    let w = 32;
+    let smooth: Vec<Vec2> = (w..roots.len().saturating_sub(w))
+        .map(|k| roots[k - w..k + w].iter().copied().sum::<Vec2>() / (2 * w) as f32)
+        .collect();
+    let (mut sign, mut count) = (0.0f32, 0);
+    for p in smooth.windows(2) {
+        let v = (p[1] - p[0]).dot(across) * 60.0;
+        if v.abs() < 0.05 {
+            continue;
+        }
+        if sign != 0.0 && v.signum() != sign {
+            count += 1;
+        }
+        sign = v.signum();
+    }
+    count
+}
+
+#[test]
+fn the_wall_and_goal_scene_is_walked_by_footsteps_without_zig_zag_or_sliding() {
+    let (_, steered, _) = walk("steering");
+    eprintln!("steering: worst slide {:.1} mm", steered * 1e3);
+    let (roots, slide, feedback) = walk("footsteps");
+    let end = *roots.last().unwrap();
+    let goal = Vec2::new(4.0, 10.0);
+    eprintln!(
+        "footsteps: ended {:.3} m from the goal, {} reversals, worst slide {:.1} mm",
+        end.distance(goal),
+        reversals(&roots),
+        slide * 1e3
+    );
+    assert!(end.distance(goal) <= 0.3, "ended at {end}");
+    assert!(reversals(&roots) <= 2, "{} reversals", reversals(&roots));
+    assert!(slide < 0.01, "a planted foot slid {:.1} mm", slide * 1e3);
+    // never through the wall
+    assert!(
+        roots.iter().all(|p| p.y < 4.75 || p.x > 3.0),
+        "through the wall"
+    );
+    assert!(
+        feedback
+            .iter()
+            .any(|f| matches!(f, Feedback::BlockProgress(b) if b.sync.as_str() == "end")),
+        "the block ends"
+    );
+    assert!(
+        !feedback.iter().any(|f| matches!(f, Feedback::Warning(_))),
+        "{feedback:?}"
+    );
+}
+
+#[test]
+fn an_unknown_planner_is_named_and_the_walk_steers() {
+    let (roots, _, feedback) = walk("teleport");
+    let warned = feedback
+        .iter()
+        .any(|f| matches!(f, Feedback::Warning(w) if w.text.contains("bmlt:planner 'teleport'")));
+    assert!(warned, "{feedback:?}");
+    assert!(roots.last().unwrap().distance(Vec2::new(4.0, 10.0)) <= 0.3);
+}
