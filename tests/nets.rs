@@ -123,3 +123,58 @@ fn a_bad_nets_file_is_refused_with_exit_2_naming_the_file_and_field() {
     assert!(err.contains("--until"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_sees_guard_makes_a_character_look_at_a_newcomer_only_after_it_appears() {
+    use bml_realizer::feedback::{Feedback, WorldFeedback};
+    use bml_realizer::nets::{file, Nets};
+    use bml_realizer::realizer::Realizer;
+    use bml_realizer::world::World;
+    // b walks out from behind a wall into a's view; a's net looks at b once a sees it
+    let world = r#"{"characters": {"a": {"position": [0, 0, 0]}, "b": {"position": [-2.5, 0, 6], "facing": 90}},
+                    "obstacles": [{"segment": [-4, 4, 0, 4], "height": 2.5}]}"#;
+    let nets = r#"{"nets": {"watch": {"character": "a", "states": ["idle", "looking"], "transitions": [
+        {"from": "idle", "to": "looking", "when": {"sees": "b"},
+         "do": [{"bml": "<bml xmlns=\"http://www.bml-initiative.org/bml/bml-1.0\" id=\"look\"><gaze id=\"g\" target=\"b\" start=\"0\" end=\"2\"/></bml>"}]}]}}}"#;
+    let mut r = Realizer::new().with_idle(false);
+    *r.world_mut() = World::from_json(world).unwrap().0;
+    r.set_perception(Some(r.world().vision()), true).unwrap();
+    let nets = Nets::new(file::read(nets, r.limits()).unwrap(), Default::default());
+    r.set_nets(Some(nets), true).unwrap();
+    r.perform_bml(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="walk" characterId="b"><locomotion id="l" target="3,6"/></bml>"#,
+    )
+    .unwrap();
+    let (mut appeared, mut turned, mut gaze) = (None, None, None);
+    for k in 1..=(8 * 60) {
+        let t = f64::from(k) / 60.0;
+        for f in r.tick(t).feedback {
+            match f {
+                Feedback::World(WorldFeedback::Perception(p))
+                    if p.character_id == "a" && p.appeared.iter().any(|s| s == "b") =>
+                {
+                    appeared.get_or_insert(t);
+                }
+                Feedback::World(WorldFeedback::Net(n)) if n.to == "looking" => {
+                    turned.get_or_insert(t);
+                }
+                Feedback::BlockProgress(b)
+                    if b.block.as_str() == "look" && b.sync.as_str() == "start" =>
+                {
+                    gaze.get_or_insert(b.global_time);
+                }
+                _ => {}
+            }
+        }
+    }
+    let (appeared, turned, gaze) = (
+        appeared.expect("b appears"),
+        turned.expect("the net turns"),
+        gaze.expect("a looks"),
+    );
+    eprintln!("b appeared at {appeared:.3} s; the net turned at {turned:.3} s; the gaze started at {gaze:.3} s");
+    // not before b appeared to a: in the frame it appeared (sensing comes first in a frame,
+    // then the nets), at most the next
+    assert!(turned >= appeared && turned - appeared <= 1.0 / 60.0 + 1e-9);
+    assert!(gaze >= turned - 1e-9 && gaze - turned < 1e-9);
+}
