@@ -39,6 +39,9 @@ pub struct Profile {
     pub field_of_view: f32,
     /// Extra cost of turning to the other side from the one chosen while a contact lasts.
     pub keep_side: f32,
+    /// Whether it avoids only those it has seen or remembers (synthetic vision: turned on
+    /// for the world when a profile asks for it); off by default: it knows where everyone is.
+    pub only_seen: bool,
 }
 
 impl Default for Profile {
@@ -58,6 +61,7 @@ impl Default for Profile {
             distortion: 0.1,
             field_of_view: 200.0,
             keep_side: 0.3,
+            only_seen: false,
         }
     }
 }

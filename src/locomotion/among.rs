@@ -19,6 +19,9 @@ pub struct Others<'a> {
     pub crowd: &'a Crowd,
     /// The walker's own index in it.
     pub me: Option<usize>,
+    /// Those it knows of (indices in the crowd, sorted), when it avoids only those it has
+    /// seen or remembers; everyone when `None`.
+    pub known: Option<&'a [usize]>,
 }
 
 /// How often a walker among others chooses its velocity again (steps): every
@@ -126,6 +129,7 @@ pub(super) fn neighbours(o: Others<'_>, time: f64, here: Vec2, r: f32) -> Vec<Ag
     let ahead = (time - o.crowd.time) as f32;
     (found.into_iter())
         .filter(|&i| Some(i) != o.me)
+        .filter(|i| o.known.is_none_or(|k| k.binary_search(i).is_ok()))
         .map(|i| {
             let a = o.crowd.agent(i);
             Agent {

@@ -90,6 +90,12 @@ impl Realizer {
 
     /// The sensing stage of a tick at `now` (before the characters step).
     pub(super) fn sense(&mut self, now: f64) {
+        // walkers that avoid only those they have seen need sight
+        if self.sensing.is_none() && self.world.wants_sight() {
+            let vision = self.world.vision();
+            // (the world file's vision settings were checked when it was read)
+            let _ = self.set_perception(Some(vision), false);
+        }
         let Some(mut s) = self.sensing.take() else {
             return;
         };
@@ -105,6 +111,19 @@ impl Realizer {
         let scene = self.scene(&s.poses);
         let mut changes = Vec::new();
         s.perception.sense(now, &scene, &mut changes);
+        if self.world.wants_sight() {
+            let known = (scene.things().iter().enumerate())
+                .filter(|(i, _)| scene.eyes(*i).is_some())
+                .map(|(_, t)| {
+                    let mut ids: Vec<String> = s.perception.seen(&t.id).to_vec();
+                    ids.extend(s.perception.remembered(&t.id).into_iter().map(|r| r.id));
+                    ids.sort();
+                    ids.dedup();
+                    (t.id.clone(), ids)
+                })
+                .collect();
+            self.world_mut().set_known(known);
+        }
         if s.report {
             self.unframed
                 .extend(changes.into_iter().map(Feedback::World));

@@ -88,6 +88,9 @@ pub struct World {
     vision: Option<Arc<crate::perception::Vision>>,
     /// World variables' first values (the world file's `"variables"`).
     variables: Arc<BTreeMap<String, crate::feedback::world::VarValue>>,
+    /// Whom each character has seen or remembers (sorted), for walkers that avoid only those
+    /// (written by the realizer's sensing stage).
+    known: Arc<BTreeMap<String, Vec<String>>>,
     /// The frame things are read and written in: the origin for the world itself, where a
     /// character stands for its view.
     frame: Placement,
@@ -138,8 +141,24 @@ impl World {
             crowd: Default::default(),
             vision: None,
             variables: Default::default(),
+            known: Default::default(),
             frame: Placement::default(),
         }
+    }
+
+    /// Whether some character's profile avoids only those it has seen (sight is then needed).
+    pub fn wants_sight(&self) -> bool {
+        self.profiles.values().any(|p| p.only_seen)
+    }
+
+    /// Whom character `id` has seen or remembers, once sight has looked (sorted).
+    pub fn known(&self, id: &str) -> Option<&[String]> {
+        self.known.get(id).map(Vec::as_slice)
+    }
+
+    /// Sets whom each character has seen or remembers.
+    pub fn set_known(&mut self, known: BTreeMap<String, Vec<String>>) {
+        self.known = Arc::new(known);
     }
 
     /// The world variables' first values (the world file's `"variables"`).
@@ -301,6 +320,7 @@ impl World {
             crowd: Default::default(),
             vision: self.vision.clone(),
             variables: self.variables.clone(),
+            known: self.known.clone(),
             characters: self.characters.clone(),
             // `from` is given in this world's frame
             frame: Placement {

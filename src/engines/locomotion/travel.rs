@@ -49,9 +49,22 @@ impl Travel for LocomotionEngine {
                 .and_then(|k| self.units.get(k))
                 .map_or(f64::INFINITY, |u| u.deadline);
             let stop = until.min(deadline + walker::STEP);
+            // (a walker that avoids only those it has seen knows them by name)
+            let known: Option<Vec<usize>> = (self.walker.as_ref())
+                .filter(|w| w.profile.only_seen)
+                .map(|_| {
+                    let names = world.known(id).unwrap_or_default();
+                    let mut k: Vec<usize> = names
+                        .iter()
+                        .filter_map(|n| world.crowd().index(n))
+                        .collect();
+                    k.sort_unstable();
+                    k
+                });
             let others = walker::Others {
                 crowd: world.crowd(),
                 me: world.crowd().index(id),
+                known: known.as_deref(),
             };
             let ended = self
                 .walker

@@ -583,7 +583,9 @@ impl Walker {
         // never into another body, nor into an obstacle
         if let Some(o) = others {
             let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
-            let near = neighbours(o, time, here, self.radius + 1.0);
+            // (bodies never pass through each other, seen or not)
+            let everyone = Others { known: None, ..o };
+            let near = neighbours(everyone, time, here, self.radius + 1.0);
             let out = crate::crowd::contact::pushed_out(here, self.radius, near, dt);
             self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
         }
