@@ -9,9 +9,12 @@ use glam::Vec2;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 
+/// A frame: its time, where `a` is, where `b` is.
+type Sample = (f64, Vec2, Option<Vec2>);
+
 /// `a` walks north along x = 0, `b` (when there) west along z = 0.5, a wall along x = 1 from
 /// z = −5 to 0 between them until they meet.
-fn run(only_seen: bool, with_b: bool) -> (Vec<(f64, Vec2, Option<Vec2>)>, Option<f64>) {
+fn run(only_seen: bool, with_b: bool) -> (Vec<Sample>, Option<f64>) {
     let profile = if only_seen {
         r#", "profile": "looking""#
     } else {
