@@ -135,19 +135,7 @@ impl SetupArgs {
             .with_posix_time(posix_time)
             .with_idle(!self.no_idle)
             .with_limits(self.limits.limits());
-        if self.perception {
-            let vision = realizer.world().vision();
-            realizer.set_perception(Some(vision), true)?;
-        }
-        if let Some(path) = &self.nets {
-            let at = path.display();
-            let text = std::fs::read_to_string(path).map_err(|e| format!("--nets {at}: {e}"))?;
-            let nets = bml_realizer::nets::file::read(&text, realizer.limits())
-                .map_err(|e| format!("--nets {at}: {e}"))?;
-            let variables = realizer.world().variables().clone();
-            let nets = bml_realizer::nets::Nets::new(nets, variables);
-            realizer.set_nets(Some(nets), true)?;
-        }
+        realizer = with_sight_and_nets(realizer, self.perception, self.nets.as_deref())?;
         Ok(realizer)
     }
 }
@@ -241,6 +229,29 @@ impl TtsArg {
             ..SpeechTiming::default()
         })
     }
+}
+
+/// `realizer` with sight reported (`perception`) and the nets of the file at `nets`, if
+/// given. The error names the option and the file.
+pub fn with_sight_and_nets(
+    mut realizer: Realizer,
+    perception: bool,
+    nets: Option<&Path>,
+) -> Result<Realizer, String> {
+    if perception {
+        let vision = realizer.world().vision();
+        realizer.set_perception(Some(vision), true)?;
+    }
+    if let Some(path) = nets {
+        let at = path.display();
+        let text = std::fs::read_to_string(path).map_err(|e| format!("--nets {at}: {e}"))?;
+        let nets = bml_realizer::nets::file::read(&text, realizer.limits())
+            .map_err(|e| format!("--nets {at}: {e}"))?;
+        let variables = realizer.world().variables().clone();
+        let nets = bml_realizer::nets::Nets::new(nets, variables);
+        realizer.set_nets(Some(nets), true)?;
+    }
+    Ok(realizer)
 }
 
 /// `realizer` in the world of the file at `path`, if given. The error names the file.

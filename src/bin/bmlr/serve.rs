@@ -83,6 +83,13 @@ pub struct ServeArgs {
     /// gaze, pointing and headDirectionShift, added to the built-in scene.
     #[arg(long, value_name = "WORLD.json")]
     world: Option<std::path::PathBuf>,
+    /// Characters see; perception feedback reports what each sees when it changes.
+    #[arg(long)]
+    perception: bool,
+    /// PaT-Nets (JSON, docs/nets.md) run with the behaviours; their transitions and the
+    /// world variables' changes are reported.
+    #[arg(long, value_name = "NETS.json")]
+    nets: Option<std::path::PathBuf>,
     #[command(flatten)]
     avatar: crate::avatar::AvatarArgs,
 }
@@ -148,6 +155,14 @@ pub fn serve(args: ServeArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let realizer =
+        match crate::run::with_sight_and_nets(realizer, args.perception, args.nets.as_deref()) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("bmlr serve: {e}");
+                return ExitCode::from(2);
+            }
+        };
     if args.avatar.avatar.is_some() && args.view.is_none() {
         eprintln!("bmlr serve: --avatar shows the characters in the live view; give --view too");
         return ExitCode::from(2);
