@@ -6,7 +6,9 @@ use bml_realizer::feedback::{self, Format};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(line) = std::str::from_utf8(data) else { return };
+    let Ok(line) = std::str::from_utf8(data) else {
+        return;
+    };
     if let Ok(fb) = feedback::from_line(line) {
         for f in [Format::Xml, Format::Jsonl] {
             let encoded = f.encode(&fb);

@@ -6,14 +6,21 @@
 #![no_main]
 
 use bml_realizer::bml::{self, BlockStream, Code};
-use bml_realizer::timing::DefaultTimingModels;
 use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::timing::DefaultTimingModels;
 use libfuzzer_sys::arbitrary::Unstructured;
 use libfuzzer_sys::fuzz_target;
 
 const WRAPPERS: &[&str] = &["required", "x:deep", "constraint", "speech", "description"];
-const ATTRIBUTES: &[&str] = &["a{i}=\"1\"", "xmlns:p{i}=\"urn:{i}\" p{i}:a=\"1\"", "start=\"{t}\"", "id=\"dup\""];
-const TIMES: &[&str] = &["0", "1e-300", "999999", "1e6", "1e7", "1e308", "-1e6", "nan", "1e-9"];
+const ATTRIBUTES: &[&str] = &[
+    "a{i}=\"1\"",
+    "xmlns:p{i}=\"urn:{i}\" p{i}:a=\"1\"",
+    "start=\"{t}\"",
+    "id=\"dup\"",
+];
+const TIMES: &[&str] = &[
+    "0", "1e-300", "999999", "1e6", "1e7", "1e308", "-1e6", "nan", "1e-9",
+];
 
 fn block(u: &mut Unstructured) -> Option<String> {
     let depth = usize::from(u.arbitrary::<u16>().ok()? % 10_000);
