@@ -4,7 +4,10 @@
 //! stand midway between the feet over one step's time (the cadence of the walk's speed),
 //! turning with it, and the gait plays the steps. When the trailing foot can close within
 //! [`ARRIVE`] of the goal, the walk closes its feet there; when no step lowers the energy, it
-//! stops where it is (a local minimum: stuck).
+//! stops where it is (a local minimum: stuck). Under load the fan is thinned: all walkers
+//! share a budget of [`BUDGET`] samples a 60 Hz frame, counting those of the crowd that plan
+//! in one frame on average; and a walk among others sets off staggered by its place in the
+//! crowd over one step, so that walks started together do not all plan in the same frames.
 
 use glam::Vec2;
 
@@ -12,6 +15,9 @@ use crate::locomotion::footsteps::{self, Fan, Feet, Footstep};
 use crate::locomotion::gait;
 use crate::locomotion::Obstacles;
 use crate::nets::behaviour::{BehaviourNet, Surroundings};
+
+/// Samples the walkers of a crowd may take together in one 60 Hz frame.
+pub const BUDGET: usize = 1500;
 
 /// A footstep walk arrives when its body can stand within this of the goal (m).
 pub const ARRIVE: f32 = 0.3;
@@ -50,6 +56,17 @@ pub(super) struct Plan {
     top_speed: f32,
     /// Whether the walk stopped short of its goal: no step led anywhere better.
     pub stuck: bool,
+    /// When it sets off (staggered among others), once its first call has said.
+    sets_off: Option<f64>,
+    /// Samples its last plan took.
+    pub samples: usize,
+}
+
+/// A walker's place in its crowd: its index and how many there are.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(super) struct Place {
+    pub index: usize,
+    pub count: usize,
 }
 
 impl Plan {
@@ -76,6 +93,8 @@ impl Plan {
             closing: false,
             top_speed: speed * TOP_SPEED,
             stuck: false,
+            sets_off: None,
+            samples: 0,
         }
     }
 
@@ -88,7 +107,14 @@ impl Plan {
         obstacles: &Obstacles,
         walkers: &[Vec2],
         radius: f32,
+        place: Place,
     ) -> Option<Vec2> {
+        let sets_off = *self.sets_off.get_or_insert_with(|| {
+            time + footsteps::stagger(place.index, place.count, self.step_time)
+        });
+        if time < sets_off - 1e-9 {
+            return Some(Vec2::ZERO);
+        }
         if self.next.is_none_or(|(_, _, due)| time >= due - 1e-9) {
             if self.closing {
                 // the body stands midway between the closed feet
@@ -99,6 +125,9 @@ impl Plan {
                 let v = (target - here) / self.step_time as f32;
                 return Some(v.clamp_length_max(self.top_speed));
             }
+            // those of the crowd that plan in one frame, on average
+            let planning = (place.count as f64 / 60.0 / self.step_time).ceil().max(1.0);
+            self.samples = footsteps::allot(BUDGET, planning as usize, self.fan.len());
             let Some(step) = self.choose(obstacles, walkers, radius) else {
                 self.stuck = true;
                 return None;
@@ -130,17 +159,49 @@ impl Plan {
             walkers,
         };
         let now = self.net.energy(self.walk_node, &here);
-        let full = self.fan.len();
         let step = footsteps::choose(
             &mut self.net,
             self.walk_node,
             &self.feet,
             &self.fan,
-            full,
+            self.samples,
             obstacles,
             walkers,
             radius,
         )?;
         (step.energy < now - 1e-6).then_some(step)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn among_many_the_fan_is_thinned_and_walks_set_off_staggered() {
+        let obstacles = Obstacles::default();
+        let go = |place: Place| {
+            let mut p = Plan::new(Vec2::ZERO, 0.0, Vec2::new(0.0, 10.0), 1.3, false, 0.25);
+            let moving = (0..240).map(|k| k as f64 / 240.0).find(|&t| {
+                p.velocity(t, Vec2::ZERO, &obstacles, &[], 0.25, place)
+                    .is_some_and(|v| v.length() > 0.0)
+            });
+            (moving.unwrap(), p.samples)
+        };
+        let full = Fan::new(0.69, MAX_TURN, 9).len();
+        // alone: at once, the whole fan
+        assert_eq!(go(Place { index: 0, count: 1 }), (0.0, full));
+        // third of four: a half step later (0.53 s a step at 1.3 m/s)
+        let (t, _) = go(Place { index: 2, count: 4 });
+        assert!(
+            (t - 0.5 * 60.0 / gait::cadence(1.3, false) as f64).abs() < 1.0 / 240.0,
+            "{t}"
+        );
+        // among 20 000: fewer samples, never fewer than the three lengths
+        let (_, n) = go(Place {
+            index: 0,
+            count: 20_000,
+        });
+        assert!((3..full).contains(&n), "{n} of {full}");
     }
 }

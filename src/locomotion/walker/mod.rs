@@ -475,7 +475,12 @@ impl Walker {
                                 .collect()
                         })
                         .unwrap_or_default();
-                    match plan.velocity(time, here, obstacles, &walkers, self.radius) {
+                    let place =
+                        others.map_or(footstep_mode::Place::default(), |o| footstep_mode::Place {
+                            index: o.me.unwrap_or(0),
+                            count: o.crowd.len(),
+                        });
+                    match plan.velocity(time, here, obstacles, &walkers, self.radius, place) {
                         Some(v) => {
                             // speeding up and braking as a person does
                             let now = Vec2::new(self.vehicle.velocity.x, self.vehicle.velocity.z);
