@@ -126,6 +126,22 @@ fn the_wall_and_goal_scene_is_walked_by_footsteps_without_zig_zag_or_sliding() {
         !feedback.iter().any(|f| matches!(f, Feedback::Warning(_))),
         "{feedback:?}"
     );
+    // its sync points in order, the final deceleration before the end (found when the way to
+    // the goal, not a route, is short: it was at the end before)
+    let at = |sync: &str| {
+        (feedback.iter())
+            .find_map(|f| match f {
+                Feedback::SyncPointProgress(p) if p.sync.as_str() == sync => Some(p.global_time),
+                _ => None,
+            })
+            .unwrap_or_else(|| panic!("no {sync}"))
+    };
+    let (start, ready, relax, end) = (at("start"), at("ready"), at("relax"), at("end"));
+    eprintln!("start {start:.3} ready {ready:.3} relax {relax:.3} end {end:.3}");
+    assert!(
+        start < ready && ready < relax && relax + 0.5 < end,
+        "{start} {ready} {relax} {end}"
+    );
 }
 
 #[test]

@@ -183,3 +183,24 @@ fn a_character_walking_out_from_behind_a_wall_appears_within_one_period_of_showi
         appeared - showing
     );
 }
+
+#[test]
+fn the_world_file_s_vision_and_variables_are_read_and_bad_values_named() {
+    let (w, _) = World::from_json(
+        r#"{"vision": {"rate": 5, "side": 10, "memory": {"count": 3}}, "lights": {"light": "WALK"}}"#,
+    )
+    .unwrap();
+    assert_eq!((w.vision().rate, w.vision().side), (5.0, 10));
+    assert_eq!(w.vision().memory.count, Some(3));
+    assert_eq!(w.vision().memory.millis, None, "a bound left out is off");
+    assert_eq!(w.variables()["light"].to_string(), "WALK");
+    for (bad, field) in [
+        (r#"{"vision": {"rate": 0}}"#, "vision.rate"),
+        (r#"{"vision": {"side": 65}}"#, "vision.side"),
+        (r#"{"vision": {"field": [120, 200]}}"#, "vision.field[1]"),
+        (r#"{"vision": {"sight": 1}}"#, "sight"),
+    ] {
+        let e = World::from_json(bad).unwrap_err();
+        assert!(e.contains(field), "{e}");
+    }
+}

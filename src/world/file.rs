@@ -33,7 +33,7 @@ struct WorldFile {
     #[serde(default)]
     vision: Option<crate::perception::Vision>,
     /// Named world values that nets read and write, with their first values.
-    #[serde(default)]
+    #[serde(default, alias = "lights")]
     variables: BTreeMap<String, crate::feedback::world::VarValue>,
 }
 

@@ -1,8 +1,8 @@
 //! A walker's footstep mode (`bmlt:planner="footsteps"`): instead of steering, the walk is a
 //! sequence of footsteps chosen one at a time by [`crate::locomotion::footsteps`]. At each
 //! footfall the next placement is chosen from where the feet are; the body then moves to
-//! stand midway between the feet over one step's time (the cadence of the walk's speed),
-//! turning with it, and the gait plays the steps. When the trailing foot can close within
+//! stand midway between the feet at the walk's speed (a longer step takes longer), turning
+//! with it, and the gait plays the steps. When the trailing foot can close within
 //! [`ARRIVE`] of the goal, the walk closes its feet there; when no step lowers the energy, it
 //! stops where it is (a local minimum: stuck). Under load the fan is thinned: all walkers
 //! share a budget of [`BUDGET`] samples a 60 Hz frame, counting those of the crowd that plan
@@ -54,6 +54,8 @@ pub(super) struct Plan {
     closing: bool,
     /// The fastest the body moves (m/s).
     top_speed: f32,
+    /// The walk's speed (m/s).
+    speed: f32,
     /// Whether the walk stopped short of its goal: no step led anywhere better.
     pub stuck: bool,
     /// When it sets off (staggered among others), once its first call has said.
@@ -92,6 +94,7 @@ impl Plan {
             step_time: 60.0 / gait::cadence(speed, running) as f64,
             closing: false,
             top_speed: speed * TOP_SPEED,
+            speed,
             stuck: false,
             sets_off: None,
             samples: 0,
@@ -122,8 +125,10 @@ impl Plan {
                 if here.distance(target) <= 0.02 {
                     return None;
                 }
-                let v = (target - here) / self.step_time as f32;
-                return Some(v.clamp_length_max(self.top_speed));
+                // braking to stand there (not creeping up on it)
+                let d = here.distance(target);
+                let pace = (2.0 * ACCELERATION * d).sqrt().min(self.speed);
+                return Some((target - here) / d * pace);
             }
             // those of the crowd that plan in one frame, on average
             let planning = (place.count as f64 / 60.0 / self.step_time).ceil().max(1.0);
@@ -141,7 +146,11 @@ impl Plan {
             } else {
                 (step.body, step.heading)
             };
-            self.next = Some((target, heading, time + self.step_time));
+            // the step takes as long as the body needs at the walk's speed (longer steps at a
+            // slower cadence: the walk keeps its speed), within a cadence of 75 to 170 a minute
+            let span = (here.distance(target) / self.speed) as f64;
+            let step_time = span.clamp(60.0 / 170.0, 60.0 / 75.0);
+            self.next = Some((target, heading, time + step_time));
         }
         let (target, _, due) = self.next?;
         let left = (due - time).max(1e-3) as f32;

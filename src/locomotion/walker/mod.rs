@@ -465,7 +465,11 @@ impl Walker {
                 }
             } else if !a.stopped {
                 let route = ahead;
-                let left = path::length(&route);
+                // (a footstep walk keeps to no route: what is left is the way to the goal)
+                let left = match a.plan {
+                    Some(_) => to_goal.length(),
+                    None => path::length(&route),
+                };
                 if let Some(plan) = a.plan.as_mut() {
                     let walkers: Vec<Vec2> = others
                         .map(|o| {
@@ -564,7 +568,7 @@ impl Walker {
                     a.moments.relax = Some(time);
                     a.moments.ready.get_or_insert(time);
                 }
-                if a.moments.relax.is_some() {
+                if a.moments.relax.is_some() && a.plan.is_none() {
                     // where the body will stand: arrived, STOP_RADIUS short of the goal
                     let back = (a.walk.goal - here).normalize_or_zero() * STOP_RADIUS;
                     self.gait.stop_at = Some(a.walk.goal - back);
