@@ -2,12 +2,13 @@
 //! chosen one at a time, through the realizer: round the wall's end without zig-zag, arriving
 //! within 0.3 m, with the gait's planted feet staying where they were put down.
 
-use std::collections::HashMap;
+#[path = "common/feet.rs"]
+mod feet;
 
-use bml_realizer::body::Skeleton;
 use bml_realizer::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
+use feet::Slides;
 use glam::Vec2;
 
 const WORLD: &str = r#"{"characters": {"w": {"position": [0, 0, 0], "facing": 0}},
@@ -22,54 +23,24 @@ fn block(planner: &str) -> String {
 /// The walk at 60 fps: the root's ground positions, the worst slide of a planted foot point
 /// (m), and the feedback.
 fn walk(planner: &str) -> (Vec<Vec2>, f32, Vec<Feedback>) {
-    let s = Skeleton::adult();
     let mut r = Realizer::new().with_idle(false);
     *r.world_mut() = World::from_json(WORLD).unwrap().0;
     r.perform_bml(&block(planner)).unwrap();
-    let points: Vec<(usize, usize)> = [
-        "l_talocrural",
-        "r_talocrural",
-        "l_metatarsal",
-        "r_metatarsal",
-    ]
-    .iter()
-    .enumerate()
-    .map(|(k, n)| (k % 2, s.joint(n).unwrap()))
-    .collect();
-    let (mut rest, mut down) = (HashMap::new(), HashMap::new());
-    let (mut roots, mut worst, mut feedback) = (Vec::new(), 0f32, Vec::new());
+    let mut slides = Slides::new();
+    let (mut roots, mut feedback) = (Vec::new(), Vec::new());
     for i in 1..=(20 * 60) {
-        let frame = r.tick(f64::from(i) / 60.0);
+        let t = f64::from(i) / 60.0;
+        let frame = r.tick(t);
         feedback.extend(frame.feedback.iter().cloned());
-        let Some(p) = frame.character("w") else {
-            continue;
-        };
-        roots.push(Vec2::new(p.pose.root.x, p.pose.root.z));
-        let Some(contacts) = p.contacts else { continue };
-        let world = p.pose.world(&s);
-        for &(side, joint) in &points {
-            let at = world.positions[joint];
-            let ground = *rest.entry(joint).or_insert(at.y);
-            if contacts[side] && at.y - ground < 0.005 {
-                let from = *down.entry(joint).or_insert(Vec2::new(at.x, at.z));
-                let d = from.distance(Vec2::new(at.x, at.z));
-                if d > worst && std::env::var_os("SLIDE_AT").is_some() {
-                    eprintln!(
-                        "slide {d:.4} at {:.3} joint {joint} root {}",
-                        f64::from(i) / 60.0,
-                        p.pose.root
-                    );
-                }
-                worst = worst.max(d);
-            } else {
-                down.remove(&joint);
-            }
+        if let Some(p) = frame.character("w") {
+            roots.push(Vec2::new(p.pose.root.x, p.pose.root.z));
         }
+        slides.frame(t, &frame.poses);
         if r.next_event().is_none() {
             break;
         }
     }
-    (roots, worst, feedback)
+    (roots, slides.worst.0, feedback)
 }
 
 /// Changes of direction of the root's sideways motion (across the straight line to the goal),

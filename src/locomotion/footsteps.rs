@@ -12,7 +12,6 @@
 use glam::Vec2;
 
 use super::gait::HALF_WIDTH;
-use super::Obstacles;
 use crate::nets::behaviour::{BehaviourNet, Node, Sensor, Surroundings};
 
 /// The fan of candidate steps.
@@ -166,18 +165,19 @@ pub fn walking_net(goal: Vec2, arrive: f32, clear: f32, personal: f32) -> (Behav
 /// Chooses the next step from `feet` by sampling `samples` places of `fan` (at least its
 /// three lengths straight on; the turns thinned evenly when fewer than the whole fan): the
 /// least energy of `net`'s walk node `walk`, among places that keep `radius` from every
-/// obstacle. Ties go to the first sampled.
-#[allow(clippy::too_many_arguments)]
+/// obstacle of `here` — where the body stands now, which the step must improve on: `None`
+/// when no place has less energy than standing still (arrived, or stuck). Ties go to the
+/// first sampled.
 pub fn choose(
     net: &mut BehaviourNet,
     walk: usize,
     feet: &Feet,
     fan: &Fan,
     samples: usize,
-    obstacles: &Obstacles,
-    walkers: &[Vec2],
+    here: &Surroundings,
     radius: f32,
 ) -> Option<Footstep> {
+    let standing = net.energy(walk, here);
     let turns = (samples / fan.lengths.len()).clamp(1, fan.turns.len());
     // every k-th turn of the list (straight on first, then outwards in pairs)
     let stride = fan.turns.len().div_ceil(turns);
@@ -186,16 +186,15 @@ pub fn choose(
         for &length in &fan.lengths {
             let (at, heading) = feet.candidate(length, turn);
             let body = (feet.planted + at) / 2.0;
-            if obstacles.clearance(body, radius + 0.5) < radius
-                || !obstacles.segment_clear(feet.planted, at, 0.02)
+            if here.obstacles.clearance(body, radius + 0.5) < radius
+                || !here.obstacles.segment_clear(feet.planted, at, 0.02)
             {
                 continue;
             }
             let env = Surroundings {
                 at: body,
                 heading,
-                obstacles,
-                walkers,
+                ..*here
             };
             let energy = net.energy(walk, &env);
             if best.is_none_or(|b| energy < b.energy) {
@@ -208,7 +207,7 @@ pub fn choose(
             }
         }
     }
-    best
+    best.filter(|b| b.energy < standing - 1e-6)
 }
 
 /// How many places each of `due` agents planning in one frame samples under a budget of

@@ -133,14 +133,16 @@ pub fn avoid(theta: f32, d: f32, t_d: f32, k_theta: f32, k_d: f32) -> (f32, f32)
     (dt, k_d * (t_d - d))
 }
 
+/// Steps that carry a sensor's reading to the motor: a net is sensors, then controls reading
+/// them, then walk nodes reading the controls ([`BehaviourNet::new`] refuses any other shape).
+const DEPTH: usize = 3;
+
 /// A behaviour net.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BehaviourNet {
     nodes: Vec<Node>,
     /// What each node emitted at the last step.
     out: Vec<Signal>,
-    /// Steps that carry a sensor's reading to the motor: the longest path, plus one.
-    depth: usize,
 }
 
 impl BehaviourNet {
@@ -165,7 +167,6 @@ impl BehaviourNet {
         Ok(BehaviourNet {
             out: vec![[0.0; 3]; n],
             nodes,
-            depth: 3,
         })
     }
 
@@ -204,7 +205,7 @@ impl BehaviourNet {
     /// [`settle`](Self::settle) evaluating nodes in `order`.
     pub fn settle_in(&mut self, order: &[usize], env: &Surroundings) -> &[Signal] {
         self.rest();
-        for _ in 0..self.depth {
+        for _ in 0..DEPTH {
             self.step(order, env);
         }
         &self.out

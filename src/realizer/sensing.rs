@@ -58,10 +58,8 @@ impl Realizer {
     /// The scene as the previous frame left it: every character (its last pose, or at rest
     /// where the world places it) and every named point, among the world's obstacles.
     fn scene(&self, poses: &BTreeMap<String, Pose>) -> Scene {
-        let mut ids: Vec<&str> = self.world.placements().map(|(id, _)| id).collect();
-        ids.extend(self.characters.keys().map(String::as_str));
+        let mut ids: Vec<&str> = self.everyone().collect();
         ids.sort_unstable();
-        ids.dedup();
         let mut things = Vec::with_capacity(ids.len());
         for id in ids {
             let skeleton = self
@@ -100,11 +98,7 @@ impl Realizer {
             return;
         };
         // (the scene is made only when someone looks or someone new is to be met)
-        let everyone = self.world.placements().count()
-            + (self.characters.keys())
-                .filter(|id| !self.world.is_placed(id))
-                .count();
-        if !s.perception.due(now, everyone) {
+        if !s.perception.due(now, self.everyone().count()) {
             self.sensing = Some(s);
             return;
         }

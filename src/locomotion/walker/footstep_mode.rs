@@ -167,18 +167,16 @@ impl Plan {
             obstacles,
             walkers,
         };
-        let now = self.net.energy(self.walk_node, &here);
-        let step = footsteps::choose(
-            &mut self.net,
-            self.walk_node,
+        let (net, walk) = (&mut self.net, self.walk_node);
+        footsteps::choose(
+            net,
+            walk,
             &self.feet,
             &self.fan,
             self.samples,
-            obstacles,
-            walkers,
+            &here,
             radius,
-        )?;
-        (step.energy < now - 1e-6).then_some(step)
+        )
     }
 }
 
