@@ -327,20 +327,19 @@ fn a_flood_for_one_character_does_not_hold_up_another_s_block() {
 }
 
 #[test]
-fn ipaaca_messages_round_trip_as_the_contract_gives_them() {
+fn ipaaca_channels_are_characters_on_ipaacar_s_message_topics() {
+    // (the library itself is the partner in tests/ipaaca.rs; this one needs only mosquitto)
     let Some(broker) = Broker::start() else {
         return;
     };
-    let _r = realizer(&broker, "asap", &[], &["--ipaaca", "asapcomp"]);
-    let mut p = planner_on(
-        &broker,
-        "ipaaca",
-        &["asapcomp/bmlfeedback/+", "bml/realizers/+"],
-    );
+    let _r = realizer(&broker, "asap", &[], &["--ipaaca", "default,alice"]);
+    let mut p = planner_on(&broker, "ipaaca", &["+/bmlfeedback/M", "bml/realizers/+"]);
     until_online(&p, &["asap"]);
-    let message = serde_json::json!({"bml": block("ib"), "character": "alice"});
-    p.publish("asapcomp/bml/m1", message.to_string().into_bytes(), false);
-    p.publish("asapcomp/bml/m2", b"<bml/>".to_vec(), false);
+    let message = serde_json::json!({"bml": block("ib")});
+    p.publish("alice/bml/M", message.to_string().into_bytes(), false);
+    p.publish("default/bml/M", b"{\"not\": \"bml\"}".to_vec(), false);
+    // a channel not served is not heard
+    p.publish("bob/bml/M", message.to_string().into_bytes(), false);
     let feedback = |h: &[(String, String)]| -> Vec<(String, String)> {
         (h.iter())
             .filter_map(|(t, m)| {
@@ -355,28 +354,32 @@ fn ipaaca_messages_round_trip_as_the_contract_gives_them() {
             && f.iter().any(|(_, x)| x.contains("warningFeedback"))
     });
     let f = feedback(&heard);
-    // every message is {"bmlfeedback": XML}, on the character's topic
+    // every message is {"bmlfeedback": XML}, on the character's channel
     assert_eq!(
         f.len(),
         heard
             .iter()
-            .filter(|(t, _)| t.starts_with("asapcomp/"))
+            .filter(|(t, _)| t.ends_with("/bmlfeedback/M"))
             .count()
     );
     let end = f
         .iter()
         .find(|(_, x)| x.contains(r#"id="ib:end""#))
         .expect("the block's end");
-    assert_eq!(end.0, "asapcomp/bmlfeedback/alice");
+    assert_eq!(end.0, "alice/bmlfeedback/M");
     assert!(end.1.starts_with("<blockProgress") && end.1.contains(r#"characterId="alice""#));
     let warning = f
         .iter()
         .find(|(_, x)| x.contains("warningFeedback"))
         .unwrap();
-    assert_eq!(warning.0, "asapcomp/bmlfeedback/_");
+    assert_eq!(warning.0, "default/bmlfeedback/M");
     assert!(
         warning.1.contains("not an ipaaca BML message"),
         "{}",
         warning.1
+    );
+    assert!(
+        !heard.iter().any(|(t, _)| t.starts_with("bob/")),
+        "{heard:?}"
     );
 }

@@ -57,6 +57,10 @@ impl fmt::Display for BrokerUrl {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Topics {
     prefix: String,
+    /// Between levels: `/` on MQTT, `.` on STOMP brokers (ActiveMQ, RabbitMQ).
+    sep: char,
+    /// The one-level wildcard: `+` on MQTT, `*` on STOMP brokers.
+    any: char,
 }
 
 impl Topics {
@@ -70,56 +74,75 @@ impl Topics {
         }
         Ok(Topics {
             prefix: prefix.to_string(),
+            sep: '/',
+            any: '+',
+        })
+    }
+
+    /// The same names with `.` between levels and `*` as the wildcard, as STOMP brokers name
+    /// topics (`bml.world.alice`).
+    pub fn dotted(prefix: &str) -> Result<Topics, String> {
+        let t = Topics::new(prefix)?;
+        if t.prefix.contains('.') || t.prefix.contains('*') {
+            return Err(format!("'{prefix}' is not a topic prefix (no '.' or '*')"));
+        }
+        Ok(Topics {
+            prefix: t.prefix.replace('/', "."),
+            sep: '.',
+            any: '*',
         })
     }
 
     /// Where blocks for `character` come in.
     pub fn bml(&self, character: &str) -> String {
-        format!("{}/{character}/bml", self.prefix)
+        format!("{}{s}{character}{s}bml", self.prefix, s = self.sep)
     }
 
     /// Where `character`'s feedback goes out.
     pub fn feedback(&self, character: &str) -> String {
-        format!("{}/{character}/feedback", self.prefix)
+        format!("{}{s}{character}{s}feedback", self.prefix, s = self.sep)
     }
 
     /// A realizer's presence (retained `online`; `offline` as its last will).
     pub fn presence(&self, realizer: &str) -> String {
-        format!("{}/realizers/{realizer}", self.prefix)
+        format!("{}{s}realizers{s}{realizer}", self.prefix, s = self.sep)
     }
 
     /// Every realizer's presence (a subscription).
     pub fn all_presence(&self) -> String {
-        format!("{}/realizers/+", self.prefix)
+        format!("{}{s}realizers{s}{}", self.prefix, self.any, s = self.sep)
     }
 
     /// Blocks for every character (a subscription).
     pub fn all_bml(&self) -> String {
-        format!("{}/+/bml", self.prefix)
+        format!("{}{s}{}{s}bml", self.prefix, self.any, s = self.sep)
     }
 
     /// Where `character`'s root state goes (realizers sharing one world).
     pub fn world(&self, character: &str) -> String {
-        format!("{}/world/{character}", self.prefix)
+        format!("{}{s}world{s}{character}", self.prefix, s = self.sep)
     }
 
     /// Every character's root state (a subscription).
     pub fn all_world(&self) -> String {
-        format!("{}/world/+", self.prefix)
+        format!("{}{s}world{s}{}", self.prefix, self.any, s = self.sep)
     }
 
     /// The character a root-state topic is about, if `topic` is one.
     pub fn world_character<'t>(&self, topic: &'t str) -> Option<&'t str> {
-        let rest = topic.strip_prefix(&self.prefix)?.strip_prefix('/')?;
-        let character = rest.strip_prefix("world/")?;
-        level_ok(character).then_some(character)
+        let rest = topic.strip_prefix(&self.prefix)?.strip_prefix(self.sep)?;
+        let character = rest.strip_prefix("world")?.strip_prefix(self.sep)?;
+        (level_ok(character) && !character.contains(self.sep)).then_some(character)
     }
 
     /// The character a block topic is for, if `topic` is one.
     pub fn bml_character<'t>(&self, topic: &'t str) -> Option<&'t str> {
-        let rest = topic.strip_prefix(&self.prefix)?.strip_prefix('/')?;
-        let character = rest.strip_suffix("/bml")?;
-        (level_ok(character) && character != "realizers" && character != "world")
+        let rest = topic.strip_prefix(&self.prefix)?.strip_prefix(self.sep)?;
+        let character = rest.strip_suffix("bml")?.strip_suffix(self.sep)?;
+        (level_ok(character)
+            && !character.contains(self.sep)
+            && character != "realizers"
+            && character != "world")
             .then_some(character)
     }
 
@@ -174,6 +197,13 @@ mod tests {
         let deep = Topics::new("/site/one/").unwrap();
         assert_eq!(deep.bml("bob"), "site/one/bob/bml");
         assert!(Topics::new("a/+/b").is_err());
+        let dotted = Topics::dotted("bml").unwrap();
+        assert_eq!(dotted.world("a"), "bml.world.a");
+        assert_eq!(dotted.all_world(), "bml.world.*");
+        assert_eq!(dotted.presence("r"), "bml.realizers.r");
+        assert_eq!(dotted.world_character("bml.world.a"), Some("a"));
+        assert_eq!(dotted.world_character("bml.world.a.b"), None);
+        assert!(Topics::dotted("a.b").is_err());
         assert!(Topics::new("").is_err());
     }
 }

@@ -11,15 +11,18 @@ macro_rules! eprintln {
 }
 
 mod avatar;
+mod brokered;
+mod dialect;
 mod diff;
 mod live;
-mod mqtt;
+mod live_frames;
 mod mqtt_port;
 mod outcome;
 mod pack;
 mod record;
 mod run;
 mod serve;
+mod serve_broker;
 mod spool;
 mod tcp;
 mod view;

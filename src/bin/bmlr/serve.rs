@@ -20,78 +20,90 @@ use realizer_tests::{run, Outcome, ProcessPort, TestPort};
 
 /// Arguments of `bmlr serve`.
 #[derive(Args)]
-#[command(group(clap::ArgGroup::new("port").required(true).args(["stdio", "tcp", "mqtt"])))]
+#[command(group(clap::ArgGroup::new("port").required(true).args(["stdio", "tcp", "mqtt", "stomp"])))]
 pub struct ServeArgs {
     /// Serve on stdin/stdout.
-    #[arg(long, conflicts_with_all = ["tcp", "mqtt"])]
-    stdio: bool,
+    #[arg(long, conflicts_with_all = ["tcp", "mqtt", "stomp"])]
+    pub(crate) stdio: bool,
     /// Serve several clients on a TCP address (e.g. 127.0.0.1:7700; port 0 picks one, printed
     /// on stderr).
     #[arg(long, value_name = "ADDR")]
-    tcp: Option<String>,
+    pub(crate) tcp: Option<String>,
     /// Serve on an MQTT broker (mqtt://HOST[:PORT]): blocks in on PREFIX/CHARACTER/bml, feedback
     /// out on PREFIX/CHARACTER/feedback, presence on PREFIX/realizers/NAME (docs/broker.md).
+    #[arg(long, value_name = "URL", conflicts_with_all = ["tcp", "stomp"])]
+    pub(crate) mqtt: Option<String>,
+    /// Serve on a STOMP 1.2 broker (stomp://[USER:PASS@]HOST[:PORT]; ActiveMQ, RabbitMQ):
+    /// AsapRealizer's or Greta's topics (--flavour), docs/broker.md.
     #[arg(long, value_name = "URL", conflicts_with = "tcp")]
-    mqtt: Option<String>,
-    /// With --mqtt: the topics' first level(s) (bml by default).
-    #[arg(long, value_name = "PREFIX", requires = "mqtt")]
-    prefix: Option<String>,
-    /// With --mqtt: this realizer's name on the broker (its presence topic and client id;
-    /// bmlr-PID by default).
-    #[arg(long, value_name = "NAME", requires = "mqtt")]
-    name: Option<String>,
-    /// With --mqtt: serve only these characters (comma-separated; '_' is the default
-    /// character); all by default.
-    #[arg(long, value_name = "A,B", value_delimiter = ',', requires = "mqtt")]
-    characters: Vec<String>,
-    /// With --mqtt: the feedback's encoding (xml by default).
-    #[arg(long, value_enum, requires = "mqtt")]
-    format: Option<crate::run::FormatArg>,
-    /// With --mqtt: speak ipaaca's messages as component COMPONENT (BML in on
-    /// COMPONENT/bml/M as {"bml": TEXT}, feedback out on COMPONENT/bmlfeedback/CHARACTER as
-    /// {"bmlfeedback": XML}) instead of the block and feedback topics.
-    #[arg(long, value_name = "COMPONENT")]
-    ipaaca: Option<String>,
-    /// With --mqtt: stop after this many seconds.
-    #[arg(long, value_name = "SECS", requires = "mqtt")]
-    until: Option<f64>,
+    pub(crate) stomp: Option<String>,
+    /// With --stomp: whose conventions: asap (asap.bml.request -> asap.bml.feedback, the
+    /// default) or greta (greta.BML -> greta.output.feedback.BML callbacks).
+    #[arg(long, value_enum)]
+    pub(crate) flavour: Option<Flavour>,
+    /// With --mqtt or --stomp: the topics' first level(s) (bml by default).
+    #[arg(long, value_name = "PREFIX")]
+    pub(crate) prefix: Option<String>,
+    /// With --mqtt or --stomp: this realizer's name on the broker (its presence topic and
+    /// client id; bmlr-PID by default).
+    #[arg(long, value_name = "NAME")]
+    pub(crate) name: Option<String>,
+    /// With --mqtt or --stomp: serve only these characters (comma-separated; '_' is the
+    /// default character); all by default.
+    #[arg(long, value_name = "A,B", value_delimiter = ',')]
+    pub(crate) characters: Vec<String>,
+    /// With --mqtt or --stomp: the feedback's encoding (xml by default).
+    #[arg(long, value_enum)]
+    pub(crate) format: Option<crate::run::FormatArg>,
+    /// With --mqtt: speak ipaaca as ipaacar does on these channels, one per character
+    /// ('default' is the default character): `bml` messages and `realizerRequest` IUs in,
+    /// `bmlfeedback` messages out (docs/broker.md).
+    #[arg(long, value_name = "CH,CH2", value_delimiter = ',')]
+    pub(crate) ipaaca: Vec<String>,
+    /// With --mqtt or --stomp: stop after this many seconds.
+    #[arg(long, value_name = "SECS")]
+    pub(crate) until: Option<f64>,
+    /// Write the frames of the characters served as JSON lines as they happen (docs/cli.md,
+    /// "Frames"); flushed at --until and on SIGTERM.
+    #[arg(long, value_name = "OUT.jsonl")]
+    pub(crate) frames: Option<std::path::PathBuf>,
     /// With --tcp: also serve the viewer's page on this loopback address (e.g. 127.0.0.1:8080;
     /// port 0 picks one, printed on stderr); it shows the character move as blocks arrive.
     #[arg(long, value_name = "ADDR", requires = "tcp")]
-    view: Option<String>,
+    pub(crate) view: Option<String>,
     /// With --tcp: send each client only the feedback about its own blocks.
     #[arg(long, requires = "tcp")]
-    per_client: bool,
+    pub(crate) per_client: bool,
     /// Frames per second of the engine loop.
     #[arg(long, value_name = "HZ", default_value_t = 60.0)]
-    fps: f64,
+    pub(crate) fps: f64,
     /// Characters stand still between behaviours: no breathing, no weight shift.
     #[arg(long)]
-    no_idle: bool,
+    pub(crate) no_idle: bool,
     /// The voice that says speech: the built-in TTS, or flite (Debian package `flite`).
     #[arg(long, value_enum, default_value = "builtin")]
-    tts: crate::run::TtsArg,
+    pub(crate) tts: crate::run::TtsArg,
     /// Speech may change its rate to meet its constraints (an incremental TTS).
     #[arg(long)]
-    retimable_speech: bool,
+    pub(crate) retimable_speech: bool,
     /// A directory of motion data adding to the embedded defaults (see `bmlr run --assets`).
     #[arg(long, value_name = "DIR")]
-    assets: Option<std::path::PathBuf>,
+    pub(crate) assets: Option<std::path::PathBuf>,
     #[command(flatten)]
-    limits: crate::run::LimitArgs,
+    pub(crate) limits: crate::run::LimitArgs,
     /// A world file (JSON): named points and points moving along keyed paths, as targets of
     /// gaze, pointing and headDirectionShift, added to the built-in scene.
     #[arg(long, value_name = "WORLD.json")]
-    world: Option<std::path::PathBuf>,
+    pub(crate) world: Option<std::path::PathBuf>,
     /// Characters see; perception feedback reports what each sees when it changes.
     #[arg(long)]
-    perception: bool,
+    pub(crate) perception: bool,
     /// PaT-Nets (JSON, docs/nets.md) run with the behaviours; their transitions and the
     /// world variables' changes are reported.
     #[arg(long, value_name = "NETS.json")]
-    nets: Option<std::path::PathBuf>,
+    pub(crate) nets: Option<std::path::PathBuf>,
     #[command(flatten)]
-    avatar: crate::avatar::AvatarArgs,
+    pub(crate) avatar: crate::avatar::AvatarArgs,
 }
 
 /// `bmlr serve --stdio` (runs until stdin closes and nothing more is scheduled) or `--tcp`.
@@ -101,27 +113,49 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         return ExitCode::from(2);
     }
     // (clap's `requires` is not checked beside the port group: said here)
-    let mqtt_only = [
-        ("--prefix", args.prefix.is_some()),
-        ("--name", args.name.is_some()),
-        ("--characters", !args.characters.is_empty()),
-        ("--format", args.format.is_some()),
-        ("--until", args.until.is_some()),
-        ("--ipaaca", args.ipaaca.is_some()),
+    let brokered = args.mqtt.is_some() || args.stomp.is_some();
+    let misplaced = [
+        (
+            "--prefix",
+            args.prefix.is_some(),
+            brokered,
+            "--mqtt or --stomp",
+        ),
+        ("--name", args.name.is_some(), brokered, "--mqtt or --stomp"),
+        (
+            "--characters",
+            !args.characters.is_empty(),
+            brokered,
+            "--mqtt or --stomp",
+        ),
+        (
+            "--format",
+            args.format.is_some(),
+            brokered,
+            "--mqtt or --stomp",
+        ),
+        (
+            "--until",
+            args.until.is_some(),
+            brokered,
+            "--mqtt or --stomp",
+        ),
+        (
+            "--ipaaca",
+            !args.ipaaca.is_empty(),
+            args.mqtt.is_some(),
+            "--mqtt",
+        ),
+        (
+            "--flavour",
+            args.flavour.is_some(),
+            args.stomp.is_some(),
+            "--stomp",
+        ),
+        ("--view", args.view.is_some(), args.tcp.is_some(), "--tcp"),
+        ("--per-client", args.per_client, args.tcp.is_some(), "--tcp"),
     ];
-    let tcp_only = [
-        ("--view", args.view.is_some()),
-        ("--per-client", args.per_client),
-    ];
-    let misplaced = (mqtt_only.iter().filter(|_| args.mqtt.is_none()))
-        .chain(tcp_only.iter().filter(|_| args.tcp.is_none()))
-        .find(|(_, given)| *given);
-    if let Some((flag, _)) = misplaced {
-        let port = if mqtt_only.iter().any(|m| m.0 == *flag) {
-            "--mqtt"
-        } else {
-            "--tcp"
-        };
+    if let Some((flag, _, _, port)) = misplaced.iter().find(|m| m.1 && !m.2) {
         eprintln!("bmlr serve: {flag} goes with {port}");
         return ExitCode::from(2);
     }
@@ -188,79 +222,63 @@ pub fn serve(args: ServeArgs) -> ExitCode {
             }
             view => view.and_then(Result::ok),
         };
-        return crate::tcp::serve(addr, args.per_client, args.fps, realizer, view);
+        let frames = match live_frames(&args, &realizer) {
+            Ok(f) => f,
+            Err(e) => {
+                eprintln!("bmlr serve: --frames {e}");
+                return ExitCode::from(2);
+            }
+        };
+        return crate::tcp::serve(addr, args.per_client, args.fps, realizer, view, frames);
     }
-    if let Some(url) = &args.mqtt {
-        return match mqtt_args(&args, url) {
-            Ok(m) => crate::mqtt::serve(m, realizer),
+    if args.mqtt.is_some() || args.stomp.is_some() {
+        return match crate::serve_broker::brokered(&args, &realizer) {
+            Ok(m) => crate::brokered::serve(m, realizer),
             Err(e) => {
                 eprintln!("bmlr serve: {e}");
                 ExitCode::from(2)
             }
         };
     }
-    serve_stdio(realizer, Duration::from_secs_f64(1.0 / args.fps))
+    let frames = match live_frames(&args, &realizer) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("bmlr serve: --frames {e}");
+            return ExitCode::from(2);
+        }
+    };
+    serve_stdio(realizer, Duration::from_secs_f64(1.0 / args.fps), frames)
 }
 
-/// What `serve --mqtt URL` needs, checked.
-fn mqtt_args(args: &ServeArgs, url: &str) -> Result<crate::mqtt::MqttServe, String> {
-    use bml_realizer::broker::{BrokerUrl, LinkOptions, Topics};
-    let url = BrokerUrl::parse(url).map_err(|e| format!("--mqtt {e}"))?;
-    let prefix = args.prefix.as_deref().unwrap_or("bml");
-    let topics = Topics::new(prefix).map_err(|e| format!("--prefix {e}"))?;
-    let name = (args.name.clone()).unwrap_or_else(|| format!("bmlr-{}", std::process::id()));
-    if !bml_realizer::broker::level_ok(&name) {
-        return Err(format!(
-            "--name '{name}' is not a topic level (no '/', '+', '#')"
-        ));
-    }
-    if let Some(bad) = args
-        .characters
-        .iter()
-        .find(|c| !bml_realizer::broker::level_ok(c))
-    {
-        return Err(format!(
-            "--characters '{bad}' is not a topic level (no '/', '+', '#')"
-        ));
-    }
-    let until = args.until.unwrap_or(f64::INFINITY);
-    if until.is_nan() || until < 0.0 {
-        return Err("--until must be a number of seconds".into());
-    }
-    // one subscription per character served, or the wildcard
-    let ipaaca = (args.ipaaca.as_deref())
-        .map(bml_realizer::broker::Ipaaca::new)
-        .transpose()
-        .map_err(|e| format!("--ipaaca {e}"))?;
-    let mut subscriptions = match (&ipaaca, args.characters.is_empty()) {
-        (Some(ip), _) => vec![ip.subscription()],
-        (None, true) => vec![topics.all_bml()],
-        (None, false) => args.characters.iter().map(|c| topics.bml(c)).collect(),
+/// The frames file asked for, started.
+pub(crate) fn live_frames(
+    args: &ServeArgs,
+    realizer: &Realizer,
+) -> Result<Option<crate::live_frames::LiveFrames>, String> {
+    let Some(path) = &args.frames else {
+        return Ok(None);
     };
-    // (the world the realizers on the broker share)
-    subscriptions.push(topics.all_world());
-    Ok(crate::mqtt::MqttServe {
-        link: LinkOptions {
-            url,
-            client_id: name.clone(),
-            subscriptions,
-            presence: Some(topics.presence(&name)),
-            inbox: 4_096,
-            start_tries: 6,
-        },
-        topics,
-        characters: args.characters.iter().cloned().collect(),
-        format: args.format.unwrap_or(crate::run::FormatArg::Xml).into(),
-        period: Duration::from_secs_f64(1.0 / args.fps),
-        until,
-        ipaaca,
-    })
+    let ids = crate::live_frames::shown(&args.characters, realizer);
+    crate::live_frames::LiveFrames::create(path, ids, realizer, args.fps).map(Some)
+}
+
+/// Whose conventions a STOMP realizer follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Flavour {
+    /// AsapRealizer's ActiveMQ adapters.
+    Asap,
+    /// Greta's ActiveMQ components.
+    Greta,
 }
 
 /// `bmlr serve --stdio`: one block per line, read and checked on a thread of its own (parsing
 /// and validation need no realizer), scheduled and played on this one; what is due is written
 /// out at least once a frame, also while a queue of blocks waits.
-fn serve_stdio(mut realizer: Realizer, period: Duration) -> ExitCode {
+fn serve_stdio(
+    mut realizer: Realizer,
+    period: Duration,
+    mut frames: Option<crate::live_frames::LiveFrames>,
+) -> ExitCode {
     let clock = WallClock::new();
     // bounded: the reader waits while the realizer is behind, and the pipe fills (backpressure)
     let (tx, rx) = mpsc::sync_channel::<Option<Result<Checked, BadLine>>>(256);
@@ -288,8 +306,19 @@ fn serve_stdio(mut realizer: Realizer, period: Duration) -> ExitCode {
             .all(|fb| writeln!(out, "{}", Format::Xml.encode(fb)).is_ok())
             && out.flush().is_ok()
     };
+    let tick = |realizer: &mut Realizer, frames: &mut Option<crate::live_frames::LiveFrames>| {
+        let frame = realizer.tick(clock.now());
+        if let Some(f) = frames.as_mut() {
+            f.push(frame.time, &frame.poses);
+        }
+        frame.feedback
+    };
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    if frames.is_some() {
+        let _ = signal_hook::flag::register(signal_hook::consts::SIGTERM, stop.clone());
+    }
     let mut open = true;
-    loop {
+    let code = 'serve: loop {
         let mut items = Vec::new();
         if open {
             match rx.recv_timeout(period) {
@@ -308,7 +337,7 @@ fn serve_stdio(mut realizer: Realizer, period: Duration) -> ExitCode {
             std::thread::sleep(period);
         }
         // bring the clock up to date before blocks arrive (they are planned at this time)
-        let mut feedback = realizer.tick(clock.now()).feedback;
+        let mut feedback = tick(&mut realizer, &mut frames);
         let mut frame_start = clock.now();
         for item in items {
             match item {
@@ -318,20 +347,29 @@ fn serve_stdio(mut realizer: Realizer, period: Duration) -> ExitCode {
                 Err(bad) => realizer.refuse_line("<stdin>", &bad),
             }
             if clock.now() - frame_start >= period.as_secs_f64() {
-                feedback.extend(realizer.tick(clock.now()).feedback);
+                feedback.extend(tick(&mut realizer, &mut frames));
                 if !write(std::mem::take(&mut feedback)) {
-                    return ExitCode::SUCCESS;
+                    break 'serve ExitCode::SUCCESS;
                 }
                 frame_start = clock.now();
             }
         }
-        feedback.extend(realizer.tick(clock.now()).feedback);
+        feedback.extend(tick(&mut realizer, &mut frames));
         if !write(feedback) {
-            return ExitCode::SUCCESS;
+            break 'serve ExitCode::SUCCESS;
         }
-        if !open && realizer.next_event().is_none() {
-            return ExitCode::SUCCESS;
+        if (!open && realizer.next_event().is_none())
+            || stop.load(std::sync::atomic::Ordering::SeqCst)
+        {
+            break 'serve ExitCode::SUCCESS;
         }
+    };
+    match frames.map(crate::live_frames::LiveFrames::finish) {
+        Some(Err(e)) => {
+            eprintln!("bmlr serve: --frames {e}");
+            ExitCode::from(2)
+        }
+        _ => code,
     }
 }
 

@@ -16,6 +16,7 @@ use std::collections::HashMap;
 use std::io::{BufReader, Write};
 use std::net::{TcpListener, TcpStream};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
 use std::sync::Arc;
 use std::time::Duration;
@@ -121,6 +122,7 @@ pub fn serve(
     fps: f64,
     realizer: Realizer,
     view: Option<LiveView>,
+    frames: Option<crate::live_frames::LiveFrames>,
 ) -> ExitCode {
     let listener = match TcpListener::bind(addr) {
         Ok(l) => l,
@@ -141,8 +143,19 @@ pub fn serve(
     std::thread::spawn(move || accept(listener, tx, limits));
     let mut server = Server::new(realizer, per_client, fps);
     server.view = view;
-    server.run(events);
-    ExitCode::SUCCESS
+    server.frames = frames;
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
+        let _ = signal_hook::flag::register(signal, stop.clone());
+    }
+    let frames = server.run(events, &stop);
+    match frames.map(crate::live_frames::LiveFrames::finish) {
+        Some(Err(e)) => {
+            eprintln!("bmlr serve: --frames {e}");
+            ExitCode::from(2)
+        }
+        _ => ExitCode::SUCCESS,
+    }
 }
 
 /// Feedback to send, with the client it is for (`None`: by the routing rule).
@@ -159,6 +172,8 @@ struct Server {
     owner: HashMap<String, Client>,
     /// The live view (`--view`), told every frame and every message.
     view: Option<LiveView>,
+    /// The frames file (`--frames`), told every frame.
+    frames: Option<crate::live_frames::LiveFrames>,
 }
 
 impl Server {
@@ -171,6 +186,7 @@ impl Server {
             clients: HashMap::new(),
             owner: HashMap::new(),
             view: None,
+            frames: None,
         }
     }
 
@@ -178,8 +194,16 @@ impl Server {
     /// queue's worth, so that a flood cannot hold the frame up), the feedback of each sent as
     /// soon as it is handled (encoding is the writers' work), and the clock brought up to date
     /// whenever a frame's time has passed.
-    fn run(mut self, events: Receiver<Event>) {
+    /// Returns the frames file to finish when told to stop.
+    fn run(
+        mut self,
+        events: Receiver<Event>,
+        stop: &AtomicBool,
+    ) -> Option<crate::live_frames::LiveFrames> {
         loop {
+            if stop.load(Ordering::SeqCst) {
+                return self.frames;
+            }
             match events.recv_timeout(self.period) {
                 Ok(first) => {
                     let mut frame_start = self.clock.now();
@@ -195,7 +219,7 @@ impl Server {
                     }
                 }
                 Err(mpsc::RecvTimeoutError::Timeout) => {}
-                Err(mpsc::RecvTimeoutError::Disconnected) => return,
+                Err(mpsc::RecvTimeoutError::Disconnected) => return self.frames,
             }
             let mut routed = Routed::new();
             self.tick(&mut routed);
@@ -209,6 +233,9 @@ impl Server {
         let frame = self.realizer.tick(now);
         if let Some(view) = self.view.as_mut() {
             view.frame(now, &frame.poses);
+        }
+        if let Some(f) = self.frames.as_mut() {
+            f.push(frame.time, &frame.poses);
         }
         routed.extend(frame.feedback.into_iter().map(|f| (None, f)));
     }

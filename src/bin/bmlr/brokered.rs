@@ -1,0 +1,458 @@
+//! `bmlr serve --mqtt URL` and `--stomp URL`: the realizer on a message broker
+//! (docs/broker.md). The link (`bml_realizer::broker::Link` or `StompLink`, seen through `Wire`)
+//! keeps itself connected; the dialect (`dialect.rs`) says which topics carry blocks and
+//! feedback and in what form; this loop owns the realizer, ticks it on the wall clock, routes
+//! the feedback and writes the frames (`--frames`). A payload that is not a block for that
+//! topic's character is answered with a warning on the character's feedback topic; a block for
+//! a character this realizer does not serve is left to the realizer that does. Realizers on one
+//! broker share one world: each publishes where its characters stand on `PREFIX/world/CHARACTER`
+//! (20 Hz; `PREFIX.world.CHARACTER` on STOMP) and places the others' characters in its own
+//! world (`Realizer::place_remote`), so that its walkers go round them.
+
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use bml_realizer::bml::Checked;
+use bml_realizer::broker::{Inbound, RootState, Topics, Wire, DEFAULT_CHARACTER, PUBLISH_PERIOD};
+use bml_realizer::clock::{Clock, WallClock};
+use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
+use bml_realizer::realizer::{Realizer, NO_ID};
+
+use crate::dialect::{block_character, Arrived, Dialect, Out, FROM_THE_BLOCK};
+use crate::live_frames::LiveFrames;
+
+/// Blocks performed in one frame at most (the rest wait for the next frames, so that a flood
+/// cannot hold the clock up).
+const PER_FRAME: usize = 1_024;
+
+/// Messages taken from the link in one frame at most (into the characters' queues).
+const TAKEN_PER_FRAME: usize = 65_536;
+
+/// Blocks that may wait for one character; beyond, the newest are dropped with a warning on
+/// its feedback topic.
+pub const QUEUE_LIMIT: usize = 10_000;
+
+/// What `serve --mqtt | --stomp` was given.
+pub struct Brokered {
+    /// The connected link.
+    pub wire: Box<dyn Wire>,
+    /// The broker's address (for messages).
+    pub url: String,
+    /// The topics of presence and the shared world.
+    pub topics: Topics,
+    /// Topics are STOMP destinations under `/topic/`.
+    pub stomp: bool,
+    /// How blocks and feedback travel.
+    pub dialect: Dialect,
+    /// The characters served (all when empty).
+    pub characters: BTreeSet<String>,
+    /// Feedback encoding (where the dialect leaves it open).
+    pub format: Format,
+    /// Engine loop period.
+    pub period: Duration,
+    /// Stop after this many seconds (on the realizer's clock).
+    pub until: f64,
+    /// The frames file written as the characters move.
+    pub frames: Option<LiveFrames>,
+}
+
+/// Serves until `until`, or SIGTERM, or for ever.
+pub fn serve(args: Brokered, realizer: Realizer) -> ExitCode {
+    eprintln!("bmlr serve: on the broker at {}", args.url);
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
+        let _ = signal_hook::flag::register(signal, stop.clone());
+    }
+    let mut s = Server {
+        realizer,
+        clock: WallClock::new(),
+        args,
+        others: BTreeMap::new(),
+        published: f64::NEG_INFINITY,
+        bad_states: BTreeSet::new(),
+        waiting: BTreeMap::new(),
+    };
+    if let Dialect::Ipaaca(ip, _) = &s.args.dialect {
+        let hello = ip.notify("new");
+        s.send_raw(hello.into_iter().map(|(t, p)| (t, p, Vec::new())));
+    }
+    s.run(&stop);
+    let Server { args, .. } = s;
+    let Brokered {
+        mut wire,
+        frames,
+        dialect,
+        ..
+    } = args;
+    if let Dialect::Ipaaca(ip, _) = &dialect {
+        for (t, p) in ip.notify("down") {
+            wire.send(&t, p, &[]);
+        }
+    }
+    wire.close(Duration::from_secs(2));
+    if let Some(f) = frames {
+        if let Err(e) = f.finish() {
+            eprintln!("bmlr serve: --frames {e}");
+            return ExitCode::from(2);
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+struct Server {
+    realizer: Realizer,
+    clock: WallClock,
+    args: Brokered,
+    /// The other realizers' characters: their last state and when it arrived (local clock).
+    others: BTreeMap<String, (RootState, f64)>,
+    /// When this realizer last published its characters' states.
+    published: f64,
+    /// Characters whose state could not be read (said once each on stderr).
+    bad_states: BTreeSet<String>,
+    /// Blocks waiting (and the request IU that asked for each), per character served (taken
+    /// in turns: one character's flood does not hold up the others), and how many were
+    /// dropped since last said.
+    waiting: BTreeMap<String, (VecDeque<Waiting>, usize)>,
+}
+
+/// A block waiting: its payload and the request IU that asked for it.
+type Waiting = (Vec<u8>, Option<String>);
+
+impl Server {
+    fn run(&mut self, stop: &AtomicBool) {
+        loop {
+            // wait for something only when nothing waits
+            let idle = self.waiting.values().all(|q| q.0.is_empty());
+            let wait = if idle {
+                self.args.period
+            } else {
+                Duration::ZERO
+            };
+            if let Some(first) = self.args.wire.recv_timeout(wait) {
+                self.hear(first);
+                for _ in 1..TAKEN_PER_FRAME {
+                    match self.args.wire.try_recv() {
+                        Some(i) => self.hear(i),
+                        None => break,
+                    }
+                }
+            }
+            self.perform_waiting();
+            self.tick();
+            if self.realizer.now() >= self.args.until || stop.load(Ordering::SeqCst) {
+                return;
+            }
+        }
+    }
+
+    /// Performs waiting blocks, one per character in turn, [`PER_FRAME`] at most and for no
+    /// longer than a frame; says what was dropped.
+    fn perform_waiting(&mut self) {
+        let dropped: Vec<(String, usize)> = (self.waiting.iter_mut())
+            .filter(|(_, q)| q.1 > 0)
+            .map(|(c, q)| (c.clone(), std::mem::take(&mut q.1)))
+            .collect();
+        for (c, n) in dropped {
+            let text =
+                format!("{n} blocks dropped: more than {QUEUE_LIMIT} waited for this character");
+            self.refuse(&c, text, None);
+        }
+        let (mut done, start) = (0, self.clock.now());
+        // (within a frame: the clock and the other messages are not held up)
+        while done < PER_FRAME && self.clock.now() - start < self.args.period.as_secs_f64() {
+            type Next = (String, Waiting);
+            let next: Vec<Next> = (self.waiting.iter_mut())
+                .filter_map(|(c, q)| Some((c.clone(), q.0.pop_front()?)))
+                .take(PER_FRAME - done)
+                .collect();
+            if next.is_empty() {
+                break;
+            }
+            done += next.len();
+            for (c, (payload, request)) in next {
+                self.perform(&c, payload, request);
+            }
+        }
+    }
+
+    fn tick(&mut self) {
+        let now = self.clock.now().min(self.args.until);
+        // the others' characters where they are now, as far as their states tell
+        for (id, (state, heard)) in &self.others {
+            let _ = self
+                .realizer
+                .place_remote(id, state.placement_after(now - heard));
+        }
+        let frame = self.realizer.tick(now);
+        if let Some(f) = self.args.frames.as_mut() {
+            f.push(frame.time, &frame.poses);
+        }
+        self.send(frame.feedback, None);
+        if now - self.published >= PUBLISH_PERIOD {
+            self.published = now;
+            self.publish_states(now);
+        }
+        let dropped = self.args.wire.take_dropped();
+        if dropped > 0 {
+            eprintln!("bmlr serve: the broker was away too long: {dropped} feedback messages were dropped");
+        }
+    }
+
+    fn hear(&mut self, inbound: Inbound) {
+        let (topic, payload) = match inbound {
+            Inbound::Lost(why) => {
+                return eprintln!("bmlr serve: lost the broker ({why}); trying again")
+            }
+            Inbound::Reconnected => {
+                return eprintln!("bmlr serve: back on the broker; characters kept")
+            }
+            Inbound::Message { topic, payload } => (topic, payload),
+        };
+        let topic = match self.args.stomp {
+            true => topic.strip_prefix("/topic/").unwrap_or(&topic).to_string(),
+            false => topic,
+        };
+        if let Some(character) = self.args.topics.world_character(&topic) {
+            let character = character.to_string();
+            return self.hear_state(character, &payload);
+        }
+        if let Some(answer) = self.answer_component(&topic, &payload) {
+            return self.send_raw(answer);
+        }
+        match self.args.dialect.read(&topic, payload) {
+            Some(Arrived::Block {
+                lane,
+                payload,
+                request,
+            }) => {
+                if lane == FROM_THE_BLOCK || self.serves(&lane) {
+                    let q = self.waiting.entry(lane).or_default();
+                    if q.0.len() < QUEUE_LIMIT {
+                        q.0.push_back((payload, request));
+                    } else {
+                        q.1 += 1;
+                    }
+                }
+            }
+            Some(Arrived::Bad {
+                character,
+                why,
+                request,
+            }) => self.refuse(&character, why, request),
+            Some(Arrived::Nothing) | None => {}
+        }
+    }
+
+    /// ipaaca: another component announced itself as new: say this one is here (`old`).
+    fn answer_component(&self, topic: &str, payload: &[u8]) -> Option<Vec<Out>> {
+        let Dialect::Ipaaca(ip, _) = &self.args.dialect else {
+            return None;
+        };
+        if !topic.ends_with("/componentNotify/M") {
+            return None;
+        }
+        let bml_realizer::broker::ipaaca::Heard::NewComponent { channel } =
+            ip.read(topic, payload)?
+        else {
+            return None;
+        };
+        let note = ip
+            .notify("old")
+            .into_iter()
+            .find(|(t, _)| t.starts_with(&format!("{channel}/")))?;
+        Some(vec![(note.0, note.1, Vec::new())])
+    }
+
+    /// Whether this realizer serves `character` (a topic level): one of `--characters`, or,
+    /// without them, any character no other realizer moves.
+    fn serves(&self, character: &str) -> bool {
+        if self.args.characters.is_empty() {
+            !self.others.contains_key(character)
+        } else {
+            self.args.characters.contains(character)
+        }
+    }
+
+    /// Keeps another realizer's state of `character` (not one served here).
+    fn hear_state(&mut self, character: String, payload: &[u8]) {
+        if self.args.characters.contains(&character) || self.is_ours(&character) {
+            return;
+        }
+        match RootState::from_json(payload) {
+            Ok(state) => {
+                self.others.insert(character, (state, self.clock.now()));
+            }
+            Err(e) => {
+                if self.bad_states.insert(character.clone()) {
+                    let topic = self.args.topics.world(&character);
+                    eprintln!("bmlr serve: {topic}: not a root state ({e}); ignored");
+                }
+            }
+        }
+    }
+
+    /// Whether `character` (a topic level) is one this realizer has made.
+    fn is_ours(&self, character: &str) -> bool {
+        let id = if character == DEFAULT_CHARACTER {
+            ""
+        } else {
+            character
+        };
+        self.realizer.character(id).is_some() && !self.realizer.is_remote(id)
+    }
+
+    /// Publishes where this realizer's characters stand: those it has made, and the
+    /// `--characters` the world places.
+    fn publish_states(&mut self, now: f64) {
+        let world = self.realizer.world();
+        let mut ours: BTreeSet<String> = (self.realizer.characters())
+            .map(|(id, _)| id.to_string())
+            .filter(|id| !id.is_empty() && !self.realizer.is_remote(id))
+            .collect();
+        ours.extend(
+            (self.args.characters.iter())
+                .filter(|c| world.is_placed(c))
+                .cloned(),
+        );
+        let crowd = world.crowd();
+        let states: Vec<Out> = (ours.into_iter())
+            .filter(|id| world.is_placed(id))
+            .map(|id| {
+                let velocity = crowd.index(&id).map_or(glam::Vec3::ZERO, |i| {
+                    let v = crowd.agent(i).velocity;
+                    glam::Vec3::new(v.x, 0.0, v.y)
+                });
+                let state = RootState::new(now, world.placement(&id), velocity);
+                (
+                    self.args.topics.world(&id),
+                    state.to_json().into_bytes(),
+                    Vec::new(),
+                )
+            })
+            .collect();
+        self.send_raw(states);
+    }
+
+    /// Performs a block from `lane` (a character's topic, or [`FROM_THE_BLOCK`]); what it
+    /// produces at once without a character (a block that could not be read) is that topic's.
+    fn perform(&mut self, lane: &str, payload: Vec<u8>, request: Option<String>) {
+        // the clock up to date first: the block is planned at this time
+        self.tick();
+        let limits = *self.realizer.limits();
+        let text = match String::from_utf8(payload) {
+            Ok(t) => t,
+            Err(_) => return self.refuse(lane, "the payload is not UTF-8 text".into(), request),
+        };
+        let mut checked = Checked::new(&text, &limits);
+        let block = checked.block.as_mut();
+        let character = match (lane, block) {
+            (FROM_THE_BLOCK, Some(b)) => {
+                let c = block_character(b.character_id.as_deref());
+                if !self.serves(&c) {
+                    // (another realizer's character: it answers)
+                    return;
+                }
+                c
+            }
+            (FROM_THE_BLOCK, None) => DEFAULT_CHARACTER.to_string(),
+            (_, Some(b)) => {
+                let topic_character = (lane != DEFAULT_CHARACTER).then(|| lane.to_string());
+                if b.character_id.is_none() {
+                    b.character_id = topic_character.clone();
+                }
+                if b.character_id != topic_character {
+                    let named = b.character_id.as_deref().unwrap_or(DEFAULT_CHARACTER);
+                    let id = b.id.to_string();
+                    let why = format!(
+                        "block {id} is for character '{named}' but came on the topic of '{lane}'"
+                    );
+                    return self.refuse(lane, why, request);
+                }
+                lane.to_string()
+            }
+            (_, None) => lane.to_string(),
+        };
+        let block_id = checked.block.as_ref().map(|b| b.id.to_string());
+        let source = self.args.dialect.source(&character);
+        let result = self.realizer.perform_checked(checked, Some(&source));
+        if let Some(uid) = &request {
+            let error = result.as_ref().err().map(|e| e.to_string());
+            let answer =
+                (self.args.dialect).answer_request(uid, block_id.as_deref(), error.as_deref());
+            self.send_raw(answer);
+        }
+        let mut feedback = self
+            .realizer
+            .tick(self.clock.now().min(self.args.until))
+            .feedback;
+        // (a block that could not be read names no character: the topic's is meant)
+        let topic_character = (character != DEFAULT_CHARACTER).then(|| character.clone());
+        for fb in &mut feedback {
+            if let Feedback::Warning(w) = fb {
+                w.character_id = w.character_id.take().or_else(|| topic_character.clone());
+            }
+        }
+        self.send(feedback, Some(&character));
+    }
+
+    fn refuse(&mut self, character: &str, text: String, request: Option<String>) {
+        let character = if character == FROM_THE_BLOCK {
+            DEFAULT_CHARACTER
+        } else {
+            character
+        };
+        let text = format!("{}: {text}", self.args.dialect.source(character));
+        if let Some(uid) = request {
+            let answer = self.args.dialect.answer_request(&uid, None, Some(&text));
+            self.send_raw(answer);
+        }
+        let warning = Feedback::Warning(WarningFeedback {
+            id: NO_ID.into(),
+            kind: KnownWarning::ParsingFailure.into(),
+            character_id: (character != DEFAULT_CHARACTER).then(|| character.to_string()),
+            text,
+        });
+        self.send(vec![warning], Some(character));
+    }
+
+    /// Publishes each message on its character's feedback topic (one without a character on
+    /// `fallback`'s, or the default character's).
+    fn send(&mut self, feedback: Vec<Feedback>, fallback: Option<&str>) {
+        let mut out = Vec::new();
+        for fb in feedback {
+            let character = fb
+                .character_id()
+                .or(fallback)
+                .unwrap_or(DEFAULT_CHARACTER)
+                .to_string();
+            let posix = self.posix_zero();
+            out.extend(
+                self.args
+                    .dialect
+                    .feedback(&character, &fb, self.args.format, posix),
+            );
+        }
+        self.send_raw(out);
+    }
+
+    /// The POSIX time (s) of the realizer's time 0.
+    fn posix_zero(&self) -> f64 {
+        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH);
+        now.map_or(0.0, |d| d.as_secs_f64()) - self.clock.now()
+    }
+
+    /// Sends messages as they are (topics made STOMP destinations where needed).
+    fn send_raw(&mut self, out: impl IntoIterator<Item = Out>) {
+        for (topic, payload, headers) in out {
+            let topic = match self.args.stomp && !topic.starts_with('/') {
+                true => format!("/topic/{topic}"),
+                false => topic,
+            };
+            self.args.wire.send(&topic, payload, &headers);
+        }
+        self.args.wire.flush();
+    }
+}
