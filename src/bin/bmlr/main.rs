@@ -11,12 +11,12 @@ macro_rules! eprintln {
 }
 
 mod avatar;
+mod broker_port;
 mod brokered;
 mod dialect;
 mod diff;
 mod live;
 mod live_frames;
-mod mqtt_port;
 mod outcome;
 mod pack;
 mod record;

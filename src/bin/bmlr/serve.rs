@@ -41,6 +41,10 @@ pub struct ServeArgs {
     /// default) or greta (greta.BML -> greta.output.feedback.BML callbacks).
     #[arg(long, value_enum)]
     pub(crate) flavour: Option<Flavour>,
+    /// With --stomp: the topics of blocks in and feedback out (IN,OUT), instead of the
+    /// flavour's (AsapRealizer's adapters take other topics too).
+    #[arg(long, value_name = "IN,OUT", value_delimiter = ',')]
+    pub(crate) topics: Vec<String>,
     /// With --mqtt or --stomp: the topics' first level(s) (bml by default).
     #[arg(long, value_name = "PREFIX")]
     pub(crate) prefix: Option<String>,
@@ -149,6 +153,12 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         (
             "--flavour",
             args.flavour.is_some(),
+            args.stomp.is_some(),
+            "--stomp",
+        ),
+        (
+            "--topics",
+            !args.topics.is_empty(),
             args.stomp.is_some(),
             "--stomp",
         ),
@@ -388,6 +398,18 @@ pub struct ConformanceArgs {
     /// --mqtt`), in real time.
     #[arg(long, value_name = "URL", conflicts_with = "realizer")]
     mqtt: Option<String>,
+    /// Test a realizer reached only through a STOMP broker (stomp://HOST[:PORT]; `bmlr serve
+    /// --stomp`), in real time.
+    #[arg(long, value_name = "URL", conflicts_with_all = ["realizer", "mqtt"])]
+    stomp: Option<String>,
+    /// With --stomp: the realizer's topics (IN,OUT; asap.bml.request,asap.bml.feedback by
+    /// default).
+    #[arg(long, value_name = "IN,OUT", value_delimiter = ',')]
+    topics: Vec<String>,
+    /// With --stomp: the topics of the realizer for the incremental-speech tests (one with
+    /// retimable speech; by default --topics).
+    #[arg(long, value_name = "IN,OUT", value_delimiter = ',')]
+    incremental_topics: Vec<String>,
     /// With --mqtt: the topics' first level(s).
     #[arg(long, value_name = "PREFIX", default_value = "bml")]
     prefix: String,
@@ -467,11 +489,37 @@ fn started(port: std::io::Result<ProcessPort>) -> Result<ProcessPort, String> {
 /// `bmlr conformance`.
 pub fn conformance(args: ConformanceArgs) -> ExitCode {
     let mut port: Box<dyn TestPort> = match (&args.realizer, &args.mqtt) {
+        (None, None) if args.stomp.is_some() => {
+            let pair = |t: &[String]| match t {
+                [] => Ok(crate::serve_broker::ASAP_TOPICS)
+                    .map(|(i, o)| (i.to_string(), o.to_string())),
+                [i, o] => Ok((i.clone(), o.clone())),
+                _ => Err("--topics takes two topics: IN,OUT"),
+            };
+            let pairs = pair(&args.topics).and_then(|std| {
+                let inc = match args.incremental_topics.is_empty() {
+                    true => std.clone(),
+                    false => pair(&args.incremental_topics)?,
+                };
+                Ok([std, inc])
+            });
+            let url = args.stomp.as_deref().unwrap_or_default();
+            match pairs
+                .map_err(str::to_string)
+                .and_then(|p| crate::broker_port::BrokerPort::stomp(url, p))
+            {
+                Ok(p) => Box::new(p),
+                Err(e) => {
+                    eprintln!("bmlr conformance: --stomp {e}");
+                    return ExitCode::from(2);
+                }
+            }
+        }
         (None, Some(url)) => {
             let incremental =
                 (args.incremental_character.clone()).unwrap_or_else(|| args.character.clone());
             let characters = [args.character.clone(), incremental];
-            match crate::mqtt_port::MqttPort::connect(url, &args.prefix, characters) {
+            match crate::broker_port::BrokerPort::mqtt(url, &args.prefix, characters) {
                 Ok(p) => Box::new(p),
                 Err(e) => {
                     eprintln!("bmlr conformance: --mqtt {e}");
@@ -501,7 +549,7 @@ pub fn conformance(args: ConformanceArgs) -> ExitCode {
             }
         }
     };
-    let external = args.realizer.is_some() || args.mqtt.is_some();
+    let external = args.realizer.is_some() || args.mqtt.is_some() || args.stomp.is_some();
     let mut out = std::io::stdout().lock();
     let outcomes = run(port.as_mut(), &args.filter, |i, n, o: &Outcome| {
         let line = match &o.failure {

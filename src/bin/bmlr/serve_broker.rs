@@ -45,6 +45,11 @@ pub fn brokered(args: &ServeArgs, realizer: &Realizer) -> Result<Brokered, Strin
     if until.is_nan() || until < 0.0 {
         return Err("--until must be a number of seconds".into());
     }
+    let pair = |(i, o): (&str, &str)| match args.topics.as_slice() {
+        [] => Ok((i.to_string(), o.to_string())),
+        [i, o] if level_ok(i) && level_ok(o) => Ok((i.clone(), o.clone())),
+        _ => Err("--topics takes two topics, IN,OUT (no '/', '+', '#')".to_string()),
+    };
     let dialect = match (&args.mqtt, args.flavour) {
         (Some(_), _) if !args.ipaaca.is_empty() => Dialect::Ipaaca(
             Ipaaca::new(&args.ipaaca, &name).map_err(|e| format!("--ipaaca {e}"))?,
@@ -52,9 +57,13 @@ pub fn brokered(args: &ServeArgs, realizer: &Realizer) -> Result<Brokered, Strin
         ),
         (Some(_), _) => Dialect::Topics(topics.clone()),
         (None, Some(Flavour::Greta)) => {
-            Dialect::Greta(GRETA_TOPICS.0.into(), GRETA_TOPICS.1.into())
+            let (i, o) = pair(GRETA_TOPICS)?;
+            Dialect::Greta(i, o)
         }
-        (None, _) => Dialect::Asap(ASAP_TOPICS.0.into(), ASAP_TOPICS.1.into()),
+        (None, _) => {
+            let (i, o) = pair(ASAP_TOPICS)?;
+            Dialect::Asap(i, o)
+        }
     };
     let mut subscriptions = dialect.subscriptions(&topics, &args.characters);
     // (the world the realizers on the broker share)

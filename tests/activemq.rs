@@ -1,0 +1,248 @@
+//! ActiveMQ, as AsapRealizer and Greta use it, tested with the peers' own kind of client: Debian's
+//! `activemq` on free loopback ports (tests/common/activemq.rs), `bmlr serve --stomp`, and
+//! - a Java JMS peer (tests/peers/JmsPeer.java, OpenWire with ActiveMQ's own client jars, as
+//!   AsapRealizer's adapters are): BML on `asap.bml.request`, feedback on `asap.bml.feedback` as
+//!   `TextMessage`s with the block's start and end;
+//! - a stomp.py peer speaking Greta's conventions (tests/peers/greta_peer.py): `greta.BML` in,
+//!   Greta's callbacks out on `greta.output.feedback.BML`;
+//! - a planner on this crate's own STOMP link: garbage gives a warning and the next block runs,
+//!   a restarted broker has the realizer back within 10 s, the conformance suite over STOMP.
+//!
+//! Each says "skipped" when its package is missing (`.ci/run` installs them all and fails on a
+//! skip). The Python with stomp.py is `$BMLR_STOMP_PYTHON` (else `python3` if it has it).
+
+#[path = "common/activemq.rs"]
+mod amq;
+#[path = "common/broker.rs"]
+mod kit;
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use amq::ActiveMq;
+use bml_realizer::broker::{Inbound, StompLink, StompOptions, StompUrl};
+use kit::{block, free_port, Served};
+
+/// `bmlr serve --stomp URL` with `extra` flags.
+fn serve(broker: &ActiveMq, extra: &[&str]) -> Served {
+    Served(
+        Command::new(env!("CARGO_BIN_EXE_bmlr"))
+            .args(["serve", "--stomp", &broker.stomp_url()])
+            .args(extra)
+            .stdout(Stdio::null())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("bmlr runs"),
+    )
+}
+
+/// A planner on the crate's STOMP link, hearing `topics` (`/topic/…`).
+fn planner(broker: &ActiveMq, topics: &[&str]) -> StompLink {
+    StompLink::connect(StompOptions {
+        url: StompUrl::parse(&broker.stomp_url()).unwrap(),
+        subscriptions: topics.iter().map(|t| t.to_string()).collect(),
+        presence: None,
+        inbox: 100_000,
+        start_tries: 3,
+    })
+    .expect("the planner connects")
+}
+
+/// The bodies heard for up to `secs`, until `done` says so.
+fn hear(link: &StompLink, secs: f64, done: impl Fn(&[String]) -> bool) -> Vec<String> {
+    let until = Instant::now() + Duration::from_secs_f64(secs);
+    let mut heard = Vec::new();
+    while Instant::now() < until && !done(&heard) {
+        if let Some(Inbound::Message { payload, .. }) = link.recv_timeout(Duration::from_millis(20))
+        {
+            heard.push(String::from_utf8_lossy(&payload).into_owned());
+        }
+    }
+    heard
+}
+
+fn ended(heard: &[String], id: &str) -> bool {
+    let id = format!(r#"id="{id}:end""#);
+    heard
+        .iter()
+        .any(|p| p.starts_with("<blockProgress") && p.contains(&id))
+}
+
+/// Sends `block` until the realizer ends it (it may still be subscribing at first).
+fn runs(p: &mut StompLink, id: &str, secs: f64) -> Vec<String> {
+    let until = Instant::now() + Duration::from_secs_f64(secs);
+    let mut heard = Vec::new();
+    while Instant::now() < until && !ended(&heard, id) {
+        p.send("/topic/asap.bml.request", block(id).into_bytes(), &[]);
+        p.flush();
+        heard.extend(hear(p, 1.0, |h| ended(h, id)));
+    }
+    heard
+}
+
+#[test]
+fn a_java_jms_peer_gets_textmessage_feedback_as_asaprealizer_s_adapters_do() {
+    let Some(broker) = ActiveMq::start() else {
+        return;
+    };
+    let _r = serve(&broker, &["--flavour", "asap"]);
+    // (the realizer is subscribed once a block of our own has run)
+    let mut p = planner(&broker, &["/topic/asap.bml.feedback"]);
+    assert!(ended(&runs(&mut p, "warmup", 15.0), "warmup"));
+    let peer = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/peers/JmsPeer.java");
+    let out = Command::new("java")
+        .args(["-cp", &ActiveMq::client_classpath(), peer])
+        .args([&broker.openwire_url(), "jms1"])
+        .output()
+        .expect("java runs");
+    let said = String::from_utf8_lossy(&out.stdout);
+    let err = String::from_utf8_lossy(&out.stderr);
+    if err.contains("compiler") && !said.contains("failed") {
+        eprintln!("skipped: the JMS peer needs a JDK (Debian default-jdk-headless; .ci/run installs it): {err}");
+        return;
+    }
+    eprintln!("{said}{err}");
+    assert!(
+        out.status.success(),
+        "the JMS peer's checks failed:\n{said}{err}"
+    );
+    assert!(
+        said.contains("0 failed") && said.matches("ok ").count() == 3,
+        "{said}"
+    );
+}
+
+fn stomp_python() -> Option<String> {
+    let python = std::env::var("BMLR_STOMP_PYTHON").unwrap_or_else(|_| "python3".into());
+    let ok = Command::new(&python)
+        .args(["-c", "import stomp"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    ok.then_some(python)
+}
+
+#[test]
+fn a_stomp_py_peer_speaking_greta_s_conventions_gets_greta_s_callbacks() {
+    let Some(python) = stomp_python() else {
+        eprintln!("skipped: stomp.py is not installed (set BMLR_STOMP_PYTHON to a python with `pip install stomp.py`; .ci/run does)");
+        return;
+    };
+    let Some(broker) = ActiveMq::start() else {
+        return;
+    };
+    let _r = serve(&broker, &["--flavour", "greta"]);
+    std::thread::sleep(Duration::from_millis(1500));
+    let peer = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/peers/greta_peer.py");
+    let out = Command::new(&python)
+        .args([peer, &format!("127.0.0.1:{}", broker.stomp)])
+        .output()
+        .expect("the peer runs");
+    let said = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{said}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "the Greta peer's checks failed:\n{said}"
+    );
+    assert!(
+        said.contains("0 failed") && said.matches("ok ").count() >= 9,
+        "{said}"
+    );
+}
+
+#[test]
+fn garbage_and_oversize_get_a_warning_and_the_next_block_runs() {
+    let Some(broker) = ActiveMq::start() else {
+        return;
+    };
+    let _r = serve(&broker, &[]);
+    let mut p = planner(&broker, &["/topic/asap.bml.feedback"]);
+    assert!(ended(&runs(&mut p, "first", 15.0), "first"));
+    // (over the 8 MiB block limit, under the 16 MiB frame limit)
+    let mut huge = block("huge").into_bytes();
+    huge.extend(std::iter::repeat_n(b' ', 9 << 20));
+    for (bad, says) in [
+        (b"\xff\xfe not bml <".to_vec(), "warningFeedback"),
+        (huge, "more than the limit"),
+    ] {
+        let warned = |h: &[String]| {
+            (h.iter()).any(|m| m.starts_with("<warningFeedback") && m.contains(says))
+        };
+        p.send("/topic/asap.bml.request", bad, &[]);
+        p.flush();
+        let heard = hear(&p, 10.0, warned);
+        assert!(warned(&heard), "{heard:?}");
+    }
+    assert!(ended(&runs(&mut p, "next", 10.0), "next"));
+}
+
+#[test]
+fn after_activemq_restarts_the_realizer_is_back_and_the_next_block_runs_within_10_s() {
+    let Some(mut broker) = ActiveMq::start() else {
+        return;
+    };
+    let _r = serve(&broker, &[]);
+    {
+        let mut p = planner(&broker, &["/topic/asap.bml.feedback"]);
+        assert!(ended(&runs(&mut p, "before", 15.0), "before"));
+    }
+    let (openwire, stomp) = (broker.openwire, broker.stomp);
+    broker.stop();
+    drop(broker);
+    let broker = ActiveMq::on(openwire, stomp).expect("ActiveMQ again");
+    let back = Instant::now();
+    let mut p = planner(&broker, &["/topic/asap.bml.feedback"]);
+    let heard = runs(&mut p, "after", 10.0);
+    assert!(ended(&heard, "after"), "{heard:?}");
+    assert!(
+        back.elapsed() < Duration::from_secs(10),
+        "{:?}",
+        back.elapsed()
+    );
+}
+
+#[test]
+fn no_stomp_broker_at_the_start_is_exit_2_naming_the_url_within_20_s() {
+    // (nothing listens on the port: no broker needed)
+    let url = format!("stomp://127.0.0.1:{}", free_port());
+    let started = Instant::now();
+    let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(["serve", "--stomp", &url])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(&url), "{err}");
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "{:?}",
+        started.elapsed()
+    );
+}
+
+#[test]
+fn conformance_tests_pass_over_stomp_on_both_fixtures() {
+    // (the whole suite, 41/41, takes about 4 minutes in real time: .ci/run runs it; here the
+    // shifts on the standard realizer and the speech retiming on one with retimable speech)
+    let Some(broker) = ActiveMq::start() else {
+        return;
+    };
+    let _std = serve(&broker, &[]);
+    let inc_topics = "inc.request,inc.feedback";
+    let _inc = serve(&broker, &["--retimable-speech", "--topics", inc_topics]);
+    let mut p = planner(&broker, &["/topic/asap.bml.feedback"]);
+    assert!(ended(&runs(&mut p, "warmup", 15.0), "warmup"));
+    std::thread::sleep(Duration::from_millis(500));
+    for (filter, n) in [("Shift", 2), ("Retime", 1)] {
+        let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+            .args(["conformance", "--stomp", &broker.stomp_url()])
+            .args(["--incremental-topics", inc_topics, "--filter", filter])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains(&format!("{n} passed, 0 failed")),
+            "{text}\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
