@@ -1,5 +1,6 @@
 //! A character's root state as realizers sharing one world publish it on `PREFIX/world/ID`:
-//! JSON `{"time": s, "position": [x, y, z], "velocity": [x, y, z], "facing": degrees}` (world
+//! JSON `{"time": s, "position": [x, y, z], "velocity": [x, y, z], "facing": degrees}` and,
+//! while a walker held back asks someone to make room, `"asks": ID` (world
 //! frame, metres, y up; `facing` about +y from +z, as in the world file; `time` is the sender's
 //! clock, for reading only: clocks of different realizers have different origins, so a
 //! receiver ages a state from when it arrived). A state is moved on along its velocity for at
@@ -17,7 +18,7 @@ pub const EXTRAPOLATE: f64 = 0.5;
 pub const PUBLISH_PERIOD: f64 = 0.05;
 
 /// One character's root state.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RootState {
     /// The sender's clock (s).
     pub time: f64,
@@ -27,6 +28,10 @@ pub struct RootState {
     pub velocity: [f32; 3],
     /// Its heading (degrees about +y from +z).
     pub facing: f32,
+    /// The character it asks to make room (a walker held back), if it asks anyone: the realizer
+    /// that moves that one has it step aside as if a walker of its own asked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub asks: Option<String>,
 }
 
 impl RootState {
@@ -37,6 +42,7 @@ impl RootState {
             position: at.position.to_array(),
             velocity: velocity.to_array(),
             facing: at.facing.to_degrees(),
+            asks: None,
         }
     }
 
@@ -83,6 +89,16 @@ mod tests {
         assert!((back.placement_after(0.0).facing - at.facing).abs() < 1e-6);
         assert!(RootState::from_json(br#"{"time": 1}"#).is_err());
         assert!(RootState::from_json(b"not json").is_err());
+        let asking = RootState {
+            asks: Some("s3".into()),
+            ..s.clone()
+        };
+        assert!(asking.to_json().contains(r#""asks":"s3""#));
+        assert_eq!(
+            RootState::from_json(asking.to_json().as_bytes()).unwrap(),
+            asking
+        );
+        assert!(!s.to_json().contains("asks"));
         let nan = br#"{"time": 0, "position": [0, 0, 0], "velocity": [0, 0, 0], "facing": 1e999}"#;
         assert!(RootState::from_json(nan).is_err());
     }

@@ -134,6 +134,17 @@ impl Crowd {
             .map(|(asked, who)| (asked as u32, who as u32))
             .collect();
         self.asks.sort_unstable();
+        self.asks.dedup();
+    }
+
+    /// Every (asked, asking) pair, in order.
+    pub fn ask_pairs(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        (self.asks.iter()).map(|&(t, w)| (t as usize, w as usize))
+    }
+
+    /// Whom character `i` asks to make room, if anyone.
+    pub fn asked_by(&self, i: usize) -> Option<usize> {
+        self.ask_pairs().find(|&(_, w)| w == i).map(|(t, _)| t)
     }
 
     /// Who asks character `i` to make room (indices, in order).
@@ -265,6 +276,10 @@ mod tests {
         for nobody in [0, 2, 3] {
             assert_eq!(crowd.askers(nobody).count(), 0);
         }
+        assert_eq!(
+            (0..4).map(|i| crowd.asked_by(i)).collect::<Vec<_>>(),
+            [Some(1), None, Some(1), None]
+        );
         // asking the place where it stands itself asks nobody
         crowd.set_asks([(1, Vec2::new(1.0, 0.0))]);
         assert_eq!((0..4).map(|i| crowd.askers(i).count()).sum::<usize>(), 0);

@@ -75,6 +75,11 @@ impl Realizer {
             .filter_map(|(id, m)| Some((crowd.index(id)?, m.asking()?)))
             .collect();
         crowd.set_asks(asking);
+        // (walkers of other realizers asking someone here)
+        let remote = (self.remote_asks.iter())
+            .filter_map(|(who, asked)| Some((crowd.index(asked)?, crowd.index(who)?)));
+        let pairs: Vec<(usize, usize)> = crowd.ask_pairs().chain(remote).collect();
+        crowd.set_ask_pairs(pairs);
         // one placed by the world file alone, asked to make room, becomes a character here
         // (standing, with the engines that can move it aside)
         let asked: Vec<String> = (0..crowd.len())

@@ -65,6 +65,8 @@ pub struct Realizer {
     parallel: bool,
     /// Characters another realizer moves (`remote.rs`): placed here, never made characters.
     remote: std::collections::BTreeSet<String>,
+    /// Whom remote characters ask to make room (asking → asked).
+    remote_asks: std::collections::BTreeMap<String, String>,
     /// Synthetic vision, when on (`sensing.rs`).
     sensing: Option<Box<sensing::Sensing>>,
     /// PaT-Nets, when given (`netting.rs`).
@@ -92,6 +94,7 @@ impl Realizer {
             idle: true,
             world: std::sync::Arc::new(World::default()),
             remote: Default::default(),
+            remote_asks: Default::default(),
             sensing: None,
             netting: None,
             parallel: true,

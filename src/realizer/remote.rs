@@ -2,7 +2,9 @@
 //! publish where their characters stand and place the others' here. Such a character is placed
 //! in this realizer's world (walkers here see it in the crowd, gaze and pointing can aim at it),
 //! but it is never made a character of this realizer when a walker asks it for room (the host
-//! sends its blocks to the realizer that moves it).
+//! sends its blocks to the realizer that moves it). A walker there that asks one of this
+//! realizer's characters for room ([`remote_asks`](Realizer::remote_asks)) is heard as a walker
+//! here would be: the one asked steps aside.
 
 use super::Realizer;
 use crate::world::Placement;
@@ -20,6 +22,27 @@ impl Realizer {
         self.world_mut().place(id, at)?;
         self.remote.insert(id.to_string());
         Ok(())
+    }
+
+    /// Notes whom character `id`, moved by another realizer, asks to make room (`None`: nobody).
+    /// Refused for a character that is not remote.
+    pub fn remote_asks(&mut self, id: &str, asked: Option<&str>) -> Result<(), String> {
+        if !self.remote.contains(id) {
+            return Err(format!("character '{id}' is not moved by another realizer"));
+        }
+        match asked {
+            Some(a) => self.remote_asks.insert(id.to_string(), a.to_string()),
+            None => self.remote_asks.remove(id),
+        };
+        Ok(())
+    }
+
+    /// Whom this realizer's character `id` asks to make room now, if anyone (for other
+    /// realizers: the character asked may be theirs).
+    pub fn asks(&self, id: &str) -> Option<&str> {
+        let crowd = self.world.crowd();
+        let asked = crowd.asked_by(crowd.index(id)?)?;
+        Some(crowd.id(asked))
     }
 
     /// Whether character `id` is moved by another realizer ([`place_remote`](Self::place_remote)).

@@ -182,9 +182,14 @@ impl Server {
         let now = self.clock.now().min(self.args.until);
         // the others' characters where they are now, as far as their states tell
         for (id, (state, heard)) in &self.others {
-            let _ = self
+            let placed = self
                 .realizer
                 .place_remote(id, state.placement_after(now - heard));
+            if placed.is_ok() {
+                // (an ask heard more than a second ago is over: its realizer may be gone)
+                let asks = state.asks.as_deref().filter(|_| now - heard < 1.0);
+                let _ = self.realizer.remote_asks(id, asks);
+            }
         }
         let frame = self.realizer.tick(now);
         if let Some(f) = self.args.frames.as_mut() {
@@ -325,7 +330,10 @@ impl Server {
                     let v = crowd.agent(i).velocity;
                     glam::Vec3::new(v.x, 0.0, v.y)
                 });
-                let state = RootState::new(now, world.placement(&id), velocity);
+                let state = RootState {
+                    asks: self.realizer.asks(&id).map(str::to_string),
+                    ..RootState::new(now, world.placement(&id), velocity)
+                };
                 (
                     self.args.topics.world(&id),
                     state.to_json().into_bytes(),
