@@ -28,6 +28,9 @@ pub struct LiveFrames {
     flushed: Instant,
     count: usize,
     fps: f64,
+    /// The time of the last frame written (frames closer than a tenth short of 1/fps to it
+    /// are skipped: the loop also ticks when messages arrive).
+    last: f64,
     /// The first error writing (said at the end; serving goes on).
     failed: Option<String>,
 }
@@ -65,15 +68,18 @@ impl LiveFrames {
             flushed: Instant::now(),
             count: 0,
             fps,
+            last: f64::NEG_INFINITY,
             failed: None,
         })
     }
 
-    /// Writes the frame at `time` from `poses`.
+    /// Writes the frame at `time` from `poses`, unless one was written less than about 1/fps
+    /// before.
     pub fn push(&mut self, time: f64, poses: &[CharacterPose]) {
-        if self.failed.is_some() {
+        if self.failed.is_some() || time - self.last < 0.9 / self.fps {
             return;
         }
+        self.last = time;
         let parts: Vec<String> = (self.ids.iter().zip(&self.rest))
             .map(|(id, rest)| {
                 (poses.iter())

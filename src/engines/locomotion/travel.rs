@@ -107,7 +107,11 @@ impl Travel for LocomotionEngine {
     }
 
     fn moving(&self) -> bool {
-        self.current.is_some() || (self.walker.as_ref()).is_some_and(|w| !w.gait.at_rest(w.body()))
+        // (one that made room is "moving" until it is back: it decides to go back on the
+        // crowd's grid, which is kept only while someone moves)
+        self.current.is_some()
+            || self.room.is_some()
+            || (self.walker.as_ref()).is_some_and(|w| !w.gait.at_rest(w.body()))
     }
 
     fn asking(&self) -> Option<Vec2> {
