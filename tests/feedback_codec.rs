@@ -119,3 +119,40 @@ fn json_times_read_back_exactly() {
     let fb = from_line(&xml).unwrap();
     assert_eq!(from_json(&to_json(&fb)).unwrap(), fb);
 }
+
+#[test]
+fn a_peer_s_prediction_keeps_its_behaviours_attributes() {
+    // as AsapRealizer and BML 1.0 write it: the behaviours inside the block's <bml>, ids
+    // unqualified, with their attributes beside the predicted times
+    let xml = r#"<predictionFeedback xmlns="http://www.bml-initiative.org/bml/bml-1.0" characterId="Armandia"><bml id="bml1" globalStart="1.0" globalEnd="3.0"><gesture id="g1" lexeme="BEAT" mode="RIGHT_HAND" repetition="2" start="1.0" stroke="1.5" end="2.2"/><gaze id="z1" target="person1" influence="HEAD" start="1.0" end="3.0"/><speech id="s1" start="1" end="2.5"><text>Hello <sync id="tm1"/></text></speech></bml></predictionFeedback>"#;
+    let Feedback::Prediction(p) = from_line(xml).unwrap() else {
+        panic!("a prediction");
+    };
+    assert_eq!(p.blocks.len(), 1);
+    assert_eq!(p.behaviours.len(), 3);
+    let g = &p.behaviours[0];
+    assert_eq!((g.block.as_str(), g.behaviour.as_str()), ("bml1", "g1"));
+    let attrs: Vec<(&str, &str)> = (g.attributes.iter())
+        .map(|(a, b)| (a.as_str(), b.as_str()))
+        .collect();
+    assert_eq!(
+        attrs,
+        [
+            ("lexeme", "BEAT"),
+            ("mode", "RIGHT_HAND"),
+            ("repetition", "2")
+        ]
+    );
+    let syncs: Vec<&str> = g.syncs.iter().map(|s| s.0.as_str()).collect();
+    assert_eq!(syncs, ["start", "stroke", "end"]);
+    assert_eq!(
+        p.behaviours[1].attributes[0],
+        ("target".into(), "person1".into())
+    );
+    // (and written back, the attributes go with it)
+    let back = from_line(&Format::Xml.encode(&Feedback::Prediction(p.clone()))).unwrap();
+    assert_eq!(back, Feedback::Prediction(p));
+    // a standard sync point that is not a time is still an error
+    let bad = xml.replace(r#"stroke="1.5""#, r#"stroke="soon""#);
+    assert!(from_line(&bad).is_err());
+}

@@ -33,6 +33,7 @@ fn messages() -> Vec<Feedback> {
                     ("stroke".into(), 0.85),
                     ("end".into(), 2.1),
                 ],
+                attributes: Vec::new(),
             }],
         }),
         Feedback::BlockProgress(BlockProgress {

@@ -506,6 +506,7 @@ fn feedback() -> impl Strategy<Value = Feedback> {
                             block: block.into(),
                             behaviour: behaviour.into(),
                             syncs: names.into_iter().map(Into::into).zip(times).collect(),
+                            attributes: Vec::new(),
                         }
                     }),
                 0..3

@@ -45,6 +45,7 @@ impl BlockManager {
                     block: b.id.clone(),
                     behaviour: x.id.clone(),
                     syncs,
+                    attributes: Vec::new(),
                 }
             }));
             v

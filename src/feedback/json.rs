@@ -360,6 +360,7 @@ impl BehaviourLine {
             block: block.into(),
             behaviour: behaviour.into(),
             syncs,
+            attributes: Vec::new(),
         })
     }
 }

@@ -179,6 +179,9 @@ pub struct BehaviourPrediction {
     pub behaviour: crate::bml::Id,
     /// (sync id, predicted time) in sync order.
     pub syncs: Vec<(crate::bml::Id, f64)>,
+    /// The behaviour's other attributes as a peer wrote them (`lexeme`, `mode`, `target`…),
+    /// kept verbatim in order; this realizer's own predictions carry none.
+    pub attributes: Vec<(String, String)>,
 }
 
 /// `<predictionFeedback>`: predicted timing of blocks and behaviours.

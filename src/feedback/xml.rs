@@ -104,6 +104,9 @@ pub fn to_xml(fb: &Feedback) -> String {
             for b in &p.behaviours {
                 let _ = write!(o, "<{}", b.kind);
                 attr(&mut o, "id", &format!("{}:{}", b.block, b.behaviour));
+                for (name, v) in &b.attributes {
+                    attr(&mut o, name, v);
+                }
                 for (sync, v) in &b.syncs {
                     attr(&mut o, sync, &t(*v));
                 }
@@ -283,7 +286,7 @@ pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
                     ..Default::default()
                 };
                 if !empty {
-                    prediction_children(&mut r, &mut p)?;
+                    prediction_children(&mut r, &mut p, None)?;
                 }
                 Ok(Feedback::Prediction(p))
             }
@@ -320,9 +323,11 @@ fn element_text(r: &mut NsReader<&[u8]>) -> Result<String, FeedbackError> {
     }
 }
 
+/// The children of a `<predictionFeedback>` (or, with `block`, of its `<bml id=block>`).
 fn prediction_children(
     r: &mut NsReader<&[u8]>,
     p: &mut PredictionFeedback,
+    block: Option<&str>,
 ) -> Result<(), FeedbackError> {
     let xml_err = |e: quick_xml::Error| FeedbackError(format!("not well-formed XML: {e}"));
     loop {
@@ -337,32 +342,91 @@ fn prediction_children(
         let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
         check_name(&name)?;
         let a = attrs(r, &e)?;
-        if !empty {
-            r.read_to_end(e.name()).map_err(xml_err)?;
-        }
-        if name == "bml" {
+        if name == "bml" && block.is_none() {
+            let id = req(&a, "id", "bml")?;
             p.blocks.push(BlockPrediction {
-                id: req(&a, "id", "bml")?.into(),
+                id: id.into(),
                 global_start: opt_num(&a, false, "globalStart")?,
                 global_end: opt_num(&a, false, "globalEnd")?,
                 status: status(&a)?,
             });
-        } else {
-            let parts = split_id(req(&a, "id", &name)?, 2, "behaviour prediction")?;
-            let [block, behaviour] = <[String; 2]>::try_from(parts).expect("two parts");
-            let mut syncs = Vec::new();
-            for (bmla, n, v) in &a {
-                if !bmla && n != "id" {
-                    check_name(n)?;
-                    syncs.push((n.as_str().into(), num(v, n)?));
-                }
+            // (BML 1.0 as the peers write it: the block's behaviours inside its <bml>)
+            if !empty {
+                prediction_children(r, p, Some(id))?;
             }
-            p.behaviours.push(BehaviourPrediction {
-                kind: name.into(),
-                block: block.into(),
-                behaviour: behaviour.into(),
-                syncs,
-            });
+            continue;
+        }
+        if !empty {
+            r.read_to_end(e.name()).map_err(xml_err)?;
+        }
+        p.behaviours.push(behaviour_prediction(
+            &name,
+            &a,
+            block.or(p.blocks.last().map(|b| b.id.as_str())),
+        )?);
+    }
+}
+
+/// The BML 1.0 sync points: attributes of these names are predicted times.
+const SYNC_NAMES: [&str; 7] = [
+    "start",
+    "ready",
+    "strokeStart",
+    "stroke",
+    "strokeEnd",
+    "relax",
+    "end",
+];
+
+/// Numeric attributes of BML behaviours that are not times.
+const NOT_TIMES: [&str; 6] = [
+    "amount",
+    "repetition",
+    "offsetAngle",
+    "speed",
+    "power",
+    "weight",
+];
+
+/// A behaviour inside a prediction: its id `B:beh` (or `beh` inside or after the `<bml>` of
+/// block `block`), its sync points (the standard ones, and any other attribute whose value is a
+/// time) and its other attributes, kept as they are.
+fn behaviour_prediction(
+    name: &str,
+    a: &Attrs,
+    block: Option<&str>,
+) -> Result<BehaviourPrediction, FeedbackError> {
+    let id = req(a, "id", name)?;
+    let (block, behaviour) = match (id.split_once(':'), block) {
+        (None, Some(b)) if !id.is_empty() => (b.to_string(), id.to_string()),
+        _ => {
+            let parts = split_id(id, 2, "behaviour prediction")?;
+            let [b, beh] = <[String; 2]>::try_from(parts).expect("two parts");
+            (b, beh)
+        }
+    };
+    let (mut syncs, mut attributes) = (Vec::new(), Vec::new());
+    for (bmla, n, v) in a {
+        if *bmla || n == "id" {
+            continue;
+        }
+        check_name(n)?;
+        let time = v.trim().parse::<f64>().ok().filter(|t| t.is_finite());
+        let is_sync = SYNC_NAMES.contains(&n.as_str())
+            || (time.is_some() && !NOT_TIMES.contains(&n.as_str()));
+        match time {
+            Some(t) if is_sync => syncs.push((n.as_str().into(), t)),
+            None if SYNC_NAMES.contains(&n.as_str()) => {
+                return Err(FeedbackError(format!("{n}='{v}' is not a number")))
+            }
+            _ => attributes.push((n.clone(), v.clone())),
         }
     }
+    Ok(BehaviourPrediction {
+        kind: name.into(),
+        block: block.into(),
+        behaviour: behaviour.into(),
+        syncs,
+        attributes,
+    })
 }
