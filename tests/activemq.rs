@@ -113,12 +113,7 @@ fn a_java_jms_peer_gets_textmessage_feedback_as_asaprealizer_s_adapters_do() {
 }
 
 fn stomp_python() -> Option<String> {
-    let python = std::env::var("BMLR_STOMP_PYTHON").unwrap_or_else(|_| "python3".into());
-    let ok = Command::new(&python)
-        .args(["-c", "import stomp"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    ok.then_some(python)
+    kit::python_with("BMLR_STOMP_PYTHON", "stomp")
 }
 
 #[test]

@@ -18,12 +18,7 @@ use std::process::Command;
 use kit::{Broker, Served};
 
 fn ipaaca_python() -> Option<String> {
-    let python = std::env::var("BMLR_IPAACA_PYTHON").unwrap_or_else(|_| "python3".into());
-    let ok = Command::new(&python)
-        .args(["-c", "import ipaacar.components"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    ok.then_some(python)
+    kit::python_with("BMLR_IPAACA_PYTHON", "ipaacar.components")
 }
 
 #[test]

@@ -367,18 +367,8 @@ fn prediction_children(
     }
 }
 
-/// The BML 1.0 sync points: attributes of these names are predicted times.
-const SYNC_NAMES: [&str; 7] = [
-    "start",
-    "ready",
-    "strokeStart",
-    "stroke",
-    "strokeEnd",
-    "relax",
-    "end",
-];
-
-/// Numeric attributes of BML behaviours that are not times.
+/// Numeric attributes of BML behaviours that are not times (the standard sync points, the
+/// gesture's, are always times).
 const NOT_TIMES: [&str; 6] = [
     "amount",
     "repetition",
@@ -412,13 +402,12 @@ fn behaviour_prediction(
         }
         check_name(n)?;
         let time = v.trim().parse::<f64>().ok().filter(|t| t.is_finite());
-        let is_sync = SYNC_NAMES.contains(&n.as_str())
-            || (time.is_some() && !NOT_TIMES.contains(&n.as_str()));
+        let standard = crate::bml::GESTURE_SYNCS.contains(&n.as_str());
         match time {
-            Some(t) if is_sync => syncs.push((n.as_str().into(), t)),
-            None if SYNC_NAMES.contains(&n.as_str()) => {
-                return Err(FeedbackError(format!("{n}='{v}' is not a number")))
+            Some(t) if standard || !NOT_TIMES.contains(&n.as_str()) => {
+                syncs.push((n.as_str().into(), t))
             }
+            None if standard => return Err(FeedbackError(format!("{n}='{v}' is not a number"))),
             _ => attributes.push((n.clone(), v.clone())),
         }
     }

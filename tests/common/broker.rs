@@ -164,3 +164,14 @@ pub fn ended(heard: &[(String, String)], character: &str, block: &str) -> bool {
 pub fn block(id: &str) -> String {
     format!(r#"<bml {NS} id="{id}"><head id="h" lexeme="NOD" start="0" end="0.3"/></bml>"#)
 }
+
+/// The Python named by `$var` (else `python3`) if it can import `module`: the peers' libraries
+/// are installed in a venv for the tests (`.ci/run` makes one).
+pub fn python_with(var: &str, module: &str) -> Option<String> {
+    let python = std::env::var(var).unwrap_or_else(|_| "python3".into());
+    let ok = Command::new(&python)
+        .args(["-c", &format!("import {module}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    ok.then_some(python)
+}

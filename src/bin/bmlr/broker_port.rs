@@ -34,11 +34,7 @@ impl BrokerPort {
             inbox: 100_000,
             start_tries: 6,
         })?;
-        Ok(BrokerPort {
-            wire: Box::new(link),
-            pairs,
-            running: Fixture::Standard,
-        })
+        Ok(BrokerPort::on(Box::new(link), pairs))
     }
 
     /// On STOMP: the topic pairs (blocks in, feedback out) of the two fixtures.
@@ -54,11 +50,15 @@ impl BrokerPort {
             inbox: 100_000,
             start_tries: 6,
         })?;
-        Ok(BrokerPort {
-            wire: Box::new(link),
+        Ok(BrokerPort::on(Box::new(link), pairs))
+    }
+
+    fn on(wire: Box<dyn Wire>, pairs: [(String, String); 2]) -> BrokerPort {
+        BrokerPort {
+            wire,
             pairs,
             running: Fixture::Standard,
-        })
+        }
     }
 
     fn pair(&self) -> &(String, String) {
