@@ -6,7 +6,8 @@
 //! - a stomp.py peer speaking Greta's conventions (tests/peers/greta_peer.py): `greta.BML` in,
 //!   Greta's callbacks out on `greta.output.feedback.BML`;
 //! - a planner on this crate's own STOMP link: garbage gives a warning and the next block runs,
-//!   a restarted broker has the realizer back within 10 s, the conformance suite over STOMP.
+//!   a restarted broker has the realizer back within 10 s, the same feedback as through
+//!   `serve --stdio`, the conformance suite over STOMP.
 //!
 //! Each says "skipped" when its package is missing (`.ci/run` installs them all and fails on a
 //! skip). The Python with stomp.py is `$BMLR_STOMP_PYTHON` (else `python3` if it has it).
@@ -240,4 +241,70 @@ fn conformance_tests_pass_over_stomp_on_both_fixtures() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
+}
+
+/// `feedback` without what depends on the wall clock (global times, POSIX times).
+fn clockless(feedback: &str) -> String {
+    let mut out = feedback.to_string();
+    for name in [
+        " globalTime=\"",
+        " globalStart=\"",
+        " globalEnd=\"",
+        " bmla:posixTime=\"",
+    ] {
+        while let Some(at) = out.find(name) {
+            let value = at + name.len();
+            let end = value + out[value..].find('"').expect("a closed attribute");
+            out.replace_range(at..=end, "");
+        }
+    }
+    out
+}
+
+#[test]
+fn a_block_gets_the_same_feedback_over_stomp_as_through_serve_stdio() {
+    let Some(broker) = ActiveMq::start() else {
+        return;
+    };
+    let _r = serve(&broker, &["--no-idle"]);
+    let mut p = planner(&broker, &["/topic/asap.bml.feedback"]);
+    assert!(ended(&runs(&mut p, "warm", 15.0), "warm"));
+    let both = format!(
+        r#"<bml {} id="b1"><head id="h" lexeme="NOD" start="0" end="0.4"/><gesture id="g" lexeme="BEAT" stroke="h:stroke"/><gaze id="z" target="nobody" start="0.1"/></bml>"#,
+        r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#
+    );
+    p.send("/topic/asap.bml.request", both.clone().into_bytes(), &[]);
+    p.flush();
+    let brokered: Vec<String> = hear(&p, 10.0, |h| ended(h, "b1"))
+        .iter()
+        .map(|m| clockless(m))
+        .collect();
+    assert!(ended(&brokered, "b1"), "{brokered:?}");
+
+    let mut stdio = Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args(["serve", "--stdio", "--no-idle"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("bmlr runs");
+    use std::io::{BufRead, Write};
+    let mut stdin = stdio.stdin.take().unwrap();
+    writeln!(stdin, "{both}").unwrap();
+    stdin.flush().unwrap();
+    let mut piped = Vec::new();
+    for line in std::io::BufReader::new(stdio.stdout.take().unwrap()).lines() {
+        piped.push(clockless(&line.unwrap()));
+        if ended(&piped, "b1") {
+            break;
+        }
+    }
+    drop(stdin);
+    let _ = stdio.kill();
+    let _ = stdio.wait();
+    // (a warning for the unknown gaze target, predictions, progress: element for element)
+    assert!(
+        piped.iter().any(|m| m.starts_with("<warningFeedback")),
+        "{piped:?}"
+    );
+    assert_eq!(brokered, piped);
 }

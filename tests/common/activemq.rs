@@ -43,7 +43,7 @@ impl ActiveMq {
         let base = std::env::temp_dir().join(format!("bmlr-amq-{}-{stomp}", std::process::id()));
         std::fs::create_dir_all(base.join("data")).expect("a directory for the broker");
         let uri = format!(
-            "broker:(tcp://127.0.0.1:{openwire},stomp://127.0.0.1:{stomp})?persistent=false&useJmx=false"
+            "broker:(tcp://127.0.0.1:{openwire},stomp://127.0.0.1:{stomp}?transport.tcpNoDelay=true)?persistent=false&useJmx=false"
         );
         let child = Command::new("java")
             .arg("-Xmx256m")
