@@ -430,6 +430,35 @@ const FACE: &[(&str, f64)] = &[
     ("end", 1.5),
 ];
 
+/// A head motion repeated `strokes` times: the first nod as [`HEAD`], each further stroke
+/// (`stroke:1` …, as OpenBMLParser names them) one nod's cycle (`relax` − `start`, 0.5 s) after
+/// the one before, and the last one's retraction after them; preparation and retraction
+/// limited as one nod's are.
+fn head(strokes: u32) -> TimingModel {
+    let one = limited(HEAD, 1.0);
+    if strokes <= 1 {
+        return one;
+    }
+    let at = |name: &str| one.keys[one.key(name).expect("a head key")].at;
+    let (stroke, cycle) = (
+        one.key("stroke").expect("a stroke"),
+        at("relax") - at("start"),
+    );
+    let extra = cycle * f64::from(strokes - 1);
+    let mut keys = one.keys[..=stroke].to_vec();
+    keys.extend((1..strokes).map(|n| {
+        SyncKey::new(
+            crate::bml::stroke_name(n),
+            at("stroke") + cycle * f64::from(n),
+        )
+    }));
+    keys.extend(one.keys[stroke + 1..].iter().map(|k| SyncKey {
+        at: k.at + extra,
+        ..k.clone()
+    }));
+    TimingModel { keys, ..one }
+}
+
 /// A stretchable model of `keys` whose preparation (start to `ready`; for a face, to
 /// `attackPeak`) and retraction (`relax` to `end`) last at most `max` seconds: a hand, head or
 /// gaze gets to where it is going in about a second, however far apart the constraints put the
@@ -471,10 +500,7 @@ impl TimingModels for DefaultTimingModels {
                 limited(GESTURE, 1.0)
             }
             BehaviourKind::Pointing(_) => limited(POINTING, 1.5),
-            // the limits are per nod or shake: they scale with `repetition`
-            BehaviourKind::Head(h) => {
-                limited(HEAD, 1.0).scaled(h.repetition.unwrap_or(1).max(1) as f64)
-            }
+            BehaviourKind::Head(_) => head(b.strokes()),
             BehaviourKind::Gaze(_) => limited(GAZE, 1.5),
             BehaviourKind::Posture(_) => limited(POSTURE, 3.0),
             BehaviourKind::Face(_)
@@ -628,11 +654,30 @@ mod tests {
     }
 
     #[test]
-    fn head_repetition_scales_the_nod() {
+    fn a_repeated_head_has_a_stroke_each_nod_s_cycle_apart() {
         let b = behaviours(r#"<head id="h" lexeme="NOD" repetition="3"/>"#);
         let m = DefaultTimingModels::default().model(&b[0]).unwrap();
-        assert!((m.preferred_duration() - 1.8).abs() < 1e-12);
-        assert!((m.keys[m.key("stroke").unwrap()].at - 0.9).abs() < 1e-12);
+        m.check().unwrap();
+        let keys: Vec<(&str, f64)> = m.keys.iter().map(|k| (k.name.as_str(), k.at)).collect();
+        let want = [
+            ("start", 0.0),
+            ("ready", 0.1),
+            ("strokeStart", 0.15),
+            ("stroke", 0.3),
+            ("stroke:1", 0.8),
+            ("stroke:2", 1.3),
+            ("strokeEnd", 1.45),
+            ("relax", 1.5),
+            ("end", 1.6),
+        ];
+        assert_eq!(keys.len(), want.len());
+        for ((name, at), (w, wat)) in keys.iter().zip(want) {
+            assert_eq!(*name, w);
+            assert!((at - wat).abs() < 1e-12, "{name} at {at}, not {wat}");
+        }
+        // preparation and retraction limited as one nod's
+        assert_eq!(m.keys[1].max_phase, 1.0);
+        assert_eq!(m.keys[8].max_phase, 1.0);
     }
 
     #[test]

@@ -308,3 +308,72 @@ fn a_block_gets_the_same_feedback_over_stomp_as_through_serve_stdio() {
     );
     assert_eq!(brokered, piped);
 }
+
+/// Milliseconds since the UNIX epoch now.
+fn posix_ms() -> u128 {
+    let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH);
+    now.unwrap().as_millis()
+}
+
+#[test]
+fn a_flood_for_one_character_does_not_hold_up_another_s_block_on_the_shared_topic() {
+    let Some(broker) = ActiveMq::start() else {
+        return;
+    };
+    let _r = serve(&broker, &["--no-idle"]);
+    let mut p = planner(&broker, &["/topic/asap.bml.feedback"]);
+    assert!(ended(&runs(&mut p, "warm", 15.0), "warm"));
+    // (another subscriber of the blocks' topic: when it hears y's block, the broker has
+    // delivered it to the realizer too)
+    let witness = planner(&broker, &["/topic/asap.bml.request"]);
+    let ns = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+    let block_for = |c: &str, id: &str| {
+        let head = r#"<head id="h" lexeme="NOD" start="0" end="0.3"/>"#;
+        format!(r#"<bml {ns} id="{id}" characterId="{c}">{head}</bml>"#).into_bytes()
+    };
+    // (x's blocks and y's share asap.bml.request: the realizer queues them by characterId)
+    for k in 0..12_000 {
+        p.send(
+            "/topic/asap.bml.request",
+            block_for("x", &format!("f{k}")),
+            &[],
+        );
+    }
+    p.flush();
+    while p.waiting() > 0 {
+        p.flush();
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let sent = Instant::now();
+    p.send("/topic/asap.bml.request", block_for("y", "mine"), &[]);
+    p.flush();
+    let mine = |h: &[String]| h.last().is_some_and(|m| m.contains(r#"id="mine""#));
+    assert!(
+        mine(&hear(&witness, 60.0, mine)),
+        "the broker did not deliver y's block"
+    );
+    let delivered = posix_ms();
+    eprintln!(
+        "the broker delivered y's block {:?} after it was sent",
+        sent.elapsed()
+    );
+    // (on the shared feedback topic y's start comes after x's feedback made before it: the
+    // time the realizer started it, bmla:posixTime, is what is measured)
+    let start = |h: &[String]| h.iter().find(|m| m.contains(r#"id="mine:start""#)).cloned();
+    let dropped = |h: &[String]| {
+        h.iter()
+            .any(|m| m.contains("blocks dropped") && m.contains(r#"characterId="x""#))
+    };
+    let heard = hear(&p, 60.0, |h| start(h).is_some() && dropped(h));
+    let line = start(&heard).expect("y's block started");
+    let at = line
+        .split("bmla:posixTime=\"")
+        .nth(1)
+        .and_then(|r| r.split('"').next());
+    let at: u128 = at.and_then(|t| t.parse().ok()).expect("a posixTime");
+    let waited = at.saturating_sub(delivered);
+    eprintln!("y's block started {waited} ms after the broker delivered it");
+    // x's queue overflowed: said on the shared topic, naming x
+    assert!(dropped(&heard), "no warning of dropped blocks");
+    assert!(waited < 250, "{waited} ms");
+}

@@ -1188,3 +1188,46 @@ fn a_wrist_never_moves_faster_than_a_hand_can() {
         assert!(speed < 5.0, "{wrist} moves at {speed:.1} m/s at {t:.2} s");
     }
 }
+
+#[test]
+fn a_repeated_nod_peaks_at_each_stroke_also_one_tied_to_a_gesture() {
+    // the second nod's stroke (`stroke:1`) pulled to a gesture's stroke at 1.4 s
+    let (pitches, syncs) = run(
+        concat!(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><head id="n" lexeme="NOD" repetition="3" start="0.2"/>"#,
+            r#"<gesture id="g" lexeme="BEAT" stroke="1.4"/><constraint><synchronize><sync ref="n:stroke:1"/><sync ref="g:stroke"/></synchronize></constraint></bml>"#
+        ),
+        3.0,
+    );
+    let amplitude = DEFAULT_AMOUNT * NOD_DEGREES;
+    let strokes = ["stroke", "stroke:1", "stroke:2"].map(|s| at(&syncs, s));
+    assert!((strokes[1] - 1.4).abs() < 1e-3, "{strokes:?}");
+    assert!(
+        strokes[0] < strokes[1] && strokes[1] < strokes[2],
+        "{strokes:?}"
+    );
+    let pitch = |t: f64| {
+        let near = pitches
+            .iter()
+            .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()));
+        near.unwrap().1
+    };
+    for (k, s) in strokes.iter().enumerate() {
+        // each stroke a peak: within 5 % of the amplitude, the frames a tenth of a second
+        // either side lower
+        assert!(
+            (pitch(*s) - amplitude).abs() <= 0.05 * amplitude,
+            "stroke {k} at {s}: pitch {}",
+            pitch(*s)
+        );
+        assert!(pitch(s - 0.1) < pitch(*s) - 1.0 && pitch(s + 0.1) < pitch(*s) - 1.0);
+        // and the head comes up between two strokes
+        if let Some(next) = strokes.get(k + 1) {
+            let between = pitch((s + next) / 2.0);
+            assert!(
+                between < 0.1 * amplitude,
+                "between {s} and {next}: {between}"
+            );
+        }
+    }
+}

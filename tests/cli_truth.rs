@@ -365,3 +365,125 @@ fn serve_without_a_port_names_both_and_conformance_says_when_its_realizer_cannot
         "{err}"
     );
 }
+
+/// A repeated head and a gesture whose stroke is tied to the head's third stroke (`stroke:2`,
+/// counted from 0 as OpenBMLParser does).
+const THIRD_STROKE: &str = r#"<head id="h" lexeme="NOD" repetition="3" start="0"/><gesture id="g" lexeme="BEAT" stroke="h:stroke:2"/>"#;
+
+/// The row of docs/bml-support.md on stroke iterations.
+fn stroke_iteration_row() -> String {
+    let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/bml-support.md"))
+        .unwrap();
+    let row = docs.lines().find(|l| l.starts_with("| stroke iterations"));
+    row.expect("docs/bml-support.md has a row on stroke iterations")
+        .to_string()
+}
+
+#[test]
+fn docs_say_stroke_iterations_are_realized_and_their_example_validates() {
+    let row = stroke_iteration_row();
+    assert!(row.contains("| realized"), "{row}");
+    assert!(
+        row.contains("unknown-sync-point") && row.contains("NO_SUCH_TARGET"),
+        "{row}"
+    );
+    // the example the row gives is valid BML to validate
+    let example = row.split('`').nth(1).unwrap();
+    assert_eq!(example, "h1:stroke:2");
+    let body = format!(
+        r#"<head id="h1" lexeme="NOD" repetition="3"/><gesture id="g" lexeme="BEAT" stroke="{example}"/>"#
+    );
+    let (code, out) = validate("docs-stroke", &body);
+    assert_eq!(code, 0, "{out}");
+}
+
+#[test]
+fn validate_takes_a_repeated_head_s_later_strokes_and_refuses_strokes_a_behaviour_lacks() {
+    let (code, out) = validate("stroke-ok", THIRD_STROKE);
+    assert_eq!(code, 0, "{out}");
+    for (name, body, says) in [
+        (
+            "stroke-gesture",
+            r#"<gesture id="g1" lexeme="BEAT"/><head id="h" lexeme="NOD" stroke="g1:stroke:2"/>"#,
+            "error[unknown-sync-point]: <gesture> 'g1' has no sync point 'stroke:2'",
+        ),
+        (
+            "stroke-past",
+            r#"<head id="h" lexeme="NOD" repetition="3"/><gesture id="g" lexeme="BEAT" stroke="h:stroke:3"/>"#,
+            "sync points are start, ready, strokeStart, stroke, stroke:1, stroke:2, strokeEnd",
+        ),
+        (
+            "stroke-start",
+            r#"<head id="h" lexeme="NOD" repetition="3"/><gesture id="g" lexeme="BEAT" stroke="b1:h:start:2"/>"#,
+            "error[malformed-sync-ref]",
+        ),
+        (
+            "stroke-many",
+            r#"<head id="h" lexeme="NOD" repetition="1001"/>"#,
+            "error[limit-exceeded]: attribute 'repetition' is 1001, more than the limit of 1000",
+        ),
+    ] {
+        let (code, out) = validate(name, body);
+        assert_eq!(code, 1, "{name}: {out}");
+        assert!(out.contains(says), "{name}: {out}");
+    }
+}
+
+#[test]
+fn plan_and_run_tie_a_gesture_to_a_repeated_head_s_third_stroke() {
+    let dir = dir_with(
+        "stroke-run",
+        &[(
+            "b.xml",
+            &format!(r#"<bml {NS} id="b1">{THIRD_STROKE}</bml>"#),
+        )],
+    );
+    let file = dir.join("b.xml");
+    let (code, out, err) = bmlr(&["plan", file.to_str().unwrap()], "");
+    assert_eq!(code, 0, "{err}");
+    for line in [
+        "b1:h:stroke 0.300",
+        "b1:h:stroke:1 0.800",
+        "b1:h:stroke:2 1.300",
+        "b1:g:stroke 1.300",
+    ] {
+        assert!(out.contains(line), "{line} not in\n{out}");
+    }
+    let (code, out, err) = bmlr(&["run", file.to_str().unwrap()], "");
+    assert_eq!(code, 0, "{err}");
+    for line in [
+        r#"id="b1:h:stroke:1" time="0.800""#,
+        r#"id="b1:h:stroke:2" time="1.300""#,
+        r#"id="b1:g:stroke" time="1.300""#,
+    ] {
+        assert!(out.contains(line), "{line} not in\n{out}");
+    }
+    assert!(!out.contains("warningFeedback"), "{out}");
+    // the feedback reads back (bmlr diff of the log against itself)
+    std::fs::write(dir.join("fb.xml"), &out).unwrap();
+    let fb = dir.join("fb.xml");
+    let (code, said, err) = bmlr(&["diff", fb.to_str().unwrap(), fb.to_str().unwrap()], "");
+    assert_eq!(code, 0, "{said}{err}");
+    // to another block's head without that stroke: dropped, saying which strokes there are
+    let other = dir.join("c.xml");
+    std::fs::write(
+        &other,
+        format!(
+            r#"<bml {NS} id="b2"><gesture id="g" lexeme="BEAT" stroke="b1:g:stroke:1"/></bml>"#
+        ),
+    )
+    .unwrap();
+    let (_, out, _) = bmlr(
+        &["run", file.to_str().unwrap(), other.to_str().unwrap()],
+        "",
+    );
+    let warning = out
+        .lines()
+        .find(|l| l.contains("NO_SUCH_TARGET"))
+        .unwrap_or_default();
+    assert!(
+        warning.contains("id=\"b2:g\"")
+            && warning.contains("has no sync point &apos;stroke:1&apos;"),
+        "{out}"
+    );
+}

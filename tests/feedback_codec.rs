@@ -24,7 +24,22 @@ fn malformed_xml_lines_are_rejected_with_a_reason() {
     assert!(err(&format!(
         r#"<syncPointProgress {NS} id="b1:g1" time="0" globalTime="1"/>"#
     ))
-    .contains("3 non-empty parts"));
+    .contains("block:behaviour:sync"));
+    // four parts only for a later stroke of a repeated head
+    assert!(err(&format!(
+        r#"<syncPointProgress {NS} id="b1:g1:start:2" time="0" globalTime="1"/>"#
+    ))
+    .contains("block:behaviour:stroke:N"));
+    let line =
+        format!(r#"<syncPointProgress {NS} id="b1:h1:stroke:2" time="1.300" globalTime="1.300"/>"#);
+    let Ok(Feedback::SyncPointProgress(p)) = from_line(&line) else {
+        panic!("{line} not read");
+    };
+    assert_eq!(
+        (p.block.as_str(), p.behaviour.as_str(), p.sync.as_str()),
+        ("b1", "h1", "stroke:2")
+    );
+    assert_eq!(to_xml(&Feedback::SyncPointProgress(p)), line);
     assert!(err(&format!(
         r#"<blockProgress {NS} xmlns:bmla="http://www.asap-project.org/bmla" id="b:end" globalTime="1" bmla:status="FINE"/>"#
     ))

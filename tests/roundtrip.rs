@@ -174,7 +174,7 @@ fn kind() -> impl Strategy<Value = BehaviourKind> {
             .prop_map(|(lexeme, mode)| BehaviourKind::Gesture(Gesture { lexeme, mode })),
         (text(), option::of(pick(Mode::ALL)))
             .prop_map(|(target, mode)| BehaviourKind::Pointing(Pointing { target, mode })),
-        (text(), option::of(any::<u32>()), option::of(num())).prop_map(
+        (text(), option::of(0..=MAX_REPETITION), option::of(num())).prop_map(
             |(lexeme, repetition, amount)| BehaviourKind::Head(Head {
                 lexeme,
                 repetition,

@@ -34,7 +34,7 @@ fn sync_points(element: &str) -> Vec<String> {
     );
     let block = bml::load(&src).unwrap().block;
     let points = block.behaviours[0].sync_points();
-    points.into_iter().map(str::to_string).collect()
+    points.into_iter().map(String::from).collect()
 }
 
 #[derive(Debug, Clone)]
@@ -100,6 +100,7 @@ fn block(speeches: &[Speech], moves: &[Move]) -> String {
         body.push_str("</text></speech>");
         syncs.push(format!("s{i}:end"));
     }
+    let mut constraints = String::new();
     for (i, m) in moves.iter().enumerate() {
         let element = MOTIONS[m.kind];
         let keys = sync_points(element);
@@ -122,7 +123,15 @@ fn block(speeches: &[Speech], moves: &[Move]) -> String {
                 (Some(sync), o) => format!("{sync}{sign}{}", o.unsigned_abs() as f64 / 1000.0),
                 (None, o) => format!("{}", (pick - syncs.len()) as f64 + o.max(0) as f64 / 1000.0),
             };
-            attrs.push_str(&format!(r#" {}="{value}""#, keys[key]));
+            if keys[key].contains(':') {
+                // (a repeated head's later strokes are no attribute names: tied by a constraint)
+                constraints.push_str(&format!(
+                    r#"<constraint id="c{i}_{key}"><synchronize><sync ref="m{i}:{}"/><sync ref="{value}"/></synchronize></constraint>"#,
+                    keys[key]
+                ));
+            } else {
+                attrs.push_str(&format!(r#" {}="{value}""#, keys[key]));
+            }
         }
         let name = element.split(' ').next().unwrap();
         body.push_str(&format!(
@@ -130,7 +139,9 @@ fn block(speeches: &[Speech], moves: &[Move]) -> String {
             &element[name.len() + 1..]
         ));
     }
-    format!(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b">{body}</bml>"#)
+    format!(
+        r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b">{body}{constraints}</bml>"#
+    )
 }
 
 /// The least over σ ≥ 0 of `|σ − 1| · d + 2 · Σ |x − σ · p|` (a convex piecewise-linear function

@@ -31,6 +31,35 @@ impl ExternalTimes for OtherBlocks<'_> {
             SyncPoint::Local { .. } => None,
         }
     }
+
+    fn why_unknown(&self, point: &SyncPoint) -> String {
+        let SyncPoint::External {
+            block,
+            behaviour,
+            sync,
+        } = point
+        else {
+            return format!("the time of {point} is not known");
+        };
+        let Some(b) = self.blocks.named(block) else {
+            return format!("the time of {point} is not known: block '{block}' is not in the plan");
+        };
+        let Some(beh) = b.behaviour(behaviour) else {
+            return format!(
+                "the time of {point} is not known: block '{block}' has no behaviour '{behaviour}' (now)"
+            );
+        };
+        let names: Vec<&str> = beh.syncs.iter().map(|(n, _)| n.as_str()).collect();
+        let hint = if bml::stroke_iteration_of(sync).is_some() {
+            bml::STROKE_ITERATION_HINT
+        } else {
+            ""
+        };
+        format!(
+            "the time of {point} is not known: '{block}:{behaviour}' has no sync point '{sync}'; its sync points are {}{hint}",
+            names.join(", ")
+        )
+    }
 }
 
 impl BlockManager {

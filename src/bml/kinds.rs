@@ -2,6 +2,7 @@
 //! and whether its sync points are open (defined by animation data rather than by BML).
 
 use super::model::{Behaviour, BehaviourKind, NS_BML, NS_BMLA, NS_BMLT, NS_CORE_EXT};
+use std::borrow::Cow;
 
 /// gesture, pointing, head (and BMLT procanimationgesture).
 pub const GESTURE_SYNCS: &[&str] = &[
@@ -205,16 +206,34 @@ impl BehaviourKind {
 
 impl Behaviour {
     /// All sync points of the behaviour in time order: the standard ones, with speech's inline
-    /// sync points between `start` and `end`.
-    pub fn sync_points(&self) -> Vec<&str> {
+    /// sync points between `start` and `end` and a repeated head's later strokes (`stroke:1` …
+    /// `stroke:N-1`, as OpenBMLParser numbers them) after `stroke`.
+    pub fn sync_points(&self) -> Vec<Cow<'_, str>> {
         match &self.kind {
             BehaviourKind::Speech(s) | BehaviourKind::Text(s) => {
-                let mut v = vec!["start"];
-                v.extend(s.sync_ids());
-                v.push("end");
+                let inline = s.sync_ids().map(Cow::Borrowed);
+                let mut v = vec![Cow::Borrowed("start")];
+                v.extend(inline);
+                v.push(Cow::Borrowed("end"));
                 v
             }
-            k => k.standard_syncs().to_vec(),
+            k => {
+                let mut v: Vec<Cow<str>> = k.standard_syncs().iter().map(|&s| s.into()).collect();
+                if let Some(at) = v.iter().position(|s| s == "stroke") {
+                    let later =
+                        (1..self.strokes()).map(|n| Cow::Owned(super::stroke_name(n).into()));
+                    v.splice(at + 1..at + 1, later);
+                }
+                v
+            }
+        }
+    }
+
+    /// How many strokes the behaviour has: `repetition` for a head, 1 for others with a stroke.
+    pub fn strokes(&self) -> u32 {
+        match &self.kind {
+            BehaviourKind::Head(h) => h.repetition.unwrap_or(1).max(1),
+            _ => 1,
         }
     }
 
@@ -224,7 +243,11 @@ impl Behaviour {
             BehaviourKind::Speech(s) | BehaviourKind::Text(s) => {
                 sync == "start" || sync == "end" || s.sync_ids().any(|id| id == sync)
             }
-            k => k.has_open_syncs() || k.standard_syncs().contains(&sync),
+            k if k.has_open_syncs() || k.standard_syncs().contains(&sync) => true,
+            k => {
+                k.standard_syncs().contains(&"stroke")
+                    && super::stroke_iteration_of(sync).is_some_and(|n| n < self.strokes())
+            }
         }
     }
 }

@@ -1,7 +1,10 @@
 //! The limits on what one block may hold, so that hostile or broken input costs a bounded amount
 //! of work and memory and is refused with a diagnostic that names the limit: nesting depth,
 //! attributes per element (and namespace declarations in scope), the size of a block, behaviours
-//! per block, and how far from the block start a sync time may lie.
+//! per block, how far from the block start a sync time may lie, and how often a head repeats.
+
+/// Most repetitions of a `<head>` (each is a stroke of its own, `stroke:N`, in its timing).
+pub const MAX_REPETITION: u32 = 1_000;
 
 /// Limits on one block. The defaults are far above anything a behaviour planner writes; the CLI
 /// changes each with a flag (`--max-depth`, `--max-attributes`, `--max-block-bytes`,

@@ -29,11 +29,14 @@ pub use kinds::{
     ALL_STANDARD_SYNCS, BMLT_BEHAVIOURS, BUILTIN_KINDS, CONTROL_BEHAVIOURS, CORE_BEHAVIOURS,
     FACE_SYNCS, GAZE_SYNCS, GESTURE_SYNCS, START_END,
 };
-pub use limits::Limits;
+pub use limits::{Limits, MAX_REPETITION};
 pub use model::*;
 pub use parser::{parse, parse_with_diagnostics, Parsed};
 pub use stream::{advance, lines, BadLine, BlockStream, StreamItem};
-pub use syncref::{SyncPoint, SyncRef, SyncRefError, ANTICIPATORS};
+pub use syncref::{
+    stroke_iteration_of, stroke_name, SyncPoint, SyncRef, SyncRefError, ANTICIPATORS,
+    STROKE_ITERATION_HINT,
+};
 pub use validate::validate;
 pub use writer::write;
 

@@ -1502,18 +1502,28 @@ impl<'i> Parser<'i> {
         v
     }
 
-    fn opt_u32(&mut self, attrs: &mut Attrs<'i>, name: &str) -> Option<u32> {
+    /// An integer attribute from 0 to `max`: above it, a `limit-exceeded` error.
+    fn opt_u32(&mut self, attrs: &mut Attrs<'i>, name: &str, max: u32) -> Option<u32> {
         let a = attrs.take(name)?;
         let v = a.value.trim_ascii().parse::<u32>().ok();
-        if v.is_none() {
-            self.error(
+        match v {
+            None => self.error(
                 Code::InvalidNumber,
                 a.offset,
                 format!(
                     "attribute '{name}' is '{}'; expected a non-negative integer",
                     a.value
                 ),
-            );
+            ),
+            Some(n) if n > max => {
+                self.error(
+                    Code::LimitExceeded,
+                    a.offset,
+                    format!("attribute '{name}' is {n}, more than the limit of {max}"),
+                );
+                return None;
+            }
+            Some(_) => {}
         }
         v
     }
@@ -1612,7 +1622,7 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
         self.p.opt_f64(self.attrs, name)
     }
     fn u32(&mut self, name: &str) -> Option<u32> {
-        self.p.opt_u32(self.attrs, name)
+        self.p.opt_u32(self.attrs, name, u32::MAX)
     }
     fn mode(&mut self) -> Option<Mode> {
         self.p
@@ -1694,7 +1704,9 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
             }
             "head" => {
                 let lexeme = self.req("lexeme");
-                let repetition = self.u32("repetition");
+                let repetition = self
+                    .p
+                    .opt_u32(self.attrs, "repetition", super::MAX_REPETITION);
                 let amount = self.f64("amount");
                 BehaviourKind::Head(Head {
                     lexeme: lexeme?,

@@ -194,19 +194,21 @@ impl SyncRef {
                 "empty sync reference: expected a time in seconds or behaviour:sync".into(),
             ));
         }
-        let mut parts = t.split(':').map(str::trim_ascii);
-        let first = parts.next().unwrap_or_default();
-        let (second, third) = (parts.next(), parts.next());
-        if parts.next().is_some() {
+        let parts: Vec<&str> = t.split(':').map(str::trim_ascii).collect();
+        if let Some(point) = stroke_iteration(&parts, t)? {
+            return Ok(point);
+        }
+        if parts.len() > 3 {
             return Err(err(
                 Code::MalformedSyncRef,
                 format!(
-                    "sync reference '{t}' has {} parts; expected behaviour:sync, block:behaviour:sync or anticipators:id:sync",
-                    t.split(':').count()
+                    "sync reference '{t}' has {} parts; expected behaviour:sync, block:behaviour:sync, anticipators:id:sync or [block:]behaviour:stroke:N",
+                    parts.len()
                 ),
             ));
         }
-        let point = match (second, third) {
+        let first = parts[0];
+        let point = match (parts.get(1).copied(), parts.get(2).copied()) {
             (None, _) => {
                 return parse_seconds(t).map(SyncRef::Time).ok_or_else(|| {
                     err(
@@ -229,6 +231,78 @@ impl SyncRef {
             offset: point.1,
         })
     }
+}
+
+/// Said after "has no sync point 'stroke:N'".
+pub const STROKE_ITERATION_HINT: &str =
+    " (stroke:N is the stroke of repetition N, counted from 0, of a <head> whose repetition is above N)";
+
+/// The name of the `n`th stroke of a repeated behaviour, counted from 0: `stroke` for the
+/// first, `stroke:N` for the others (the sync points a head with `repetition` > 1 has).
+pub fn stroke_name(n: u32) -> Id {
+    if n == 0 {
+        Id::new_static("stroke")
+    } else {
+        Id::new(format!("stroke:{n}"))
+    }
+}
+
+/// The iteration of a sync name `stroke:N` (`stroke` is iteration 0); `None` for other names.
+pub fn stroke_iteration_of(sync: &str) -> Option<u32> {
+    if sync == "stroke" {
+        return Some(0);
+    }
+    let n = sync.strip_prefix("stroke:")?;
+    n.bytes()
+        .all(|b| b.is_ascii_digit())
+        .then(|| n.parse().ok())?
+}
+
+/// `[block:]behaviour:stroke:N[±o]`: the stroke of repetition N (from 0) of a repeated
+/// behaviour, as OpenBMLParser reads a sync reference with an iteration (the behaviour's sync
+/// point `stroke:N`; `stroke:0` is `stroke`). `None` when `parts` are not of this form.
+fn stroke_iteration(parts: &[&str], t: &str) -> Result<Option<SyncRef>, SyncRefError> {
+    let (block, behaviour, sync, last) = match parts {
+        [b, s, last] if *s == "stroke" => (None, *b, *s, *last),
+        [k, b, s, last] => (Some(*k), *b, *s, *last),
+        _ => return Ok(None),
+    };
+    let digits = last
+        .find(['+', '-'])
+        .map_or(last, |i| last[..i].trim_ascii());
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return Ok(None);
+    }
+    if sync != "stroke" {
+        return Err(err(
+            Code::MalformedSyncRef,
+            format!("sync reference '{t}': an iteration (:{digits}) may follow only 'stroke'"),
+        ));
+    }
+    let n: u32 = digits.parse().map_err(|_| {
+        err(
+            Code::MalformedSyncRef,
+            format!("sync reference '{t}': iteration {digits} is too large"),
+        )
+    })?;
+    let (_, offset) = sync_and_offset(last, t)?;
+    let sync = stroke_name(n);
+    let behaviour = check_id(behaviour, "behaviour id", t)?;
+    let point = match block {
+        Some(b) if b == ANTICIPATORS => {
+            return Err(err(
+                Code::MalformedSyncRef,
+                format!("anticipator reference '{t}' needs the form anticipators:ID:SYNC"),
+            ))
+        }
+        Some(b) => SyncPoint::External {
+            block: check_id(b, "block id", t)?,
+            behaviour,
+            sync,
+        },
+        None => SyncPoint::Local { behaviour, sync },
+    };
+    Ok(Some(SyncRef::Point { point, offset }))
 }
 
 /// The last part of reference `t`: a sync id optionally followed by `+o` or `-o` seconds.
@@ -377,6 +451,47 @@ mod tests {
                 offset: -0.5
             }
         );
+    }
+
+    #[test]
+    fn a_stroke_iteration_names_the_stroke_of_that_repetition() {
+        assert_eq!(
+            SyncRef::parse("h1:stroke:2").unwrap(),
+            local("h1", "stroke:2", 0.0)
+        );
+        assert_eq!(
+            SyncRef::parse("h1 : stroke : 02 + 0.5").unwrap(),
+            local("h1", "stroke:2", 0.5)
+        );
+        // the first stroke has no number
+        assert_eq!(
+            SyncRef::parse("h1:stroke:0").unwrap(),
+            local("h1", "stroke", 0.0)
+        );
+        assert_eq!(
+            SyncRef::parse("bml1:h1:stroke:1-1").unwrap(),
+            SyncRef::Point {
+                point: SyncPoint::External {
+                    block: "bml1".into(),
+                    behaviour: "h1".into(),
+                    sync: "stroke:1".into()
+                },
+                offset: -1.0
+            }
+        );
+        let code = |s: &str| SyncRef::parse(s).unwrap_err().code;
+        // only strokes repeat (as OpenBMLParser reads it)
+        assert_eq!(code("b:h1:start:2"), Code::MalformedSyncRef);
+        assert_eq!(code("h1:stroke:99999999999"), Code::MalformedSyncRef);
+        assert_eq!(code("anticipators:a:stroke:1"), Code::MalformedSyncRef);
+        for s in ["h1:stroke:2", "bml1:h1:stroke:1+0.5"] {
+            assert_eq!(SyncRef::parse(s).unwrap().to_string(), s);
+        }
+        assert_eq!(stroke_iteration_of("stroke:3"), Some(3));
+        assert_eq!(stroke_iteration_of("stroke"), Some(0));
+        assert_eq!(stroke_iteration_of("stroke:x"), None);
+        assert_eq!(stroke_iteration_of("strokeEnd"), None);
+        assert_eq!(stroke_name(2), "stroke:2");
     }
 
     #[test]

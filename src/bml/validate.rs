@@ -244,9 +244,14 @@ fn check_point(block: &Block, ids: &Ids, p: &SyncPoint, pos: Pos, diags: &mut Ve
             Code::UnknownSyncPoint,
             pos,
             format!(
-                "<{}> '{behaviour}' has no sync point '{sync}'; its sync points are {}",
+                "<{}> '{behaviour}' has no sync point '{sync}'; its sync points are {}{}",
                 b.kind.element_name(),
-                b.sync_points().join(", ")
+                b.sync_points().join(", "),
+                if super::stroke_iteration_of(sync).is_some() {
+                    super::STROKE_ITERATION_HINT
+                } else {
+                    ""
+                }
             ),
         )),
         Some(_) => {}

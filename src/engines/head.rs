@@ -1,9 +1,10 @@
 //! The head engine: `head` lexemes as real motion of the neck and skull, defined as data in
 //! `fixtures/bindings/heads.json` (the default [`HeadLexicon`]: NOD pitches the head forward
 //! about +x, SHAKE turns it about +y alternating sides, TILT rolls it about +z, TOSS pitches it
-//! back). Each of the `repetition` cycles rises smoothly to its peak — the first one exactly at
-//! `stroke` — and falls back, so the head is at rest again at `relax` and stays there until
-//! `end`. The amplitude is `amount` × the lexeme's full amplitude; 70 % of the rotation is at the
+//! back). Each of the `repetition` cycles rises smoothly to its peak exactly at its stroke
+//! (`stroke`, then `stroke:1` …, the sync points a repeated head has, so that other behaviours
+//! can be tied to any of them) and falls back, so the head is at rest again at `relax` and
+//! stays there until `end`. The amplitude is `amount` × the lexeme's full amplitude; 70 % of the rotation is at the
 //! skull base and 30 % at the neck (vc4). Head motions add up with other rotations of those joints.
 //! Lexemes the lexicon lacks are played with their timing only (no motion).
 
@@ -133,34 +134,50 @@ fn sync(syncs: &[(SyncName, f64)], name: &str) -> Option<f64> {
     syncs.iter().find(|s| s.0 == name).map(|s| s.1)
 }
 
-/// The rotation angle (radians) of a head unit at global time `t`.
+/// The rotation angle (radians) of a head unit at global time `t`: cycle `k` rises from the
+/// middle between strokes `k-1` and `k` (from `start` for the first) to its peak at stroke `k`
+/// and falls to the middle before the next (to `relax` after the last).
 fn angle(u: &HeadUnit, syncs: &[(SyncName, f64)], t: f64) -> f64 {
-    let (Some(start), Some(stroke), Some(relax)) = (
-        sync(syncs, "start"),
-        sync(syncs, "stroke"),
-        sync(syncs, "relax"),
-    ) else {
+    let (Some(start), Some(relax)) = (sync(syncs, "start"), sync(syncs, "relax")) else {
         return 0.0;
     };
     if !(t > start && t < relax) || relax <= start {
         return 0.0;
     }
-    let cycle = (relax - start) / f64::from(u.cycles.max(1));
-    let k = ((t - start) / cycle).floor();
-    let v = (t - start) / cycle - k; // position in the cycle, 0..1
-    let peak = ((stroke - start) / cycle).clamp(0.05, 0.95);
-    let shape = if v <= peak {
-        (1.0 - (std::f64::consts::PI * v / peak).cos()) / 2.0
+    // (in key order: stroke, stroke:1, …)
+    let peaks: Vec<f64> = (syncs.iter())
+        .filter(|(name, _)| crate::bml::stroke_iteration_of(name).is_some())
+        .map(|s| s.1)
+        .take(u.cycles.max(1) as usize)
+        .collect();
+    // the cycle holding t: its bounds and peak
+    let k = peaks.partition_point(|&p| p < t);
+    let k = if k > 0 && k < peaks.len() && t - peaks[k - 1] < peaks[k] - t {
+        k - 1
     } else {
-        (1.0 + (std::f64::consts::PI * (v - peak) / (1.0 - peak)).cos()) / 2.0
+        k.min(peaks.len().saturating_sub(1))
+    };
+    let Some(&peak) = peaks.get(k) else {
+        return 0.0;
+    };
+    let from = if k == 0 {
+        start
+    } else {
+        (peaks[k - 1] + peak) / 2.0
+    };
+    let to = peaks.get(k + 1).map_or(relax, |next| (peak + next) / 2.0);
+    let shape = if t <= peak {
+        (1.0 - (std::f64::consts::PI * (t - from) / (peak - from).max(1e-9)).cos()) / 2.0
+    } else {
+        (1.0 + (std::f64::consts::PI * (t - peak) / (to - peak).max(1e-9)).cos()) / 2.0
     };
     // a shake alternates sides, a nod and a tilt repeat
-    let sign = if u.motion.is_some_and(|m| m.alternate) && (k as u64) % 2 == 1 {
+    let sign = if u.motion.is_some_and(|m| m.alternate) && k % 2 == 1 {
         -1.0
     } else {
         1.0
     };
-    sign * u.amplitude * shape
+    sign * u.amplitude * shape.clamp(0.0, 1.0)
 }
 
 /// The head engine (see the module documentation).
@@ -342,6 +359,18 @@ mod tests {
         assert!((max - 0.2).abs() < 1e-9);
     }
 
+    /// A head's syncs with strokes at `strokes`, from `start` 1.0 to `relax` 2.0.
+    fn repeated_syncs(strokes: &[f64]) -> Vec<(SyncName, f64)> {
+        let mut s = vec![(crate::bml::Id::new_static("start"), 1.0)];
+        s.extend(
+            (0..)
+                .zip(strokes)
+                .map(|(n, &t)| (crate::bml::stroke_name(n), t)),
+        );
+        s.push((crate::bml::Id::new_static("relax"), 2.0));
+        s
+    }
+
     #[test]
     fn a_shake_alternates_sides() {
         let u = HeadUnit {
@@ -349,13 +378,39 @@ mod tests {
             amplitude: 0.3,
             cycles: 2,
         };
-        let s = nod_syncs(); // two cycles of 0.25 s from 1.0 to 1.5
-        let first: f64 = (0..250)
+        let s = repeated_syncs(&[1.25, 1.75]);
+        let first: f64 = (0..500)
             .map(|i| angle(&u, &s, 1.0 + f64::from(i) / 1000.0))
             .sum();
-        let second: f64 = (250..500)
+        let second: f64 = (500..1000)
             .map(|i| angle(&u, &s, 1.0 + f64::from(i) / 1000.0))
             .sum();
         assert!(first > 0.0 && second < 0.0);
+    }
+
+    #[test]
+    fn a_repeated_nod_peaks_at_each_of_its_strokes_wherever_they_are() {
+        let u = HeadUnit {
+            motion: HeadLexicon::default_lexicon().get("NOD"),
+            amplitude: 0.2,
+            cycles: 3,
+        };
+        // the second stroke pulled late (tied to something else)
+        let strokes = [1.2, 1.7, 1.85];
+        let s = repeated_syncs(&strokes);
+        let at = |t: f64| angle(&u, &s, t);
+        for p in strokes {
+            assert!((at(p) - 0.2).abs() < 1e-9, "no peak at {p}: {}", at(p));
+        }
+        // down between the strokes: at rest at the middles, lower on either side of a peak
+        assert!(at(1.45).abs() < 1e-9 && at(1.775).abs() < 1e-9);
+        for p in strokes {
+            assert!(at(p - 0.02) < at(p) && at(p + 0.02) < at(p));
+        }
+        let max = (0..=1000)
+            .map(|i| at(1.0 + f64::from(i) / 1000.0))
+            .fold(0.0, f64::max);
+        assert!((max - 0.2).abs() < 1e-9);
+        assert_eq!(at(2.0), 0.0);
     }
 }

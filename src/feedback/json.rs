@@ -261,8 +261,7 @@ impl Line {
                 skipped,
                 ..
             }) => {
-                let p = split_id(&id, 3, "syncPointProgress")?;
-                let [block, behaviour, sync] = <[String; 3]>::try_from(p).expect("three parts");
+                let [block, behaviour, sync] = sync_point_id(&id)?;
                 Feedback::SyncPointProgress(SyncPointProgress {
                     block: block.into(),
                     behaviour: behaviour.into(),

@@ -327,6 +327,25 @@ pub(crate) fn block_and_sync(id: &str) -> Result<(&str, &str), FeedbackError> {
         .ok_or_else(|| FeedbackError(format!("blockProgress id '{id}' should be block:sync")))
 }
 
+/// A syncPointProgress id `block:behaviour:sync`, or `block:behaviour:stroke:N` for the later
+/// strokes of a repeated head (the sync `stroke:N`).
+pub(crate) fn sync_point_id(id: &str) -> Result<[String; 3], FeedbackError> {
+    let parts: Vec<&str> = id.split(':').collect();
+    let sync = match parts[..] {
+        [_, _, s] => s.to_string(),
+        [_, _, "stroke", n] if !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) => {
+            format!("stroke:{n}")
+        }
+        _ => String::new(),
+    };
+    if sync.is_empty() || parts[..2].iter().any(|p| p.is_empty()) {
+        return Err(FeedbackError(format!(
+            "syncPointProgress id '{id}' should be block:behaviour:sync (or block:behaviour:stroke:N)"
+        )));
+    }
+    Ok([parts[0].to_string(), parts[1].to_string(), sync])
+}
+
 /// Splits `a:b` ids; `n` is the number of parts expected.
 pub(crate) fn split_id(id: &str, n: usize, what: &str) -> Result<Vec<String>, FeedbackError> {
     let parts: Vec<String> = id.split(':').map(str::to_string).collect();

@@ -107,7 +107,9 @@ pub fn to_xml(fb: &Feedback) -> String {
                 for (name, v) in &b.attributes {
                     attr(&mut o, name, v);
                 }
-                for (sync, v) in &b.syncs {
+                // (a repeated head's later strokes, `stroke:1` …, are no XML attribute names:
+                // their times come in syncPointProgress and in the JSON form)
+                for (sync, v) in b.syncs.iter().filter(|(s, _)| !s.contains(':')) {
                     attr(&mut o, sync, &t(*v));
                 }
                 o.push_str("/>");
@@ -252,8 +254,7 @@ pub fn from_xml(line: &str) -> Result<Feedback, FeedbackError> {
                 }))
             }
             "syncPointProgress" => {
-                let p = split_id(req(&a, "id", &name)?, 3, "syncPointProgress")?;
-                let [block, behaviour, sync] = <[String; 3]>::try_from(p).expect("three parts");
+                let [block, behaviour, sync] = sync_point_id(req(&a, "id", &name)?)?;
                 Ok(Feedback::SyncPointProgress(SyncPointProgress {
                     block: block.into(),
                     behaviour: behaviour.into(),

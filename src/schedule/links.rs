@@ -166,12 +166,7 @@ pub(crate) fn resolve(
                     return external
                         .time(p)
                         .map(|t| Some(Term::Fixed(t)))
-                        .ok_or_else(|| {
-                            (
-                                KnownWarning::NoSuchTarget,
-                                format!("the time of {p} is not known"),
-                            )
-                        });
+                        .ok_or_else(|| (KnownWarning::NoSuchTarget, external.why_unknown(p)));
                 }
             };
             let Some(i) = index.get(behaviour) else {

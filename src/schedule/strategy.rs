@@ -25,6 +25,11 @@ pub trait SchedulingStrategy: Send {
 pub trait ExternalTimes {
     /// The block-local time of `point`, or `None` if it is unknown.
     fn time(&self, point: &SyncPoint) -> Option<f64>;
+
+    /// Why the time of `point` is unknown, in a sentence (for the `NO_SUCH_TARGET` warning).
+    fn why_unknown(&self, point: &SyncPoint) -> String {
+        format!("the time of {point} is not known")
+    }
 }
 
 /// No external references are known.

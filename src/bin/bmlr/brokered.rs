@@ -21,7 +21,7 @@ use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
 use bml_realizer::realizer::{Realizer, NO_ID};
 
-use crate::dialect::{block_character, Arrived, Dialect, Out, FROM_THE_BLOCK};
+use crate::dialect::{block_character, Arrived, Dialect, Lane, Out};
 use crate::live_frames::LiveFrames;
 
 /// Blocks performed in one frame at most (the rest wait for the next frames, so that a flood
@@ -115,7 +115,7 @@ struct Server {
     /// Blocks waiting (and the request IU that asked for each), per character served (taken
     /// in turns: one character's flood does not hold up the others), and how many were
     /// dropped since last said.
-    waiting: BTreeMap<String, (VecDeque<Waiting>, usize)>,
+    waiting: BTreeMap<Lane, (VecDeque<Waiting>, usize)>,
 }
 
 /// A block waiting: its payload and the request IU that asked for it.
@@ -153,7 +153,7 @@ impl Server {
     fn perform_waiting(&mut self) {
         let dropped: Vec<(String, usize)> = (self.waiting.iter_mut())
             .filter(|(_, q)| q.1 > 0)
-            .map(|(c, q)| (c.clone(), std::mem::take(&mut q.1)))
+            .map(|(lane, q)| (lane.character().to_string(), std::mem::take(&mut q.1)))
             .collect();
         for (c, n) in dropped {
             let text =
@@ -163,7 +163,7 @@ impl Server {
         let (mut done, start) = (0, self.clock.now());
         // (within a frame: the clock and the other messages are not held up)
         while done < PER_FRAME && self.clock.now() - start < self.args.period.as_secs_f64() {
-            type Next = (String, Waiting);
+            type Next = (Lane, Waiting);
             let next: Vec<Next> = (self.waiting.iter_mut())
                 .filter_map(|(c, q)| Some((c.clone(), q.0.pop_front()?)))
                 .take(PER_FRAME - done)
@@ -233,7 +233,7 @@ impl Server {
                 payload,
                 request,
             }) => {
-                if lane == FROM_THE_BLOCK || self.serves(&lane) {
+                if matches!(lane, Lane::Shared(_)) || self.serves(lane.character()) {
                     let q = self.waiting.entry(lane).or_default();
                     if q.0.len() < QUEUE_LIMIT {
                         q.0.push_back((payload, request));
@@ -344,20 +344,23 @@ impl Server {
         self.send_raw(states);
     }
 
-    /// Performs a block from `lane` (a character's topic, or [`FROM_THE_BLOCK`]); what it
-    /// produces at once without a character (a block that could not be read) is that topic's.
-    fn perform(&mut self, lane: &str, payload: Vec<u8>, request: Option<String>) {
+    /// Performs a block from `lane`; what it produces at once without a character (a block
+    /// that could not be read) is the lane's character's.
+    fn perform(&mut self, lane: &Lane, payload: Vec<u8>, request: Option<String>) {
         // the clock up to date first: the block is planned at this time
         self.tick();
         let limits = *self.realizer.limits();
         let text = match String::from_utf8(payload) {
             Ok(t) => t,
-            Err(_) => return self.refuse(lane, "the payload is not UTF-8 text".into(), request),
+            Err(_) => {
+                let why = "the payload is not UTF-8 text".into();
+                return self.refuse(lane.character(), why, request);
+            }
         };
         let mut checked = Checked::new(&text, &limits);
         let block = checked.block.as_mut();
         let character = match (lane, block) {
-            (FROM_THE_BLOCK, Some(b)) => {
+            (Lane::Shared(_), Some(b)) => {
                 let c = block_character(b.character_id.as_deref());
                 if !self.serves(&c) {
                     // (another realizer's character: it answers)
@@ -365,8 +368,8 @@ impl Server {
                 }
                 c
             }
-            (FROM_THE_BLOCK, None) => DEFAULT_CHARACTER.to_string(),
-            (_, Some(b)) => {
+            (Lane::Shared(c), None) => c.clone(),
+            (Lane::Topic(lane), Some(b)) => {
                 let topic_character = (lane != DEFAULT_CHARACTER).then(|| lane.to_string());
                 if b.character_id.is_none() {
                     b.character_id = topic_character.clone();
@@ -381,7 +384,7 @@ impl Server {
                 }
                 lane.to_string()
             }
-            (_, None) => lane.to_string(),
+            (Lane::Topic(lane), None) => lane.to_string(),
         };
         let block_id = checked.block.as_ref().map(|b| b.id.to_string());
         let source = self.args.dialect.source(&character);
@@ -407,11 +410,6 @@ impl Server {
     }
 
     fn refuse(&mut self, character: &str, text: String, request: Option<String>) {
-        let character = if character == FROM_THE_BLOCK {
-            DEFAULT_CHARACTER
-        } else {
-            character
-        };
         let text = format!("{}: {text}", self.args.dialect.source(character));
         if let Some(uid) = request {
             let answer = self.args.dialect.answer_request(&uid, None, Some(&text));

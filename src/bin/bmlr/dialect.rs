@@ -16,9 +16,46 @@
 use bml_realizer::broker::ipaaca::{self, iu::Requests, Heard};
 use bml_realizer::broker::{Ipaaca, Topics, DEFAULT_CHARACTER};
 use bml_realizer::feedback::{BlockStatus, Feedback, Format};
+use quick_xml::events::Event;
 
-/// The lane of blocks whose character only the block itself says (the STOMP dialects).
-pub const FROM_THE_BLOCK: &str = "*";
+/// Whose queue a block waits in (each character's in turn: one character's flood does not
+/// hold up another's).
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Lane {
+    /// The character a topic names (MQTT topics, ipaaca channels).
+    Topic(String),
+    /// A shared topic (the STOMP dialects): the character the block's `characterId` names,
+    /// peeked at on arrival ([`peek_character`]); the block, once read, decides.
+    Shared(String),
+}
+
+impl Lane {
+    /// The character the lane is for.
+    pub fn character(&self) -> &str {
+        match self {
+            Lane::Topic(c) | Lane::Shared(c) => c,
+        }
+    }
+}
+
+/// The `characterId` of the root element of `payload` (the default character when it has none
+/// or cannot be read): only the start of the text is read.
+pub fn peek_character(payload: &[u8]) -> String {
+    let mut reader = quick_xml::Reader::from_reader(payload);
+    let mut buf = Vec::new();
+    loop {
+        match reader.read_event_into(&mut buf) {
+            Ok(Event::Start(e) | Event::Empty(e)) => {
+                let id = (e.attributes().flatten())
+                    .find(|a| a.key.local_name().as_ref() == b"characterId")
+                    .and_then(|a| a.unescape_value().ok().map(|v| v.into_owned()));
+                return block_character(id.as_deref());
+            }
+            Ok(Event::Eof) | Err(_) => return DEFAULT_CHARACTER.to_string(),
+            Ok(_) => buf.clear(),
+        }
+    }
+}
 
 /// A dialect (see the module documentation).
 pub enum Dialect {
@@ -34,10 +71,9 @@ pub enum Dialect {
 
 /// What arrived, as the serving loop needs it.
 pub enum Arrived {
-    /// A block for the character `lane` (a topic level; [`FROM_THE_BLOCK`]: the block says),
-    /// asked for by request IU `request` if one did.
+    /// A block waiting in `lane`, asked for by request IU `request` if one did.
     Block {
-        lane: String,
+        lane: Lane,
         payload: Vec<u8>,
         request: Option<String>,
     },
@@ -72,7 +108,7 @@ impl Dialect {
     pub fn read(&mut self, topic: &str, payload: Vec<u8>) -> Option<Arrived> {
         match self {
             Dialect::Topics(t) => {
-                let lane = t.bml_character(topic)?.to_string();
+                let lane = Lane::Topic(t.bml_character(topic)?.to_string());
                 Some(Arrived::Block {
                     lane,
                     payload,
@@ -80,8 +116,8 @@ impl Dialect {
                 })
             }
             Dialect::Asap(bml, _) | Dialect::Greta(bml, _) => {
-                (topic == bml).then_some(Arrived::Block {
-                    lane: FROM_THE_BLOCK.into(),
+                (topic == bml).then(|| Arrived::Block {
+                    lane: Lane::Shared(peek_character(&payload)),
                     payload,
                     request: None,
                 })
@@ -97,7 +133,7 @@ impl Dialect {
                         uid
                     });
                     Arrived::Block {
-                        lane: Ipaaca::character(&channel).to_string(),
+                        lane: Lane::Topic(Ipaaca::character(&channel).to_string()),
                         payload: text.into_bytes(),
                         request,
                     }

@@ -156,12 +156,23 @@ impl Decoder {
             .map_err(|_| "a frame's head is not UTF-8".to_string())?;
         let mut lines = head.split('\n').map(|l| l.strip_suffix('\r').unwrap_or(l));
         let command = lines.next().unwrap_or_default().to_string();
+        // (STOMP's commands are words in capitals)
+        if command.is_empty() || !command.bytes().all(|b| b.is_ascii_uppercase()) {
+            return Err(format!(
+                "'{}' is not a STOMP command",
+                command.escape_debug()
+            ));
+        }
         let raw = matches!(command.as_str(), "CONNECT" | "CONNECTED" | "STOMP");
         let mut headers = Vec::new();
         for line in lines {
             let (k, v) = line
                 .split_once(':')
                 .ok_or_else(|| format!("a header line without ':' in {command}"))?;
+            if raw && line.contains('\r') {
+                // (unescaped headers cannot say a carriage return: it would end the line)
+                return Err(format!("a carriage return inside a header of {command}"));
+            }
             if raw {
                 headers.push((k.to_string(), v.to_string()));
             } else {
@@ -271,5 +282,14 @@ mod tests {
         let mut d = Decoder::default();
         d.push(b"MESSAGE\ncontent-length:2\n\nabc\0");
         assert!(d.take().is_err());
+        // (found by the broker fuzz target: neither can be written back as it was read)
+        for garbage in [
+            &b"MESSAGE\r\r\n\n\0"[..],
+            b"CONNECTED\nversion:1.2\r\r\n\n\0",
+        ] {
+            let mut d = Decoder::default();
+            d.push(garbage);
+            assert!(d.take().is_err(), "{garbage:?}");
+        }
     }
 }
