@@ -9,53 +9,13 @@ mod avatars;
 
 use std::collections::BTreeMap;
 
-use avatars::{glb, random_rotation, test_avatar, Kind, BONES, LIMBS, TWISTS};
+use avatars::{glb, limb_errors, random_pose, test_avatar, Kind, LIMBS, TWISTS};
 use bml_realizer::avatar::{self, Model, Retarget};
 use bml_realizer::body::pose::Pose;
 use bml_realizer::body::skeleton::Skeleton;
 use bml_realizer::rng::Rng;
 use glam::{Mat4, Quat, Vec3};
 use serde_json::json;
-
-/// A random pose of the realizer: every joint turned up to `most` radians, the root moved and
-/// turned.
-fn random_pose(skeleton: &Skeleton, rng: &mut Rng, most: f32) -> Pose {
-    let mut pose = Pose::rest(skeleton);
-    for r in &mut pose.rotations {
-        *r = random_rotation(rng, most);
-    }
-    pose.root += Vec3::new(
-        rng.next_f32() * 4.0 - 2.0,
-        rng.next_f32() * 0.3,
-        rng.next_f32() * 4.0 - 2.0,
-    );
-    pose
-}
-
-/// The angles (degrees) between every limb bone of the posed avatar and its realizer bone.
-fn limb_errors(model: &Model, retarget: &Retarget, skeleton: &Skeleton, pose: &Pose) -> Vec<f32> {
-    let posed = retarget.world(&retarget.pose(pose));
-    let realizer = pose.world(skeleton);
-    let node_of = |bone: &str| {
-        model.nodes.iter().position(|n| {
-            n.name.ends_with(&format!("J_{bone}")) || {
-                let m = BONES.iter().find(|b| b.0 == bone).unwrap().3;
-                n.name == format!("mixamorig:{m}")
-            }
-        })
-    };
-    let place = |m: &Mat4| m.w_axis.truncate();
-    LIMBS
-        .iter()
-        .filter_map(|&(a, b)| {
-            let (na, nb) = (node_of(a)?, node_of(b)?);
-            let ours = place(&posed[nb]) - place(&posed[na]);
-            let (ja, jb) = (retarget.source(na)?, retarget.source(nb)?);
-            let theirs = retarget.frame() * (realizer.positions[jb] - realizer.positions[ja]);
-            Some(ours.angle_between(theirs).to_degrees())
-        })
-        .collect()
-}
 
 #[test]
 fn every_limb_bone_of_three_kinds_of_avatar_points_where_the_realizer_s_does() {
@@ -182,9 +142,13 @@ fn bad_avatars_are_refused_naming_the_file_and_what_is_missing() {
         .remove("leftLowerArm");
     let model = Model::from_glb("vrm.vrm", &glb(&json)).unwrap();
     let e = Retarget::new(&model, &skeleton, None).unwrap_err();
-    assert_eq!(
-        e.to_string(),
-        "vrm.vrm: its skeleton lacks the bones leftLowerArm"
+    assert!(
+        e.to_string().starts_with(concat!(
+            "vrm.vrm: its skeleton is not a whole humanoid: no bone leftLowerArm was found. ",
+            r#"Give a bone map (--bone-map MAP.json) naming the node of each: {"leftLowerArm": "NODE"}; "#,
+            "the skin's joints are J_hips, J_spine,"
+        )),
+        "{e}"
     );
     // broken bytes
     for bytes in [

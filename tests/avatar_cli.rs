@@ -115,7 +115,7 @@ fn bmlr_refuses_a_bad_avatar_with_exit_2_naming_the_file() {
     let (code, err) = welcome_on(&vrm, &out);
     assert_eq!(code, 2, "{err}");
     assert!(
-        err.contains("nolowerarm.vrm: its skeleton lacks the bones rightLowerArm"),
+        err.contains("nolowerarm.vrm: its skeleton is not a whole humanoid: no bone rightLowerArm was found. Give a bone map"),
         "{err}"
     );
     let (code, err) = bmlr(&[

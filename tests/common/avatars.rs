@@ -7,10 +7,11 @@
 
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
+use bml_realizer::avatar::{Model, Retarget};
 use bml_realizer::body::pose::Pose;
 use bml_realizer::body::skeleton::Skeleton;
 use bml_realizer::rng::Rng;
-use glam::{Quat, Vec3};
+use glam::{Mat4, Quat, Vec3};
 use serde_json::{json, Value};
 
 /// A test avatar's bones: (bone as VRM 1.0 names it, where it sits: a realizer joint, its
@@ -318,4 +319,49 @@ pub fn test_avatar(kind: Kind) -> Vec<u8> {
         Kind::Mixamo => {}
     }
     glb(&doc)
+}
+
+/// A random pose of the realizer: every joint turned up to `most` radians, the root moved and
+/// turned.
+pub fn random_pose(skeleton: &Skeleton, rng: &mut Rng, most: f32) -> Pose {
+    let mut pose = Pose::rest(skeleton);
+    for r in &mut pose.rotations {
+        *r = random_rotation(rng, most);
+    }
+    pose.root += Vec3::new(
+        rng.next_f32() * 4.0 - 2.0,
+        rng.next_f32() * 0.3,
+        rng.next_f32() * 4.0 - 2.0,
+    );
+    pose
+}
+
+/// The angles (degrees) between every limb bone of the posed avatar and its realizer bone.
+pub fn limb_errors(
+    model: &Model,
+    retarget: &Retarget,
+    skeleton: &Skeleton,
+    pose: &Pose,
+) -> Vec<f32> {
+    let posed = retarget.world(&retarget.pose(pose));
+    let realizer = pose.world(skeleton);
+    let node_of = |bone: &str| {
+        model.nodes.iter().position(|n| {
+            n.name.ends_with(&format!("J_{bone}")) || {
+                let m = BONES.iter().find(|b| b.0 == bone).unwrap().3;
+                n.name == format!("mixamorig:{m}")
+            }
+        })
+    };
+    let place = |m: &Mat4| m.w_axis.truncate();
+    LIMBS
+        .iter()
+        .filter_map(|&(a, b)| {
+            let (na, nb) = (node_of(a)?, node_of(b)?);
+            let ours = place(&posed[nb]) - place(&posed[na]);
+            let (ja, jb) = (retarget.source(na)?, retarget.source(nb)?);
+            let theirs = retarget.frame() * (realizer.positions[jb] - realizer.positions[ja]);
+            Some(ours.angle_between(theirs).to_degrees())
+        })
+        .collect()
 }

@@ -1,14 +1,17 @@
 //! Reading an avatar file: a binary glTF (`.glb`, and VRM 0.x/1.0 `.vrm`, which are GLB) or a
-//! JSON glTF (`.gltf`) whose buffers are files beside it. The `gltf` crate checks the document
-//! (every index in range, the structure valid); the file's own JSON is kept as it is (VRM's
-//! extensions included) together with its binary buffer, so that an export can write the
-//! avatar back unchanged with the animation added. Out of the document come the nodes (names,
-//! parents, rest transforms), the first skin's joints and every mesh's morph target names.
+//! JSON glTF (`.gltf`) whose buffers are `data:` URIs or files beside it. Out of the document
+//! (`document`: read as the specification says, every index it uses checked) come the nodes
+//! (names, parents, rest transforms), the largest skin's joints and every mesh's morph target
+//! names. The file's own JSON is kept as it is (VRM's extensions included) with its buffers
+//! gathered into one (`buffers`), so that an export can write the avatar back unchanged with
+//! the animation added. An FBX file is refused saying how to convert it.
 
 use std::path::Path;
 
 use glam::{Mat4, Quat, Vec3};
 use serde_json::Value;
+
+use super::{buffers, document};
 
 /// The largest avatar file read (bytes).
 pub const MAX_AVATAR_BYTES: u64 = 256 << 20;
@@ -95,30 +98,19 @@ impl Model {
         if bytes.starts_with(b"glTF") {
             return Model::from_glb(&file, &bytes);
         }
-        let json: Value = serde_json::from_slice(&bytes)
+        if bytes.starts_with(b"Kaydara FBX Binary") || bytes.starts_with(b"; FBX") {
+            return Err(AvatarError::new(
+                &file,
+                "an FBX file, which this realizer does not read: convert it to glTF binary (.glb), \
+                 e.g. in Blender (File > Import > FBX, then File > Export > glTF 2.0, format GLB) \
+                 or with FBX2glTF (`FBX2glTF --binary --input X.fbx --output X`)",
+            ));
+        }
+        let mut json: Value = serde_json::from_slice(&bytes)
             .map_err(|e| AvatarError::new(&file, format!("neither GLB nor glTF JSON: {e}")))?;
-        let bin = match json["buffers"].as_array().map(Vec::as_slice) {
-            None | Some([]) => Vec::new(),
-            Some([one]) => {
-                let uri = one["uri"].as_str().unwrap_or("");
-                if uri.is_empty() || uri.starts_with("data:") {
-                    return Err(AvatarError::new(
-                        &file,
-                        "its buffer is embedded as a data: URI; convert it to .glb",
-                    ));
-                }
-                let beside = path.parent().unwrap_or(Path::new(".")).join(uri);
-                std::fs::read(&beside).map_err(|e| {
-                    AvatarError::new(&file, format!("buffer {}: {e}", beside.display()))
-                })?
-            }
-            Some(_) => {
-                return Err(AvatarError::new(
-                    &file,
-                    "more than one buffer; convert it to .glb",
-                ))
-            }
-        };
+        let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let bin = buffers::gather(&mut json, buffers::First::Beside(dir))
+            .map_err(|e| AvatarError::new(&file, e))?;
         Model::from_parts(&file, json, bin)
     }
 
@@ -147,42 +139,36 @@ impl Model {
             at += 8 + length.next_multiple_of(4);
         }
         let json = json.ok_or_else(|| bad("no JSON chunk"))?;
-        let json: Value = serde_json::from_slice(json)
+        let mut json: Value = serde_json::from_slice(json)
             .map_err(|e| AvatarError::new(file, format!("its JSON: {e}")))?;
+        let bin = buffers::gather(&mut json, buffers::First::Glb(bin))
+            .map_err(|e| AvatarError::new(file, e))?;
         Model::from_parts(file, json, bin)
     }
 
-    /// The avatar of glTF `json` with binary buffer `bin`.
+    /// The avatar of glTF `json` with its one binary buffer `bin`.
     fn from_parts(file: &str, json: Value, bin: Vec<u8>) -> Result<Model, AvatarError> {
-        let text = serde_json::to_vec(&json).expect("a JSON value serialises");
-        let document = gltf::Gltf::from_slice(&text)
-            .map_err(|e| AvatarError::new(file, format!("not valid glTF: {e}")))?
-            .document;
-        let mut nodes: Vec<Node> = document
-            .nodes()
-            .map(|n| {
-                let (t, r, s) = n.transform().decomposed();
-                Node {
-                    name: n.name().unwrap_or("").to_string(),
-                    parent: None,
-                    translation: Vec3::from(t),
-                    rotation: Quat::from_array(r).normalize(),
-                    scale: Vec3::from(s),
-                }
-            })
-            .collect();
-        for n in document.nodes() {
-            for c in n.children() {
-                nodes[c.index()].parent = Some(n.index());
-            }
+        let invalid = |e: String| AvatarError::new(file, format!("not valid glTF: {e}"));
+        if !json.is_object() {
+            return Err(invalid("the document is not a JSON object".into()));
         }
-        let joints = match document.skins().next() {
-            Some(skin) => skin.joints().map(|j| j.index()).collect(),
-            None => return Err(AvatarError::new(file, "it has no skin (no skinned mesh)")),
-        };
-        let morphs = document
-            .meshes()
-            .map(|m| target_names(&json["meshes"][m.index()]))
+        let version = json["asset"]["version"].as_str().unwrap_or("");
+        if !version.starts_with("2.") {
+            return Err(invalid(format!(
+                "asset.version is '{version}', not 2.x (glTF 1.0 files must be converted)"
+            )));
+        }
+        document::check_required(&json).map_err(|e| AvatarError::new(file, e))?;
+        let nodes = document::nodes(&json).map_err(invalid)?;
+        let skins = document::skins(&json, nodes.len()).map_err(invalid)?;
+        // (the skin with most joints: a figure's body, not an accessory's)
+        let joints = skins.into_iter().max_by_key(Vec::len).unwrap_or_default();
+        if joints.is_empty() {
+            return Err(AvatarError::new(file, "it has no skin (no skinned mesh)"));
+        }
+        let meshes = json["meshes"].as_array().map_or(0, Vec::len);
+        let morphs = (0..meshes)
+            .map(|m| target_names(&json["meshes"][m]))
             .collect();
         Ok(Model {
             file: file.to_string(),

@@ -157,20 +157,46 @@ pub fn recognise(
         .copied()
         .filter(|b| !found.contains_key(b))
         .collect();
-    if missing.len() == REQUIRED.len() {
-        return Err(AvatarError::new(
-            &model.file,
-            "its skeleton's names match no known scheme (H-Anim, Mixamo, VRM, Unreal); \
-             give a bone map",
-        ));
+    if missing.is_empty() {
+        return Ok(found);
     }
-    if !missing.is_empty() {
-        return Err(AvatarError::new(
-            &model.file,
-            format!("its skeleton lacks the bones {}", missing.join(", ")),
-        ));
-    }
-    Ok(found)
+    let why = if missing.len() == REQUIRED.len() {
+        "its skeleton's names match no known scheme (H-Anim, Mixamo, VRM, Unreal): none of the humanoid bones".to_string()
+    } else {
+        "its skeleton is not a whole humanoid: no bone".to_string()
+    };
+    Err(AvatarError::new(
+        &model.file,
+        format!(
+            "{why} {} was found. Give a bone map (--bone-map MAP.json) naming the node of each: {}",
+            missing.join(", "),
+            bone_map_form(model, &missing)
+        ),
+    ))
+}
+
+/// The form of a bone map for the `missing` bones, and the names of the skin's joints to fill
+/// it with (the first 40).
+fn bone_map_form(model: &Model, missing: &[&str]) -> String {
+    let items: Vec<String> = missing
+        .iter()
+        .map(|b| format!("\"{b}\": \"NODE\""))
+        .collect();
+    let names: Vec<&str> = (model.joints.iter())
+        .map(|&j| model.nodes[j].name.as_str())
+        .take(40)
+        .collect();
+    let more = model.joints.len().saturating_sub(names.len());
+    format!(
+        "{{{}}}; the skin's joints are {}{}",
+        items.join(", "),
+        names.join(", "),
+        if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
+        }
+    )
 }
 
 /// The bone of a VRM 1.0 name, as a `'static` name from [`BONES`].

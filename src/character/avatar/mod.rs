@@ -6,6 +6,8 @@
 //! data (`assets/avatar/NOTICE.md`), is compiled in: its skeleton is the realizer's own, its
 //! face has the 52 ARKit morph targets.
 
+mod buffers;
+mod document;
 mod drive;
 mod export;
 mod file;
