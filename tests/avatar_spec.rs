@@ -5,7 +5,7 @@
 //! retargeted within 1° mean / 2° worst over 500 random poses, and driven by `bmlr run --avatar
 //! … --gltf`: the export keeps the file's own data and adds the animation (its arm turns, its
 //! `jawOpen` target is keyed where it has one). The exports are left in
-//! `target/avatar-spec/` for `.ci/run`, which passes them through the Khronos glTF-Validator
+//! `target/avatar-forms/` for `.ci/run`, which passes them through the Khronos glTF-Validator
 //! and three.js's loader. Also: what is refused, and how (exit 2, a sentence, nothing on
 //! stdout).
 
@@ -37,7 +37,7 @@ fn skeleton_only() -> (Value, Vec<glam::Mat4>) {
 
 /// Where this test writes its files.
 fn out_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/avatar-spec");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/avatar-forms");
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
@@ -235,4 +235,65 @@ fn what_cannot_be_driven_is_refused_with_a_sentence_that_says_what_to_do() {
             assert!(err.contains(&s), "{file}: '{s}' not in {err}");
         }
     }
+}
+
+/// The floats of accessor `a` of a GLB (tightly packed, as the export writes them).
+fn floats_of(bytes: &[u8], json: &Value, a: usize) -> Vec<f32> {
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let bin = &bytes[20 + length + 8..];
+    let acc = &json["accessors"][a];
+    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let start = (view["byteOffset"].as_u64().unwrap_or(0) + acc["byteOffset"].as_u64().unwrap_or(0))
+        as usize;
+    let n = acc["count"].as_u64().unwrap() as usize * if acc["type"] == "SCALAR" { 1 } else { 4 };
+    (0..n)
+        .map(|k| f32::from_le_bytes(bin[start + 4 * k..start + 4 * k + 4].try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn a_vrm_0_x_s_blend_shape_presets_move_its_own_targets_while_it_speaks() {
+    let model = Model::from_glb("vrm0", &test_avatar(Kind::Vrm0)).unwrap();
+    let rest: Vec<glam::Mat4> = (0..model.nodes.len())
+        .map(|i| model.rest_world(i))
+        .collect();
+    let (mut doc, bin) = with_mesh(model.json, &rest, Case::SparseNoBase);
+    // VRoid's own target name, reached only through the preset "a" (VRM 0.x weighs 0–100)
+    doc["meshes"][0]["extras"]["targetNames"] = json!(["Fcl_MTH_A"]);
+    doc["extensions"]["VRM"]["blendShapeMaster"] = json!({"blendShapeGroups": [
+        {"name": "A", "presetName": "a", "binds": [{"mesh": 0, "index": 0, "weight": 100}]},
+    ]});
+    let dir = out_dir().join("in-vrm0");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("presets.vrm");
+    std::fs::write(&path, glb_with(&doc, &bin)).unwrap();
+    let out = out_dir().join("vrm0-presets.glb");
+    let (code, _, err) = bmlr(
+        &[
+            "run",
+            "--avatar",
+            path.to_str().unwrap(),
+            "--gltf",
+            out.to_str().unwrap(),
+            "fixtures/examples/welcome.xml",
+        ],
+        "",
+    );
+    assert_eq!(code, 0, "{err}");
+    let bytes = std::fs::read(&out).unwrap();
+    let json = glb_json(&bytes);
+    let animation = &json["animations"][0];
+    let nodes = json["nodes"].as_array().unwrap();
+    let channel = (animation["channels"].as_array().unwrap().iter())
+        .find(|c| {
+            c["target"]["path"] == "weights"
+                && nodes[c["target"]["node"].as_u64().unwrap() as usize]["name"] == "body"
+        })
+        .expect("the body's target weights are keyed");
+    let sampler = &animation["samplers"][channel["sampler"].as_u64().unwrap() as usize];
+    let weights = floats_of(&bytes, &json, sampler["output"].as_u64().unwrap() as usize);
+    let most = weights.iter().fold(0.0f32, |a, &b| a.max(b));
+    eprintln!("the A target peaks at {most} over {} keys", weights.len());
+    // the mouth opens on "a" while "Hello and welcome" is spoken
+    assert!(most > 0.2, "the A target's weight peaks at {most}");
 }

@@ -82,9 +82,15 @@ pub fn with_mesh(mut json: Value, rest: &[Mat4], case: Case) -> (Value, Vec<u8>)
         .collect();
     let named = |suffix: &str| {
         let n = json["nodes"].as_array().unwrap();
-        let node = (0..n.len()).find(|&i| n[i]["name"].as_str().unwrap_or("").ends_with(suffix));
+        let vrm = match suffix {
+            "LeftArm" => "J_leftUpperArm",
+            _ => "J_hips",
+        };
+        let name = |i: usize| n[i]["name"].as_str().unwrap_or("");
+        let node = (0..n.len()).find(|&i| name(i).ends_with(suffix) || name(i) == vrm);
         joints.iter().position(|&j| Some(j) == node).unwrap()
     };
+    // (Mixamo's names, or VRM's J_ names)
     let (arm, hips) = (named("LeftArm"), named("Hips"));
     // the triangle, in the world at rest (metres)
     let at = rest[joints[arm]].w_axis.truncate();

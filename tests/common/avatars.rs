@@ -343,8 +343,6 @@ pub fn limb_errors(
     skeleton: &Skeleton,
     pose: &Pose,
 ) -> Vec<f32> {
-    let posed = retarget.world(&retarget.pose(pose));
-    let realizer = pose.world(skeleton);
     let node_of = |bone: &str| {
         model.nodes.iter().position(|n| {
             n.name.ends_with(&format!("J_{bone}")) || {
@@ -353,6 +351,19 @@ pub fn limb_errors(
             }
         })
     };
+    limb_errors_by(retarget, skeleton, pose, node_of)
+}
+
+/// The angles (degrees) between every limb bone (of [`LIMBS`], where `node_of` finds both
+/// ends) of the posed avatar and its realizer bone.
+pub fn limb_errors_by(
+    retarget: &Retarget,
+    skeleton: &Skeleton,
+    pose: &Pose,
+    node_of: impl Fn(&str) -> Option<usize>,
+) -> Vec<f32> {
+    let posed = retarget.world(&retarget.pose(pose));
+    let realizer = pose.world(skeleton);
     let place = |m: &Mat4| m.w_axis.truncate();
     LIMBS
         .iter()

@@ -1,7 +1,8 @@
 //! An avatar's buffers gathered into one, as a GLB holds them: the GLB's own BIN chunk, buffers
 //! given as `data:` URIs (base64) and buffers in files beside a `.gltf`, laid one after the other
 //! (each at a multiple of 4 bytes) with every buffer view's `buffer` and `byteOffset` moved to
-//! match. The avatar is then written back as one GLB with the animation added.
+//! match; images given by `uri` (a file beside, or `data:`) are taken into the buffer too. The
+//! avatar is then written back as one self-contained GLB with the animation added.
 
 use std::path::Path;
 
@@ -89,7 +90,7 @@ fn percent_decoded(uri: &str) -> String {
 /// Every buffer of `json` in one, the views moved to match; `json` then has one buffer.
 pub fn gather(json: &mut Value, mut first: First) -> Result<Vec<u8>, String> {
     let buffers = json["buffers"].as_array().cloned().unwrap_or_default();
-    if buffers.is_empty() {
+    if buffers.is_empty() && json["images"].as_array().is_none_or(|i| i.is_empty()) {
         return Ok(match first {
             First::Glb(bin) => bin,
             First::Beside(_) => Vec::new(),
@@ -120,6 +121,65 @@ pub fn gather(json: &mut Value, mut first: First) -> Result<Vec<u8>, String> {
         v["buffer"] = json!(0);
         v["byteOffset"] = json!(offset);
     }
+    embed_images(json, &mut bin, &first)?;
     json["buffers"] = json!([{"byteLength": bin.len()}]);
     Ok(bin)
+}
+
+/// Images given by `uri` taken into `bin` (a view each, with their MIME type).
+fn embed_images(json: &mut Value, bin: &mut Vec<u8>, first: &First) -> Result<(), String> {
+    let images = json["images"].as_array().cloned().unwrap_or_default();
+    for (i, image) in images.iter().enumerate() {
+        let Some(uri) = image["uri"].as_str() else {
+            continue;
+        };
+        let (bytes, mime) = if let Some(rest) = uri.strip_prefix("data:") {
+            let mime = rest.split([';', ',']).next().unwrap_or("").to_string();
+            (
+                data_uri(uri).map_err(|e| format!("images[{i}]: {e}"))?,
+                mime,
+            )
+        } else {
+            let First::Beside(dir) = first else {
+                return Err(format!(
+                    "images[{i}] is the file '{uri}' (read the avatar from its path, with the file beside it)"
+                ));
+            };
+            let name = percent_decoded(uri);
+            if Path::new(&name).is_absolute() || name.contains("..") || name.contains("://") {
+                return Err(format!(
+                    "images[{i}]: '{uri}' is not a file beside the avatar"
+                ));
+            }
+            let path = dir.join(&name);
+            let bytes =
+                std::fs::read(&path).map_err(|e| format!("images[{i}] {}: {e}", path.display()))?;
+            let lower = name.to_ascii_lowercase();
+            let mime = if lower.ends_with(".png") {
+                "image/png"
+            } else if lower.ends_with(".jpg") || lower.ends_with(".jpeg") {
+                "image/jpeg"
+            } else {
+                image["mimeType"]
+                    .as_str()
+                    .unwrap_or("application/octet-stream")
+            };
+            (bytes, mime.to_string())
+        };
+        bin.resize(bin.len().next_multiple_of(4), 0);
+        let views = json["bufferViews"].as_array().map_or(0, Vec::len);
+        let view = json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()});
+        bin.extend(bytes);
+        match json["bufferViews"].as_array_mut() {
+            Some(v) => v.push(view),
+            None => json["bufferViews"] = json!([view]),
+        }
+        let image = &mut json["images"][i];
+        if let Some(o) = image.as_object_mut() {
+            o.remove("uri");
+        }
+        image["bufferView"] = json!(views);
+        image["mimeType"] = json!(mime);
+    }
+    Ok(())
 }

@@ -5,7 +5,7 @@
 //!
 //! Read here rather than through the `gltf` crate's document: its validation refuses files
 //! the specification and the Khronos validator allow — accessors without a `bufferView`, which
-//! are zeros (gltf-rs issue #346), as exporters write them for morph targets that do not move a
+//! are zeros (gltf-rs issue 346 on GitHub), as exporters write them for morph targets that do not move a
 //! primitive — and an avatar needs none of what it would check beyond these few arrays (vertex
 //! data is read by the viewer's three.js and checked by the validator on export).
 

@@ -136,7 +136,8 @@ pub fn spine_sources(count: usize) -> &'static [&'static str] {
 }
 
 /// Which node each human bone is (bone name → node), as found in `model`: by the bone map
-/// given (keys: bone names or realizer joint names; values: node names), else by VRM's
+/// given (keys: bone names or realizer joint names; values: node names, or `#N` for node N),
+/// else by VRM's
 /// humanoid extension, else by the node names.
 pub fn recognise(
     model: &Model,
@@ -176,14 +177,18 @@ pub fn recognise(
 }
 
 /// The form of a bone map for the `missing` bones, and the names of the skin's joints to fill
-/// it with (the first 40).
+/// it with (the first 40; a node without a name is given by its index, a number in the map).
 fn bone_map_form(model: &Model, missing: &[&str]) -> String {
     let items: Vec<String> = missing
         .iter()
         .map(|b| format!("\"{b}\": \"NODE\""))
         .collect();
-    let names: Vec<&str> = (model.joints.iter())
-        .map(|&j| model.nodes[j].name.as_str())
+    // (a joint without a name by its index, as a bone map may give it: a number)
+    let names: Vec<String> = (model.joints.iter())
+        .map(|&j| match model.nodes[j].name.as_str() {
+            "" => format!("{j} (no name)"),
+            name => name.to_string(),
+        })
         .take(40)
         .collect();
     let more = model.joints.len().saturating_sub(names.len());
@@ -250,7 +255,11 @@ fn from_map(
             .ok_or_else(|| {
                 AvatarError::new(&model.file, format!("bone map: unknown bone '{key}'"))
             })?;
-        let n = model.node(node).ok_or_else(|| {
+        // (`#N`: node N, for nodes without names)
+        let index = (node.strip_prefix('#'))
+            .and_then(|n| n.parse::<usize>().ok())
+            .filter(|&n| n < model.nodes.len());
+        let n = model.node(node).or(index).ok_or_else(|| {
             AvatarError::new(
                 &model.file,
                 format!("bone map: {key}: no node named '{node}'"),
