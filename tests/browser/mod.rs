@@ -49,6 +49,12 @@ pub fn chromium() -> Option<PathBuf> {
 /// Headless Chromium on `url` with `what` (e.g. `--dump-dom` or `--screenshot=OUT.png`):
 /// (stdout, the page's console lines).
 pub fn browse(url: &str, what: &str) -> (String, Vec<String>) {
+    browse_for(url, what, 5_000)
+}
+
+/// [`browse`] with `budget` ms of virtual time (more for avatars whose textures decode off the
+/// page's thread: the screenshot is taken when the budget is spent).
+pub fn browse_for(url: &str, what: &str, budget: u32) -> (String, Vec<String>) {
     let chromium =
         chromium().expect("Debian's chromium (apt-get install chromium; .ci/run installs it)");
     // one profile per run: Chromium locks its profile, and the tests run browsers in parallel
@@ -70,10 +76,10 @@ pub fn browse(url: &str, what: &str) -> (String, Vec<String>) {
             "--disable-component-update",
             "--disable-sync",
             "--window-size=1280,720",
-            "--virtual-time-budget=5000",
             "--enable-logging=stderr",
             "--v=0",
         ])
+        .arg(format!("--virtual-time-budget={budget}"))
         .arg(format!("--user-data-dir={}", profile.display()))
         .arg(what)
         .arg(url)
