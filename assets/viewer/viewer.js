@@ -31,6 +31,13 @@
 
   /** Frames a live page keeps (ten minutes at 30 a second); older ones are let go. */
   const LIVE_FRAMES = 18000;
+  /** A world point's name: its size (m) and how far above its ball it floats. */
+  const LABEL_WIDTH = 0.32;
+  const LABEL_HEIGHT = 0.08;
+  const LABEL_ABOVE = 0.08;
+  /** The box round a person that names keep out of: radius about the root and height (m). */
+  const BODY_RADIUS = 0.25;
+  const BODY_HEIGHT = 1.85;
 
   /** The frames of a run: times, and per frame each character's root and joint rotations. */
   class Clip {
@@ -458,10 +465,17 @@
         const ball = new THREE.Mesh(new THREE.SphereGeometry(0.035, 16, 12), material);
         ball.position.fromArray(at);
         const label = this.label(name);
-        label.position.set(0, 0.08, 0);
+        label.position.set(0, LABEL_ABOVE, 0);
         ball.add(label);
+        // a thin line from the ball to its name when the name had to move aside
+        const leader = new THREE.Line(
+          new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(), new THREE.Vector3()]),
+          new THREE.LineBasicMaterial({ color: 0xb39a80 }),
+        );
+        leader.visible = false;
+        ball.add(leader);
         this.scene.add(ball);
-        this.points.push({ ball, keys: (world.paths || {})[name] });
+        this.points.push({ ball, label, leader, keys: (world.paths || {})[name] });
       }
       // obstacles: grey blocks to their height
       const grey = new THREE.MeshStandardMaterial({ color: 0x8a8f98, transparent: true, opacity: 0.6 });
@@ -494,6 +508,78 @@
       }
     }
 
+    /**
+     * Keeps each world point's name off the people: above its ball, unless that would cross a
+     * body on the screen (a box round each character, feet to head); then at the nearest place
+     * beside the people that crosses none and stays in the view, else above them all.
+     */
+    placeLabels() {
+      const THREE = this.THREE;
+      const camera = this.camera;
+      camera.updateMatrixWorld();
+      const scratch = this.labelScratch || (this.labelScratch = {
+        v: new THREE.Vector3(), right: new THREE.Vector3(), up: new THREE.Vector3(),
+      });
+      const { v, right, up } = scratch;
+      right.setFromMatrixColumn(camera.matrixWorld, 0);
+      up.setFromMatrixColumn(camera.matrixWorld, 1);
+      // the people's boxes on the screen (normalized device coordinates)
+      const boxes = this.figures.map((f) => {
+        const root = f.nodes[0].position;
+        const box = { x0: Infinity, x1: -Infinity, y0: Infinity, y1: -Infinity };
+        for (const dx of [-BODY_RADIUS, BODY_RADIUS]) {
+          for (const dz of [-BODY_RADIUS, BODY_RADIUS]) {
+            for (const y of [0, BODY_HEIGHT]) {
+              v.set(root.x + dx, y, root.z + dz).project(camera);
+              box.x0 = Math.min(box.x0, v.x); box.x1 = Math.max(box.x1, v.x);
+              box.y0 = Math.min(box.y0, v.y); box.y1 = Math.max(box.y1, v.y);
+            }
+          }
+        }
+        return box;
+      });
+      const tan = Math.tan((camera.fov * Math.PI) / 360);
+      // (what was placed, for the page's tests: the people's boxes and the names' on the screen)
+      this.placed = { people: boxes, names: [] };
+      for (const p of this.points) {
+        const ball = p.ball.position;
+        // half the label's size on the screen, at the ball's depth
+        const depth = v.copy(ball).applyMatrix4(camera.matrixWorldInverse).z;
+        const perNdc = Math.max(-depth, 1e-3) * tan; // world units per unit of NDC (vertical)
+        const half = { x: LABEL_WIDTH / 2 / (perNdc * camera.aspect), y: LABEL_HEIGHT / 2 / perNdc };
+        v.copy(ball).addScaledVector(up, LABEL_ABOVE).project(camera);
+        const at = { x: v.x, y: v.y };
+        const clear = (x, y) => !boxes.some((b) =>
+          x + half.x > b.x0 && x - half.x < b.x1 && y + half.y > b.y0 && y - half.y < b.y1);
+        let dx = 0;
+        let dy = 0;
+        if (!clear(at.x, at.y)) {
+          // beside the people, the nearest place on the screen that crosses none; else above them
+          const gap = 0.02;
+          const xs = boxes.flatMap((b) => [b.x0 - half.x - gap, b.x1 + half.x + gap])
+            .filter((x) => x - half.x > -1 && x + half.x < 1 && clear(x, at.y))
+            .sort((p1, p2) => Math.abs(p1 - at.x) - Math.abs(p2 - at.x));
+          if (xs.length) {
+            dx = (xs[0] - at.x) * perNdc * camera.aspect;
+          } else {
+            const top = Math.max(...boxes.map((b) => b.y1)) + half.y + gap;
+            dy = (top - at.y) * perNdc;
+          }
+        }
+        p.label.position.copy(right).multiplyScalar(dx).addScaledVector(up, LABEL_ABOVE + dy);
+        v.copy(ball).addScaledVector(right, dx).addScaledVector(up, LABEL_ABOVE + dy).project(camera);
+        this.placed.names.push({ x0: v.x - half.x, x1: v.x + half.x, y0: v.y - half.y, y1: v.y + half.y });
+        p.leader.visible = dx !== 0 || dy !== 0;
+        if (p.leader.visible) {
+          // to the near end of the name, a little below its middle
+          const end = v.copy(p.label.position).addScaledVector(right, -Math.sign(dx) * LABEL_WIDTH * 0.3)
+            .addScaledVector(up, -LABEL_HEIGHT * 0.25);
+          p.leader.geometry.attributes.position.setXYZ(1, end.x, end.y, end.z);
+          p.leader.geometry.attributes.position.needsUpdate = true;
+        }
+      }
+    }
+
     label(text) {
       const THREE = this.THREE;
       const canvas = document.createElement('canvas');
@@ -507,7 +593,7 @@
       const sprite = new THREE.Sprite(
         new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(canvas), depthWrite: false }),
       );
-      sprite.scale.set(0.32, 0.08, 1);
+      sprite.scale.set(LABEL_WIDTH, LABEL_HEIGHT, 1);
       return sprite;
     }
 
@@ -685,6 +771,7 @@
         target.z + distance * Math.cos(azimuth) * Math.cos(v.elevation),
       );
       this.camera.lookAt(target);
+      this.placeLabels();
       this.renderer.render(this.scene, this.camera);
       this.scrub.min = String(this.clip.start);
       this.scrub.max = String(Math.max(this.clip.duration, this.clip.start + 0.001));
@@ -698,6 +785,7 @@
         // time, also under a headless browser's virtual time)
         if (/(?:^#|&)timing(?:&|$)/.test(location.hash)) console.info('bmlr view: ready');
         document.title = 'bmlr view: ready';
+        if (this.placed) document.documentElement.dataset.placed = JSON.stringify(this.placed);
       }
     }
 
