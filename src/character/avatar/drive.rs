@@ -4,6 +4,7 @@
 //! morph targets the face drives, flat, in a fixed order the host learns once.
 
 use super::file::Model;
+use super::morph::Look;
 use super::morph::MorphMap;
 use super::retarget::Retarget;
 use crate::body::pose::Pose;
@@ -64,8 +65,9 @@ impl Driver {
         rotations.extend(posed.hips.1.to_array());
         weights.clear();
         let mut one = Vec::new();
+        let look = Look::of(pose, self.retarget.eyes());
         for k in 0..self.morphs.nodes().count() {
-            self.morphs.weights(k, face, &mut one);
+            self.morphs.weights(k, face, look, &mut one);
             weights.extend_from_slice(&one);
         }
     }

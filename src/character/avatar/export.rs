@@ -7,7 +7,7 @@
 use serde_json::{json, Value};
 
 use super::file::Model;
-use super::morph::MorphMap;
+use super::morph::{Look, MorphMap};
 use super::retarget::Retarget;
 use crate::body::gltf::{glb, Buffer};
 use crate::body::pose::Pose;
@@ -125,7 +125,8 @@ fn animation(
     for (k, (node, targets)) in morphs.nodes().enumerate() {
         let mut all = Vec::with_capacity(targets * frames.len());
         for f in frames {
-            morphs.weights(k, f.face, &mut weights);
+            let look = Look::of(f.pose, retarget.eyes());
+            morphs.weights(k, f.face, look, &mut weights);
             all.extend_from_slice(&weights);
         }
         let output = buf.floats(&all, "SCALAR", all.len(), None);

@@ -20,7 +20,7 @@ mod twist;
 pub use drive::Driver;
 pub use export::{animated_document, animated_glb, Frame};
 pub use file::{AvatarError, Model, Node, MAX_AVATAR_BYTES};
-pub use morph::MorphMap;
+pub use morph::{Look, MorphMap};
 pub use retarget::{Posed, Retarget};
 pub use scene::scene_glb;
 

@@ -4,12 +4,98 @@
 //! VRM expressions (1.0 `expressions`, 0.x
 //! `blendShapeMaster`) are weighed from the face (visemes aa ih ou ee oh, blinks from the
 //! blink weights, happy/angry/sad/surprised from the smile, brow and frown weights) and spread
-//! onto the morph targets they bind, scaled by each bind's weight.
+//! onto the morph targets they bind, scaled by each bind's weight. An avatar whose eyes look by
+//! expressions (VRM 1.0 `lookAt.type` `expression`, 0.x `lookAtTypeName` `BlendShape`) has its
+//! lookLeft/Right/Up/Down weighed from where the realizer's eyes look ([`Look`]) through the
+//! file's range maps (the angle at which the weight is full, and the weight then).
 
+use glam::Vec3;
 use serde_json::Value;
 
 use super::file::Model;
+use crate::body::pose::Pose;
 use crate::face::model::{morph_index, Face, VISEMES};
+
+/// Where the eyes look, in the head's frame: yaw (degrees, + to the character's left) and
+/// pitch (degrees, + up).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Look {
+    /// Degrees to the left (negative: to the right).
+    pub yaw: f32,
+    /// Degrees up (negative: down).
+    pub pitch: f32,
+}
+
+impl Look {
+    /// Where the eyes look in `pose`: the mean direction of the two eyeball joints (`eyes`,
+    /// their indices) turned from rest, where they look ahead (+z). Ahead without eyes.
+    pub fn of(pose: &Pose, eyes: Option<(usize, usize)>) -> Look {
+        let Some((l, r)) = eyes else {
+            return Look::default();
+        };
+        let (Some(ql), Some(qr)) = (pose.rotations.get(l), pose.rotations.get(r)) else {
+            return Look::default();
+        };
+        let d = (*ql * Vec3::Z + *qr * Vec3::Z).normalize_or(Vec3::Z);
+        Look {
+            yaw: d.x.atan2(d.z).to_degrees(),
+            pitch: d.y.atan2(d.x.hypot(d.z)).to_degrees(),
+        }
+    }
+}
+
+/// The range maps of looking by expressions: per direction (left, right, up, down) the angle
+/// (degrees) at which the weight is full, and that weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct LookRanges([(f32, f32); 4]);
+
+impl LookRanges {
+    /// The ranges of `json` if its eyes look by expressions.
+    fn of(json: &Value) -> Option<LookRanges> {
+        let range = |m: &Value, max: &str, scale: &str, default_scale: f32| {
+            let max = m[max].as_f64().unwrap_or(90.0) as f32;
+            (
+                max.max(1e-3),
+                m[scale].as_f64().map_or(default_scale, |s| s as f32),
+            )
+        };
+        let vrm1 = &json["extensions"]["VRMC_vrm"]["lookAt"];
+        if vrm1["type"] == "expression" {
+            let m = |k: &str| range(&vrm1[k], "inputMaxValue", "outputScale", 1.0);
+            let side = m("rangeMapHorizontalOuter");
+            return Some(LookRanges([
+                side,
+                side,
+                m("rangeMapVerticalUp"),
+                m("rangeMapVerticalDown"),
+            ]));
+        }
+        let vrm0 = &json["extensions"]["VRM"]["firstPerson"];
+        if vrm0["lookAtTypeName"] == "BlendShape" {
+            let m = |k: &str| range(&vrm0[k], "xRange", "yRange", 1.0);
+            let side = m("lookAtHorizontalOuter");
+            return Some(LookRanges([
+                side,
+                side,
+                m("lookAtVerticalUp"),
+                m("lookAtVerticalDown"),
+            ]));
+        }
+        None
+    }
+
+    /// The weight of look expression `name` at `look`.
+    fn weigh(&self, name: &str, look: Look) -> f32 {
+        let (angle, (max, scale)) = match name {
+            "lookLeft" => (look.yaw, self.0[0]),
+            "lookRight" => (-look.yaw, self.0[1]),
+            "lookUp" => (look.pitch, self.0[2]),
+            "lookDown" => (-look.pitch, self.0[3]),
+            _ => return 0.0,
+        };
+        (angle / max).clamp(0.0, 1.0) * scale
+    }
+}
 
 /// What drives one morph target.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,11 +113,14 @@ enum Source {
 pub struct MorphMap {
     /// (node, per morph target the sources that add up to its weight).
     nodes: Vec<(usize, Vec<Vec<Source>>)>,
+    /// How far the eyes look for full weight, when they look by expressions.
+    look: Option<LookRanges>,
 }
 
 impl MorphMap {
     /// The morph targets of `model` that the face drives.
     pub fn new(model: &Model) -> MorphMap {
+        let look = LookRanges::of(&model.json);
         let mut nodes = Vec::new();
         for (i, node) in model.json["nodes"]
             .as_array()
@@ -47,6 +136,9 @@ impl MorphMap {
             };
             let mut sources: Vec<Vec<Source>> = names.iter().map(|n| by_name(n)).collect();
             for (expression, target, weight) in expression_binds(&model.json, i, mesh) {
+                if expression.starts_with("look") && look.is_none() {
+                    continue; // (the eyes look by bones: these expressions are not used)
+                }
                 if let Some(s) = sources.get_mut(target) {
                     s.push(Source::Expression(expression, weight));
                 }
@@ -55,7 +147,7 @@ impl MorphMap {
                 nodes.push((i, sources));
             }
         }
-        MorphMap { nodes }
+        MorphMap { nodes, look }
     }
 
     /// The animated mesh nodes and how many morph targets each has.
@@ -68,12 +160,24 @@ impl MorphMap {
         self.nodes.is_empty()
     }
 
-    /// The weights of the `k`-th node's (of [`MorphMap::nodes`]) morph targets for `face`, into `out`.
-    pub fn weights(&self, k: usize, face: &Face, out: &mut Vec<f32>) {
+    /// The weights of the `k`-th node's (of [`MorphMap::nodes`]) morph targets for `face` with
+    /// the eyes at `look`, into `out`.
+    pub fn weights(&self, k: usize, face: &Face, look: Look, out: &mut Vec<f32>) {
         out.clear();
         for sources in &self.nodes[k].1 {
-            let w: f32 = sources.iter().map(|s| weigh(s, face)).sum();
+            let w: f32 = sources.iter().map(|s| self.weigh(s, face, look)).sum();
             out.push(w.clamp(0.0, 1.0));
+        }
+    }
+
+    fn weigh(&self, source: &Source, face: &Face, look: Look) -> f32 {
+        match *source {
+            Source::Arkit(i) => face.morphs.0[i],
+            Source::Viseme(v) => face.visemes.get(v).copied().unwrap_or(0.0),
+            Source::Expression(name, weight) if name.starts_with("look") => {
+                self.look.map_or(0.0, |r| r.weigh(name, look)) * weight
+            }
+            Source::Expression(name, weight) => expression(name, face) * weight,
         }
     }
 }
@@ -86,14 +190,6 @@ fn by_name(name: &str) -> Vec<Source> {
         .strip_prefix("viseme_")
         .and_then(|v| VISEMES.iter().position(|x| *x == v));
     viseme.map(Source::Viseme).into_iter().collect()
-}
-
-fn weigh(source: &Source, face: &Face) -> f32 {
-    match *source {
-        Source::Arkit(i) => face.morphs.0[i],
-        Source::Viseme(v) => face.visemes.get(v).copied().unwrap_or(0.0),
-        Source::Expression(name, weight) => expression(name, face) * weight,
-    }
 }
 
 /// The weight of VRM 1.0 expression `name` in `face`.
@@ -132,12 +228,16 @@ fn preset_of_vrm0(name: &str) -> Option<&'static str> {
         "angry" => "angry",
         "sorrow" => "sad",
         "fun" => "surprised",
+        "lookleft" => "lookLeft",
+        "lookright" => "lookRight",
+        "lookup" => "lookUp",
+        "lookdown" => "lookDown",
         _ => return None,
     })
 }
 
 /// The VRM 1.0 preset names the realizer weighs.
-const PRESETS: [&str; 12] = [
+const PRESETS: [&str; 16] = [
     "aa",
     "ih",
     "ou",
@@ -150,6 +250,10 @@ const PRESETS: [&str; 12] = [
     "angry",
     "sad",
     "surprised",
+    "lookLeft",
+    "lookRight",
+    "lookUp",
+    "lookDown",
 ];
 
 /// The (expression, morph target, weight 0–1) binds of VRM expressions onto node `node`
@@ -256,16 +360,86 @@ mod tests {
             let map = MorphMap::new(&m);
             assert_eq!(map.nodes().collect::<Vec<_>>(), vec![(0, 5)]);
             let mut w = Vec::new();
-            map.weights(0, &speaking(), &mut w);
+            map.weights(0, &speaking(), Look::default(), &mut w);
             // jawOpen as is, the viseme on, the expression aa on, blink (the lesser eye) × 0.5
             assert_eq!(w, vec![0.4, 1.0, 1.0, 0.4, 0.0]);
-            map.weights(0, &Face::default(), &mut w);
+            map.weights(0, &Face::default(), Look::default(), &mut w);
             assert_eq!(w, vec![0.0; 5]);
         }
         // nothing the face drives: nothing animated
         let mut plain = model(json!({"nodes": [{"mesh": 0}]}));
         plain.morphs = vec![vec!["Key 1".into()]];
         assert!(MorphMap::new(&plain).is_empty());
+    }
+
+    #[test]
+    fn eyes_that_look_by_expressions_weigh_them_from_where_the_realizer_looks() {
+        let binds =
+            |i: usize| json!({"morphTargetBinds": [{"node": 0, "index": i, "weight": 1.0}]});
+        let vrm1 = |kind: &str| {
+            model(json!({
+                "nodes": [{"mesh": 0}],
+                "extensions": {"VRMC_vrm": {
+                    "lookAt": {"type": kind,
+                               "rangeMapHorizontalOuter": {"inputMaxValue": 20.0, "outputScale": 1.0},
+                               "rangeMapVerticalUp": {"inputMaxValue": 10.0, "outputScale": 0.5}},
+                    "expressions": {"preset": {"lookLeft": binds(0), "lookUp": binds(2)}}}}
+            }))
+        };
+        let look = Look {
+            yaw: 10.0,
+            pitch: 15.0,
+        };
+        let mut w = Vec::new();
+        let map = MorphMap::new(&vrm1("expression"));
+        map.weights(0, &Face::default(), look, &mut w);
+        // half way to the 20° of a full lookLeft; up past its 10°, at its scale 0.5
+        assert_eq!(w, vec![0.5, 0.0, 0.5, 0.0, 0.0]);
+        map.weights(
+            0,
+            &Face::default(),
+            Look {
+                yaw: -10.0,
+                pitch: -5.0,
+            },
+            &mut w,
+        );
+        assert_eq!(w, vec![0.0; 5]);
+        // eyes that look by bones leave the expressions alone
+        MorphMap::new(&vrm1("bone")).weights(0, &Face::default(), look, &mut w);
+        assert_eq!(w, vec![0.0; 5]);
+        // VRM 0.x: lookAtTypeName BlendShape, presets lookleft …, ranges in degrees
+        let vrm0 = model(json!({
+            "nodes": [{"mesh": 0}],
+            "extensions": {"VRM": {
+                "firstPerson": {"lookAtTypeName": "BlendShape",
+                                "lookAtHorizontalOuter": {"xRange": 40.0, "yRange": 1.0}},
+                "blendShapeMaster": {"blendShapeGroups": [
+                    {"presetName": "lookleft", "binds": [{"mesh": 0, "index": 1, "weight": 100}]}]}}}
+        }));
+        MorphMap::new(&vrm0).weights(0, &Face::default(), look, &mut w);
+        assert_eq!(w, vec![0.0, 0.25, 0.0, 0.0, 0.0]);
+    }
+
+    /// A gaze to the character's left turns its eyes left: `Look` says so from the pose.
+    #[test]
+    fn look_follows_the_realizer_s_eyes() {
+        let skeleton = crate::body::Skeleton::adult();
+        let eyes = skeleton
+            .joint("l_eyeball_joint")
+            .zip(skeleton.joint("r_eyeball_joint"));
+        let mut r = crate::realizer::Realizer::new().with_idle(false);
+        r.world_mut().set("left", glam::Vec3::new(2.0, 1.6, 1.0));
+        r.perform_bml(
+            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gaze id="g" target="left" influence="EYES" start="0" ready="0.3" end="2"/></bml>"#,
+        )
+        .unwrap();
+        let mut look = Look::default();
+        for k in 0..60 {
+            look = Look::of(&r.tick(f64::from(k) / 60.0).poses[0].pose, eyes);
+        }
+        assert!(look.yaw > 10.0, "the eyes look {look:?}");
+        assert_eq!(Look::of(&r.tick(1.0).poses[0].pose, None), Look::default());
     }
 
     /// Visemes blend into each other: over a spoken sentence at 60 frames a second, a
@@ -284,7 +458,7 @@ mod tests {
         let (mut jump, mut between, mut w, mut was) = (0.0f32, 0, Vec::new(), None::<Vec<f32>>);
         for k in 0..240 {
             let frame = r.tick(f64::from(k) / 60.0);
-            map.weights(0, &frame.poses[0].face, &mut w);
+            map.weights(0, &frame.poses[0].face, Look::default(), &mut w);
             let aa = w[1];
             if aa > 0.05 && aa < 0.95 {
                 between += 1;

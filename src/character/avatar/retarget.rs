@@ -89,6 +89,8 @@ pub struct Retarget {
     hips_parent: (Quat, Vec3, Vec3),
     /// The realizer's root at rest.
     root_rest: Vec3,
+    /// The realizer's eyeball joints (left, right), if its skeleton has them.
+    eyes: Option<(usize, usize)>,
     /// Where the character stands: the realizer's root at rest there. Its travel from here is
     /// scaled by leg length; the way from the origin to here is not.
     anchor: Vec3,
@@ -243,6 +245,7 @@ impl Retarget {
             },
             root_rest: rest.positions[0],
             anchor: rest.positions[0],
+            eyes: (skeleton.joint("l_eyeball_joint")).zip(skeleton.joint("r_eyeball_joint")),
             hips_parent: match model.nodes[hips].parent {
                 Some(p) => {
                     let (scale, rotation, place) = world[p].to_scale_rotation_translation();
@@ -252,6 +255,11 @@ impl Retarget {
             },
             direct,
         })
+    }
+
+    /// The realizer's eyeball joints (left, right), if its skeleton has them.
+    pub fn eyes(&self) -> Option<(usize, usize)> {
+        self.eyes
     }
 
     /// The avatar posed as the realizer's `pose` (of the skeleton it was made for).
