@@ -1231,3 +1231,47 @@ fn a_repeated_nod_peaks_at_each_stroke_also_one_tied_to_a_gesture() {
         }
     }
 }
+
+/// With the idle layer on, a standing character's eyes jump now and then (idle saccades);
+/// a BML gaze sets them over that and holds its target as steadily as without.
+#[test]
+fn idle_eyes_look_about_and_a_bml_gaze_still_holds_its_target() {
+    let skeleton = Skeleton::adult();
+    let mut r = Realizer::new();
+    // (a block that moves nothing, so that the character is there)
+    r.perform_bml(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="w"><wait id="w" start="0" end="10"/></bml>"#)
+        .unwrap();
+    let (mut jumps, mut was) = (0, None::<Vec<(f32, f32)>>);
+    for i in 0..=600 {
+        let pose = r.tick(f64::from(i) / FPS).poses[0].pose.clone();
+        let now = eye_angles(&skeleton, &pose);
+        if let Some(w) = &was {
+            // (a frame in which the eyes turned by more than half a degree)
+            if (now[0].0 - w[0].0).abs().max((now[0].1 - w[0].1).abs()) > 0.5 {
+                jumps += 1;
+            }
+        }
+        was = Some(now);
+    }
+    assert!(
+        jumps >= 6,
+        "the idle eyes moved in {jumps} frames over 10 s"
+    );
+    let target = Vec3::new(0.5, 1.3, 1.0);
+    let mut r = Realizer::new();
+    r.world_mut().set("cup", target);
+    r.perform_bml(&gaze_block(
+        "b",
+        "cup",
+        r#"start="0" ready="0.5" relax="4" end="4.5""#,
+    ))
+    .unwrap();
+    for i in 0..=240 {
+        let t = f64::from(i) / FPS;
+        let pose = r.tick(t).poses[0].pose.clone();
+        if (0.5..4.0).contains(&t) {
+            let e = eye_error(&skeleton, &pose, target);
+            assert!(e < 0.5, "eye-line error {e}° at {t} with the idle layer on");
+        }
+    }
+}

@@ -1,7 +1,7 @@
 //! The idle layer: what a standing person does while nothing else moves them — breathing (the
-//! chest and the shoulders rise and fall) and a slow shift of weight from foot to foot (the pelvis
+//! chest and the shoulders rise and fall), a slow shift of weight from foot to foot (the pelvis
 //! sways sideways, the spine leans back against it, the feet stay where they stand: the legs
-//! follow by inverse kinematics). It is the pose every frame starts from, so
+//! follow by inverse kinematics) and the eyes' small saccades (`saccades`). It is the pose every frame starts from, so
 //! behaviours play on top of it and inverse kinematics and gaze aim from where it put the body.
 //! It is not a behaviour: it has no timing and never shows in the feedback. Deterministic: the
 //! same character (by id) at the same time gets the same pose.
@@ -9,6 +9,7 @@
 use glam::{Quat, Vec3};
 
 use super::pose::Pose;
+use super::saccades::Saccades;
 use super::skeleton::Skeleton;
 
 /// Breaths per second (15 a minute, a person at rest).
@@ -39,6 +40,8 @@ pub struct Idle {
     /// interpolates between the two nearest (measured: solving both legs every frame cost more
     /// than all the rest of a standing character's frame).
     table: [(f32, [Quat; 6]); LEG_TABLE],
+    /// The eyes' idle saccades.
+    saccades: Saccades,
 }
 
 /// Entries of the legs' table (the solutions differ by well under a millimetre at the feet
@@ -68,6 +71,7 @@ impl Idle {
                 Some((leg, Pose::rest(skeleton).joint_world(skeleton, leg[2]).0))
             }),
             table: [(0.0, [Quat::IDENTITY; 6]); LEG_TABLE],
+            saccades: Saccades::new(id, skeleton),
         };
         for k in 0..LEG_TABLE {
             let shift = -1.0 + 2.0 * k as f32 / (LEG_TABLE - 1) as f32;
@@ -97,9 +101,11 @@ impl Idle {
         }
     }
 
-    /// The pose at global time `t`: the rest pose with breathing and the weight shift.
+    /// The pose at global time `t`: the rest pose with breathing, the weight shift and the
+    /// eyes' saccades.
     pub fn pose(&self, skeleton: &Skeleton, t: f64) -> Pose {
         let mut pose = Pose::rest(skeleton);
+        self.saccades.apply(t, &mut pose);
         let t = t as f32 + self.phase;
         let tau = std::f32::consts::TAU;
         // breathing: in for the first part of the cycle, out after (a raised cosine, 0 at rest)

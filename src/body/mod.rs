@@ -10,6 +10,7 @@ pub mod ik;
 pub mod limits;
 pub mod mannequin;
 pub mod pose;
+pub mod saccades;
 pub mod skeleton;
 pub mod sketch;
 

@@ -481,7 +481,8 @@ impl Aim {
                 yaw += t.eye_weight * (y - yaw);
                 pitch += t.eye_weight * (p - pitch);
             }
-            pose.rotate(e, donders(yaw, pitch));
+            // (set, not added: a gaze wins over the idle layer's saccades)
+            pose.rotations[e] = donders(yaw, pitch);
             // the eye's anatomical range (a swing ellipse and a little twist, which the yaw and
             // pitch box only approximates: its corners lie outside): an aim beyond it holds the
             // eye at its edge
