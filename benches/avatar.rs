@@ -86,11 +86,10 @@ fn avatar(c: &mut Criterion) {
 
 const CESIUM_MAN: &str = "fixtures/avatars/cesium-man/CesiumMan.gltf";
 
-/// CesiumMan's bone map (node indices as `#N`).
+/// CesiumMan's bone map (node indices), as `--bone-map` reads it.
 fn cesium_map() -> std::collections::BTreeMap<String, String> {
     let text = std::fs::read_to_string("fixtures/avatars/cesium-man/bone-map.json").unwrap();
-    let raw: std::collections::BTreeMap<String, u64> = serde_json::from_str(&text).unwrap();
-    raw.into_iter().map(|(k, v)| (k, format!("#{v}"))).collect()
+    bml_realizer::avatar::humanoid::bone_map_from_json(&text).unwrap()
 }
 
 criterion_group!(benches, avatar);

@@ -128,21 +128,8 @@ fn a_stomp_py_peer_speaking_greta_s_conventions_gets_greta_s_callbacks() {
     };
     let _r = serve(&broker, &["--flavour", "greta"]);
     std::thread::sleep(Duration::from_millis(1500));
-    let peer = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/peers/greta_peer.py");
-    let out = Command::new(&python)
-        .args([peer, &format!("127.0.0.1:{}", broker.stomp)])
-        .output()
-        .expect("the peer runs");
-    let said = String::from_utf8_lossy(&out.stdout);
-    eprintln!("{said}{}", String::from_utf8_lossy(&out.stderr));
-    assert!(
-        out.status.success(),
-        "the Greta peer's checks failed:\n{said}"
-    );
-    assert!(
-        said.contains("0 failed") && said.matches("ok ").count() >= 9,
-        "{said}"
-    );
+    let address = format!("127.0.0.1:{}", broker.stomp);
+    kit::run_peer(&python, "greta_peer.py", &address, "Greta", 9);
 }
 
 #[test]

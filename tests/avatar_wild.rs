@@ -11,47 +11,28 @@ mod avatars;
 mod common;
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
-use avatars::{limb_errors_by, random_pose};
-use bml_realizer::avatar::{Model, Retarget};
+use avatars::{glb_json, limb_errors_by, random_pose};
+use bml_realizer::avatar::{humanoid, Model, Retarget};
 use bml_realizer::body::pose::Pose;
 use bml_realizer::body::skeleton::Skeleton;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::rng::Rng;
-use common::bmlr;
+use common::drive;
 
 const CESIUM_MAN: &str = "fixtures/avatars/cesium-man/CesiumMan.gltf";
 const CESIUM_MAP: &str = "fixtures/avatars/cesium-man/bone-map.json";
 
-/// A bone map file as `Retarget` takes it (numbers as `#N`).
+/// A bone map file, as `--bone-map` reads it.
 fn bone_map(path: &str) -> BTreeMap<String, String> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let raw: BTreeMap<String, serde_json::Value> = serde_json::from_str(&text).unwrap();
-    raw.into_iter()
-        .map(|(k, v)| {
-            (
-                k,
-                v.as_u64()
-                    .map_or_else(|| v.as_str().unwrap().to_string(), |n| format!("#{n}")),
-            )
-        })
-        .collect()
+    humanoid::bone_map_from_json(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 #[test]
 fn cesium_man_without_a_bone_map_is_refused_showing_the_map_to_write() {
     let out = std::env::temp_dir().join(format!("cesium-{}.glb", std::process::id()));
-    let (code, stdout, err) = bmlr(
-        &[
-            "run",
-            "--avatar",
-            CESIUM_MAN,
-            "--gltf",
-            out.to_str().unwrap(),
-            "fixtures/examples/welcome.xml",
-        ],
-        "",
-    );
+    let (code, stdout, err) = drive(Path::new(CESIUM_MAN), &[], &out);
     assert_eq!(code, 2, "{err}");
     assert!(stdout.is_empty());
     for says in [
@@ -67,7 +48,7 @@ fn cesium_man_without_a_bone_map_is_refused_showing_the_map_to_write() {
 #[test]
 fn cesium_man_with_its_bone_map_follows_every_limb() {
     let skeleton = Skeleton::adult();
-    let model = Model::read(std::path::Path::new(CESIUM_MAN)).unwrap();
+    let model = Model::read(Path::new(CESIUM_MAN)).unwrap();
     assert_eq!((model.nodes.len(), model.joints.len()), (22, 19));
     let map = bone_map(CESIUM_MAP);
     let retarget = Retarget::new(&model, &skeleton, Some(&map)).unwrap();
@@ -126,23 +107,9 @@ fn cesium_man_with_its_bone_map_follows_every_limb() {
 #[test]
 fn bmlr_drives_cesium_man_with_its_bone_map_into_one_glb_with_its_texture() {
     let out = std::env::temp_dir().join(format!("cesium-driven-{}.glb", std::process::id()));
-    let (code, _, err) = bmlr(
-        &[
-            "run",
-            "--avatar",
-            CESIUM_MAN,
-            "--bone-map",
-            CESIUM_MAP,
-            "--gltf",
-            out.to_str().unwrap(),
-            "fixtures/examples/welcome.xml",
-        ],
-        "",
-    );
+    let (code, _, err) = drive(Path::new(CESIUM_MAN), &["--bone-map", CESIUM_MAP], &out);
     assert_eq!(code, 0, "{err}");
-    let bytes = std::fs::read(&out).unwrap();
-    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
+    let json = glb_json(&std::fs::read(&out).unwrap());
     // one buffer, no file beside it: the texture went into the GLB
     assert_eq!(json["buffers"].as_array().unwrap().len(), 1);
     assert!(json["buffers"][0].get("uri").is_none());

@@ -45,19 +45,6 @@ fn ipaacar_python_planners_on_two_channels_are_served() {
             .spawn()
             .expect("bmlr runs"),
     );
-    let peer = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/peers/ipaaca_peer.py");
-    let out = Command::new(&python)
-        .args([peer, &format!("127.0.0.1:{}", broker.port)])
-        .output()
-        .expect("the peer runs");
-    let said = String::from_utf8_lossy(&out.stdout);
-    eprintln!("{said}{}", String::from_utf8_lossy(&out.stderr));
-    assert!(
-        out.status.success(),
-        "the ipaacar peer's checks failed:\n{said}"
-    );
-    assert!(
-        said.contains("0 failed") && said.matches("ok ").count() >= 11,
-        "{said}"
-    );
+    let address = format!("127.0.0.1:{}", broker.port);
+    kit::run_peer(&python, "ipaaca_peer.py", &address, "ipaacar", 11);
 }

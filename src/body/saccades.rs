@@ -15,6 +15,11 @@ use glam::Quat;
 
 use super::pose::Pose;
 use super::skeleton::Skeleton;
+use crate::rng::{fnv1a, normals, unit};
+
+/// The salts of the saccades' streams of numbers: when they start, where they aim.
+const JITTER: u64 = 0xA5A5_A5A5;
+const AIM: u64 = 0x5A5A_5A5A;
 
 /// The mean time between saccades (seconds).
 pub const MEAN_INTERVAL: f64 = 1.1;
@@ -34,15 +39,6 @@ pub struct Saccades {
     eyes: Option<(usize, usize)>,
 }
 
-/// A number in 0..1 from `seed` and `k` (splitmix64).
-fn unit(seed: u64, k: u64) -> f64 {
-    let mut z = seed.wrapping_add(k.wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    (z >> 11) as f64 / (1u64 << 53) as f64
-}
-
 /// Minimum jerk from 0 to 1 over 0..1.
 fn minimum_jerk(x: f64) -> f64 {
     let x = x.clamp(0.0, 1.0);
@@ -52,9 +48,8 @@ fn minimum_jerk(x: f64) -> f64 {
 impl Saccades {
     /// The saccades of character `id` on `skeleton` (none without eyeball joints).
     pub fn new(id: &str, skeleton: &Skeleton) -> Saccades {
-        let seed = (id.bytes()).fold(0x6a09_e667_f3bc_c908u64, |h, b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-        });
+        // (a stream of its own, apart from the blinks')
+        let seed = fnv1a(id) ^ 0x6a09_e667_f3bc_c908;
         let eyes = skeleton
             .joint("l_eyeball_joint")
             .zip(skeleton.joint("r_eyeball_joint"));
@@ -63,22 +58,13 @@ impl Saccades {
 
     /// When saccade `k` starts (seconds; saccade 0 at the start, to the first fixation).
     pub fn start(&self, k: i64) -> f64 {
-        let jitter = unit(self.seed, k as u64 ^ 0xA5A5) - 0.5;
+        let jitter = unit(self.seed ^ JITTER, k as u64) - 0.5;
         (k as f64 + 0.8 * jitter) * MEAN_INTERVAL
     }
 
     /// Fixation `k` (yaw left, pitch up; degrees): where saccade `k` lands.
     pub fn fixation(&self, k: i64) -> (f64, f64) {
-        let k2 = (k as u64).wrapping_mul(2);
-        let (u, v) = (
-            unit(self.seed, k2).max(1e-12),
-            unit(self.seed, k2.wrapping_add(1)),
-        );
-        let r = (-2.0 * u.ln()).sqrt();
-        let (a, b) = (
-            r * (std::f64::consts::TAU * v).cos(),
-            r * (std::f64::consts::TAU * v).sin(),
-        );
+        let (a, b) = normals(unit(self.seed, k as u64), unit(self.seed ^ AIM, k as u64));
         let yaw = (a * SPREAD.0).clamp(-FIELD.0, FIELD.0);
         let pitch = (b * SPREAD.1).clamp(-FIELD.1, FIELD.1);
         (yaw, pitch)

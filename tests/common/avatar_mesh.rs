@@ -233,34 +233,6 @@ pub fn with_mesh(mut json: Value, rest: &[Mat4], case: Case) -> (Value, Vec<u8>)
     (json, bin.bytes)
 }
 
-/// A GLB of `json` and its binary buffer.
-pub fn glb_with(json: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut text = serde_json::to_vec(json).unwrap();
-    while !text.len().is_multiple_of(4) {
-        text.push(b' ');
-    }
-    let mut bin = bin.to_vec();
-    bin.resize(bin.len().next_multiple_of(4), 0);
-    let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
-    let mut out = Vec::new();
-    for word in [
-        0x4654_6C67u32,
-        2,
-        total as u32,
-        text.len() as u32,
-        0x4E4F_534A,
-    ] {
-        out.extend(word.to_le_bytes());
-    }
-    out.extend(text);
-    if !bin.is_empty() {
-        out.extend((bin.len() as u32).to_le_bytes());
-        out.extend(0x004E_4942u32.to_le_bytes());
-        out.extend(bin);
-    }
-    out
-}
-
 /// `json` and `bin` as a `.gltf` whose buffer is a `data:` URI.
 pub fn gltf_embedded(json: &Value, bin: &[u8]) -> Vec<u8> {
     let mut json = json.clone();

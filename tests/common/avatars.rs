@@ -156,18 +156,41 @@ pub enum Kind {
 
 /// A GLB holding `json` alone.
 pub fn glb(json: &Value) -> Vec<u8> {
+    glb_with(json, &[])
+}
+
+/// A GLB of `json` and its binary buffer.
+pub fn glb_with(json: &Value, bin: &[u8]) -> Vec<u8> {
     let mut text = serde_json::to_vec(json).unwrap();
     while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
+    let mut bin = bin.to_vec();
+    bin.resize(bin.len().next_multiple_of(4), 0);
+    let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
     let mut out = Vec::new();
-    for word in [0x4654_6C67u32, 2, (12 + 8 + text.len()) as u32] {
+    for word in [
+        0x4654_6C67u32,
+        2,
+        total as u32,
+        text.len() as u32,
+        0x4E4F_534A,
+    ] {
         out.extend(word.to_le_bytes());
     }
-    out.extend((text.len() as u32).to_le_bytes());
-    out.extend(0x4E4F_534Au32.to_le_bytes());
     out.extend(text);
+    if !bin.is_empty() {
+        out.extend((bin.len() as u32).to_le_bytes());
+        out.extend(0x004E_4942u32.to_le_bytes());
+        out.extend(bin);
+    }
     out
+}
+
+/// The JSON chunk of a GLB.
+pub fn glb_json(bytes: &[u8]) -> Value {
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    serde_json::from_slice(&bytes[20..20 + length]).unwrap()
 }
 
 pub fn random_rotation(rng: &mut Rng, most: f32) -> Quat {

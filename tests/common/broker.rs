@@ -175,3 +175,24 @@ pub fn python_with(var: &str, module: &str) -> Option<String> {
         .is_ok_and(|o| o.status.success());
     ok.then_some(python)
 }
+
+/// Runs the peer `script` (in tests/peers/, printing `ok …` per check and `N failed` at the
+/// end) with `python` against the broker at `address`: it must pass, with at least `checks`
+/// checks. `who` names the peer in messages.
+pub fn run_peer(python: &str, script: &str, address: &str, who: &str, checks: usize) {
+    let peer = format!("{}/tests/peers/{script}", env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new(python)
+        .args([&peer, address])
+        .output()
+        .expect("the peer runs");
+    let said = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{said}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "the {who} peer's checks failed:\n{said}"
+    );
+    assert!(
+        said.contains("0 failed") && said.matches("ok ").count() >= checks,
+        "{said}"
+    );
+}

@@ -1,4 +1,5 @@
-//! What the command-line tests share: running the built `bmlr`.
+//! What the command-line tests share: running the built `bmlr`, and driving an avatar with it.
+#![allow(dead_code)] // each test file uses its own share of these
 
 use std::io::Write;
 use std::process::{Command, Stdio};
@@ -27,4 +28,21 @@ pub fn bmlr<I: AsRef<[u8]> + ?Sized>(args: &[&str], input: &I) -> (i32, String, 
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// `bmlr run --avatar AVATAR EXTRA… --gltf OUT fixtures/examples/welcome.xml`: (exit code,
+/// stdout, stderr).
+pub fn drive(
+    avatar: &std::path::Path,
+    extra: &[&str],
+    out: &std::path::Path,
+) -> (i32, String, String) {
+    let mut args = vec!["run", "--avatar", avatar.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    args.extend([
+        "--gltf",
+        out.to_str().unwrap(),
+        "fixtures/examples/welcome.xml",
+    ]);
+    bmlr(&args, "")
 }

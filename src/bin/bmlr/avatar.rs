@@ -92,26 +92,14 @@ impl AvatarArgs {
     }
 }
 
-/// A bone map file: bone names to node names, or to node indices (numbers, for nodes without
-/// names), read as `#N`.
+/// A bone map file: bone names to node names or node indices.
 fn read_map(path: &Path) -> Result<BTreeMap<String, String>, String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("{}: cannot read it: {e}", path.display()))?;
-    let bad = |e: String| {
+    bml_realizer::avatar::humanoid::bone_map_from_json(&text).map_err(|e| {
         format!(
             "{}: a bone map is a JSON object of bone names to node names or node indices: {e}",
             path.display()
         )
-    };
-    let raw: BTreeMap<String, serde_json::Value> =
-        serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
-    raw.into_iter()
-        .map(|(bone, node)| match node {
-            serde_json::Value::String(n) => Ok((bone, n)),
-            serde_json::Value::Number(n) if n.is_u64() => Ok((bone, format!("#{n}"))),
-            other => Err(bad(format!(
-                "{bone}: {other} is neither a name nor an index"
-            ))),
-        })
-        .collect()
+    })
 }

@@ -238,6 +238,20 @@ fn vrm_bones(json: &Value) -> Option<BTreeMap<&'static str, usize>> {
     )
 }
 
+/// A bone map as a user writes it: a JSON object of bone names (or realizer joint names) to
+/// node names, or to node indices (numbers, for nodes without names), which the map holds as
+/// `#N` (what [`recognise`] takes).
+pub fn bone_map_from_json(text: &str) -> Result<BTreeMap<String, String>, String> {
+    let raw: BTreeMap<String, Value> = serde_json::from_str(text).map_err(|e| e.to_string())?;
+    raw.into_iter()
+        .map(|(bone, node)| match node {
+            Value::String(n) => Ok((bone, n)),
+            Value::Number(n) if n.is_u64() => Ok((bone, format!("#{n}"))),
+            other => Err(format!("{bone}: {other} is neither a name nor an index")),
+        })
+        .collect()
+}
+
 /// The bones of a user's map (bone or realizer joint → node name).
 fn from_map(
     model: &Model,
