@@ -52,36 +52,40 @@ struct LookRanges([(f32, f32); 4]);
 impl LookRanges {
     /// The ranges of `json` if its eyes look by expressions.
     fn of(json: &Value) -> Option<LookRanges> {
-        let range = |m: &Value, max: &str, scale: &str, default_scale: f32| {
-            let max = m[max].as_f64().unwrap_or(90.0) as f32;
+        // VRM 1.0 and 0.x name the same four maps and their two numbers differently
+        let versions = [
             (
-                max.max(1e-3),
-                m[scale].as_f64().map_or(default_scale, |s| s as f32),
+                &json["extensions"]["VRMC_vrm"]["lookAt"],
+                ("type", "expression"),
+                [
+                    "rangeMapHorizontalOuter",
+                    "rangeMapVerticalUp",
+                    "rangeMapVerticalDown",
+                ],
+                ("inputMaxValue", "outputScale"),
+            ),
+            (
+                &json["extensions"]["VRM"]["firstPerson"],
+                ("lookAtTypeName", "BlendShape"),
+                [
+                    "lookAtHorizontalOuter",
+                    "lookAtVerticalUp",
+                    "lookAtVerticalDown",
+                ],
+                ("xRange", "yRange"),
+            ),
+        ];
+        let (look, _, [side, up, down], (max, scale)) =
+            (versions.into_iter()).find(|(look, (key, value), _, _)| look[*key] == *value)?;
+        let range = |k: &str| {
+            let m = &look[k];
+            (
+                (m[max].as_f64().unwrap_or(90.0) as f32).max(1e-3),
+                m[scale].as_f64().map_or(1.0, |s| s as f32),
             )
         };
-        let vrm1 = &json["extensions"]["VRMC_vrm"]["lookAt"];
-        if vrm1["type"] == "expression" {
-            let m = |k: &str| range(&vrm1[k], "inputMaxValue", "outputScale", 1.0);
-            let side = m("rangeMapHorizontalOuter");
-            return Some(LookRanges([
-                side,
-                side,
-                m("rangeMapVerticalUp"),
-                m("rangeMapVerticalDown"),
-            ]));
-        }
-        let vrm0 = &json["extensions"]["VRM"]["firstPerson"];
-        if vrm0["lookAtTypeName"] == "BlendShape" {
-            let m = |k: &str| range(&vrm0[k], "xRange", "yRange", 1.0);
-            let side = m("lookAtHorizontalOuter");
-            return Some(LookRanges([
-                side,
-                side,
-                m("lookAtVerticalUp"),
-                m("lookAtVerticalDown"),
-            ]));
-        }
-        None
+        let side = range(side);
+        Some(LookRanges([side, side, range(up), range(down)]))
     }
 
     /// The weight of look expression `name` at `look`.
