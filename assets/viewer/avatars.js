@@ -17,8 +17,13 @@ function bmlrLoadAvatars(viewer, fail) {
   const module = (s) => URL.createObjectURL(new Blob([s], { type: 'text/javascript' }));
   const three = (s) => s.replace(/from 'three'/g, `from '${viewer.threeURL}'`);
   const utils = module(three(text('three-geometry-utils')));
+  // textures decoded from <img> elements, not ImageBitmaps: an ImageBitmap decodes off the
+  // page's thread, where a headless browser's virtual time does not wait for it, so a picture
+  // taken under a virtual-time budget now and then showed the page before the avatar was in it
   const loader = module(
-    three(text('three-gltf')).replace("'../utils/BufferGeometryUtils.js'", `'${utils}'`),
+    three(text('three-gltf'))
+      .replace("'../utils/BufferGeometryUtils.js'", `'${utils}'`)
+      .replace("typeof createImageBitmap === 'undefined'", 'true'),
   );
   viewer.avatarsLoading = avatars.length;
   const done = () => {
