@@ -111,7 +111,7 @@ fn fifty_clients_times_200_blocks_lose_no_feedback() {
                 let mut text = String::new();
                 for b in 0..200 {
                     text.push_str(&format!(
-                        r#"<bml {NS} id="c{c}b{b}"><head id="h" lexeme="NOD" start="0" end="0.02"/></bml>"#
+                        r#"<bml {NS} id="c{c}b{b}"><head id="h" lexeme="NOD" start="0" end="0.3"/></bml>"#
                     ));
                     text.push('\n');
                 }

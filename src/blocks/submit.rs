@@ -203,6 +203,10 @@ impl BlockManager {
             let id = format!("{}:{}", live.id, d.behaviour);
             self.warn(id, d.warning, d.reason.clone());
         }
+        for s in crate::schedule::performable::squeezed(&live.source, &schedule) {
+            let id = format!("{}:{}", live.id, s.behaviour);
+            self.warn(id, KnownWarning::InvalidTiming, s.sentence());
+        }
         Some(schedule)
     }
 

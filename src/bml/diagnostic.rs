@@ -172,6 +172,9 @@ pub enum Code {
     ContradictoryConstraints,
     /// The block passes one of its limits (nesting depth, attributes, size, behaviours, time).
     LimitExceeded,
+    /// A schedule that squeezes a phase of a behaviour (a gesture's stroke, say) below what a
+    /// person can perform: the realizer performs it that fast, with an `INVALID_TIMING` warning.
+    SqueezedPhase,
 }
 
 impl Code {
@@ -203,6 +206,7 @@ impl Code {
             Code::UnknownLexeme => "unknown-lexeme",
             Code::ContradictoryConstraints => "contradictory-constraints",
             Code::LimitExceeded => "limit-exceeded",
+            Code::SqueezedPhase => "squeezed-phase",
         }
     }
 }

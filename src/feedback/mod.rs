@@ -85,7 +85,8 @@ constants!(
         CustomAttributeNotSupported = "CUSTOM_ATTRIBUTE_NOT_SUPPORTED",
         /// The constraints cannot all hold.
         CannotSatisfyConstraints = "CANNOT_SATISFY_CONSTRAINTS",
-        /// A timing that breaks sync order or block start.
+        /// A timing that breaks sync order or block start, or squeezes a phase of a behaviour
+        /// below what a person can perform.
         InvalidTiming = "INVALID_TIMING",
         /// An engine failed while executing.
         ExecutionFailure = "EXECUTION_FAILURE",

@@ -2,10 +2,12 @@
 //! diagnostics. The block is scheduled with `Optimal` and the given timing models; each behaviour
 //! it would drop because its constraints contradict each other (or stretch it beyond its bounds)
 //! becomes an error at that behaviour, naming the constraints, and so does a required block that
-//! cannot be scheduled at all. References to other blocks and anticipators are not known here:
+//! cannot be scheduled at all; a behaviour whose phases the schedule squeezes below what a person
+//! can perform becomes a warning. References to other blocks and anticipators are not known here:
 //! behaviours that use them are left out of the check, not reported.
 
 use super::optimal::Optimal;
+use super::performable::squeezed;
 use super::strategy::{NoExternal, SchedulingStrategy};
 use crate::bml::{Block, Code, Diagnostic};
 use crate::timing::TimingModels;
@@ -22,18 +24,24 @@ pub fn timing_diagnostics(block: &Block, models: &dyn TimingModels) -> Vec<Diagn
             )]
         }
         Err(_) => Vec::new(),
-        Ok(schedule) => schedule
-            .dropped
-            .iter()
-            .filter(|d| d.contradiction)
-            .map(|d| {
-                let pos = block
-                    .behaviours
-                    .iter()
-                    .find(|b| b.id == d.behaviour)
-                    .map_or(block.pos, |b| b.pos);
-                error(pos, format!("refused at run time: {}", d.reason))
-            })
-            .collect(),
+        Ok(schedule) => {
+            let pos = |id: &crate::bml::Id| {
+                (block.behaviours.iter())
+                    .find(|b| b.id == *id)
+                    .map_or(block.pos, |b| b.pos)
+            };
+            let refused = (schedule.dropped.iter())
+                .filter(|d| d.contradiction)
+                .map(|d| {
+                    error(
+                        pos(&d.behaviour),
+                        format!("refused at run time: {}", d.reason),
+                    )
+                });
+            let squeezed = squeezed(block, &schedule)
+                .into_iter()
+                .map(|s| Diagnostic::warning(Code::SqueezedPhase, pos(&s.behaviour), s.sentence()));
+            refused.chain(squeezed).collect()
+        }
     }
 }

@@ -4,7 +4,9 @@
 //! - [`optimal`]: the default, order-invariant strategy;
 //! - [`greedy`]: Elckerlyc's sorted greedy algorithm, the baseline;
 //! - [`diff`]: the difference-constraint solver under it;
-//! - [`check`]: what the scheduler would refuse, as diagnostics (`bmlr validate`).
+//! - [`check`]: what the scheduler would refuse, as diagnostics (`bmlr validate`);
+//! - [`performable`]: the shortest phases a person can perform, and the phases a schedule
+//!   squeezes below them.
 //!
 //! A schedule goes on the peg board in [`crate::plan::to_pegs`].
 
@@ -14,6 +16,7 @@ pub mod greedy;
 mod links;
 pub(crate) mod offsets;
 pub mod optimal;
+pub mod performable;
 pub mod strategy;
 
 pub use greedy::SortedGreedy;
