@@ -73,6 +73,9 @@ pub enum Foot {
         from: Vec2,
         /// Its heading then.
         from_yaw: f32,
+        /// The foot's phase when it lifted: the stance's end, or later for a foot that stayed
+        /// down into its swing's phase (it lifts flat, and swings in what is left).
+        since: f32,
     },
 }
 
@@ -123,6 +126,18 @@ pub fn angle_diff(a: f32, b: f32) -> f32 {
 /// twist (45°) less the pelvis's own rotation in the stride and a margin (at 30° the body turned in
 /// jerks round a table: the head no longer led its turns).
 pub const MAX_STANCE_TWIST: f32 = 0.6;
+
+/// The least of its swing (fraction of a cycle) a foot that stayed down into its swing's phase
+/// must have left to lift; with less it waits for its next stance.
+const LATE_LIFT: f32 = 0.2;
+
+/// How far ahead of a landing foot the body is, in stances' lengths, when it lands.
+const LANDING_LEAD: f32 = 0.42;
+/// How far the body may pass a planted foot ahead of the foot's phase before the stepping
+/// quickens (m).
+const AHEAD_FREE: f32 = 0.08;
+/// Each this much further (m) adds one cadence to the stepping.
+const AHEAD_PER_CADENCE: f32 = 0.1;
 
 /// Side of each foot: +1 left (+x when facing +z), −1 right.
 const SIDE: [f32; 2] = [1.0, -1.0];
@@ -221,9 +236,10 @@ impl Gait {
     /// turns 34° over it; a walker speeding up out of a 30° turn over a foot 0.55 m behind
     /// could no longer reach it, and dragged it 8 cm (seen in the plaza).
     fn hurry(&self, body: Body) -> f32 {
+        let behind = self.behind_its_phase(body);
         // (only walking on: stopping and turning on the spot the feet close at their own pace)
         if self.speed < HURRY_SPEED {
-            return 1.0;
+            return behind;
         }
         let strain = (self.feet.iter())
             .filter_map(|foot| match *foot {
@@ -235,7 +251,27 @@ impl Gait {
                 Foot::Swing { .. } => None,
             })
             .fold(0.0f32, f32::max);
-        1.0 + (strain - STRAIN_FREE).max(0.0) / STRAIN_PER_CADENCE
+        behind.max(1.0 + (strain - STRAIN_FREE).max(0.0) / STRAIN_PER_CADENCE)
+    }
+
+    /// How much quicker than its cadence the walker steps (1 or more) because a planted foot is
+    /// further behind the body than its phase says: a foot lands [`LANDING_LEAD`] of a stance
+    /// ahead and is passed at the cadence's pace, but a body speeding up (setting off, after a
+    /// turn on the spot) passes it sooner; stepping at the slow cadence of its speed, the walker
+    /// left the foot 0.55 m behind while its phase still stood in mid-stance, and the pelvis sank
+    /// 20 cm to reach it. Each [`AHEAD_PER_CADENCE`] beyond [`AHEAD_FREE`] adds one cadence.
+    fn behind_its_phase(&self, body: Body) -> f32 {
+        let (stride, beta) = (self.stride(), self.stance());
+        let ahead = (0..2)
+            .filter_map(|k| match self.feet[k] {
+                Foot::Planted { at, .. } if self.foot_phase(k) < beta => {
+                    let expected = stride * (self.foot_phase(k) - LANDING_LEAD * beta);
+                    Some((body.at - at).dot(self.heading) - expected)
+                }
+                _ => None,
+            })
+            .fold(0.0f32, f32::max);
+        1.0 + (ahead - AHEAD_FREE).max(0.0) / AHEAD_PER_CADENCE
     }
 
     /// Whether the walker stands: both feet planted where they belong and no speed.
@@ -248,7 +284,7 @@ impl Gait {
     /// stance, beside the line of travel; beside the stopping point when that is nearer.
     pub fn landing(&self, k: usize, body: Body, left: f32) -> Vec2 {
         let stride = self.stride();
-        let lead = (left.max(0.0) * stride + self.stance() * stride * 0.42).min(0.55);
+        let lead = (left.max(0.0) * stride + self.stance() * stride * LANDING_LEAD).min(0.55);
         if let Some(stop) = self.stop_at {
             if stop.distance(body.at) < lead + 0.05 {
                 return standing_spot(
@@ -292,7 +328,12 @@ impl Gait {
         for (k, &was) in before.iter().enumerate() {
             let now = self.foot_phase(k);
             let beta = self.stance();
-            let lifts = was < beta && now >= beta;
+            // a foot lifts as its phase enters the swing, or later in the swing when it stayed
+            // down until then (setting off from standing: the foot whose phase stood in its swing
+            // stayed planted a whole cycle, and the body ran 0.6 m ahead of it), unless too
+            // little of the swing is left to make one
+            let late = now >= beta && 1.0 - now > LATE_LIFT;
+            let lifts = (was < beta && now >= beta) || late;
             let lands = now < was; // wrapped: heel strike
             match self.feet[k] {
                 // a foot already where it belongs stays down while the body stands, or
@@ -301,6 +342,7 @@ impl Gait {
                     self.feet[k] = Foot::Swing {
                         from: at,
                         from_yaw: yaw,
+                        since: if was < beta { beta } else { now },
                     };
                 }
                 Foot::Swing { .. } if lands => {
@@ -378,8 +420,14 @@ impl Gait {
                     planted: true,
                 }
             }
-            Foot::Swing { from, from_yaw } => {
-                let s = ((psi - beta) / (1.0 - beta)).clamp(0.0, 1.0);
+            Foot::Swing {
+                from,
+                from_yaw,
+                since,
+            } => {
+                let s = ((psi - since) / (1.0 - since).max(1e-3)).clamp(0.0, 1.0);
+                // (a foot lifting late lifts flat)
+                let toe_off = if since > beta { 0.0 } else { toe_off };
                 let to = self.landing(k, body, 1.0 - psi);
                 let e = smooth(s);
                 let yaw = from_yaw + angle_diff(self.landing_yaw(body), from_yaw) * e;

@@ -26,6 +26,9 @@ pub const TURN_RATE: f32 = 2.0;
 /// How fast the body turns on the spot (rad/s): about 45° a step, the most a planted foot lets
 /// the leg twist.
 pub const TURN_ON_THE_SPOT: f32 = 1.0;
+/// How long the rate the landing feet are turned ahead for takes to follow the body's (s).
+const TURN_EASE: f32 = 0.2;
+
 /// A goal more than this off the facing (rad) is turned to on the spot before walking.
 pub const TURN_FIRST: f32 = 0.8;
 /// How hard a halted walk brakes (m/s²).
@@ -626,7 +629,11 @@ impl Walker {
         }
         let attend = if attended.is_some() { 1.0 } else { 0.0 };
         self.attention += (attend - self.attention) * (1.0 - (-dt / 0.25).exp());
-        self.gait.turn_rate = angle_diff(self.facing, facing_before) / dt;
+        // the rate the feet are turned ahead for, eased over a fifth of a second: when a turn on
+        // the spot ends, the swinging foot's landing heading eases back instead of jumping (it
+        // twisted the hip at 30 rad/s in one frame)
+        let turning = angle_diff(self.facing, facing_before) / dt;
+        self.gait.turn_rate += (turning - self.gait.turn_rate) * (1.0 - (-dt / TURN_EASE).exp());
         self.gait.step(dt, body, self.velocity());
         if let Some(a) = self.active.as_mut() {
             let facing_done = a.walk.face.is_none_or(|p| {
