@@ -112,15 +112,8 @@ const KINDS: &[&str] = &[
     r#"head lexeme="SHAKE" repetition="2""#,
     r#"gaze target="user""#,
 ];
-const SYNCS: &[&str] = &[
-    "start",
-    "ready",
-    "strokeStart",
-    "stroke",
-    "strokeEnd",
-    "relax",
-    "end",
-];
+/// A gesture's or head's sync points, in order.
+const SYNCS: &[&str] = bml_realizer::bml::GESTURE_SYNCS;
 const TIMES: &[&str] = &["0", "0.01", "0.05", "0.2", "1", "1.02", "3"];
 
 /// A behaviour: its kind and (sync, time, tied to an earlier behaviour's sync?) constraints.
