@@ -4,6 +4,9 @@
 //! will happen. Each block that was scheduled (a PENDING prediction) reports exactly one start
 //! and one end, or one REVOKED end and no start; the others were refused with a warning.
 
+#[path = "common/random_bml.rs"]
+mod random_bml;
+
 use std::collections::BTreeMap;
 
 use bml_realizer::bml::Limits;
@@ -33,25 +36,19 @@ fn block(i: usize, composition: usize, behaviours: &[Beh]) -> String {
     for (b, (kind, syncs)) in behaviours.iter().enumerate() {
         let kind = KINDS[*kind];
         let name = kind.split(' ').next().unwrap();
-        let mut attrs = String::new();
-        let mut seen = Vec::new();
-        for &(sync, number, tie) in syncs {
+        let syncs = syncs.iter().map(|&(sync, number, tie)| {
             let sync = if name == "wait" || name == "locomotion" {
                 sync % 2 * 4
             } else {
                 sync
             };
-            if seen.contains(&sync) {
-                continue;
-            }
-            seen.push(sync);
             let value = match tie.filter(|_| b > 0) {
                 Some(other) => format!("x{}:{}+{}", other % b, SYNCS[sync], NUMBERS[number]),
                 None => NUMBERS[number].to_string(),
             };
-            attrs.push_str(&format!(r#" {}="{value}""#, SYNCS[sync]));
-        }
-        body.push_str(&format!(r#"<{kind} id="x{b}"{attrs}/>"#));
+            (SYNCS[sync], value)
+        });
+        body.push_str(&random_bml::behaviour(kind, b, syncs));
     }
     format!(
         r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b{i}"{}>{body}</bml>"#,

@@ -4,6 +4,9 @@
 //! warning names the behaviour and the phase. Checked on the known cases and on random
 //! constraint sets through the whole realizer (its predictions and its warnings).
 
+#[path = "common/random_bml.rs"]
+mod random_bml;
+
 use bml_realizer::feedback::{Feedback, WarningType};
 use bml_realizer::realizer::Realizer;
 use proptest::prelude::*;
@@ -124,26 +127,20 @@ fn block(behaviours: &[Beh]) -> String {
     for (b, (kind, syncs)) in behaviours.iter().enumerate() {
         let kind = KINDS[*kind];
         let gaze = kind.starts_with("gaze");
-        let mut attrs = String::new();
-        let mut seen = Vec::new();
-        for &(sync, t, tie) in syncs {
+        let syncs = syncs.iter().map(|&(sync, t, tie)| {
             // a gaze has start, ready, relax and end
             let sync = if gaze {
                 [0, 1, 1, 1, 5, 5, 6][sync]
             } else {
                 sync
             };
-            if seen.contains(&sync) {
-                continue;
-            }
-            seen.push(sync);
             let value = match tie.filter(|_| b > 0) {
                 Some((other, s)) => format!("x{}:{}+{}", other % b, ["start", "end"][s], TIMES[t]),
                 None => TIMES[t].to_string(),
             };
-            attrs.push_str(&format!(r#" {}="{value}""#, SYNCS[sync]));
-        }
-        body.push_str(&format!(r#"<{kind} id="x{b}"{attrs}/>"#));
+            (SYNCS[sync], value)
+        });
+        body.push_str(&random_bml::behaviour(kind, b, syncs));
     }
     format!(r#"<bml xmlns="{NS}" id="r">{body}</bml>"#)
 }

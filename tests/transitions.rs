@@ -4,10 +4,13 @@
 //! than 25 rad/s), and rounding a wall's end by footsteps (the heading changing by at most 30°
 //! from one step to the next; not met yet, so that test is ignored and says why).
 
+#[path = "common/motion.rs"]
+mod motion;
+
 use bml_realizer::body::{Pose, Skeleton};
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
-use glam::Quat;
+use motion::fastest_joint_but_the_eyes;
 
 const FPS: f64 = 60.0;
 
@@ -41,21 +44,7 @@ const STANDING: &str = r#"{"characters": {"w": {"position": [0, 0, 0], "facing":
 /// The fastest any joint but the eyes turns from frame to frame (rad/s), which and when.
 fn fastest_joint(frames: &[(f64, Pose, [bool; 2])]) -> (f32, String, f64) {
     let skeleton = Skeleton::adult();
-    let mut worst = (0.0, String::new(), 0.0);
-    for w in frames.windows(2) {
-        let ((_, a, _), (t, b, _)) = (&w[0], &w[1]);
-        for (j, joint) in skeleton.joints().iter().enumerate() {
-            if joint.name.contains("eyeball") {
-                continue;
-            }
-            let turned = (a.rotations[j].inverse() * b.rotations[j]).normalize();
-            let speed = turned.angle_between(Quat::IDENTITY) * FPS as f32;
-            if speed > worst.0 {
-                worst = (speed, joint.name.clone(), *t);
-            }
-        }
-    }
-    worst
+    fastest_joint_but_the_eyes(&skeleton, frames.iter().map(|(t, p, _)| (*t, p)))
 }
 
 /// The furthest any foot point (ankle, ball) goes below its height standing (m), which and when.

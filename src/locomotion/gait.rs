@@ -332,8 +332,7 @@ impl Gait {
             // down until then (setting off from standing: the foot whose phase stood in its swing
             // stayed planted a whole cycle, and the body ran 0.6 m ahead of it), unless too
             // little of the swing is left to make one
-            let late = now >= beta && 1.0 - now > LATE_LIFT;
-            let lifts = (was < beta && now >= beta) || late;
+            let lifts = now >= beta && (was < beta || 1.0 - now > LATE_LIFT);
             let lands = now < was; // wrapped: heel strike
             match self.feet[k] {
                 // a foot already where it belongs stays down while the body stands, or
