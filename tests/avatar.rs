@@ -51,7 +51,7 @@ fn every_limb_bone_of_three_kinds_of_avatar_points_where_the_realizer_s_does() {
 }
 
 #[test]
-fn forearm_twist_bones_take_their_share_of_the_wrist_s_twist() {
+fn arm_twist_bones_take_their_share_of_the_wrist_s_and_the_shoulder_s_twist() {
     let skeleton = Skeleton::adult();
     let model = Model::from_glb("vrm1", &test_avatar(Kind::Vrm1)).unwrap();
     let retarget = Retarget::new(&model, &skeleton, None).unwrap();
@@ -62,38 +62,36 @@ fn forearm_twist_bones_take_their_share_of_the_wrist_s_twist() {
     };
     let rotation = |m: &Mat4| m.to_scale_rotation_translation().1;
     let rest = retarget.world(&retarget.pose(&Pose::rest(&skeleton)));
+    let realizer_rest = Pose::rest(&skeleton).world(&skeleton).positions;
     let mut rng = Rng(5);
-    let mut worst = 0.0f32;
+    let mut worst = [0.0f32; 2];
     for _ in 0..300 {
         let pose = random_pose(&skeleton, &mut rng, 1.2);
         let posed = retarget.world(&retarget.pose(&pose));
-        for &(name, _, lower, share) in TWISTS {
-            let (t, e) = (node(name), node(lower));
-            let hand = node(&lower.replace("LowerArm", "Hand"));
-            let side = if lower.starts_with("left") {
-                "l_"
-            } else {
-                "r_"
-            };
+        for &(name, _, bone, share) in TWISTS {
+            let (end_bone, start, end, twisting, kept) = avatars::twist_segment(bone);
+            let (t, b, e) = (node(name), node(bone), node(&end_bone));
+            let side = if bone.starts_with("left") { "l_" } else { "r_" };
             let joint = |j: &str| skeleton.joint(&format!("{side}{j}")).unwrap();
-            // the wrist's twist about the realizer's forearm
-            let realizer_rest = Pose::rest(&skeleton).world(&skeleton).positions;
-            let forearm =
-                (realizer_rest[joint("wrist")] - realizer_rest[joint("elbow")]).normalize();
-            let q = pose.rotations[joint("wrist")];
-            let angle = 2.0 * Vec3::new(q.x, q.y, q.z).dot(forearm).atan2(q.w);
-            // the twist bone turned, since rest, relative to its lower arm: about the
-            // avatar's forearm by its share of that
-            let axis = (rest[hand].w_axis - rest[e].w_axis).truncate().normalize();
+            // the twisting joint's twist about the realizer's segment
+            let about = (realizer_rest[joint(end)] - realizer_rest[joint(start)]).normalize();
+            let q = pose.rotations[joint(twisting)];
+            let angle = 2.0 * Vec3::new(q.x, q.y, q.z).dot(about).atan2(q.w);
+            // the twist bone turned, since rest, relative to the segment's bone: about the
+            // avatar's segment by its share of that, less what the bone keeps itself
+            let axis = (rest[e].w_axis - rest[b].w_axis).truncate().normalize();
             let since = |i: usize| rotation(&posed[i]) * rotation(&rest[i]).inverse();
-            let relative = since(e).inverse() * since(t);
-            let expected = Quat::from_axis_angle(axis, share * angle);
-            worst = worst.max(relative.angle_between(expected).to_degrees());
+            let relative = since(b).inverse() * since(t);
+            let expected = Quat::from_axis_angle(axis, (share - kept) * angle);
+            let upper = usize::from(kept > 0.5);
+            worst[upper] = worst[upper].max(relative.angle_between(expected).to_degrees());
         }
     }
     assert!(
-        worst < 0.5,
-        "a twist bone is {worst}° off its share of the wrist's twist"
+        worst[0] < 0.5 && worst[1] < 0.5,
+        "a twist bone is off its share of the twist: forearm {}°, upper arm {}°",
+        worst[0],
+        worst[1]
     );
 }
 

@@ -131,8 +131,8 @@ pub const LIMBS: &[(&str, &str)] = &[
     ("rightFoot", "rightToes"),
 ];
 
-/// The VRM 1.0 avatar's forearm twist bones: (name, parent node, lower arm bone, share of the
-/// way from elbow to wrist).
+/// The VRM 1.0 avatar's arm twist bones: (name, parent node, the limb segment's bone, share of
+/// the way along the segment).
 pub const TWISTS: &[(&str, &str, &str, f32)] = &[
     ("J_leftLowerArmTwist1", "leftLowerArm", "leftLowerArm", 0.5),
     (
@@ -142,7 +142,33 @@ pub const TWISTS: &[(&str, &str, &str, f32)] = &[
         0.9,
     ),
     ("lowerarm_twist_01_r", "rightLowerArm", "rightLowerArm", 0.3),
+    ("upperarm_twist_01_l", "leftUpperArm", "leftUpperArm", 0.0),
+    (
+        "upperarm_twist_02_l",
+        "upperarm_twist_01_l",
+        "leftUpperArm",
+        0.5,
+    ),
+    ("J_rightUpperArmRoll", "rightUpperArm", "rightUpperArm", 0.6),
 ];
+
+/// A twisting limb segment of [`TWISTS`]: the bone at its end, the realizer's joints at its
+/// start and end (without side), the joint whose twist its twist bones share and the share its
+/// own bone keeps (the forearm none of the wrist's, the upper arm all of the shoulder's).
+pub fn twist_segment(bone: &str) -> (String, &'static str, &'static str, &'static str, f32) {
+    if bone.contains("LowerArm") {
+        (
+            bone.replace("LowerArm", "Hand"),
+            "elbow",
+            "wrist",
+            "wrist",
+            0.0,
+        )
+    } else {
+        let end = bone.replace("UpperArm", "LowerArm");
+        (end, "shoulder", "elbow", "shoulder", 1.0)
+    }
+}
 
 #[derive(Clone, Copy, PartialEq)]
 pub enum Kind {
@@ -285,14 +311,14 @@ pub fn test_avatar(kind: Kind) -> Vec<u8> {
         world_place.push(w);
     }
     if kind == Kind::Vrm1 {
-        // forearm twist bones: two chained on the left, one on the right
-        for &(name, parent, lower, share) in TWISTS {
+        // arm twist bones: two chained on the left, one on the right, of each segment
+        for &(name, parent, bone, share) in TWISTS {
             let p = match bones.iter().position(|b| b.0 == parent) {
                 Some(k) => 1 + k,
                 None => nodes.iter().position(|n| n["name"] == parent).unwrap(),
             };
-            let (elbow, wrist) = (index(lower), index(&lower.replace("LowerArm", "Hand")));
-            let w = world_place[elbow].lerp(world_place[wrist], share);
+            let (start, end) = (index(bone), index(&twist_segment(bone).0));
+            let w = world_place[start].lerp(world_place[end], share);
             let g = random_rotation(&mut rng, PI);
             let (gp, wp) = (world_rotation[p], world_place[p]);
             let k = nodes.len();

@@ -54,11 +54,12 @@ pub(super) enum Drive {
         to: usize,
         after: Quat,
     },
-    /// A forearm twist bone: it turns about `axis` (in its parent's frame) by `share` of the
-    /// wrist's twist about the realizer's forearm (`forearm`, in the elbow's frame).
+    /// An arm twist bone: it turns about `axis` (in its parent's frame) by `share` of the
+    /// realizer joint `joint`'s twist about the realizer's limb segment (`about`, in the
+    /// joint's parent's frame).
     Twist {
-        wrist: usize,
-        forearm: Vec3,
+        joint: usize,
+        about: Vec3,
         axis: Vec3,
         share: f32,
     },
@@ -299,12 +300,12 @@ impl Retarget {
                     *rotation = (q * after).normalize();
                 }
                 Drive::Twist {
-                    wrist,
-                    forearm,
+                    joint,
+                    about,
                     axis,
                     share,
                 } => {
-                    let angle = twist::angle(turn(wrist), forearm);
+                    let angle = twist::angle(turn(joint), about);
                     *rotation = Quat::from_axis_angle(axis, share * angle) * *rotation;
                 }
             }

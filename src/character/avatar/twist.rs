@@ -1,12 +1,15 @@
-//! Forearm twist bones. Turning the hand about the forearm (pronation, supination) turns the
-//! skin along the whole forearm, most near the wrist; rigs made for games carry that with
-//! twist bones under the lower arm (Unreal's `lowerarm_twist_01_l`, Blender's
-//! `forearm_twist.L`, a `…Roll` bone). The realizer's skeleton has none: the twist is in its
-//! wrist. An avatar node is taken for a forearm twist bone when it follows no joint, its name
-//! holds `twist` or `roll` (any case), it hangs from the lower arm (directly or under another
-//! twist bone) and nothing below it follows a joint. It turns about the forearm by the wrist's
-//! twist times its share: how far along the forearm it sits at rest (0 at the elbow, 1 at the
-//! wrist), less its twist parent's share.
+//! Twist bones of the arms. Turning the hand about the forearm (pronation, supination) turns
+//! the skin along the whole forearm, most near the wrist; turning the arm about itself at the
+//! shoulder turns the skin of the upper arm, most near the elbow and hardly at the shoulder.
+//! Rigs made for games carry that with twist bones (Unreal's `lowerarm_twist_01_l` and
+//! `upperarm_twist_01_l`, Blender's `forearm_twist.L`, a `…Roll` bone). The realizer's
+//! skeleton has none: the twists are in its wrist and shoulder joints. An avatar node is taken
+//! for a twist bone of a limb segment when it follows no joint, its name holds `twist` or
+//! `roll` (any case), it hangs from the segment's bone (directly or under another twist bone)
+//! and nothing below it follows a joint. It keeps, of the twisting joint's twist about the
+//! segment, its share: how far along the segment it sits at rest (0 at the segment's start, 1
+//! at its end). The forearm's bone itself keeps none of the wrist's twist; the upper arm's bone
+//! keeps all of the shoulder's, so an upper-arm twist bone turns back by what it does not keep.
 
 use glam::{Mat4, Quat, Vec3};
 
@@ -14,7 +17,31 @@ use super::file::Model;
 use super::retarget::Drive;
 use crate::body::skeleton::Skeleton;
 
-/// The twist drives of `model`'s forearm twist bones (node, drive).
+/// A limb segment with twist bones: the joints at its start and end, the joint whose twist
+/// about the segment the twist bones share, and the share its own bone keeps.
+struct Segment {
+    start: &'static str,
+    end: &'static str,
+    twisting: &'static str,
+    kept: f32,
+}
+
+const SEGMENTS: [Segment; 2] = [
+    Segment {
+        start: "elbow",
+        end: "wrist",
+        twisting: "wrist",
+        kept: 0.0,
+    },
+    Segment {
+        start: "shoulder",
+        end: "elbow",
+        twisting: "shoulder",
+        kept: 1.0,
+    },
+];
+
+/// The twist drives of `model`'s arm twist bones (node, drive).
 pub(super) fn drives(
     model: &Model,
     skeleton: &Skeleton,
@@ -29,8 +56,61 @@ pub(super) fn drives(
         let name = model.nodes[i].name.to_lowercase();
         source[i].is_none() && (name.contains("twist") || name.contains("roll"))
     };
-    // nodes with a follower at or below them: each follower and its ancestors, up to the
-    // first one already marked
+    let carries = carrying(model, source);
+    let mut out = Vec::new();
+    for side in ["l_", "r_"] {
+        for segment in &SEGMENTS {
+            let joint = |name: &str| skeleton.joint(&format!("{side}{name}"));
+            let (Some(start), Some(end), Some(twisting)) = (
+                joint(segment.start),
+                joint(segment.end),
+                joint(segment.twisting),
+            ) else {
+                continue;
+            };
+            let Some((bone, far)) = node_of(start).zip(node_of(end)) else {
+                continue;
+            };
+            let about = (rest[end] - rest[start]).normalize_or_zero();
+            let along = place(far) - place(bone);
+            if about == Vec3::ZERO || along.length_squared() < 1e-12 {
+                continue;
+            }
+            let share = |i: usize| {
+                ((place(i) - place(bone)).dot(along) / along.length_squared()).clamp(0.0, 1.0)
+            };
+            // the twist bones under the segment's bone, parents first, with the segment's axis
+            // in their parent's frame and their parent's share
+            let mut stack = vec![(bone, pre[bone].inverse() * about, segment.kept)];
+            while let Some((parent, axis, given)) = stack.pop() {
+                for child in
+                    (0..model.nodes.len()).filter(|&c| model.nodes[c].parent == Some(parent))
+                {
+                    if !named(child) || carries[child] {
+                        continue;
+                    }
+                    let s = share(child);
+                    out.push((
+                        child,
+                        Drive::Twist {
+                            joint: twisting,
+                            about,
+                            axis,
+                            share: s - given,
+                        },
+                    ));
+                    let rest_rotation = model.nodes[child].rotation;
+                    stack.push((child, rest_rotation.inverse() * axis, s));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Per node, whether a node following a joint is at or below it: each follower and its
+/// ancestors, up to the first one already marked.
+fn carrying(model: &Model, source: &[Option<usize>]) -> Vec<bool> {
     let mut carries = vec![false; model.nodes.len()];
     for i in (0..model.nodes.len()).filter(|&i| source[i].is_some()) {
         carries[i] = true;
@@ -40,47 +120,7 @@ pub(super) fn drives(
             at = model.nodes[k].parent;
         }
     }
-    let mut out = Vec::new();
-    for side in ["l_", "r_"] {
-        let joint = |name: &str| skeleton.joint(&format!("{side}{name}"));
-        let Some((elbow, wrist)) = joint("elbow").zip(joint("wrist")) else {
-            continue;
-        };
-        let Some((lower, hand)) = node_of(elbow).zip(node_of(wrist)) else {
-            continue;
-        };
-        let forearm = (rest[wrist] - rest[elbow]).normalize_or_zero();
-        let along = place(hand) - place(lower);
-        if forearm == Vec3::ZERO || along.length_squared() < 1e-12 {
-            continue;
-        }
-        let share = |i: usize| {
-            ((place(i) - place(lower)).dot(along) / along.length_squared()).clamp(0.0, 1.0)
-        };
-        // the twist bones under the lower arm, parents first, with the forearm in their
-        // parent's frame and their parent's share
-        let mut stack = vec![(lower, pre[lower].inverse() * forearm, 0.0)];
-        while let Some((parent, axis, given)) = stack.pop() {
-            for child in (0..model.nodes.len()).filter(|&c| model.nodes[c].parent == Some(parent)) {
-                if !named(child) || carries[child] {
-                    continue;
-                }
-                let s = share(child);
-                out.push((
-                    child,
-                    Drive::Twist {
-                        wrist,
-                        forearm,
-                        axis,
-                        share: s - given,
-                    },
-                ));
-                let rest_rotation = model.nodes[child].rotation;
-                stack.push((child, rest_rotation.inverse() * axis, s));
-            }
-        }
-    }
-    out
+    carries
 }
 
 /// The angle of `q`'s twist about the unit `axis` (rad, in (−π, π]).
