@@ -29,6 +29,17 @@ pub const NS_BMLIS: &str = "http://www.asap-project.org/bmlis";
 /// Length of a hesitation filler ("uhm"), seconds.
 pub const FILLER_SECONDS: f64 = 0.5;
 
+/// A speech's own sound (`bmlt:audiofile`) and its timing marks (`bmlt:marks`), if it brings
+/// them: paths as given or relative to the working directory.
+fn own_sound(b: &Behaviour) -> Option<(String, Option<String>)> {
+    let attr = |name: &str| {
+        (b.foreign_attrs.iter())
+            .find(|a| a.ns == crate::bml::NS_BMLT && a.name == name)
+            .map(|a| a.value.trim().to_string())
+    };
+    Some((attr("audiofile")?, attr("marks")))
+}
+
 /// Whether a speech asks for a hesitation filler after its text.
 fn wants_filler(b: &Behaviour) -> bool {
     b.foreign_attrs
@@ -79,10 +90,14 @@ pub struct SpeechEngine {
     units: Units<Speaking>,
     /// The last frame's time.
     now: f64,
-    /// The last [`CACHE`] texts said, with what the voice made of them: timing, warnings and the
-    /// unit ask for the same text, and a voice that runs a program is asked once.
-    said: std::sync::Mutex<std::collections::VecDeque<(Vec<TextPart>, Arc<Said>)>>,
+    /// The last [`CACHE`] texts said (with their own sound and marks, if any), with what the
+    /// voice made of them: timing, warnings and the unit ask for the same text, and a voice
+    /// that runs a program is asked once.
+    said: std::sync::Mutex<std::collections::VecDeque<(Saying, Arc<Said>)>>,
 }
+
+/// What is said: the text, and the speech's own sound and marks files if it brings them.
+type Saying = (Vec<TextPart>, Option<(String, Option<String>)>);
 
 /// How many texts the engine remembers.
 const CACHE: usize = 64;
@@ -92,7 +107,8 @@ const CACHE: usize = 64;
 pub struct Said {
     /// The utterance (phones, syncs, end, sound).
     pub utterance: Utterance,
-    /// Why the chosen voice could not say it, if it could not.
+    /// Why the chosen voice could not say it as asked (a voice missing, a speech's own sound
+    /// unreadable, its marks bad or past the sound's end), if it could not.
     pub failed: Option<String>,
 }
 
@@ -107,13 +123,27 @@ impl SpeechEngine {
         }
     }
 
-    /// What the voice makes of `text` (remembered).
-    fn say(&self, text: &[TextPart]) -> Arc<Said> {
+    /// What the voice makes of `behaviour`'s text, or its own sound makes of it (remembered).
+    fn say(&self, behaviour: &Behaviour) -> Arc<Said> {
+        let saying: Saying = (Self::text(behaviour).to_vec(), own_sound(behaviour));
         let mut cache = self.said.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, s)) = cache.iter().find(|(t, _)| t.as_slice() == text) {
+        if let Some((_, s)) = cache.iter().find(|(t, _)| *t == saying) {
             return s.clone();
         }
-        let said = Arc::new(match self.timing.speak(text) {
+        let said = Arc::new(match &saying.1 {
+            Some((audio, marks)) => Self::own(&saying.0, audio, marks.as_deref()),
+            None => self.voiced(&saying.0),
+        });
+        cache.push_back((saying, said.clone()));
+        if cache.len() > CACHE {
+            cache.pop_front();
+        }
+        said
+    }
+
+    /// What the TTS makes of `text` (the built-in TTS's timing, silent, if it fails).
+    fn voiced(&self, text: &[TextPart]) -> Said {
+        match self.timing.speak(text) {
             Ok(utterance) => Said {
                 utterance,
                 failed: None,
@@ -122,12 +152,39 @@ impl SpeechEngine {
                 utterance: SpeechTiming::default().speak(text).unwrap_or_default(),
                 failed: Some(e),
             },
-        });
-        cache.push_back((text.to_vec(), said.clone()));
-        if cache.len() > CACHE {
-            cache.pop_front();
         }
-        said
+    }
+
+    /// `text` said by the sound in file `audio`, timed by the marks in file `marks`
+    /// (`voice::recorded`). An unreadable sound leaves the built-in TTS's timing, silent;
+    /// unreadable marks leave the sound to time the text.
+    fn own(text: &[TextPart], audio: &str, marks: Option<&str>) -> Said {
+        let sound = match crate::sound::read_wav(std::path::Path::new(audio)) {
+            Ok(a) => Arc::new(a),
+            Err(e) => {
+                return Said {
+                    utterance: SpeechTiming::default().speak(text).unwrap_or_default(),
+                    failed: Some(format!("its audiofile cannot be read ({e})")),
+                }
+            }
+        };
+        let mut problems = Vec::new();
+        let marks = marks.and_then(|file| {
+            let read = std::fs::read_to_string(file).map_err(|e| format!("{file}: {e}"));
+            match read.and_then(|t| crate::voice::marks::parse(&t, file)) {
+                Ok(m) => Some(m),
+                Err(e) => {
+                    problems.push(format!("its marks are not used ({e})"));
+                    None
+                }
+            }
+        });
+        let (utterance, warnings) = crate::voice::recorded::utterance(text, sound, marks.as_ref());
+        problems.extend(warnings);
+        Said {
+            utterance,
+            failed: (!problems.is_empty()).then(|| problems.join("; ")),
+        }
     }
 
     /// The text of a speech behaviour.
@@ -144,7 +201,7 @@ impl SpeechEngine {
         if !matches!(behaviour.kind, BehaviourKind::Speech(_)) {
             return (Vec::new(), Vec::new()); // shown text: the lips stay still
         }
-        let said = self.say(Self::text(behaviour));
+        let said = self.say(behaviour);
         let u = &said.utterance;
         let mut phones = u.phones.clone();
         let mut anchors: Vec<f64> = std::iter::once(0.0)
@@ -198,7 +255,16 @@ impl Engine for SpeechEngine {
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         let mut model = match &behaviour.kind {
-            BehaviourKind::Speech(s) => self.timing.model_of(&self.say(&s.text).utterance),
+            BehaviourKind::Speech(_) if own_sound(behaviour).is_some() => {
+                // a sound of its own cannot stretch: rigid, at its own pace
+                let timing = SpeechTiming {
+                    rate: 1.0,
+                    retimable: false,
+                    ..self.timing
+                };
+                timing.model_of(&self.say(behaviour).utterance)
+            }
+            BehaviourKind::Speech(_) => self.timing.model_of(&self.say(behaviour).utterance),
             // shown text is timed as the built-in voice would say it, and may stretch
             BehaviourKind::Text(_) => crate::timing::DefaultTimingModels {
                 speech: SpeechTiming {
@@ -225,23 +291,27 @@ impl Engine for SpeechEngine {
         if !matches!(behaviour.kind, BehaviourKind::Speech(_)) {
             return None;
         }
-        let said = self.say(Self::text(behaviour));
+        let said = self.say(behaviour);
         let why = said.failed.as_ref()?;
-        Some(format!(
-            "speech '{}': {why}; it is timed by the built-in TTS instead, without sound",
-            behaviour.id
-        ))
+        Some(match (own_sound(behaviour), &said.utterance.audio) {
+            (Some(_), Some(_)) => format!("speech '{}': {why}", behaviour.id),
+            _ => format!(
+                "speech '{}': {why}; it is timed by the built-in TTS instead, without sound",
+                behaviour.id
+            ),
+        })
     }
 
     fn interprets(&self, ns: &str, name: &str) -> bool {
-        ns == NS_BMLIS && name == "generatefiller"
+        (ns == NS_BMLIS && name == "generatefiller")
+            || (ns == crate::bml::NS_BMLT && matches!(name, "audiofile" | "marks"))
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         // keys are unique: the runtime never adds a unit twice
         let (phones, anchors) = self.spoken(unit.behaviour);
         let audio = matches!(unit.behaviour.kind, BehaviourKind::Speech(_))
-            .then(|| self.say(Self::text(unit.behaviour)).utterance.audio.clone())
+            .then(|| self.say(unit.behaviour).utterance.audio.clone())
             .flatten();
         let knots = (unit.syncs.iter().zip(&anchors))
             .map(|(s, &a)| (s.1, a))
