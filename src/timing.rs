@@ -297,6 +297,9 @@ pub enum Voice {
     /// CMU Flite run as a program (`voice::flite`; Debian package `flite`): its phone timings and
     /// its sound.
     Flite,
+    /// espeak-ng run as a program with a voice (`voice::espeak`; Debian package `espeak-ng`): its
+    /// sound in its languages, its phonemes timed to it.
+    Espeak(crate::voice::espeak::VoiceName),
 }
 
 /// Speech timing from a voice (the built-in TTS by default): rigid, each inline sync where the
@@ -357,6 +360,7 @@ impl SpeechTiming {
             Voice::Builtin => crate::voice::builtin::Builtin.speak(text),
             Voice::Syllables => crate::voice::syllables::Syllables.speak(text),
             Voice::Flite => crate::voice::flite::Flite::default().speak(text),
+            Voice::Espeak(name) => crate::voice::espeak::Espeak::new(name).speak(text),
         }
     }
 

@@ -40,6 +40,16 @@ fn own_sound(b: &Behaviour) -> Option<(String, Option<String>)> {
     Some((attr("audiofile")?, attr("marks")))
 }
 
+/// The XML namespace (`xml:lang`).
+const NS_XML: &str = "http://www.w3.org/XML/1998/namespace";
+
+/// A speech's language (`xml:lang`), if it gives one.
+fn language(b: &Behaviour) -> Option<String> {
+    (b.foreign_attrs.iter())
+        .find(|a| a.ns == NS_XML && a.name == "lang")
+        .map(|a| a.value.trim().to_ascii_lowercase())
+}
+
 /// Whether a speech asks for a hesitation filler after its text.
 fn wants_filler(b: &Behaviour) -> bool {
     b.foreign_attrs
@@ -96,8 +106,13 @@ pub struct SpeechEngine {
     said: std::sync::Mutex<std::collections::VecDeque<(Saying, Arc<Said>)>>,
 }
 
-/// What is said: the text, and the speech's own sound and marks files if it brings them.
-type Saying = (Vec<TextPart>, Option<(String, Option<String>)>);
+/// What is said: the text, the speech's own sound and marks files if it brings them, and its
+/// language if it gives one.
+type Saying = (
+    Vec<TextPart>,
+    Option<(String, Option<String>)>,
+    Option<String>,
+);
 
 /// How many texts the engine remembers.
 const CACHE: usize = 64;
@@ -125,14 +140,18 @@ impl SpeechEngine {
 
     /// What the voice makes of `behaviour`'s text, or its own sound makes of it (remembered).
     fn say(&self, behaviour: &Behaviour) -> Arc<Said> {
-        let saying: Saying = (Self::text(behaviour).to_vec(), own_sound(behaviour));
+        let saying: Saying = (
+            Self::text(behaviour).to_vec(),
+            own_sound(behaviour),
+            language(behaviour),
+        );
         let mut cache = self.said.lock().unwrap_or_else(|e| e.into_inner());
         if let Some((_, s)) = cache.iter().find(|(t, _)| *t == saying) {
             return s.clone();
         }
         let said = Arc::new(match &saying.1 {
             Some((audio, marks)) => Self::own(&saying.0, audio, marks.as_deref()),
-            None => self.voiced(&saying.0),
+            None => self.voiced(&saying.0, saying.2.as_deref()),
         });
         cache.push_back((saying, said.clone()));
         if cache.len() > CACHE {
@@ -141,12 +160,30 @@ impl SpeechEngine {
         said
     }
 
-    /// What the TTS makes of `text` (the built-in TTS's timing, silent, if it fails).
-    fn voiced(&self, text: &[TextPart]) -> Said {
-        match self.timing.speak(text) {
+    /// What the TTS makes of `text` (the built-in TTS's timing, silent, if it fails), in
+    /// `language` where the voice speaks several (espeak-ng: its voice of that name, else its
+    /// own with a warning).
+    fn voiced(&self, text: &[TextPart], language: Option<&str>) -> Said {
+        let mut timing = self.timing;
+        let mut warning = None;
+        if let (crate::timing::Voice::Espeak(own), Some(language)) = (timing.voice, language) {
+            use crate::voice::espeak::{Espeak, VoiceName};
+            match VoiceName::new(language) {
+                Ok(name) if Espeak::new(name).has_voice() => {
+                    timing.voice = crate::timing::Voice::Espeak(name)
+                }
+                _ => {
+                    warning = Some(format!(
+                        "espeak-ng has no voice for xml:lang '{language}'; it speaks with '{}'",
+                        own.as_str()
+                    ))
+                }
+            }
+        }
+        match timing.speak(text) {
             Ok(utterance) => Said {
                 utterance,
-                failed: None,
+                failed: warning,
             },
             Err(e) => Said {
                 utterance: SpeechTiming::default().speak(text).unwrap_or_default(),
@@ -293,9 +330,9 @@ impl Engine for SpeechEngine {
         }
         let said = self.say(behaviour);
         let why = said.failed.as_ref()?;
-        Some(match (own_sound(behaviour), &said.utterance.audio) {
-            (Some(_), Some(_)) => format!("speech '{}': {why}", behaviour.id),
-            _ => format!(
+        Some(match &said.utterance.audio {
+            Some(_) => format!("speech '{}': {why}", behaviour.id),
+            None => format!(
                 "speech '{}': {why}; it is timed by the built-in TTS instead, without sound",
                 behaviour.id
             ),
@@ -305,6 +342,9 @@ impl Engine for SpeechEngine {
     fn interprets(&self, ns: &str, name: &str) -> bool {
         (ns == NS_BMLIS && name == "generatefiller")
             || (ns == crate::bml::NS_BMLT && matches!(name, "audiofile" | "marks"))
+            || (ns == NS_XML
+                && name == "lang"
+                && matches!(self.timing.voice, crate::timing::Voice::Espeak(_)))
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {

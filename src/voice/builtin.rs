@@ -93,6 +93,11 @@ pub fn phone_name(symbol: &str) -> Option<&'static str> {
     phone(symbol).map(|p| p.0)
 }
 
+/// The inherent duration of ARPAbet phone `symbol` (seconds), if it is one.
+pub fn inherent(symbol: &str) -> Option<f64> {
+    phone(symbol).map(|p| p.1)
+}
+
 /// Whether `symbol` is a vowel.
 pub fn is_vowel(symbol: &str) -> bool {
     PHONES[..VOWELS].iter().any(|(p, _)| *p == symbol)

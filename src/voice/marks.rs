@@ -105,10 +105,12 @@ fn polly(text: &str, file: &str) -> Result<Marks, String> {
             Some("viseme") => marks.visemes.push((time, polly_viseme(value))),
             Some("ssml") => marks.named.push((value.to_string(), time)),
             Some("sentence") => {}
-            other => return Err(format!(
+            other => {
+                return Err(format!(
                 "{file}: line {n}: a speech mark's type is word, viseme, sentence or ssml, not {}",
                 other.map_or("missing".to_string(), |t| format!("{t:?}"))
-            )),
+            ))
+            }
         }
     }
     Ok(marks)

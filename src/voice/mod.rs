@@ -1,13 +1,15 @@
 //! The voice: a text-to-speech interface ([`Tts`]) that turns a speech's text with inline syncs
 //! into phones with times, word times, sync times and optional audio; the built-in TTS
 //! ([`builtin`]: English letter-to-sound rules, a lexicon of common words, a duration model; no
-//! audio); flite run as a program ([`flite`]: its phone timings and its sound); a metronome
+//! audio); flite run as a program ([`flite`]: its phone timings and its sound); espeak-ng run as
+//! a program ([`espeak`]: its sound in its many languages, its phonemes timed to it); a metronome
 //! voice whose timing can be worked out by hand ([`syllables`]); a speech's own sound with its
 //! timing marks ([`recorded`], [`marks`], and [`listen`] to time a text to a sound without
 //! marks); and lip sync ([`lipsync`]: phones to visemes with coarticulation). The scheduler
 //! keeps a speech rigid with the times its voice gives.
 
 pub mod builtin;
+pub mod espeak;
 pub mod flite;
 pub mod ipa;
 pub mod lipsync;

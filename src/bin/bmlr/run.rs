@@ -106,9 +106,14 @@ pub struct SetupArgs {
     /// idle layer changes the motion only, never the feedback).
     #[arg(long)]
     pub no_idle: bool,
-    /// The voice that says speech: the built-in TTS, or flite (Debian package `flite`).
+    /// The voice that says speech: the built-in TTS, flite (Debian package `flite`) or
+    /// espeak-ng (Debian package `espeak-ng`).
     #[arg(long, value_enum, default_value = "builtin")]
     pub tts: TtsArg,
+    /// The espeak-ng voice or language (`en`, `de`, `fr`, `pt-br`; `espeak-ng --voices` lists
+    /// them) for --tts espeak; a speech's xml:lang overrides it.
+    #[arg(long, value_name = "NAME")]
+    pub voice: Option<String>,
     /// Characters see (synthetic vision, settings from the world file's "vision") and
     /// perception feedback reports what each sees when it changes.
     #[arg(long)]
@@ -126,7 +131,7 @@ impl SetupArgs {
     /// The realizer asked for (`posix_time`: feedback carries wall-clock times); the error
     /// names the option that is wrong.
     pub fn realizer(&self, posix_time: bool) -> Result<Realizer, String> {
-        let speech = self.tts.timing().map_err(|e| format!("--tts flite: {e}"))?;
+        let speech = (self.tts.timing(self.voice.as_deref())).map_err(|e| format!("--tts: {e}"))?;
         let realizer = with_assets(Realizer::new(), self.assets.as_deref(), speech)
             .map_err(|e| format!("--assets {e}"))?;
         let mut realizer = with_world(realizer, self.world.as_deref())
@@ -212,16 +217,30 @@ pub enum TtsArg {
     Builtin,
     /// CMU Flite as a program (Debian package `flite`): its timing and its sound.
     Flite,
+    /// espeak-ng as a program (Debian package `espeak-ng`): its sound in its languages (--voice,
+    /// or xml:lang on a speech), its phonemes timed to it.
+    Espeak,
 }
 
 impl TtsArg {
-    /// The speech timing of this voice; for flite, an error if it is not installed.
-    pub fn timing(self) -> Result<SpeechTiming, String> {
+    /// The speech timing of this voice (espeak-ng's `voice`, else its English); for flite and
+    /// espeak-ng, an error if the program is not installed or lacks the voice, and a voice
+    /// asked of another TTS is an error too.
+    pub fn timing(self, voice: Option<&str>) -> Result<SpeechTiming, String> {
+        use bml_realizer::voice::espeak::{Espeak, VoiceName};
+        if voice.is_some() && self != TtsArg::Espeak {
+            return Err("--voice names an espeak-ng voice: give --tts espeak".into());
+        }
         let voice = match self {
             TtsArg::Builtin => Voice::Builtin,
             TtsArg::Flite => {
                 bml_realizer::voice::flite::Flite::default().check()?;
                 Voice::Flite
+            }
+            TtsArg::Espeak => {
+                let name = voice.map_or(Ok(VoiceName::default()), VoiceName::new)?;
+                Espeak::new(name).check()?;
+                Voice::Espeak(name)
             }
         };
         Ok(SpeechTiming {

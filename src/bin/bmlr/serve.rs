@@ -169,10 +169,10 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         eprintln!("bmlr serve: {flag} goes with {port}");
         return ExitCode::from(2);
     }
-    let voice = match args.tts.timing() {
+    let voice = match args.tts.timing(None) {
         Ok(t) => t,
         Err(e) => {
-            eprintln!("bmlr serve: --tts flite: {e}");
+            eprintln!("bmlr serve: --tts: {e}");
             return ExitCode::from(2);
         }
     };
@@ -527,10 +527,10 @@ pub fn conformance(args: ConformanceArgs) -> ExitCode {
                 }
             }
         }
-        (None, None) => match args.tts.timing() {
+        (None, None) => match args.tts.timing(None) {
             Ok(t) => Box::new(InProcess::new().with_voice(t.voice)),
             Err(e) => {
-                eprintln!("bmlr conformance: --tts flite: {e}");
+                eprintln!("bmlr conformance: --tts: {e}");
                 return ExitCode::from(2);
             }
         },
