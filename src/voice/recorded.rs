@@ -46,7 +46,6 @@ pub fn utterance(
     }
     let spoken_words = said.words.len();
     let marked = marks.as_ref().filter(|m| !m.words.is_empty());
-    let heard = listen::frames(&audio);
     // knots from the TTS's time to the sound's
     let knots = match marked {
         Some(m) if spoken_words > 0 => {
@@ -60,7 +59,7 @@ pub fn utterance(
             knots
         }
         _ if spoken_words > 0 && length <= listen::MAX_ALIGNED => {
-            listen::align(&said.phones, &heard)
+            listen::align(&said.phones, &listen::frames(&audio))
         }
         _ => Vec::new(),
     };
@@ -88,7 +87,7 @@ pub fn utterance(
             .filter(|p| p.end > p.start)
             .collect()
     } else {
-        listen::phones_of_sound(&heard)
+        listen::phones_of_sound(&listen::frames(&audio))
     };
     let mut syncs: Vec<_> = (said.syncs.iter())
         .map(|(id, t)| {
