@@ -39,6 +39,9 @@ fn a_crowd_page_carries_packed_frames_that_match_the_frames_file() {
     );
     let times = packed["times"].as_array().unwrap();
     assert_eq!(times.len(), 61, "0 .. 2 s at 30 fps");
+    // 43 are few enough to be drawn as people: the default avatar goes in once
+    let avatar = data["crowdAvatar"].as_str().expect("the crowd's avatar");
+    assert!(avatar.len() > 1_000_000, "{} bytes of base64", avatar.len());
     let roots = roots(packed);
     assert_eq!(roots.len(), times.len() * ids.len() * 7);
     // the same run's frames file, roots only, at the page's rate
@@ -104,21 +107,33 @@ fn headless_chromium_draws_the_crowd() {
     let (_, console) = browse(&url, &format!("--screenshot={}", out.display()));
     assert!(console.is_empty(), "{console:?}");
     let shot = Shot::load(&out);
-    // the suits' blue in the 3D view (floor, grid, background and obstacles are grey), and
-    // spread over it: figures all over the plaza, not one heap
+    // the shirts' blue in the 3D view (floor, grid, background and obstacles are grey), and
+    // spread over it: figures all over the plaza, not one heap; drawn as people, so with the
+    // avatar's dark brown hair and shoes, which the mannequins lack (486 such pixels with
+    // people, 1 with mannequins)
     let mut columns = std::collections::BTreeSet::new();
-    let mut n = 0;
+    let (mut n, mut hair) = (0, 0);
     for y in 0..430 {
         for x in 0..895 {
-            let [r, _, b] = shot.px(x, y);
+            let [r, g, b] = shot.px(x, y);
             if u16::from(b) > u16::from(r) + 40 {
                 n += 1;
                 columns.insert(x / 50);
             }
+            if u16::from(r) > u16::from(b) + 30 && r < 140 && g < 110 {
+                hair += 1;
+            }
         }
     }
-    eprintln!("{n} suit pixels in {} of 18 columns", columns.len());
-    assert!(n > 3000, "the crowd is not drawn ({n} suit pixels)");
+    eprintln!(
+        "{n} shirt pixels in {} of 18 columns, {hair} hair and shoe pixels",
+        columns.len()
+    );
+    assert!(n > 2000, "the crowd is not drawn ({n} shirt pixels)");
+    assert!(
+        hair > 200,
+        "the crowd is not drawn as people ({hair} hair pixels)"
+    );
     assert!(
         columns.len() >= 12,
         "the crowd is not spread out: {columns:?}"

@@ -7,12 +7,8 @@
 // WebSocket brings their nodes' rotations and morph weights, interpolated here between frames.
 'use strict';
 
-/** Loads the page data's avatars into `viewer`'s scene; `fail` reports an error on the page. */
-function bmlrLoadAvatars(viewer, fail) {
-  const THREE = viewer.THREE;
-  const avatars = viewer.data.avatars || [];
-  const wiring = viewer.data.liveAvatars || [];
-  if (!avatars.length) return;
+/** A module URL of three.js's GLTFLoader working from the page's own text. */
+function bmlrGltfLoader(viewer) {
   const text = (id) => document.getElementById(id).textContent;
   const module = (s) => URL.createObjectURL(new Blob([s], { type: 'text/javascript' }));
   const three = (s) => s.replace(/from 'three'/g, `from '${viewer.threeURL}'`);
@@ -20,11 +16,21 @@ function bmlrLoadAvatars(viewer, fail) {
   // textures decoded from <img> elements, not ImageBitmaps: an ImageBitmap decodes off the
   // page's thread, where a headless browser's virtual time does not wait for it, so a picture
   // taken under a virtual-time budget now and then showed the page before the avatar was in it
-  const loader = module(
+  return module(
     three(text('three-gltf'))
       .replace("'../utils/BufferGeometryUtils.js'", `'${utils}'`)
       .replace("typeof createImageBitmap === 'undefined'", 'true'),
   );
+}
+
+/** Loads the page data's avatars into `viewer`'s scene; `fail` reports an error on the page. */
+function bmlrLoadAvatars(viewer, fail) {
+  const THREE = viewer.THREE;
+  const avatars = viewer.data.avatars || [];
+  const wiring = viewer.data.liveAvatars || [];
+  if (viewer.data.crowdAvatar && viewer.crowd) bmlrLoadCrowdPeople(viewer, fail);
+  if (!avatars.length) return;
+  const loader = bmlrGltfLoader(viewer);
   viewer.avatarsLoading = avatars.length;
   const done = () => {
     viewer.avatarsLoading--;
@@ -131,4 +137,40 @@ function bmlrDriveLive(THREE, avatar, clip, t, id) {
     }
     o += m.count;
   }
+}
+
+/** A crowd drawn as people: the default avatar (the page's `crowdAvatar`, whose bones are the
+ *  realizer's joints by name) copied once per character, every copy a skinned mesh sharing the
+ *  one geometry and material with a skeleton of its own; the crowd's mannequin boxes hide. */
+function bmlrLoadCrowdPeople(viewer, fail) {
+  const crowd = viewer.crowd;
+  viewer.avatarsLoading++;
+  const bytes = Uint8Array.from(atob(viewer.data.crowdAvatar), (c) => c.charCodeAt(0));
+  const finish = () => {
+    viewer.avatarsLoading--;
+    viewer.draw();
+  };
+  import(bmlrGltfLoader(viewer)).then(
+    ({ GLTFLoader }) => new GLTFLoader().parse(bytes.buffer, '', (gltf) => {
+      const people = [];
+      for (let k = 0; k < crowd.count; k++) {
+        const copy = gltf.scene.clone(true);
+        const byName = new Map();
+        copy.traverse((o) => { if (o.name) byName.set(o.name, o); });
+        // a clone's skinned meshes still point at the original's bones: bind them to the copy's
+        copy.traverse((o) => {
+          if (!o.isSkinnedMesh) return;
+          const bones = o.skeleton.bones.map((b) => byName.get(b.name) || b);
+          o.bind(new viewer.THREE.Skeleton(bones, o.skeleton.boneInverses), o.bindMatrix);
+          o.frustumCulled = false;
+        });
+        viewer.scene.add(copy);
+        people.push(crowd.joints.map((j) => byName.get(j.name) || null));
+      }
+      crowd.people = people;
+      for (const mesh of crowd.meshes) mesh.visible = false;
+      finish();
+    }, (e) => { fail('the crowd\'s avatar did not load: ' + e); finish(); }),
+    (e) => { fail("three.js's GLTFLoader did not load: " + e); finish(); },
+  );
 }

@@ -3,7 +3,9 @@
 // the joints that move as 16-bit integers; the rest of the joints once per character. Its
 // characters are drawn as one crowd: the mannequin's boxes as two instanced meshes (clothes,
 // skin) for all of them, placed by forward kinematics here every frame, so hundreds cost two
-// draw calls instead of thousands. Crowd pages draw no faces.
+// draw calls instead of thousands. Up to 100 characters are drawn as people instead
+// (avatars.js: the default avatar, one skinned copy each sharing its geometry), their bones
+// set here. Crowd pages draw no faces.
 'use strict';
 
 /** The packed frames of `packed` for a skeleton of `joints`: pose(i, k, out) writes frame i of
@@ -100,8 +102,21 @@ class BmlrCrowd {
     this.step = new THREE.Vector3();
   }
 
-  /** Puts character k's boxes where `pose` (root, rotation, joint rotations) has them. */
+  /** Puts character k's boxes (or, drawn as people, its avatar's bones) where `pose` (root,
+   *  rotation, joint rotations) has them. */
   place(k, pose) {
+    if (this.people) {
+      this.people[k].forEach((bone, j) => {
+        if (!bone) return;
+        if (this.parents[j] < 0) {
+          bone.position.set(pose[0], pose[1], pose[2]);
+          bone.quaternion.fromArray(pose, 3);
+        } else {
+          bone.quaternion.fromArray(pose, 7 + 4 * j);
+        }
+      });
+      return;
+    }
     const [at, turn] = [this.worldAt, this.worldTurn];
     for (let j = 0; j < this.joints.length; j++) {
       const p = this.parents[j];

@@ -86,6 +86,7 @@ impl LiveView {
             avatars: glbs,
             live_avatars: wiring,
             packed: None,
+            crowd_avatar: false,
         }
         .to_json();
         let live = Live::new(BACKLOG);

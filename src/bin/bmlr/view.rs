@@ -52,8 +52,12 @@ pub struct ViewArgs {
 pub const MAX_VIEW_AVATARS: usize = 4;
 
 /// Most characters whose frames the page carries as the frames file's lines, each drawn with
-/// its face; more are packed and drawn as one crowd (instanced, without faces).
+/// its face; more are packed and drawn as one crowd (without faces).
 pub const CROWD_PAGE: usize = 16;
+
+/// Most characters of a crowd drawn as people (the default avatar, skinned, one copy of its
+/// geometry shared by all); more are drawn as instanced mannequins.
+pub const CROWD_PEOPLE: usize = 100;
 
 /// `bmlr view`.
 pub fn view(args: ViewArgs) -> ExitCode {
@@ -141,6 +145,14 @@ fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome),
         );
         Vec::new()
     };
+    // a crowd of people, not mannequins, while the page can draw them
+    let crowd_avatar = packed.is_some() && characters.len() <= CROWD_PEOPLE;
+    if packed.is_some() && !crowd_avatar {
+        eprintln!(
+            "bmlr view: {} characters, drawn as mannequins (people for at most {CROWD_PEOPLE})",
+            characters.len()
+        );
+    }
     let data = PageData {
         title: &title(&args.items),
         live: false,
@@ -152,6 +164,7 @@ fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome),
         avatars,
         live_avatars: Vec::new(),
         packed,
+        crowd_avatar,
     };
     let page = web::page(&data.to_json());
     let s = if characters.len() == 1 { "" } else { "s" };
@@ -197,6 +210,9 @@ pub struct PageData<'a> {
     pub live_avatars: Vec<serde_json::Value>,
     /// A crowd's frames, packed (see [`crate::pack`]) instead of `lines`.
     pub packed: Option<Value>,
+    /// Whether a crowd is drawn as people: the default avatar goes in once, and every
+    /// character is a skinned copy sharing its geometry.
+    pub crowd_avatar: bool,
 }
 
 impl PageData<'_> {
@@ -220,8 +236,13 @@ impl PageData<'_> {
                 base64::engine::general_purpose::STANDARD.encode(glb)
             })
             .collect();
+        let crowd_avatar = self.crowd_avatar.then(|| {
+            use base64::Engine as _;
+            base64::engine::general_purpose::STANDARD.encode(bml_realizer::avatar::DEFAULT_GLB)
+        });
         let data = json!({
             "avatars": avatars,
+            "crowdAvatar": crowd_avatar,
             "liveAvatars": self.live_avatars,
             "title": self.title,
             "live": self.live,
