@@ -8,6 +8,9 @@ use crate::feedback::KnownWarning;
 use crate::plan::anticipator::Anticipator;
 use crate::plan::to_pegs;
 
+/// How far a block's predicted end must move for a new prediction to be sent (seconds).
+const REVISION: f64 = 1e-3;
+
 /// A behaviour (by position in its block) and the new global times of its syncs.
 type Retimed = (usize, Vec<f64>);
 
@@ -43,6 +46,8 @@ impl BlockManager {
         if changed.is_empty() {
             return;
         }
+        let announce = (self.anticipators.iter())
+            .any(|a| a.announces() && changed.iter().any(|c| c == a.id()));
         self.touch();
         let hanging: Vec<BlockKey> = (self.blocks.with_keys())
             .filter(|(_, b)| b.pegs.is_some())
@@ -58,6 +63,7 @@ impl BlockManager {
                 let x = anticipators.iter().find(|x| x.id() == a)?;
                 x.predict(sync)
             };
+            let before = self.blocks[i].predicted_end();
             let (moved, refused) = match self.blocks[i].pegs.as_mut() {
                 Some(p) => p.follow(&changed, predict),
                 None => (false, None),
@@ -71,7 +77,25 @@ impl BlockManager {
             }
             if moved {
                 self.follow_pegs(i, t);
+                if announce {
+                    self.announce_end(i, before);
+                }
             }
+        }
+    }
+
+    /// Sends block `i`'s prediction if its end moved from `before` (by more than
+    /// [`REVISION`]).
+    fn announce_end(&mut self, i: BlockKey, before: Option<f64>) {
+        let Some(after) = self.blocks.get(i).map(|b| b.predicted_end()) else {
+            return;
+        };
+        let moved = match (before, after) {
+            (Some(a), Some(b)) => (a - b).abs() > REVISION,
+            (a, b) => a.is_some() != b.is_some(),
+        };
+        if moved {
+            self.predict(i, true);
         }
     }
 

@@ -2,7 +2,7 @@
 //! part in animation prediction ([`Prediction`]), parameters that change while a unit runs
 //! ([`Parameters`]), body resources and exclusive groups ([`Resources`]), actions on the plan
 //! ([`Control`]), moving about the world ([`Travel`]) and looking at whom the walk attends to
-//! ([`Attend`]). An engine offers one by returning itself from the matching `as_…` method of
+//! ([`Attend`]), sound streamed in by the host ([`Streams`]). An engine offers one by returning itself from the matching `as_…` method of
 //! [`Engine`](super::Engine).
 
 use super::{EngineError, ParameterChange, UnitKey};
@@ -26,6 +26,13 @@ pub trait Motion {
 pub trait Expression {
     /// Shows the units running at `now` on `face`.
     fn express(&mut self, now: f64, face: &mut crate::face::Face);
+}
+
+/// An engine that plays sound the host streams in (`voice::stream`): it is handed every stream
+/// the host opens, and plays the behaviours that name one.
+pub trait Streams {
+    /// Takes `stream` (a handle shared with the host).
+    fn add_stream(&mut self, stream: crate::voice::stream::AudioStream);
 }
 
 /// An engine that makes sound (synthesized speech, audio clips).

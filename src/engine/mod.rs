@@ -17,7 +17,7 @@ use std::fmt;
 
 pub use capabilities::{
     Action, Attend, Attention, BalanceReading, Control, Expression, Motion, MotionKind, Parameters,
-    Physics, Prediction, Resources, Revision, Sound, Steering, Travel,
+    Physics, Prediction, Resources, Revision, Sound, Steering, Streams, Travel,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};
@@ -183,6 +183,11 @@ pub trait Engine: Send {
 
     /// Its sound, if it makes any.
     fn as_sound(&self) -> Option<&dyn Sound> {
+        None
+    }
+
+    /// Its streams, if it plays sound the host streams in.
+    fn as_streams(&mut self) -> Option<&mut dyn Streams> {
         None
     }
 

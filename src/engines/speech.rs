@@ -17,6 +17,7 @@ use crate::bml::{Behaviour, BehaviourKind, TextPart};
 use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
 use crate::face::{Face, FaceModel};
 use crate::timing::{SpeechTiming, SyncKey, SyncName, TimingModel, TimingModels};
+use crate::voice::stream::AudioStream;
 use crate::voice::{lipsync, Phone, Utterance};
 use std::sync::Arc;
 
@@ -38,6 +39,40 @@ fn own_sound(b: &Behaviour) -> Option<(String, Option<String>)> {
             .map(|a| a.value.trim().to_string())
     };
     Some((attr("audiofile")?, attr("marks")))
+}
+
+/// The stream a speech plays (`bmlt:stream`), if it names one.
+fn stream_name(b: &Behaviour) -> Option<&str> {
+    (b.foreign_attrs.iter())
+        .find(|a| a.ns == crate::bml::NS_BMLT && a.name == "stream")
+        .map(|a| a.value.trim())
+}
+
+/// A speech playing a stream: the stream, the text, and how many samples the lips were
+/// planned for (planned again when more come).
+#[derive(Debug, Clone)]
+struct Streamed {
+    stream: AudioStream,
+    text: Vec<TextPart>,
+    planned: usize,
+}
+
+impl Streamed {
+    /// The lips for the sound received so far, if more came since they were planned.
+    fn replan(&mut self) -> Option<Vec<Phone>> {
+        let audio = self.stream.audio()?;
+        if audio.samples.len() == self.planned {
+            return None;
+        }
+        self.planned = audio.samples.len();
+        let marks = self.stream.marks();
+        let marks = (!marks.words.is_empty() || !marks.visemes.is_empty()).then_some(&marks);
+        Some(
+            crate::voice::recorded::utterance(&self.text, audio, marks)
+                .0
+                .phones,
+        )
+    }
 }
 
 /// The XML namespace (`xml:lang`).
@@ -69,6 +104,9 @@ struct Speaking {
     anchors: Vec<f64>,
     /// Global time → TTS time: (global, TTS) knots, increasing; linear between them.
     knots: Vec<(f64, f64)>,
+    /// The stream it plays, if it plays one (its sound and lips come from there, in the
+    /// sound's own time).
+    streamed: Option<Streamed>,
 }
 
 impl Speaking {
@@ -104,6 +142,8 @@ pub struct SpeechEngine {
     /// voice made of them: timing, warnings and the unit ask for the same text, and a voice
     /// that runs a program is asked once.
     said: std::sync::Mutex<std::collections::VecDeque<(Saying, Arc<Said>)>>,
+    /// The streams the host opened.
+    streams: Vec<AudioStream>,
 }
 
 /// What is said: the text, the speech's own sound and marks files if it brings them, and its
@@ -135,6 +175,7 @@ impl SpeechEngine {
             units: Units::new(),
             now: 0.0,
             said: std::sync::Mutex::new(std::collections::VecDeque::new()),
+            streams: Vec::new(),
         }
     }
 
@@ -292,6 +333,24 @@ impl Engine for SpeechEngine {
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         let mut model = match &behaviour.kind {
+            BehaviourKind::Speech(s) if stream_name(behaviour).is_some() => {
+                // its length is the stream's: any, its inline syncs spread evenly until then
+                let ids: Vec<&str> = s.sync_ids().collect();
+                let n = ids.len() as f64 + 1.0;
+                let mut keys = vec![SyncKey::new("start", 0.0)];
+                for (k, id) in ids.iter().enumerate() {
+                    keys.push(SyncKey::new(*id, (k as f64 + 1.0) / n));
+                }
+                keys.push(SyncKey::new("end", 1.0));
+                TimingModel {
+                    keys,
+                    flexibility: crate::timing::Flexibility::Stretchable {
+                        min_duration: 1e-3,
+                        max_duration: 1e6,
+                    },
+                    persistent: false,
+                }
+            }
             BehaviourKind::Speech(_) if own_sound(behaviour).is_some() => {
                 // a sound of its own cannot stretch: rigid, at its own pace
                 let timing = SpeechTiming {
@@ -328,6 +387,14 @@ impl Engine for SpeechEngine {
         if !matches!(behaviour.kind, BehaviourKind::Speech(_)) {
             return None;
         }
+        if let Some(name) = stream_name(behaviour) {
+            return (!self.streams.iter().any(|s| s.name() == name)).then(|| {
+                format!(
+                    "speech '{}': no stream '{name}' is open (the host opens it before the block comes); it is silent",
+                    behaviour.id
+                )
+            });
+        }
         let said = self.say(behaviour);
         let why = said.failed.as_ref()?;
         Some(match &said.utterance.audio {
@@ -341,7 +408,7 @@ impl Engine for SpeechEngine {
 
     fn interprets(&self, ns: &str, name: &str) -> bool {
         (ns == NS_BMLIS && name == "generatefiller")
-            || (ns == crate::bml::NS_BMLT && matches!(name, "audiofile" | "marks"))
+            || (ns == crate::bml::NS_BMLT && matches!(name, "audiofile" | "marks" | "stream"))
             || (ns == NS_XML
                 && name == "lang"
                 && matches!(self.timing.voice, crate::timing::Voice::Espeak(_)))
@@ -349,6 +416,27 @@ impl Engine for SpeechEngine {
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         // keys are unique: the runtime never adds a unit twice
+        let streamed = stream_name(unit.behaviour).map(|name| {
+            let stream = self.streams.iter().find(|s| s.name() == name).cloned();
+            (stream, Self::text(unit.behaviour).to_vec())
+        });
+        if let Some((stream, text)) = streamed {
+            let speaking = Speaking {
+                volume: DEFAULT_VOLUME,
+                rate: 1.0,
+                audio: None,
+                phones: Vec::new(),
+                anchors: Vec::new(),
+                knots: Vec::new(),
+                streamed: stream.map(|stream| Streamed {
+                    stream,
+                    text,
+                    planned: 0,
+                }),
+            };
+            self.units.add(unit, speaking);
+            return Ok(());
+        }
         let (phones, anchors) = self.spoken(unit.behaviour);
         let audio = matches!(unit.behaviour.kind, BehaviourKind::Speech(_))
             .then(|| self.say(unit.behaviour).utterance.audio.clone())
@@ -365,6 +453,7 @@ impl Engine for SpeechEngine {
                 phones,
                 anchors,
                 knots,
+                streamed: None,
             },
         );
         Ok(())
@@ -396,6 +485,17 @@ impl Engine for SpeechEngine {
     fn as_sound(&self) -> Option<&dyn crate::engine::Sound> {
         Some(self)
     }
+
+    fn as_streams(&mut self) -> Option<&mut dyn crate::engine::Streams> {
+        Some(self)
+    }
+}
+
+impl crate::engine::Streams for SpeechEngine {
+    fn add_stream(&mut self, stream: AudioStream) {
+        self.streams.retain(|s| s.name() != stream.name());
+        self.streams.push(stream);
+    }
 }
 
 impl crate::engine::Sound for SpeechEngine {
@@ -403,7 +503,11 @@ impl crate::engine::Sound for SpeechEngine {
     /// own rate: a rate change moves the lips, not the sound), until its end or interrupt.
     fn sounds(&self, now: f64, out: &mut Vec<crate::sound::Playing>) {
         self.units.playing(now, out, |u| {
-            Some((u.audio.clone()?, (u.volume / 100.0) as f32))
+            let audio = match &u.streamed {
+                Some(s) => s.stream.audio()?,
+                None => u.audio.clone()?,
+            };
+            Some((audio, (u.volume / 100.0) as f32))
         });
     }
 }
@@ -415,14 +519,22 @@ impl crate::engine::Expression for SpeechEngine {
         self.now = now;
         let model = FaceModel::default_model();
         let mut strongest = (0.0f32, None);
-        for (syncs, u) in self.units.started(now) {
+        for (syncs, u) in self.units.started_mut(now) {
             let (Some(start), Some(end)) = (syncs.first(), syncs.last()) else {
                 continue;
             };
+            if let Some(phones) = u.streamed.as_mut().and_then(Streamed::replan) {
+                u.phones = phones;
+            }
             if now < start.1 || now > end.1 || u.phones.is_empty() {
                 continue;
             }
-            let w = lipsync::weights(&u.phones, u.tts_time(now));
+            // a stream's lips go with its sound, from its start
+            let said = match u.streamed {
+                Some(_) => now - start.1,
+                None => u.tts_time(now),
+            };
+            let w = lipsync::weights(&u.phones, said);
             let mut shapes = [0.0f32; 52];
             for (v, &wv) in w.iter().enumerate() {
                 if let Some(x) = face.visemes.get_mut(v) {

@@ -19,6 +19,13 @@ pub trait Anticipator: Send {
     /// previous call.
     fn update(&mut self, now: f64) -> bool;
 
+    /// Whether a block that hangs on it sends a new prediction when its predictions move its
+    /// end (a stream's end, revised with every chunk); by default not: the plan follows
+    /// silently.
+    fn announces(&self) -> bool {
+        false
+    }
+
     /// The next time the predictions change by themselves (a script), if known. Changes made from
     /// outside (e.g. a new tempo) are picked up at the next update.
     fn next_change(&self) -> Option<f64> {

@@ -13,6 +13,7 @@ use crowding::{grid_index, grid_time};
 mod options;
 mod remote;
 mod sensing;
+mod streaming;
 pub use netting::NET_RATE;
 pub use options::from_options;
 

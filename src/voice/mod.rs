@@ -16,6 +16,7 @@ pub mod lipsync;
 pub mod listen;
 pub mod marks;
 pub mod recorded;
+pub mod stream;
 pub mod syllables;
 
 use crate::bml::{Id, TextPart};

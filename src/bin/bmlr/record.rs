@@ -106,6 +106,8 @@ impl Recording {
                 .find(|(id, tr, on)| *on && *id == s.id && tr.start == s.start);
             match known {
                 Some((_, tr, _)) => {
+                    // a streamed sound grows while it plays
+                    tr.audio = s.audio.clone();
                     if tr.volume.last().is_none_or(|v| v.1 != s.volume) {
                         tr.volume.push((t, s.volume));
                     }
