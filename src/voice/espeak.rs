@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::{builtin, ipa, listen, Audio, Phone, Tts, Utterance, Word};
+use super::{builtin, ipa, listen, Audio, Phone, Tts, Utterance};
 use crate::bml::TextPart;
 
 /// What a missing program is told.
@@ -208,61 +208,7 @@ impl Tts for Espeak {
     }
 
     fn speak(&self, text: &[TextPart]) -> Result<Utterance, String> {
-        let mut u = Utterance::default();
-        let mut samples = Vec::new();
-        let mut rate = 22_050;
-        let mut t = 0.0;
-        let mut piece = String::new();
-        let mut flush = |piece: &mut String,
-                         u: &mut Utterance,
-                         t: &mut f64,
-                         samples: &mut Vec<i16>|
-         -> Result<(), String> {
-            let words = piece.trim().to_string();
-            piece.clear();
-            if !words.chars().any(char::is_alphanumeric) {
-                return Ok(());
-            }
-            let (phones, audio) = self.piece(&words)?;
-            rate = audio.rate;
-            let length = audio.samples.len() as f64 / f64::from(audio.rate.max(1));
-            u.phones.extend(phones.into_iter().map(|p| Phone {
-                start: p.start + *t,
-                end: p.end + *t,
-                ..p
-            }));
-            samples.extend(audio.samples);
-            u.words.push(Word {
-                text: words,
-                start: *t,
-                end: *t + length,
-            });
-            *t += length;
-            Ok(())
-        };
-        for part in text {
-            match part {
-                TextPart::Text(s) => piece.push_str(s),
-                TextPart::Sync(id) => {
-                    flush(&mut piece, &mut u, &mut t, &mut samples)?;
-                    u.syncs.push((id.clone(), t));
-                }
-            }
-        }
-        flush(&mut piece, &mut u, &mut t, &mut samples)?;
-        if t == 0.0 {
-            // nothing to say: a short silence, as the built-in TTS does
-            t = builtin::EMPTY;
-            samples = vec![0; (t * f64::from(rate)) as usize];
-            u.phones.push(Phone {
-                symbol: "pau",
-                start: 0.0,
-                end: t,
-            });
-        }
-        u.end = t;
-        u.audio = Some(std::sync::Arc::new(Audio { rate, samples }));
-        Ok(u)
+        super::pieces::say_in_pieces(text, 22_050, |words| self.piece(words))
     }
 }
 

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::{Audio, Phone, Tts, Utterance, Word};
+use super::{Audio, Phone, Tts, Utterance};
 use crate::bml::TextPart;
 
 /// The flite program (looked up on the PATH).
@@ -145,60 +145,15 @@ impl Tts for Flite {
     }
 
     fn speak(&self, text: &[TextPart]) -> Result<Utterance, String> {
-        let mut u = Utterance::default();
-        let mut samples = Vec::new();
-        let mut rate = 8000;
-        let mut t = 0.0;
-        let mut piece = String::new();
-        let mut flush = |piece: &mut String,
-                         u: &mut Utterance,
-                         t: &mut f64,
-                         samples: &mut Vec<i16>|
-         -> Result<(), String> {
-            let words = piece.trim().to_string();
-            piece.clear();
-            if !words.chars().any(char::is_alphanumeric) {
-                return Ok(());
-            }
-            let p = self.piece(&words)?;
-            rate = p.rate;
-            let length = p.samples.len() as f64 / f64::from(p.rate);
-            u.phones.extend(p.phones.into_iter().map(|ph| Phone {
-                start: ph.start + *t,
-                end: ph.end + *t,
-                ..ph
-            }));
-            samples.extend(p.samples);
-            u.words.push(Word {
-                text: words,
-                start: *t,
-                end: *t + length,
-            });
-            *t += length;
-            Ok(())
-        };
-        for part in text {
-            match part {
-                TextPart::Text(s) => piece.push_str(s),
-                TextPart::Sync(id) => {
-                    flush(&mut piece, &mut u, &mut t, &mut samples)?;
-                    u.syncs.push((id.clone(), t));
-                }
-            }
-        }
-        flush(&mut piece, &mut u, &mut t, &mut samples)?;
-        if t == 0.0 {
-            // nothing to say: a short silence, as the built-in TTS does
-            t = super::builtin::EMPTY;
-            samples = vec![0; (t * f64::from(rate)) as usize];
-            u.phones.push(Phone {
-                symbol: "pau",
-                start: 0.0,
-                end: t,
-            });
-        }
-        u.end = t;
-        u.audio = Some(std::sync::Arc::new(Audio { rate, samples }));
-        Ok(u)
+        super::pieces::say_in_pieces(text, 8000, |words| {
+            let p = self.piece(words)?;
+            Ok((
+                p.phones,
+                Audio {
+                    rate: p.rate,
+                    samples: p.samples,
+                },
+            ))
+        })
     }
 }

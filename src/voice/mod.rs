@@ -15,6 +15,7 @@ pub mod ipa;
 pub mod lipsync;
 pub mod listen;
 pub mod marks;
+mod pieces;
 pub mod recorded;
 pub mod stream;
 pub mod syllables;
