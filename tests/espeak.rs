@@ -5,13 +5,15 @@
 //! English, German and French; a gesture tied to a word's sync lands on it. Needs the Debian
 //! package espeak-ng and Python: `.ci/run` installs them and runs these with `--ignored`.
 
+#[path = "common/espeak_report.rs"]
+mod espeak_report;
+
 use bml_realizer::bml::TextPart;
 use bml_realizer::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::timing::{SpeechTiming, Voice};
 use bml_realizer::voice::espeak::{Espeak, VoiceName};
 use bml_realizer::voice::Tts;
-use serde_json::Value;
 
 /// espeak-ng's own report of `text` in `voice`: (IPA, start, end) of each phoneme, and its
 /// samples.
@@ -31,20 +33,8 @@ fn reported(voice: &str, text: &str) -> (Vec<(String, f64, f64)>, Vec<i16>) {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let phonemes: Vec<&Value> = (report["events"].as_array().unwrap().iter())
-        .filter(|e| e["type"] == "phoneme")
-        .collect();
-    let ms = |e: &Value| e["ms"].as_f64().unwrap() / 1000.0;
-    let phones = (phonemes.windows(2))
-        .map(|w| {
-            (
-                w[0]["ipa"].as_str().unwrap().to_string(),
-                ms(w[0]),
-                ms(w[1]),
-            )
-        })
-        .collect();
+    let report = espeak_report::read(&std::fs::read_to_string(&json).unwrap());
+    let phones = report.phonemes;
     let samples = bml_realizer::sound::read_wav(&wav).unwrap().samples;
     let _ = std::fs::remove_dir_all(&dir);
     (phones, samples)

@@ -8,13 +8,15 @@
 //! picture and sound, ITU-R BT.1359), and the speech ends with the sound (50 ms). Without
 //! marks, the jaw follows the sound's loudness.
 
+#[path = "common/espeak_report.rs"]
+mod espeak_report;
+
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 use bml_realizer::face::VISEMES;
 use bml_realizer::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
-use serde_json::Value;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
 const FPS: f64 = 200.0;
@@ -23,50 +25,11 @@ fn fixture(name: &str) -> String {
     format!("{}/fixtures/voice/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
-/// What espeak-ng reported: the text, its words (text, start s, character offset) and phonemes
-/// (IPA, start, end), and the sound's length.
-struct Truth {
-    text: String,
-    words: Vec<(String, f64, usize)>,
-    phones: Vec<(String, f64, f64)>,
-    length: f64,
-}
+/// What espeak-ng reported while it made the fixture's sound.
+type Truth = espeak_report::Report;
 
 fn truth() -> Truth {
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(fixture("espeak-bob.events.json")).unwrap())
-            .unwrap();
-    let text = json["text"].as_str().unwrap().to_string();
-    let length = json["samples"].as_f64().unwrap() / json["rate"].as_f64().unwrap();
-    let events = json["events"].as_array().unwrap();
-    let ms = |e: &Value| e["ms"].as_f64().unwrap() / 1000.0;
-    let mut words = Vec::new();
-    for e in events.iter().filter(|e| e["type"] == "word") {
-        let (start, n) = (
-            e["start"].as_u64().unwrap() as usize,
-            e["length"].as_u64().unwrap() as usize,
-        );
-        let word: String = text.chars().skip(start).take(n).collect();
-        if !word.is_empty() {
-            words.push((word, ms(e), start));
-        }
-    }
-    let phonemes: Vec<&Value> = events.iter().filter(|e| e["type"] == "phoneme").collect();
-    let phones = (phonemes.windows(2))
-        .map(|w| {
-            (
-                w[0]["ipa"].as_str().unwrap().to_string(),
-                ms(w[0]),
-                ms(w[1]),
-            )
-        })
-        .collect();
-    Truth {
-        text,
-        words,
-        phones,
-        length,
-    }
+    espeak_report::fixture()
 }
 
 impl Truth {
@@ -74,7 +37,7 @@ impl Truth {
     fn word_end(&self, k: usize) -> f64 {
         let next = self.words.get(k + 1).map_or(self.length, |w| w.1);
         let start = self.words[k].1;
-        (self.phones.iter())
+        (self.phonemes.iter())
             .find(|p| p.0.is_empty() && p.1 > start + 0.02 && p.1 < next)
             .map_or(next, |p| p.1)
     }
@@ -94,31 +57,10 @@ impl Truth {
     }
 
     fn polly(&self) -> String {
-        let mut lines = Vec::new();
-        let mut marks: Vec<(f64, String)> = Vec::new();
-        for (k, (word, start, at)) in self.words.iter().enumerate() {
-            let _ = k;
-            marks.push((
-                *start,
-                format!(
-                    r#"{{"time":{},"type":"word","start":{at},"end":{},"value":"{word}"}}"#,
-                    (start * 1000.0).round(),
-                    at + word.len()
-                ),
-            ));
-        }
-        for (ipa, start, _) in &self.phones {
-            marks.push((
-                *start + 1e-6,
-                format!(
-                    r#"{{"time":{},"type":"viseme","value":"{}"}}"#,
-                    (start * 1000.0).round(),
-                    polly_viseme(ipa)
-                ),
-            ));
-        }
-        marks.sort_by(|a, b| a.0.total_cmp(&b.0));
-        lines.extend(marks.into_iter().map(|m| m.1));
+        let lines: Vec<String> = espeak_report::polly_lines(self)
+            .into_iter()
+            .map(|l| l.1)
+            .collect();
         lines.join("\n") + "\n"
     }
 
@@ -157,33 +99,6 @@ impl Truth {
             );
         }
         out
-    }
-}
-
-/// Polly's viseme for an IPA phoneme (Amazon Polly's English viseme table).
-fn polly_viseme(ipa: &str) -> &'static str {
-    let c = ipa.chars().find(|c| !matches!(c, 'ˈ' | 'ˌ' | 'ː'));
-    match (c, ipa) {
-        (None, _) => "sil",
-        (_, "aɪ" | "aʊ") => "a",
-        (Some('b' | 'p' | 'm'), _) => "p",
-        (Some('t' | 'd' | 'n'), _) => "t",
-        (Some('k' | 'ɡ' | 'g' | 'ŋ' | 'h'), _) => "k",
-        (Some('f' | 'v'), _) => "f",
-        (Some('θ' | 'ð'), _) => "T",
-        (Some('s' | 'z'), _) => "s",
-        (Some('ʃ' | 'ʒ'), _) => "S",
-        (Some('ɹ' | 'r'), _) => "r",
-        (Some('l'), _) => "t",
-        (Some('j' | 'i' | 'ɪ'), _) => "i",
-        (Some('w' | 'u' | 'ʊ'), _) => "u",
-        (Some('a' | 'ɑ' | 'æ' | 'ɒ'), _) => "a",
-        (Some('ə' | 'ɐ' | 'ʌ'), _) => "@",
-        (Some('e' | 'ɛ'), _) => "e",
-        (Some('ɜ'), _) => "E",
-        (Some('o'), _) => "o",
-        (Some('ɔ'), _) => "O",
-        _ => "sil",
     }
 }
 
@@ -246,7 +161,7 @@ fn lips_follow(truth: &Truth, run: &Run) -> Result<(), String> {
     };
     let mut missed = Vec::new();
     let mut checked = 0;
-    for p in &truth.phones {
+    for p in &truth.phonemes {
         let first = p.0.chars().next();
         if matches!(first, Some('p' | 'b' | 'm')) && !near(p, &|m| m.2 == Some("PP")) {
             missed.push(format!("{} at {:.3}: lips not closed", p.0, p.1));

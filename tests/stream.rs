@@ -4,12 +4,14 @@
 //! whole file with the whole marks does (within one frame), end with its sound, carry a nod
 //! tied to its end along, and stop sound and lips within one frame of an interrupt.
 
+#[path = "common/espeak_report.rs"]
+mod espeak_report;
+
 use std::sync::{Arc, Mutex};
 
 use bml_realizer::face::VISEMES;
 use bml_realizer::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
-use serde_json::Value;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" xmlns:bmla="http://www.asap-project.org/bmla""#;
 const FPS: f64 = 60.0;
@@ -22,50 +24,7 @@ fn fixture(name: &str) -> String {
 
 /// Polly speech marks of the fixture, each line with its time (seconds).
 fn polly_lines() -> Vec<(f64, String)> {
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(fixture("espeak-bob.events.json")).unwrap())
-            .unwrap();
-    let text: Vec<char> = json["text"].as_str().unwrap().chars().collect();
-    let mut lines = Vec::new();
-    for e in json["events"].as_array().unwrap() {
-        let ms = e["ms"].as_f64().unwrap();
-        match e["type"].as_str().unwrap() {
-            "word" => {
-                let (at, n) = (
-                    e["start"].as_u64().unwrap() as usize,
-                    e["length"].as_u64().unwrap() as usize,
-                );
-                let word: String = text[at..at + n].iter().collect();
-                if !word.is_empty() {
-                    lines.push((ms / 1000.0, format!(r#"{{"time":{ms},"type":"word","start":{at},"end":{},"value":"{word}"}}"#, at + n)));
-                }
-            }
-            "phoneme" => {
-                let ipa = e["ipa"].as_str().unwrap();
-                let v = match ipa.chars().next() {
-                    None => "sil",
-                    Some('b' | 'p' | 'm') => "p",
-                    Some('a' | 'ɑ' | 'ɒ' | 'æ') => "a",
-                    Some('ə' | 'ɐ' | 'ʌ') => "@",
-                    Some('e' | 'ɛ') => "e",
-                    Some('i' | 'ɪ' | 'j') => "i",
-                    Some('o' | 'ɔ') => "o",
-                    Some('u' | 'ʊ' | 'w') => "u",
-                    Some('f' | 'v') => "f",
-                    Some('s' | 'z') => "s",
-                    Some('ɹ' | 'r') => "r",
-                    Some('k' | 'ɡ' | 'ŋ' | 'h') => "k",
-                    _ => "t",
-                };
-                lines.push((
-                    ms / 1000.0,
-                    format!(r#"{{"time":{ms},"type":"viseme","value":"{v}"}}"#),
-                ));
-            }
-            _ => {}
-        }
-    }
-    lines
+    espeak_report::polly_lines(&espeak_report::fixture())
 }
 
 /// (viseme, jawOpen) a frame.
