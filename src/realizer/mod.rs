@@ -72,6 +72,8 @@ pub struct Realizer {
     sensing: Option<Box<sensing::Sensing>>,
     /// PaT-Nets, when given (`netting.rs`).
     netting: Option<Box<netting::Netting>>,
+    /// The audio streams the host opened, by name (`streaming.rs`).
+    streams: BTreeMap<String, crate::voice::stream::AudioStream>,
 }
 
 impl Default for Realizer {
@@ -98,6 +100,7 @@ impl Realizer {
             remote_asks: Default::default(),
             sensing: None,
             netting: None,
+            streams: BTreeMap::new(),
             parallel: true,
             now: 0.0,
             unframed: Vec::new(),

@@ -3,7 +3,7 @@
 //! ends the stream. An [`AudioStream`] is a shared handle: the host keeps one, the speech engine
 //! plays from another, and the realizer makes it an anticipator (`anticipators:NAME:start`,
 //! `…:end`) that the speech's own syncs hang on, from its [`predict`](AudioStream::predict)
-//! and [`update`](AudioStream::update). `start` is when the realizer first sees a chunk (until then it is
+//! and [`update`](AudioStream::update). `start` is the first time the realizer looks after the first chunk came (until then it is
 //! predicted an hour ahead, so the speech waits); `end` is predicted as the sound received so
 //! far plus [`LOOKAHEAD`], never before the present, and revised with every chunk, until the
 //! stream ends: then it is the sound's end. A stream that gets no chunk for [`TIMEOUT`] seconds
@@ -182,7 +182,10 @@ impl AudioStream {
         let mut s = self.state();
         let was_closed = Self::closed(&s);
         s.now = now;
-        if s.started.is_none() && s.audio.is_some() {
+        // the first chunk came after the clock read `last_chunk`: the stream starts at the
+        // first later time the realizer looks (not at a catch-up look back at that time, which
+        // would put its first frame of sound in the past)
+        if s.started.is_none() && s.audio.is_some() && now > s.last_chunk {
             s.started = Some(now);
             s.last_chunk = now;
         }
@@ -204,6 +207,9 @@ mod tests {
         assert!(!s.update(1.0));
         assert_eq!(s.predict("start"), Some(1.0 + NOT_YET));
         s.push(&[0; 8000], 8000, None).unwrap();
+        // a look back at the clock the chunk came after does not start it in the past
+        s.update(1.0);
+        assert_eq!(s.predict("start"), Some(1.0 + NOT_YET));
         assert!(s.update(1.5));
         assert_eq!(s.predict("start"), Some(1.5));
         assert_eq!(s.predict("end"), Some(1.5 + 1.0 + LOOKAHEAD));
@@ -229,10 +235,10 @@ mod tests {
             .unwrap_err()
             .contains("16000 Hz"));
         assert!(s.push(&[0; 8], 8000, Some("{\"time\":")).is_err());
-        s.update(0.0);
+        s.update(0.1);
         assert!(!s.ended());
         s.update(TIMEOUT + 0.5);
         assert!(s.ended());
-        assert_eq!(s.predict("end"), Some(0.1));
+        assert_eq!(s.predict("end"), Some(0.2));
     }
 }

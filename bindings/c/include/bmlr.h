@@ -28,6 +28,9 @@ typedef enum bmlr_status {
   BMLR_ERR_RANGE = 7,
   // The library panicked (a bug): the realizer may be left half-way; free it.
   BMLR_ERR_PANIC = 8,
+  // No open stream of that name, or a chunk it refused (another rate than the first chunk's,
+  // the stream ended or full, marks that do not parse).
+  BMLR_ERR_STREAM = 9,
 } bmlr_status;
 
 // A realizer with what a host polls from it. Opaque to C.
@@ -152,6 +155,35 @@ const char *bmlr_last_error(void);
 // Panics inside the library, for hosts that test their error handling: it returns
 // `BMLR_ERR_PANIC` with the panic's message in `bmlr_last_error()`; nothing aborts.
 enum bmlr_status bmlr_debug_panic(void);
+
+// Opens the stream `name` for `character` (NULL or "": blocks without a characterId); open
+// it before performing the block whose speech plays it. Opening a name again replaces the
+// stream.
+//
+// # Safety
+// `r` is a live realizer; `character` is NULL or a NUL-terminated string; `name` a
+// NUL-terminated string.
+enum bmlr_status bmlr_open_stream(struct bmlr_realizer *r, const char *character, const char *name);
+
+// Adds `n` samples at `pcm` (mono, 16-bit, `rate` Hz: every chunk of a stream at the same
+// rate) and the chunk's `marks` (NULL or "": none) to the stream `name`. The sound plays from
+// the next tick on.
+//
+// # Safety
+// `r` is a live realizer; `name` a NUL-terminated string; `pcm` points at `n` samples (NULL
+// when `n` is 0); `marks` is NULL or a NUL-terminated string.
+enum bmlr_status bmlr_push_audio(struct bmlr_realizer *r,
+                                 const char *name,
+                                 const int16_t *pcm,
+                                 size_t n,
+                                 uint32_t rate,
+                                 const char *marks);
+
+// Ends the stream `name`: the speech playing it ends with its sound.
+//
+// # Safety
+// `r` is a live realizer; `name` a NUL-terminated string.
+enum bmlr_status bmlr_end_audio(struct bmlr_realizer *r, const char *name);
 
 #ifdef __cplusplus
 }  // extern "C"

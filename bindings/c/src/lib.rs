@@ -15,6 +15,7 @@
 #![allow(non_camel_case_types)]
 
 mod status;
+mod stream;
 
 use std::collections::VecDeque;
 use std::ffi::{c_char, c_int, CString};
@@ -26,6 +27,7 @@ use bml_realizer::realizer::Realizer;
 
 pub use status::bmlr_status;
 use status::{guard, out, text, Failure};
+pub use stream::{bmlr_end_audio, bmlr_open_stream, bmlr_push_audio};
 
 /// A realizer with what a host polls from it. Opaque to C.
 pub struct bmlr_realizer {

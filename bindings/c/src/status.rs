@@ -28,6 +28,9 @@ pub enum bmlr_status {
     BMLR_ERR_RANGE = 7,
     /// The library panicked (a bug): the realizer may be left half-way; free it.
     BMLR_ERR_PANIC = 8,
+    /// No open stream of that name, or a chunk it refused (another rate than the first chunk's,
+    /// the stream ended or full, marks that do not parse).
+    BMLR_ERR_STREAM = 9,
 }
 
 thread_local! {

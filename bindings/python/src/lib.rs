@@ -13,7 +13,7 @@ use bml_realizer::engine::{CharacterPose, Frame};
 use bml_realizer::face::ARKIT;
 use bml_realizer::feedback::Format;
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -110,6 +110,15 @@ fn error(e: String) -> PyErr {
         PyKeyError::new_err(e)
     } else {
         PyRuntimeError::new_err(e)
+    }
+}
+
+/// A stream's refusal: an unknown stream is a KeyError, a refused chunk a ValueError.
+fn refusal(e: String) -> PyErr {
+    if e.starts_with("no stream") {
+        PyKeyError::new_err(e)
+    } else {
+        PyValueError::new_err(e)
     }
 }
 
@@ -214,6 +223,63 @@ impl Realizer {
                 std::hint::black_box(s.realizer.tick(start + k as f64 * dt));
             }
             Ok(clock.elapsed().as_secs_f64())
+        })
+    }
+
+    /// Opens the audio stream `name` for `character` (None: blocks without a characterId);
+    /// open it before performing the block whose `<speech bmlt:stream="NAME">` plays it, timed
+    /// by `start="anticipators:NAME:start" end="anticipators:NAME:end"`. Opening a name again
+    /// replaces the stream.
+    #[pyo3(signature = (name, character=None))]
+    fn open_stream(&self, py: Python<'_>, name: String, character: Option<String>) -> PyResult<()> {
+        if name.is_empty() {
+            return Err(PyValueError::new_err("the stream's name is empty"));
+        }
+        with_state(py, &self.state, |s| {
+            let character = character.as_deref().filter(|c| !c.is_empty());
+            s.realizer.open_stream(character, &name);
+            Ok(())
+        })
+    }
+
+    /// Adds a chunk to the stream `name`: `pcm` mono 16-bit samples (a numpy int16 array) at
+    /// `rate` Hz (every chunk of a stream at the same rate), with the chunk's `marks` (Amazon
+    /// Polly speech marks as JSON lines, or a word list as JSON; times in the stream's time,
+    /// from its first sample). A chunk the stream refuses (another rate, the stream ended or
+    /// full, marks that do not parse) raises ValueError; an unknown name KeyError.
+    #[pyo3(signature = (name, pcm, rate, marks=None))]
+    fn push_audio(
+        &self,
+        py: Python<'_>,
+        name: String,
+        pcm: PyReadonlyArray1<'_, i16>,
+        rate: u32,
+        marks: Option<String>,
+    ) -> PyResult<()> {
+        let pcm = pcm.as_slice()?.to_vec();
+        let refused = with_state(py, &self.state, |s| {
+            Ok(s.realizer
+                .push_audio(&name, &pcm, rate, marks.as_deref())
+                .err())
+        })?;
+        refused.map_or(Ok(()), |e| Err(refusal(e)))
+    }
+
+    /// Ends the stream `name`: the speech playing it ends with its sound.
+    fn end_audio(&self, py: Python<'_>, name: String) -> PyResult<()> {
+        let refused = with_state(py, &self.state, |s| Ok(s.realizer.end_audio(&name).err()))?;
+        refused.map_or(Ok(()), |e| Err(refusal(e)))
+    }
+
+    /// The sounds character `character` makes in the last frame: (id, seconds into the
+    /// sound) each, the id being `block:behaviour`.
+    #[pyo3(signature = (character=""))]
+    fn sounds(&self, py: Python<'_>, character: &str) -> PyResult<Vec<(String, f64)>> {
+        with_state(py, &self.state, |s| {
+            let now = s.frame.as_ref().map_or(0.0, |f| f.time);
+            Ok((find_character(s, character)?.sounds.iter())
+                .map(|p| (p.id.clone(), now - p.start))
+                .collect())
         })
     }
 

@@ -281,6 +281,16 @@ pub enum Flavour {
     Greta,
 }
 
+/// A line of `serve --stdio`'s input.
+enum Line {
+    /// A `<bml>` block, read and checked.
+    Block(Box<Checked>),
+    /// A stream message (JSON).
+    Stream(String),
+    /// A line that is not UTF-8 or too long.
+    Bad(BadLine),
+}
+
 /// `bmlr serve --stdio`: one block per line, read and checked on a thread of its own (parsing
 /// and validation need no realizer), scheduled and played on this one; what is due is written
 /// out at least once a frame, also while a queue of blocks waits.
@@ -291,7 +301,7 @@ fn serve_stdio(
 ) -> ExitCode {
     let clock = WallClock::new();
     // bounded: the reader waits while the realizer is behind, and the pipe fills (backpressure)
-    let (tx, rx) = mpsc::sync_channel::<Option<Result<Checked, BadLine>>>(256);
+    let (tx, rx) = mpsc::sync_channel::<Option<Line>>(256);
     let limits = *realizer.limits();
     std::thread::spawn(move || {
         // a line that is not UTF-8 or too long costs only itself
@@ -300,8 +310,10 @@ fn serve_stdio(
                 Ok(text) if text.trim().is_empty() => continue,
                 // a live port has no use for clock advances: time passes by itself
                 Ok(text) if bml_realizer::bml::advance(text.trim()).is_some() => continue,
-                Ok(text) => Ok(Checked::new(&text, &limits)),
-                Err(bad) => Err(bad),
+                // a stream message (`Realizer::stream_message`): a JSON object
+                Ok(text) if text.trim_start().starts_with('{') => Line::Stream(text),
+                Ok(text) => Line::Block(Box::new(Checked::new(&text, &limits))),
+                Err(bad) => Line::Bad(bad),
             };
             if tx.send(Some(item)).is_err() {
                 return;
@@ -351,10 +363,13 @@ fn serve_stdio(
         let mut frame_start = clock.now();
         for item in items {
             match item {
-                Ok(checked) => {
-                    let _ = realizer.perform_checked(checked, Some("<stdin>"));
+                Line::Block(checked) => {
+                    let _ = realizer.perform_checked(*checked, Some("<stdin>"));
                 }
-                Err(bad) => realizer.refuse_line("<stdin>", &bad),
+                Line::Stream(text) => {
+                    let _ = realizer.stream_message("<stdin>", &text);
+                }
+                Line::Bad(bad) => realizer.refuse_line("<stdin>", &bad),
             }
             if clock.now() - frame_start >= period.as_secs_f64() {
                 feedback.extend(tick(&mut realizer, &mut frames));
