@@ -88,7 +88,6 @@ fn a_host_streams_a_speech_through_serve_stdio() {
         std::thread::sleep(Duration::from_millis(200));
     }
     send(r#"{"end_audio": "reply"}"#.into());
-    drop(send);
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::spawn(move || tx.send(reader.join().unwrap()));
     let log = rx
