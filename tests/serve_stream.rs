@@ -5,6 +5,8 @@
 //! and revised, it ends with its sound (feedback on the wall clock), a nod tied to its end
 //! follows; a bad message costs one warning that says why.
 
+#[path = "common/chunked.rs"]
+mod chunked;
 #[path = "common/espeak_report.rs"]
 mod espeak_report;
 
@@ -14,17 +16,9 @@ use std::time::Duration;
 
 use base64::Engine as _;
 use bml_realizer::feedback::{from_line, Feedback};
+use chunked::sync_time;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
-
-fn sync_time(log: &[Feedback], behaviour: &str, sync: &str) -> Option<f64> {
-    log.iter().find_map(|f| match f {
-        Feedback::SyncPointProgress(p) if p.behaviour == behaviour && p.sync == sync => {
-            Some(p.global_time)
-        }
-        _ => None,
-    })
-}
 
 #[test]
 fn a_host_streams_a_speech_through_serve_stdio() {
@@ -69,20 +63,14 @@ fn a_host_streams_a_speech_through_serve_stdio() {
         report.text
     ));
     std::thread::sleep(Duration::from_millis(300));
-    let chunk = audio.samples.len().div_ceil(10);
-    let rate = f64::from(audio.rate);
-    for (i, pcm) in audio.samples.chunks(chunk).enumerate() {
-        let (from, to) = ((i * chunk) as f64 / rate, ((i + 1) * chunk) as f64 / rate);
-        let marks: Vec<&str> = (lines.iter())
-            .filter(|l| l.0 >= from && (l.0 < to || i == 9))
-            .map(|l| l.1.as_str())
-            .collect();
+    for (span, marks) in chunked::chunks(audio.samples.len(), audio.rate, &lines, 10) {
+        let pcm = &audio.samples[span];
         let bytes: Vec<u8> = pcm.iter().flat_map(|s| s.to_le_bytes()).collect();
         let message = serde_json::json!({
             "push_audio": "reply",
             "rate": audio.rate,
             "pcm": base64::engine::general_purpose::STANDARD.encode(bytes),
-            "marks": marks.join("\n"),
+            "marks": marks,
         });
         send(message.to_string());
         std::thread::sleep(Duration::from_millis(200));

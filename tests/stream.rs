@@ -4,8 +4,12 @@
 //! whole file with the whole marks does (within one frame), end with its sound, carry a nod
 //! tied to its end along, and stop sound and lips within one frame of an interrupt.
 
+#[path = "common/chunked.rs"]
+mod chunked;
 #[path = "common/espeak_report.rs"]
 mod espeak_report;
+
+use chunked::sync_time;
 
 use std::sync::{Arc, Mutex};
 
@@ -51,15 +55,6 @@ fn listen(r: &mut Realizer) -> Arc<Mutex<Vec<Feedback>>> {
     log
 }
 
-fn sync_time(log: &[Feedback], behaviour: &str, sync: &str) -> Option<f64> {
-    log.iter().find_map(|f| match f {
-        Feedback::SyncPointProgress(p) if p.behaviour == behaviour && p.sync == sync => {
-            Some(p.global_time)
-        }
-        _ => None,
-    })
-}
-
 #[test]
 fn a_streamed_speech_moves_the_lips_as_its_whole_file_and_ends_with_its_sound() {
     let audio =
@@ -92,27 +87,16 @@ fn a_streamed_speech_moves_the_lips_as_its_whole_file_and_ends_with_its_sound() 
         r#"<bml {NS} id="b"><speech id="s" bmlt:stream="reply" start="anticipators:reply:start" end="anticipators:reply:end"><text>{TEXT}</text></speech><head id="n" lexeme="NOD" start="s:end"/></bml>"#
     ))
     .unwrap();
-    let chunk = audio.samples.len().div_ceil(10);
+    let chunks = chunked::chunks(audio.samples.len(), audio.rate, &lines, 10);
     let mut pushed = 0;
     let mut streamed = Vec::new();
     let mut started = None;
     for i in 0..((length + 2.5) * FPS) as usize {
         let t = i as f64 / FPS;
         while pushed < 10 && t >= 0.5 + 0.2 * pushed as f64 {
-            let (a, b) = (
-                pushed * chunk,
-                ((pushed + 1) * chunk).min(audio.samples.len()),
-            );
-            let (from, to) = (
-                a as f64 / f64::from(audio.rate),
-                b as f64 / f64::from(audio.rate),
-            );
-            let marks: Vec<&str> = (lines.iter())
-                .filter(|l| l.0 >= from && (l.0 < to || b == audio.samples.len()))
-                .map(|l| l.1.as_str())
-                .collect();
+            let (span, marks) = &chunks[pushed];
             stream
-                .push(&audio.samples[a..b], audio.rate, Some(&marks.join("\n")))
+                .push(&audio.samples[span.clone()], audio.rate, Some(marks))
                 .unwrap();
             pushed += 1;
             if pushed == 10 {

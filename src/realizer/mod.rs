@@ -380,12 +380,18 @@ impl Realizer {
     /// Reports input that could not even be read as text (a line that is not UTF-8, or too
     /// long): a PARSING_FAILURE warning with `<no id>` whose text is `SOURCE:LINE: reason`.
     pub fn refuse_line(&mut self, source: &str, bad: &bml::BadLine) {
-        let character_id = self.default_character.clone();
+        let text = format!("{source}:{}: {}", bad.line, bad.reason);
+        self.warn_input(KnownWarning::ParsingFailure, text);
+    }
+
+    /// Sends a warning of `kind` about input that belongs to no block (`<no id>`), for the
+    /// default character.
+    fn warn_input(&mut self, kind: KnownWarning, text: String) {
         self.unframed.push(Feedback::Warning(WarningFeedback {
             id: NO_ID.into(),
-            kind: KnownWarning::ParsingFailure.into(),
-            character_id,
-            text: format!("{source}:{}: {}", bad.line, bad.reason),
+            kind: kind.into(),
+            character_id: self.default_character.clone(),
+            text,
         }));
         self.deliver(self.unframed.len() - 1);
     }

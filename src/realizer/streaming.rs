@@ -9,8 +9,8 @@
 use base64::Engine as _;
 use serde::Deserialize;
 
-use super::{Realizer, NO_ID};
-use crate::feedback::{Feedback, KnownWarning, WarningFeedback};
+use super::Realizer;
+use crate::feedback::KnownWarning;
 use crate::plan::anticipator::Anticipator;
 use crate::voice::stream::AudioStream;
 
@@ -116,13 +116,7 @@ impl Realizer {
         };
         outcome.map_err(|(kind, why)| {
             let text = format!("{source}: {why}");
-            self.unframed.push(Feedback::Warning(WarningFeedback {
-                id: NO_ID.into(),
-                kind: kind.into(),
-                character_id: self.default_character.clone(),
-                text: text.clone(),
-            }));
-            self.deliver(self.unframed.len() - 1);
+            self.warn_input(kind, text.clone());
             text
         })
     }
@@ -159,6 +153,7 @@ impl Realizer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::feedback::Feedback;
 
     fn warnings(r: &mut Realizer) -> Vec<String> {
         (r.tick(r.now).feedback.into_iter())
