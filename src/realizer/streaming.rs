@@ -105,14 +105,50 @@ impl Realizer {
     /// parse is a `PARSING_FAILURE` warning, one the stream refuses an `EXECUTION_FAILURE`
     /// warning, each naming `source` and saying why; the error is returned too.
     pub fn stream_message(&mut self, source: &str, line: &str) -> Result<(), String> {
+        self.message(source, line, None)
+    }
+
+    /// [`stream_message`](Self::stream_message) from a port that belongs to one character
+    /// (a broker's topic of `character`; None: the default character's): a stream it opens
+    /// is that character's, and a message naming another character is refused.
+    pub fn stream_message_on(
+        &mut self,
+        source: &str,
+        line: &str,
+        character: Option<&str>,
+    ) -> Result<(), String> {
+        self.message(source, line, Some(character))
+    }
+
+    /// A stream message from a port of any character (`port` None) or of one.
+    fn message(
+        &mut self,
+        source: &str,
+        line: &str,
+        port: Option<Option<&str>>,
+    ) -> Result<(), String> {
         let outcome = match serde_json::from_str::<Message>(line) {
             Err(e) => Err((
                 KnownWarning::ParsingFailure,
                 format!("not a stream message: {e}"),
             )),
-            Ok(m) => self
-                .carry_out(m)
-                .map_err(|e| (KnownWarning::ExecutionFailure, e)),
+            Ok(mut m) => match port {
+                Some(own) if m.character.is_some() && m.character.as_deref() != own => Err((
+                    KnownWarning::ExecutionFailure,
+                    format!(
+                        "a stream for character '{}' came on the port of '{}'",
+                        m.character.unwrap_or_default(),
+                        own.unwrap_or("(the default character)")
+                    ),
+                )),
+                _ => {
+                    if let Some(own) = port {
+                        m.character = own.map(str::to_string);
+                    }
+                    self.carry_out(m)
+                        .map_err(|e| (KnownWarning::ExecutionFailure, e))
+                }
+            },
         };
         outcome.map_err(|(kind, why)| {
             let text = format!("{source}: {why}");
@@ -181,6 +217,31 @@ mod tests {
             .unwrap();
         assert!(r.streams["reply"].ended());
         assert!(warnings(&mut r).is_empty());
+    }
+
+    #[test]
+    fn a_port_of_one_character_opens_its_streams_and_refuses_anothers() {
+        let mut r = Realizer::new().with_idle(false);
+        r.stream_message_on("t", r#"{"open_stream": "a"}"#, Some("bob"))
+            .unwrap();
+        let e = (r.stream_message_on(
+            "t",
+            r#"{"open_stream": "b", "character": "ann"}"#,
+            Some("bob"),
+        ))
+        .unwrap_err();
+        assert!(e.contains("'ann' came on the port of 'bob'"), "{e}");
+        assert!(!r.streams.contains_key("b"));
+        let w = warnings(&mut r);
+        assert!(
+            w.len() == 1 && w[0].starts_with("EXECUTION_FAILURE"),
+            "{w:?}"
+        );
+        // the stream is bob's: a speech of bob's plays it (its start is the stream's)
+        assert!(
+            r.character("bob").is_some(),
+            "the stream made bob's manager"
+        );
     }
 
     #[test]

@@ -3,7 +3,8 @@
 //! keeps itself connected; the dialect (`dialect.rs`) says which topics carry blocks and
 //! feedback and in what form; this loop owns the realizer, ticks it on the wall clock, routes
 //! the feedback and writes the frames (`--frames`). A payload that is not a block for that
-//! topic's character is answered with a warning on the character's feedback topic; a block for
+//! topic's character is answered with a warning on the character's feedback topic (a payload
+//! that is a JSON object is a stream message for the topic's character); a block for
 //! a character this realizer does not serve is left to the realizer that does. Realizers on one
 //! broker share one world: each publishes where its characters stand on `PREFIX/world/CHARACTER`
 //! (20 Hz; `PREFIX.world.CHARACTER` on STOMP) and places the others' characters in its own
@@ -357,6 +358,9 @@ impl Server {
                 return self.refuse(lane.character(), why, request);
             }
         };
+        if text.trim_start().starts_with('{') {
+            return self.stream_message(lane, &text);
+        }
         let mut checked = Checked::new(&text, &limits);
         let block = checked.block.as_mut();
         let character = match (lane, block) {
@@ -395,18 +399,37 @@ impl Server {
                 (self.args.dialect).answer_request(uid, block_id.as_deref(), error.as_deref());
             self.send_raw(answer);
         }
-        let mut feedback = self
-            .realizer
+        self.answer(&character);
+    }
+
+    /// Sends what a message from `character`'s lane produced at once; a warning that names no
+    /// character (a block or message that could not be read) is the lane's character's.
+    fn answer(&mut self, character: &str) {
+        let mut feedback = (self.realizer)
             .tick(self.clock.now().min(self.args.until))
             .feedback;
-        // (a block that could not be read names no character: the topic's is meant)
-        let topic_character = (character != DEFAULT_CHARACTER).then(|| character.clone());
+        let topic_character = (character != DEFAULT_CHARACTER).then(|| character.to_string());
         for fb in &mut feedback {
             if let Feedback::Warning(w) = fb {
                 w.character_id = w.character_id.take().or_else(|| topic_character.clone());
             }
         }
-        self.send(feedback, Some(&character));
+        self.send(feedback, Some(character));
+    }
+
+    /// A stream message (a payload that is a JSON object): on a character's topic it is that
+    /// character's stream; its warnings go to the lane's character.
+    fn stream_message(&mut self, lane: &Lane, text: &str) {
+        let character = lane.character().to_string();
+        let source = self.args.dialect.source(&character);
+        let _ = match lane {
+            Lane::Shared(_) => self.realizer.stream_message(&source, text),
+            Lane::Topic(c) => {
+                let own = (c != DEFAULT_CHARACTER).then_some(c.as_str());
+                self.realizer.stream_message_on(&source, text, own)
+            }
+        };
+        self.answer(&character);
     }
 
     fn refuse(&mut self, character: &str, text: String, request: Option<String>) {

@@ -1,5 +1,5 @@
 //! `bmlr serve --tcp ADDR`: the realizer port for several clients at once. Each client sends one
-//! `<bml>` block per line; feedback goes to every client (or, with `--per-client`, only to the
+//! `<bml>` block per line (or a stream message: a line that is a JSON object, as on `--stdio`); feedback goes to every client (or, with `--per-client`, only to the
 //! client whose block it is about). A malformed line gets a PARSING_FAILURE warning sent to its
 //! sender only; a client that disconnects disturbs neither the others nor the plan.
 //!
@@ -47,6 +47,8 @@ enum Event {
     Connected(Client, Conn),
     /// A line read and checked on the client's thread.
     Block(Client, Box<Checked>),
+    /// A stream message (a line that is a JSON object: `Realizer::stream_message`).
+    Stream(Client, String),
     /// A line that is not UTF-8 or too long: it costs only itself.
     BadLine(Client, bml::BadLine),
     Disconnected(Client),
@@ -79,6 +81,7 @@ fn accept(listener: TcpListener, events: SyncSender<Event>, limits: Limits) {
             for line in bml::lines(BufReader::new(stream), limits.block_bytes) {
                 let event = match line {
                     Ok(line) if line.trim().is_empty() => continue,
+                    Ok(line) if line.trim_start().starts_with('{') => Event::Stream(client, line),
                     Ok(line) => Event::Block(client, Box::new(Checked::new(&line, &limits))),
                     Err(bad) => Event::BadLine(client, bad),
                 };
@@ -258,6 +261,11 @@ impl Server {
                 }),
             )),
             Event::Block(c, checked) => self.submit(c, *checked, routed),
+            Event::Stream(c, line) => {
+                self.tick(routed);
+                let _ = (self.realizer).stream_message(&format!("client {c}"), &line);
+                self.answer(c, routed);
+            }
         }
     }
 
@@ -285,6 +293,11 @@ impl Server {
                 self.owner.remove(&id); // rejected: it will never end
             }
         }
+        self.answer(c, routed);
+    }
+
+    /// Routes what client `c`'s line produced right away: warnings to it alone.
+    fn answer(&mut self, c: Client, routed: &mut Routed) {
         let frame = self.realizer.tick(self.clock.now());
         routed.extend(frame.feedback.into_iter().map(|f| {
             let to = matches!(f, Feedback::Warning(_)).then_some(c);
