@@ -206,3 +206,69 @@ fn an_interrupt_stops_a_stream_s_sound_and_lips_within_a_frame() {
         "its end is reported at the interrupt: {end}"
     );
 }
+
+#[test]
+fn a_streamed_speech_s_inline_syncs_land_on_their_words_as_the_marks_come() {
+    let audio =
+        bml_realizer::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav"))).unwrap();
+    let length = audio.samples.len() as f64 / f64::from(audio.rate);
+    let report = espeak_report::fixture();
+    let word = |w: &str| {
+        (report.words.iter())
+            .find(|x| x.0 == w)
+            .map(|x| x.1)
+            .unwrap()
+    };
+    let lines = polly_lines();
+    let mut r = Realizer::new().with_idle(false);
+    let log = listen(&mut r);
+    let stream = r.open_stream(None, "reply");
+    // syncs before "map" (in the first chunks), "Please" (past the middle) and "pears" (the
+    // last word: in the last chunk); a beat's stroke on the second, a nod on the third
+    r.perform_bml(&format!(
+        r#"<bml {NS} id="b"><speech id="s" bmlt:stream="reply" start="anticipators:reply:start" end="anticipators:reply:end"><text>Bob may bring a big <sync id="m"/>map to the market, maybe. <sync id="p"/>Please buy more apples and <sync id="e"/>pears.</text></speech><gesture id="g" lexeme="BEAT" stroke="s:p"/><head id="n" lexeme="NOD" start="s:e"/></bml>"#
+    ))
+    .unwrap();
+    let chunks = chunked::chunks(audio.samples.len(), audio.rate, &lines, 10);
+    let mut pushed = 0;
+    for i in 0..((length + 2.5) * FPS) as usize {
+        let t = i as f64 / FPS;
+        while pushed < 10 && t >= 0.5 + 0.2 * pushed as f64 {
+            let (span, marks) = &chunks[pushed];
+            (stream.push(&audio.samples[span.clone()], audio.rate, Some(marks))).unwrap();
+            pushed += 1;
+            if pushed == 10 {
+                stream.end();
+            }
+        }
+        r.tick(t);
+    }
+    let log = log.lock().unwrap();
+    let warnings: Vec<_> = (log.iter())
+        .filter(|f| matches!(f, Feedback::Warning(_)))
+        .collect();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let start = sync_time(&log, "s", "start").expect("the speech starts");
+    for (sync, w) in [("m", "map"), ("p", "Please"), ("e", "pears")] {
+        let at = sync_time(&log, "s", sync).expect("the sync passes");
+        let truth = start + word(w);
+        eprintln!(
+            "s:{sync} at {:.3} s into the speech, '{w}' at {:.3}",
+            at - start,
+            word(w)
+        );
+        assert!(
+            (at - truth).abs() <= 0.020,
+            "s:{sync} at {at:.3}, the word '{w}' starts at {truth:.3}"
+        );
+    }
+    let stroke = sync_time(&log, "g", "stroke").expect("the beat strikes");
+    let p = sync_time(&log, "s", "p").unwrap();
+    assert!(
+        (stroke - p).abs() < 1e-6,
+        "the stroke at {stroke}, s:p at {p}"
+    );
+    let nod = sync_time(&log, "n", "start").expect("the nod starts");
+    let e = sync_time(&log, "s", "e").unwrap();
+    assert!((nod - e).abs() < 1e-6, "the nod at {nod}, s:e at {e}");
+}

@@ -16,14 +16,17 @@ impl BlockManager {
         self.placement
     }
 
-    /// Steps the engines that move the character to `to`, and takes their revisions.
+    /// Steps the engines that move the character to `to`, and takes every engine's revisions
+    /// of its units' sync times (a walk's, a streamed speech's).
     pub(super) fn travel(&mut self, to: f64) {
         let id = self.character.as_deref().unwrap_or("");
         let (mut at, mut revisions) = (self.placement, Vec::new());
         for e in self.registry.engines_mut() {
             if let Some(t) = e.as_travel() {
                 at = t.travel(to, &self.shared, id, at);
-                revisions.extend(t.take_revisions());
+            }
+            if let Some(r) = e.as_revising() {
+                revisions.extend(r.take_revisions(to));
             }
         }
         if at != self.placement {

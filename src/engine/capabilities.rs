@@ -134,11 +134,6 @@ pub trait Travel {
         at: crate::world::Placement,
     ) -> crate::world::Placement;
 
-    /// Units whose sync times changed since last asked: the unit and the new global times of
-    /// all its syncs in sync order (passed syncs as they were). A sync that happened has its
-    /// real time; one still ahead is a prediction later than `now`.
-    fn take_revisions(&mut self) -> Vec<Revision>;
-
     /// Whether a foot of the character is on the ground (left, right), for the frames.
     fn contacts(&self) -> Option<[bool; 2]> {
         None
@@ -181,7 +176,17 @@ pub trait Attend {
     fn attend(&mut self, cue: Option<Attention>);
 }
 
-/// New sync times for a unit of a [`Travel`] engine.
+/// An engine that revises the sync times of its units while they run, from what happens (a
+/// walker arrives later than predicted; a streamed speech's words come in with its sound). Its
+/// engine says which behaviours with [`Engine::self_timed`](super::Engine::self_timed).
+pub trait Revising {
+    /// Units whose sync times changed since last asked, at global time `now`: the unit and the
+    /// new global times of all its syncs in sync order (passed syncs as they were). A sync that
+    /// happened has its real time; one still ahead is a prediction later than `now`.
+    fn take_revisions(&mut self, now: f64) -> Vec<Revision>;
+}
+
+/// New sync times for a unit of a [`Revising`] engine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Revision {
     /// The unit.

@@ -17,7 +17,7 @@ use std::fmt;
 
 pub use capabilities::{
     Action, Attend, Attention, BalanceReading, Control, Expression, Motion, MotionKind, Parameters,
-    Physics, Prediction, Resources, Revision, Sound, Steering, Streams, Travel,
+    Physics, Prediction, Resources, Revising, Revision, Sound, Steering, Streams, Travel,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};
@@ -222,13 +222,18 @@ pub trait Engine: Send {
         None
     }
 
+    /// Its revisions of its units' sync times, if it makes any.
+    fn as_revising(&mut self) -> Option<&mut dyn Revising> {
+        None
+    }
+
     /// Its look at whom the character's travel attends to, if it directs the eyes (gaze).
     fn as_attend(&mut self) -> Option<&mut dyn Attend> {
         None
     }
 
     /// Whether the engine revises the sync times of `behaviour`'s units while they run (through
-    /// [`Travel::take_revisions`]): the runtime then keeps every sync of it on a peg of its own,
+    /// [`Revising::take_revisions`]): the runtime then keeps every sync of it on a peg of its own,
     /// so that behaviours tied to one follow its revisions.
     fn self_timed(&self, _behaviour: &Behaviour) -> bool {
         false

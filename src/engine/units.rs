@@ -129,6 +129,13 @@ impl<T> Units<T> {
         self.units.values().map(|u| (&u.syncs, &u.data, &*u.key))
     }
 
+    /// Every unit with its key, in start order, the data mutable.
+    pub fn keyed_mut(&mut self) -> impl Iterator<Item = (&SyncTimes, &mut T, &UnitKey)> + '_ {
+        self.units
+            .values_mut()
+            .map(|u| (&u.syncs, &mut u.data, &*u.key))
+    }
+
     /// A unit's data.
     pub fn get(&self, key: &UnitKey) -> Option<&T> {
         self.units

@@ -176,13 +176,38 @@ pub fn plan_block_with(
     }
     p.join_rigid();
     p.cluster_pegs();
-    let behaviours = (schedule.behaviours.iter())
+    let behaviours: Vec<_> = (schedule.behaviours.iter())
         .map(|b| (b.id.clone(), p.place_behaviour(&block.id, b)))
         .collect();
     p.link_orders(orders);
+    keep_in_order(p.board, &behaviours, own_pegs);
     PlannedBlock {
         block: block_peg,
         behaviours,
+    }
+}
+
+/// The syncs of each behaviour of `own` (on pegs of their own) stay in their order when an
+/// anticipator moves some of them: a peg that would pass its neighbour pushes or drags it
+/// along, until the behaviour's engine gives their times.
+fn keep_in_order(
+    board: &mut PegBoard,
+    behaviours: &[(Id, Vec<(SyncName, Placement)>)],
+    own: &[&str],
+) {
+    for (_, syncs) in behaviours
+        .iter()
+        .filter(|(id, _)| own.contains(&id.as_str()))
+    {
+        let pegs: Vec<PegId> = (syncs.iter())
+            .filter_map(|(_, p)| match p {
+                Placement::Peg(p) => Some(*p),
+                Placement::Between { .. } => None,
+            })
+            .collect();
+        for w in pegs.windows(2) {
+            board.order(w[0], w[1], 0.0);
+        }
     }
 }
 

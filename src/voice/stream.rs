@@ -5,8 +5,9 @@
 //! `…:end`) that the speech's own syncs hang on, from its [`predict`](AudioStream::predict)
 //! and [`update`](AudioStream::update). `start` is the first time the realizer looks after the first chunk came (until then it is
 //! predicted an hour ahead, so the speech waits); `end` is predicted as the sound received so
-//! far plus [`LOOKAHEAD`], never before the present, and revised with every chunk, until the
-//! stream ends: then it is the sound's end. A stream that gets no chunk for [`TIMEOUT`] seconds
+//! far plus [`LOOKAHEAD`], never before the present, or the length the speech expects of its
+//! text ([`expect`](AudioStream::expect)) if that is longer, and revised with every chunk, until
+//! the stream ends: then it is the sound's end. A stream that gets no chunk for [`TIMEOUT`] seconds
 //! is taken as ended. Marks are Polly speech marks or a word list (`voice::marks`), their times
 //! counted from the stream's first sample.
 
@@ -44,6 +45,8 @@ struct State {
     /// How many lookaheads an open stream's end was predicted past its sound, at the last
     /// update.
     steps: u32,
+    /// The length of sound expected (seconds), if the speech knows its text.
+    expected: Option<f64>,
 }
 
 /// A stream of one speech's sound (see the module documentation). Clones share the stream.
@@ -115,6 +118,16 @@ impl AudioStream {
         Ok(())
     }
 
+    /// Says how long the whole sound is expected to be (a speech's estimate from its text):
+    /// until the stream ends its end is predicted no earlier than that after its start.
+    pub fn expect(&self, seconds: f64) {
+        let mut s = self.state();
+        if seconds.is_finite() && seconds > 0.0 && s.expected != Some(seconds) {
+            s.expected = Some(seconds);
+            s.fresh = true;
+        }
+    }
+
     /// Ends the stream: its end is its sound's end.
     pub fn end(&self) {
         let mut s = self.state();
@@ -169,7 +182,8 @@ impl AudioStream {
                 Some(if Self::closed(&s) {
                     sound.max(start + 1e-3)
                 } else {
-                    sound + f64::from(Self::steps(&s, start)) * LOOKAHEAD
+                    let ahead = sound + f64::from(Self::steps(&s, start)) * LOOKAHEAD;
+                    ahead.max(start + s.expected.unwrap_or(0.0))
                 })
             }
             _ => None,
@@ -224,6 +238,29 @@ mod tests {
         assert_eq!(s.predict("end"), Some(3.0));
         assert_eq!(s.marks().words[0].start, 0.1);
         assert!(s.push(&[0; 10], 8000, None).unwrap_err().contains("ended"));
+    }
+
+    #[test]
+    fn an_expected_length_holds_the_end_until_the_sound_passes_it_or_ends() {
+        let s = AudioStream::new("reply");
+        s.expect(3.0);
+        s.push(&[0; 8000], 8000, None).unwrap();
+        s.update(0.5);
+        assert_eq!(
+            s.predict("end"),
+            Some(3.5),
+            "the text's length, not 1 s + lookahead"
+        );
+        s.push(&[0; 24000], 8000, None).unwrap();
+        assert!(s.update(0.6));
+        assert_eq!(
+            s.predict("end"),
+            Some(0.5 + 4.0 + LOOKAHEAD),
+            "the sound passed it"
+        );
+        s.end();
+        s.update(0.7);
+        assert_eq!(s.predict("end"), Some(4.5), "ended: the sound's end");
     }
 
     #[test]

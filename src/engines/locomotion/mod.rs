@@ -514,6 +514,10 @@ impl Engine for LocomotionEngine {
         Some(self)
     }
 
+    fn as_revising(&mut self) -> Option<&mut dyn crate::engine::Revising> {
+        Some(self)
+    }
+
     fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
         Some(self)
     }

@@ -5,7 +5,7 @@
 use glam::{Vec2, Vec3};
 
 use super::LocomotionEngine;
-use crate::engine::{Revision, Travel, UnitKey};
+use crate::engine::{Revising, Revision, Travel, UnitKey};
 use crate::locomotion::room::make_room;
 use crate::locomotion::targets::resolve;
 use crate::locomotion::walker;
@@ -102,10 +102,6 @@ impl Travel for LocomotionEngine {
         self.at
     }
 
-    fn take_revisions(&mut self) -> Vec<Revision> {
-        std::mem::take(&mut self.revisions)
-    }
-
     fn moving(&self) -> bool {
         // (one that made room is "moving" until it is back: it decides to go back on the
         // crowd's grid, which is kept only while someone moves)
@@ -189,5 +185,11 @@ impl LocomotionEngine {
         (self.units.keyed())
             .find(|(syncs, u, _)| !u.started && syncs.first().is_some_and(|s| s.1 == start))
             .map(|(_, _, k)| k.clone())
+    }
+}
+
+impl Revising for LocomotionEngine {
+    fn take_revisions(&mut self, _now: f64) -> Vec<Revision> {
+        std::mem::take(&mut self.revisions)
     }
 }

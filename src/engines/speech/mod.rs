@@ -21,6 +21,9 @@ use crate::voice::stream::AudioStream;
 use crate::voice::{lipsync, Phone, Utterance};
 use std::sync::Arc;
 
+mod stream;
+use stream::{stream_name, Streamed};
+
 /// Volume of a speech that no one changed.
 pub const DEFAULT_VOLUME: f64 = 100.0;
 
@@ -39,40 +42,6 @@ fn own_sound(b: &Behaviour) -> Option<(String, Option<String>)> {
             .map(|a| a.value.trim().to_string())
     };
     Some((attr("audiofile")?, attr("marks")))
-}
-
-/// The stream a speech plays (`bmlt:stream`), if it names one.
-fn stream_name(b: &Behaviour) -> Option<&str> {
-    (b.foreign_attrs.iter())
-        .find(|a| a.ns == crate::bml::NS_BMLT && a.name == "stream")
-        .map(|a| a.value.trim())
-}
-
-/// A speech playing a stream: the stream, the text, and how many samples the lips were
-/// planned for (planned again when more come).
-#[derive(Debug, Clone)]
-struct Streamed {
-    stream: AudioStream,
-    text: Vec<TextPart>,
-    planned: usize,
-}
-
-impl Streamed {
-    /// The lips for the sound received so far, if more came since they were planned.
-    fn replan(&mut self) -> Option<Vec<Phone>> {
-        let audio = self.stream.audio()?;
-        if audio.samples.len() == self.planned {
-            return None;
-        }
-        self.planned = audio.samples.len();
-        let marks = self.stream.marks();
-        let marks = (!marks.words.is_empty() || !marks.visemes.is_empty()).then_some(&marks);
-        Some(
-            crate::voice::recorded::utterance(&self.text, audio, marks)
-                .0
-                .phones,
-        )
-    }
 }
 
 /// The XML namespace (`xml:lang`).
@@ -334,7 +303,8 @@ impl Engine for SpeechEngine {
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         let mut model = match &behaviour.kind {
             BehaviourKind::Speech(s) if stream_name(behaviour).is_some() => {
-                // its length is the stream's: any, its inline syncs spread evenly until then
+                // its length is the stream's: any, its inline syncs spread evenly until their
+                // words come (`stream`)
                 let ids: Vec<&str> = s.sync_ids().collect();
                 let n = ids.len() as f64 + 1.0;
                 let mut keys = vec![SyncKey::new("start", 0.0)];
@@ -421,20 +391,7 @@ impl Engine for SpeechEngine {
             (stream, Self::text(unit.behaviour).to_vec())
         });
         if let Some((stream, text)) = streamed {
-            let speaking = Speaking {
-                volume: DEFAULT_VOLUME,
-                rate: 1.0,
-                audio: None,
-                phones: Vec::new(),
-                anchors: Vec::new(),
-                knots: Vec::new(),
-                streamed: stream.map(|stream| Streamed {
-                    stream,
-                    text,
-                    planned: 0,
-                }),
-            };
-            self.units.add(unit, speaking);
+            self.units.add(unit, stream::speaking(stream, text));
             return Ok(());
         }
         let (phones, anchors) = self.spoken(unit.behaviour);
@@ -488,6 +445,16 @@ impl Engine for SpeechEngine {
 
     fn as_streams(&mut self) -> Option<&mut dyn crate::engine::Streams> {
         Some(self)
+    }
+
+    fn as_revising(&mut self) -> Option<&mut dyn crate::engine::Revising> {
+        Some(self)
+    }
+
+    fn self_timed(&self, behaviour: &Behaviour) -> bool {
+        // a streamed speech's inline syncs follow its words as they come
+        stream_name(behaviour).is_some()
+            && matches!(&behaviour.kind, BehaviourKind::Speech(s) if s.sync_ids().next().is_some())
     }
 }
 
