@@ -1,6 +1,7 @@
 //! The repository stands on its own: code comments and docs cite nothing a reader of the
 //! repository cannot see (design sections, requirement ids, spec files, issue numbers), and the
-//! README lists every subcommand `bmlr --help` knows.
+//! README lists every subcommand `bmlr --help` knows, and every code block of the README and docs
+//! closes (so that they render).
 
 use std::path::Path;
 
@@ -116,4 +117,50 @@ fn the_readme_lists_every_subcommand() {
         );
     }
     assert!(readme.contains("cargo install --path ."));
+}
+
+/// Where a Markdown file's fenced code blocks break: a closing fence with text after it (which
+/// Markdown reads as no fence, so the rest of the file becomes code), or a block left open.
+fn broken_fences(text: &str) -> Vec<String> {
+    let mut open: Option<usize> = None;
+    let mut broken = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        if !t.starts_with("```") {
+            continue;
+        }
+        match open {
+            None => open = Some(n + 1),
+            Some(_) if t.trim_end() == "```" => open = None,
+            Some(from) => {
+                broken.push(format!(
+                    "line {}: a closing fence with text after it (block from line {from})",
+                    n + 1
+                ));
+                open = None;
+            }
+        }
+    }
+    if let Some(from) = open {
+        broken.push(format!("the block from line {from} never closes"));
+    }
+    broken
+}
+
+#[test]
+fn every_code_block_of_the_readme_and_docs_closes() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut md = vec![root.join("README.md")];
+    files(&root.join("docs"), &["md"], &mut md);
+    let mut bad = Vec::new();
+    for path in md {
+        let text = std::fs::read_to_string(&path).unwrap();
+        for b in broken_fences(&text) {
+            bad.push(format!("{}: {b}", path.display()));
+        }
+    }
+    assert!(bad.is_empty(), "{bad:#?}");
+    // the check itself: the form the README once had
+    assert_eq!(broken_fences("```rust\nx\n``` See docs.\n").len(), 1);
+    assert!(broken_fences("```\nx\n```\n").is_empty());
 }
