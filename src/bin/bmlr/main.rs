@@ -19,10 +19,12 @@ mod live;
 mod live_frames;
 mod outcome;
 mod pack;
+mod plan;
 mod record;
 mod run;
 mod serve;
 mod serve_broker;
+mod setup;
 mod spool;
 mod tcp;
 mod view;
@@ -54,12 +56,12 @@ enum Command {
     /// Realize BML: send files in order on a virtual clock (default) and print the feedback.
     Run(run::RunArgs),
     /// Schedule BML files without executing them; print every sync point's time.
-    Plan(run::PlanArgs),
+    Plan(plan::PlanArgs),
     /// Realize BML on the virtual clock and show it on a web page: the character in 3D, the
     /// timeline and the feedback (--out DIR writes the page, --serve ADDR serves it).
     View(view::ViewArgs),
     /// Draw a feedback log as a timeline picture (SVG).
-    Timeline(run::TimelineArgs),
+    Timeline(plan::TimelineArgs),
     /// Compare two feedback logs (XML or JSON lines) modulo clock origin, posix times and jitter.
     Diff(diff::DiffArgs),
     /// Serve the realizer port: one `<bml>` block per input line, one feedback element per output line.
@@ -75,7 +77,7 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
         #[command(flatten)]
-        limits: run::LimitArgs,
+        limits: setup::LimitArgs,
     },
 }
 
@@ -88,10 +90,10 @@ fn main() -> ExitCode {
             limits,
         } => validate(&files, quiet, &limits.limits()),
         Command::Run(args) => run::run(args),
-        Command::Plan(args) => run::plan(args),
+        Command::Plan(args) => plan::plan(args),
         Command::Diff(args) => diff::run(args),
         Command::View(args) => view::view(args),
-        Command::Timeline(args) => run::timeline(args),
+        Command::Timeline(args) => plan::timeline(args),
         Command::Serve(args) => serve::serve(args),
         Command::Conformance(args) => serve::conformance(args),
     }

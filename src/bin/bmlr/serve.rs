@@ -58,7 +58,7 @@ pub struct ServeArgs {
     pub(crate) characters: Vec<String>,
     /// With --mqtt or --stomp: the feedback's encoding (xml by default).
     #[arg(long, value_enum)]
-    pub(crate) format: Option<crate::run::FormatArg>,
+    pub(crate) format: Option<crate::setup::FormatArg>,
     /// With --mqtt: speak ipaaca as ipaacar does on these channels, one per character
     /// ('default' is the default character): `bml` messages and `realizerRequest` IUs in,
     /// `bmlfeedback` messages out (docs/broker.md).
@@ -86,7 +86,7 @@ pub struct ServeArgs {
     pub(crate) no_idle: bool,
     /// The voice that says speech: the built-in TTS, or flite (Debian package `flite`).
     #[arg(long, value_enum, default_value = "builtin")]
-    pub(crate) tts: crate::run::TtsArg,
+    pub(crate) tts: crate::setup::TtsArg,
     /// Speech may change its rate to meet its constraints (an incremental TTS).
     #[arg(long)]
     pub(crate) retimable_speech: bool,
@@ -94,7 +94,7 @@ pub struct ServeArgs {
     #[arg(long, value_name = "DIR")]
     pub(crate) assets: Option<std::path::PathBuf>,
     #[command(flatten)]
-    pub(crate) limits: crate::run::LimitArgs,
+    pub(crate) limits: crate::setup::LimitArgs,
     /// A world file (JSON): named points and points moving along keyed paths, as targets of
     /// gaze, pointing and headDirectionShift, added to the built-in scene.
     #[arg(long, value_name = "WORLD.json")]
@@ -192,7 +192,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         .with_posix_time(true)
         .with_idle(!args.no_idle)
         .with_limits(args.limits.limits());
-    let realizer = match crate::run::with_world(realizer, args.world.as_deref()) {
+    let realizer = match crate::setup::with_world(realizer, args.world.as_deref()) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("bmlr serve: --world {e}");
@@ -200,7 +200,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         }
     };
     let realizer =
-        match crate::run::with_sight_and_nets(realizer, args.perception, args.nets.as_deref()) {
+        match crate::setup::with_sight_and_nets(realizer, args.perception, args.nets.as_deref()) {
             Ok(r) => r,
             Err(e) => {
                 eprintln!("bmlr serve: {e}");
@@ -445,7 +445,7 @@ pub struct ConformanceArgs {
         default_value = "builtin",
         conflicts_with = "realizer"
     )]
-    tts: crate::run::TtsArg,
+    tts: crate::setup::TtsArg,
 }
 
 /// The command for the incremental-speech tests: the one given, else `cmd` itself — with

@@ -107,7 +107,7 @@ pub fn brokered(args: &ServeArgs, realizer: &Realizer) -> Result<Brokered, Strin
         stomp,
         dialect,
         characters: args.characters.iter().cloned().collect(),
-        format: args.format.unwrap_or(crate::run::FormatArg::Xml).into(),
+        format: args.format.unwrap_or(crate::setup::FormatArg::Xml).into(),
         period: Duration::from_secs_f64(1.0 / args.fps),
         until,
         frames,

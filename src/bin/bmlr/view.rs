@@ -16,7 +16,8 @@ use bml_realizer::world::World;
 use clap::Args;
 use serde_json::{json, Value};
 
-use crate::run::{SetupArgs, VirtualRun};
+use crate::run::VirtualRun;
+use crate::setup::SetupArgs;
 use crate::web;
 
 /// Arguments of `bmlr view`.
@@ -90,7 +91,7 @@ fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome),
     if args.until.is_some_and(|u| !(u.is_finite() && u >= 0.0)) {
         return Err("--until must be a number of seconds >= 0".into());
     }
-    let items = crate::run::read_items(&args.items)?;
+    let items = crate::setup::read_items(&args.items)?;
     if args.setup.nets.is_some() && args.until.is_none() {
         return Err("--nets: nets may go on changing for ever; give --until SECS".into());
     }
