@@ -13,6 +13,7 @@ macro_rules! eprintln {
 mod avatar;
 mod broker_port;
 mod brokered;
+mod conformance;
 mod dialect;
 mod diff;
 mod live;
@@ -67,7 +68,7 @@ enum Command {
     /// Serve the realizer port: one `<bml>` block per input line, one feedback element per output line.
     Serve(serve::ServeArgs),
     /// Run the RealizerTester conformance suite; last line "N passed, M failed".
-    Conformance(serve::ConformanceArgs),
+    Conformance(conformance::ConformanceArgs),
     /// Parse and check BML files; print file:line:col diagnostics. Exit 1 if any file is invalid.
     Validate {
         /// BML files (one `<bml>` block each).
@@ -95,7 +96,7 @@ fn main() -> ExitCode {
         Command::View(args) => view::view(args),
         Command::Timeline(args) => plan::timeline(args),
         Command::Serve(args) => serve::serve(args),
-        Command::Conformance(args) => serve::conformance(args),
+        Command::Conformance(args) => conformance::conformance(args),
     }
 }
 
