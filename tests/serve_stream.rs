@@ -134,12 +134,16 @@ fn hear_into(link: Link, tx: mpsc::Sender<Feedback>) {
     }
 }
 
+/// espeak-ng's sentence, the sound every test streams.
+fn sound() -> bml_realizer::voice::Audio {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/voice/espeak-bob.wav");
+    bml_realizer::sound::read_wav(std::path::Path::new(path)).unwrap()
+}
+
 /// Streams the sentence through `port`, with `bad` as the one bad message; the feedback until
 /// block b's end.
 fn stream_through(mut port: Port, bad: &str) -> Vec<Feedback> {
-    let dir = env!("CARGO_MANIFEST_DIR");
-    let path = format!("{dir}/fixtures/voice/espeak-bob.wav");
-    let audio = bml_realizer::sound::read_wav(std::path::Path::new(&path)).unwrap();
+    let audio = sound();
     let report = espeak_report::fixture();
     let lines = espeak_report::polly_lines(&report);
     let send = &mut port.send;
@@ -183,9 +187,7 @@ fn stream_through(mut port: Port, bad: &str) -> Vec<Feedback> {
 /// The speech lasts its sound, is predicted as it comes, the nod follows its end, and the one
 /// bad message is one warning that says `why`.
 fn check(log: &[Feedback], why: &str) {
-    let dir = env!("CARGO_MANIFEST_DIR");
-    let path = format!("{dir}/fixtures/voice/espeak-bob.wav");
-    let audio = bml_realizer::sound::read_wav(std::path::Path::new(&path)).unwrap();
+    let audio = sound();
     let length = audio.samples.len() as f64 / f64::from(audio.rate);
     let warnings: Vec<&str> = (log.iter())
         .filter_map(|f| match f {
