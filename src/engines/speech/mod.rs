@@ -490,6 +490,8 @@ impl crate::engine::Expression for SpeechEngine {
             let (Some(start), Some(end)) = (syncs.first(), syncs.last()) else {
                 continue;
             };
+            // (revisions replan too, but a speech that started on this frame's own time was
+            // added after they were taken: its first frame plans here)
             if let Some(phones) = u.streamed.as_mut().and_then(Streamed::replan) {
                 u.phones = phones;
             }
