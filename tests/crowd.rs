@@ -561,3 +561,24 @@ proptest! {
         prop_assert!(q.stranded == q.gave_up, "{:?}", q);
     }
 }
+
+/// One standing at its goal steps aside for a walker passing near, and goes back to its place
+/// when that walker stops close by at its own goal (it used to stay aside for good, 0.47 m
+/// from its goal, with no word).
+#[test]
+fn one_who_made_room_goes_back_when_the_walker_stops_nearby() {
+    let walkers = [
+        walker((-0.48, 3.30), (1.14, -1.30)),
+        walker((-1.14, 2.48), (-0.07, 3.60)),
+        walker((-3.66, 0.0), (-0.82, 4.40)),
+    ];
+    let c = realize(&walkers, 12.0, 10.0);
+    let moved = (c.tracks[&id(1)].iter())
+        .map(|p| p.distance(walkers[1].to))
+        .fold(0.0f32, f32::max);
+    assert!(moved > 0.2, "w001 never made room ({moved} m)");
+    for (k, w) in walkers.iter().enumerate() {
+        let off = c.last(&id(k)).distance(w.to);
+        assert!(off < 0.06, "{} ended {off} m from its goal", id(k));
+    }
+}

@@ -14,7 +14,8 @@ use glam::Vec2;
 use super::gait::{forward, Body};
 use super::{Obstacles, Walk};
 use crate::crowd::negotiate::{self, STEP_SPEED, TRIGGER};
-use crate::crowd::Crowd;
+
+use crate::crowd::{Agent, Crowd};
 
 /// How long after the last ask one who stepped aside stays there at least (s): a walker's ask
 /// comes and goes as it judges its way, and one that went back at each lapse never got aside.
@@ -36,8 +37,9 @@ pub struct Room {
 /// The walk a standing character at `body` (index `me` in `crowd`, radius `radius`, among
 /// `obstacles`) sets off on at `now` to make room or to go back, given what it did so far
 /// (`room`, updated); `None` when it keeps doing what it does. It goes back once nobody has
-/// asked it for [`HOLD`] and the walker it made room for is more than [`TRIGGER`] from its
-/// place.
+/// asked it for [`HOLD`] and the walker it made room for has passed: more than [`TRIGGER`]
+/// from its place, or come to a stop clear of it (a walker that stops near, at its own goal,
+/// would otherwise keep it away from its place for good).
 pub fn make_room(
     room: &mut Option<Room>,
     now: f64,
@@ -51,9 +53,9 @@ pub fn make_room(
             r.asked = now;
         }
         if r.aside {
-            let walker_near = (crowd.index(&r.walker))
-                .is_some_and(|i| crowd.agent(i).at.distance(r.home.at) <= TRIGGER);
-            if now - r.asked < HOLD || walker_near {
+            let passing = (crowd.index(&r.walker))
+                .is_some_and(|i| in_the_way(crowd.agent(i), r.home.at, radius));
+            if now - r.asked < HOLD || passing {
                 return None;
             }
             r.aside = false;
@@ -70,6 +72,16 @@ pub fn make_room(
         asked: now,
     });
     Some(walk_to(spot, home))
+}
+
+/// Faster than this a walker still passes (m/s).
+const MOVING: f32 = 0.05;
+
+/// Whether `walker` still keeps one who made room from its place `home` (its radius `radius`):
+/// within [`TRIGGER`] of it and moving, or standing where the two would touch.
+fn in_the_way(walker: Agent, home: Vec2, radius: f32) -> bool {
+    let d = walker.at.distance(home);
+    d <= TRIGGER && (walker.velocity.length() > MOVING || d < walker.radius + radius)
 }
 
 /// A walk at the stepping speed to `spot`, ending turned as `home` faced.
