@@ -292,8 +292,15 @@ fn a_flood_for_one_character_does_not_hold_up_another_s_block() {
     let Some(broker) = Broker::start() else {
         return;
     };
-    let _r = realizer(&broker, "r", &[], &["--no-idle"]);
+    // (x's queue is kept short, so that it overflows however fast the realizer keeps up)
+    let _r = realizer(&broker, "r", &[], &["--no-idle", "--queue-limit", "100"]);
     let mut flood = planner(&broker, "flooder");
+    // (x's feedback heard all along, so that the listener's inbox never holds the broker up)
+    let x_feedback = planner_on(&broker, "x-listener", &["bml/x/feedback"]);
+    let dropped = |h: &[(String, String)]| {
+        (h.iter()).any(|(_, m)| m.contains("blocks dropped: more than 100 waited"))
+    };
+    let x_dropped = std::thread::spawn(move || dropped(&hear(&x_feedback, 30.0, dropped)));
     // (the other planner listens to its own character)
     let mut other = planner_on(&broker, "other", &["bml/y/feedback", "bml/realizers/+"]);
     until_online(&other, &["r"]);
@@ -321,8 +328,8 @@ fn a_flood_for_one_character_does_not_hold_up_another_s_block() {
     );
     eprintln!("the other character's block started {waited:?} after it was sent");
     assert!(waited < Duration::from_millis(250), "{waited:?}");
-    // (whether x's queue overflows, and its "blocks dropped" warning comes, depends on how
-    // fast the realizer keeps up: not asserted here)
+    // x's queue overflowed: said on x's feedback topic
+    assert!(x_dropped.join().unwrap(), "no warning of dropped blocks");
     drop(flood);
 }
 

@@ -204,3 +204,62 @@ fn the_world_file_s_vision_and_variables_are_read_and_bad_values_named() {
         assert!(e.contains(field), "{e}");
     }
 }
+
+/// `bmlr run --until`: after the blocks end, the characters go on looking on their own grid of
+/// times up to the end (the last look used to fall on the end itself, off the grid, and the
+/// looks between were lost).
+#[test]
+fn looks_after_the_blocks_end_stay_on_their_grid_up_to_until() {
+    let dir = std::env::temp_dir().join(format!("bmlr-looks-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // a ball crosses in front of ann and goes behind her after her nod has ended
+    let world = dir.join("world.json");
+    std::fs::write(
+        &world,
+        r#"{"paths": {"ball": {"keys": [[0, [-3, 1.6, 2]], [1.5, [0, 1.6, 2]], [2.2, [0, 1.6, -3]]]}},
+            "characters": {"ann": {"position": [0, 0, 0], "facing": 0}}}"#,
+    )
+    .unwrap();
+    let block = dir.join("nod.xml");
+    std::fs::write(
+        &block,
+        format!(r#"<bml {NS} id="b1" characterId="ann"><head id="h" lexeme="NOD" start="0" end="0.5"/></bml>"#),
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_bmlr"))
+        .args([
+            "run",
+            "--format",
+            "jsonl",
+            "--perception",
+            "--until",
+            "2.5",
+            "--world",
+        ])
+        .arg(&world)
+        .arg(&block)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let times: Vec<f64> = (String::from_utf8_lossy(&out.stdout).lines())
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter(|v| v["feedback"] == "perception" && v["characterId"] == "ann")
+        .map(|v| v["time"].as_f64().unwrap())
+        .collect();
+    assert!(
+        times.iter().any(|&t| t > 0.5 && t < 2.4),
+        "no look between the nod's end and --until: {times:?}"
+    );
+    for t in &times {
+        let on = (t - times[0]) / period();
+        assert!(
+            (on - on.round()).abs() < 0.02,
+            "{t} is off the grid of {times:?}"
+        );
+    }
+}

@@ -221,10 +221,42 @@ fn check_starts(nets: &[Net]) -> Result<(), String> {
         }
     }
     if let Err(cycle) = petgraph::algo::toposort(&graph, None) {
-        let n = &nets[cycle.node_id()].name;
-        return Err(format!(
-            "nets.{n}: nets start each other in a cycle (through '{n}')"
-        ));
+        let names: Vec<&str> = (cycle_through(&graph, cycle.node_id()).into_iter())
+            .map(|i| nets[i].name.as_str())
+            .collect();
+        return Err(match names.as_slice() {
+            [n] | [n, _] => format!("nets.{n}: the net starts itself"),
+            _ => format!(
+                "nets.{}: nets start each other in a cycle: {}",
+                names[0],
+                names.join(" → ")
+            ),
+        });
     }
     Ok(())
+}
+
+/// The shortest cycle from `start` back to it: its nodes in order, `start` first and last
+/// (just `start` if it lies on none).
+fn cycle_through(graph: &petgraph::graphmap::DiGraphMap<usize, ()>, start: usize) -> Vec<usize> {
+    // (breadth first, remembering where each node was first reached from)
+    let mut reached_from = BTreeMap::new();
+    let mut queue = std::collections::VecDeque::from([start]);
+    while let Some(n) = queue.pop_front() {
+        for m in graph.neighbors(n) {
+            if m == start {
+                let mut path = vec![start, n];
+                while let Some(&p) = reached_from.get(path.last().expect("not empty")) {
+                    path.push(p);
+                }
+                path.reverse();
+                return path;
+            }
+            if !reached_from.contains_key(&m) {
+                reached_from.insert(m, n);
+                queue.push_back(m);
+            }
+        }
+    }
+    vec![start]
 }

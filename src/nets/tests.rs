@@ -61,6 +61,32 @@ fn bad_files_are_refused_naming_the_field() {
 }
 
 #[test]
+fn a_cycle_of_nets_starting_each_other_is_named_whole() {
+    let net = |name: &str, starts: &str| {
+        format!(
+            r#""{name}": {{"states": ["x"], "transitions": [{{"from": "x", "to": "x", "when": {{"after": 1}}, "do": [{{"net": "{starts}"}}]}}]}}"#
+        )
+    };
+    let text = format!(
+        r#"{{"nets": {{{}, {}, {}, {}}}}}"#,
+        net("ping", "pong"),
+        net("pong", "pang"),
+        net("pang", "ping"),
+        net("watcher", "ping")
+    );
+    let e = read(&text).unwrap_err();
+    let ways = [
+        "nets.ping: nets start each other in a cycle: ping → pong → pang → ping",
+        "nets.pong: nets start each other in a cycle: pong → pang → ping → pong",
+        "nets.pang: nets start each other in a cycle: pang → ping → pong → pang",
+    ];
+    assert!(ways.contains(&e.as_str()), "{e}");
+    let alone = r#"{"nets": {"echo": {"states": ["x"], "transitions": [{"from": "x", "to": "x", "when": {"after": 1}, "do": [{"net": "echo"}]}]}}}"#;
+    let e = read(alone).unwrap_err();
+    assert_eq!(e, "nets.echo: the net starts itself");
+}
+
+#[test]
 fn guards_read_the_frame_as_it_began_and_actions_take_effect_together() {
     // `b` waits for the variable `a` sets; it sees the change one step later, whatever the
     // order the nets are tried in

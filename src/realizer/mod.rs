@@ -201,8 +201,17 @@ impl Realizer {
     pub fn next_event(&self) -> Option<f64> {
         let (sync, nets) = (self.next_sync(), self.nets_wake());
         sync.or(nets)?;
-        let look = self.perception().and_then(|p| p.next_look_of_any());
-        [sync, nets, look].into_iter().flatten().reduce(f64::min)
+        [sync, nets, self.next_look()]
+            .into_iter()
+            .flatten()
+            .reduce(f64::min)
+    }
+
+    /// With sight on, the time of the next look of any character (each looks on its own grid
+    /// of times); a run that goes on to a given end ticks at these so that every look falls
+    /// on its grid.
+    pub fn next_look(&self) -> Option<f64> {
+        self.perception().and_then(|p| p.next_look_of_any())
     }
 
     /// The time of the next sync point of any character.

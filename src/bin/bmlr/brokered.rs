@@ -32,9 +32,12 @@ const PER_FRAME: usize = 1_024;
 /// Messages taken from the link in one frame at most (into the characters' queues).
 const TAKEN_PER_FRAME: usize = 65_536;
 
-/// Blocks that may wait for one character; beyond, the newest are dropped with a warning on
-/// its feedback topic.
+/// Blocks that may wait for one character unless `--queue-limit` says otherwise; beyond, the
+/// newest are dropped with a warning on its feedback topic.
 pub const QUEUE_LIMIT: usize = 10_000;
+
+/// The largest `--queue-limit` taken (a million small blocks are a few hundred MB).
+pub const MAX_QUEUE_LIMIT: usize = 1_000_000;
 
 /// What `serve --mqtt | --stomp` was given.
 pub struct Brokered {
@@ -54,6 +57,8 @@ pub struct Brokered {
     pub format: Format,
     /// Engine loop period.
     pub period: Duration,
+    /// Blocks that may wait for one character (beyond, the newest are dropped).
+    pub queue_limit: usize,
     /// Stop after this many seconds (on the realizer's clock).
     pub until: f64,
     /// The frames file written as the characters move.
@@ -157,8 +162,8 @@ impl Server {
             .map(|(lane, q)| (lane.character().to_string(), std::mem::take(&mut q.1)))
             .collect();
         for (c, n) in dropped {
-            let text =
-                format!("{n} blocks dropped: more than {QUEUE_LIMIT} waited for this character");
+            let limit = self.args.queue_limit;
+            let text = format!("{n} blocks dropped: more than {limit} waited for this character");
             self.refuse(&c, text, None);
         }
         let (mut done, start) = (0, self.clock.now());
@@ -236,7 +241,7 @@ impl Server {
             }) => {
                 if matches!(lane, Lane::Shared(_)) || self.serves(lane.character()) {
                     let q = self.waiting.entry(lane).or_default();
-                    if q.0.len() < QUEUE_LIMIT {
+                    if q.0.len() < self.args.queue_limit {
                         q.0.push_back((payload, request));
                     } else {
                         q.1 += 1;

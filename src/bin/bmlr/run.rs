@@ -212,6 +212,12 @@ impl VirtualRun {
             self.advance_to(t);
         }
         if self.until.is_finite() {
+            // (the characters go on looking, each on its own grid of times, up to the end)
+            while let Some(t) =
+                (self.realizer.next_look()).filter(|&t| t > self.realizer.now() && t <= self.until)
+            {
+                self.advance_to(t);
+            }
             self.advance_to(self.until);
         }
     }

@@ -62,6 +62,10 @@ pub struct ServeArgs {
     /// `bmlfeedback` messages out (docs/broker.md).
     #[arg(long, value_name = "CH,CH2", value_delimiter = ',')]
     pub(crate) ipaaca: Vec<String>,
+    /// With --mqtt or --stomp: blocks that may wait for one character; beyond, the newest are
+    /// dropped and its feedback says how many (1 to 1 000 000).
+    #[arg(long, value_name = "N", default_value_t = crate::brokered::QUEUE_LIMIT)]
+    pub(crate) queue_limit: usize,
     /// With --mqtt or --stomp: stop after this many seconds.
     #[arg(long, value_name = "SECS")]
     pub(crate) until: Option<f64>,
@@ -114,6 +118,13 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         eprintln!("bmlr serve: --fps must be a positive number");
         return ExitCode::from(2);
     }
+    if !(1..=crate::brokered::MAX_QUEUE_LIMIT).contains(&args.queue_limit) {
+        eprintln!(
+            "bmlr serve: --queue-limit must be from 1 to {}",
+            crate::brokered::MAX_QUEUE_LIMIT
+        );
+        return ExitCode::from(2);
+    }
     // (clap's `requires` is not checked beside the port group: said here)
     let brokered = args.mqtt.is_some() || args.stomp.is_some();
     let misplaced = [
@@ -133,6 +144,12 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         (
             "--format",
             args.format.is_some(),
+            brokered,
+            "--mqtt or --stomp",
+        ),
+        (
+            "--queue-limit",
+            args.queue_limit != crate::brokered::QUEUE_LIMIT,
             brokered,
             "--mqtt or --stomp",
         ),
