@@ -252,8 +252,8 @@ fn cycle_through(graph: &petgraph::graphmap::DiGraphMap<usize, ()>, start: usize
                 path.reverse();
                 return path;
             }
-            if !reached_from.contains_key(&m) {
-                reached_from.insert(m, n);
+            if let std::collections::btree_map::Entry::Vacant(e) = reached_from.entry(m) {
+                e.insert(n);
                 queue.push_back(m);
             }
         }
