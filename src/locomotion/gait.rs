@@ -18,6 +18,9 @@
 
 use glam::{Quat, Vec2, Vec3};
 
+/// A planted foot further than this (m) from where it would stand beside the body is out of
+/// the leg's reach (at 1.3 m/s a foot leaves the ground 0.58 m behind).
+pub const OUT_OF_REACH: f32 = 0.7;
 /// A planted foot further behind the body than this (m) … see [`Gait::hurry`].
 pub const STRAIN_BEHIND: f32 = 0.45;
 /// … and turned against it by more than this (rad) strains the hip.
@@ -274,6 +277,18 @@ impl Gait {
         1.0 + (ahead - AHEAD_FREE).max(0.0) / AHEAD_PER_CADENCE
     }
 
+    /// Whether planted foot `k` is further than [`OUT_OF_REACH`] (or three quarters of a
+    /// stride, when walking fast) from where it would stand beside the body: further than any
+    /// step leaves it.
+    fn out_of_reach(&self, k: usize, body: Body) -> bool {
+        match self.feet[k] {
+            Foot::Planted { at, .. } => {
+                at.distance(standing_spot(body, k)) > OUT_OF_REACH.max(0.75 * self.stride())
+            }
+            Foot::Swing { .. } => false,
+        }
+    }
+
     /// Whether the walker stands: both feet planted where they belong and no speed.
     pub fn at_rest(&self, body: Body) -> bool {
         self.speed < 0.02 && self.settled(0, body) && self.settled(1, body)
@@ -334,7 +349,17 @@ impl Gait {
             // little of the swing is left to make one
             let lifts = now >= beta && (was < beta || 1.0 - now > LATE_LIFT);
             let lands = now < was; // wrapped: heel strike
+            let other_planted = matches!(self.feet[1 - k], Foot::Planted { .. });
             match self.feet[k] {
+                // a planted foot the body has left out of the leg's reach (pushed in a press of
+                // people) lifts at once and steps after it, while the other foot stands
+                Foot::Planted { at, yaw } if other_planted && self.out_of_reach(k, body) => {
+                    self.feet[k] = Foot::Swing {
+                        from: at,
+                        from_yaw: yaw,
+                        since: now,
+                    };
+                }
                 // a foot already where it belongs stays down while the body stands, or
                 // where it will belong when the body, nearly there, stops
                 Foot::Planted { at, yaw } if lifts && !self.stays(k, body) => {

@@ -138,8 +138,13 @@ pub fn lead_the_turn(j: &GaitJoints, ahead: f32, amount: f32, pose: &mut Pose) {
     }
 }
 
+/// Deepest the pelvis sinks to keep a planted foot in reach (m): a knee bend. A foot further
+/// away is lifted by the gait (`Gait::step`); the pelvis sank to 0.1 m above the floor for a
+/// foot left behind by a body pushed in a jam.
+pub const MAX_SINK: f32 = 0.15;
+
 /// Lowers the root so that each foot is within 98.5 % of the leg's reach (a straight knee
-/// turns fast for little change of length); over both feet, so
+/// turns fast for little change of length), by [`MAX_SINK`] at most; over both feet, so
 /// that the height changes smoothly as they lift and land.
 fn lower_to_reach(skeleton: &Skeleton, j: &GaitJoints, feet: &[FootPose; 2], pose: &mut Pose) {
     let reach = j.reach * 0.985;
@@ -151,7 +156,7 @@ fn lower_to_reach(skeleton: &Skeleton, j: &GaitJoints, feet: &[FootPose; 2], pos
         let vertical = (reach * reach - h * h).sqrt();
         drop = drop.max(d.y - vertical);
     }
-    pose.root.y -= drop;
+    pose.root.y -= drop.min(MAX_SINK);
 }
 
 /// The most the ankle is bent toes-up against the shin (rad; its limit is 20°).

@@ -197,9 +197,13 @@ impl World {
     }
 
     /// What character `id` walks round: the obstacles and the space of every conversing group
-    /// it is not in, as those groups stand now (each a circle through its members' far sides).
+    /// it is not in, as those groups stand now (each a circle through its members' far sides),
+    /// but for a space it already stands in (it walks out of that one; taken as an obstacle,
+    /// it threw the character out of it 0.5 m in one frame).
     pub fn obstacles_for(&self, id: &str) -> Arc<crate::locomotion::Obstacles> {
         use crate::locomotion::obstacles::{Obstacle, Shape};
+        let p = self.placement(id).position;
+        let (here, radius) = (glam::Vec2::new(p.x, p.z), self.radius(id));
         let spaces: Vec<Obstacle> = (self.groups.iter())
             .filter(|g| g.members.binary_search_by(|m| m.as_str().cmp(id)).is_err())
             .filter_map(|g| {
@@ -209,6 +213,7 @@ impl World {
                     .collect();
                 g.space(&members)
             })
+            .filter(|s| here.distance(s.centre) >= s.outer + crate::crowd::group::PASSING + radius)
             .map(|s| Obstacle {
                 shape: Shape::Circle {
                     centre: s.centre,
