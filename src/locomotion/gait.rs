@@ -527,4 +527,29 @@ mod tests {
             assert!((step - 0.69).abs() < 0.08, "{step}");
         }
     }
+
+    #[test]
+    fn a_foot_the_body_is_pushed_away_from_lifts_and_steps_after_it() {
+        let body = Body {
+            at: Vec2::ZERO,
+            facing: 0.0,
+        };
+        let mut g = Gait::standing(body);
+        // pushed 0.8 m to the side in a press, not walking: the foot left furthest behind
+        // lifts at once (it stayed down, and the pelvis sank to reach it)
+        let pushed = Body {
+            at: Vec2::new(0.8, 0.0),
+            ..body
+        };
+        g.step(1.0 / 60.0, pushed, Vec2::ZERO);
+        let swinging = (g.feet.iter())
+            .filter(|f| matches!(f, Foot::Swing { .. }))
+            .count();
+        assert_eq!(swinging, 1, "{:?}", g.feet);
+        // and both feet end beside the body
+        for _ in 0..240 {
+            g.step(1.0 / 60.0, pushed, Vec2::ZERO);
+        }
+        assert!(g.at_rest(pushed), "{:?}", g.feet);
+    }
 }

@@ -225,7 +225,7 @@ fn check_starts(nets: &[Net]) -> Result<(), String> {
             .map(|i| nets[i].name.as_str())
             .collect();
         return Err(match names.as_slice() {
-            [n] | [n, _] => format!("nets.{n}: the net starts itself"),
+            [n] | [n, _] => format!("nets.{n}: the net starts itself (a cycle of one)"),
             _ => format!(
                 "nets.{}: nets start each other in a cycle: {}",
                 names[0],

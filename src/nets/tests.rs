@@ -83,7 +83,7 @@ fn a_cycle_of_nets_starting_each_other_is_named_whole() {
     assert!(ways.contains(&e.as_str()), "{e}");
     let alone = r#"{"nets": {"echo": {"states": ["x"], "transitions": [{"from": "x", "to": "x", "when": {"after": 1}, "do": [{"net": "echo"}]}]}}}"#;
     let e = read(alone).unwrap_err();
-    assert_eq!(e, "nets.echo: the net starts itself");
+    assert_eq!(e, "nets.echo: the net starts itself (a cycle of one)");
 }
 
 #[test]
