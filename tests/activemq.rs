@@ -350,8 +350,9 @@ fn a_flood_for_one_character_does_not_hold_up_another_s_block_on_the_shared_topi
     // time the realizer started it, bmla:posixTime, is what is measured)
     let start = |h: &[String]| h.iter().find(|m| m.contains(r#"id="mine:start""#)).cloned();
     let dropped = |h: &[String]| {
-        h.iter()
-            .any(|m| m.contains("blocks dropped") && m.contains(r#"characterId="x""#))
+        h.iter().any(|m| {
+            m.contains("blocks dropped: more than 100 waited") && m.contains(r#"characterId="x""#)
+        })
     };
     let heard = hear(&p, 60.0, |h| start(h).is_some() && dropped(h));
     let line = start(&heard).expect("y's block started");

@@ -165,6 +165,14 @@ fn bad_broker_flags_are_named_with_the_reason() {
             &["serve", "--stdio", "--prefix", "x"][..],
             "--prefix goes with --mqtt",
         ),
+        (
+            &["serve", "--mqtt", "mqtt://x", "--queue-limit", "0"][..],
+            "--queue-limit must be from 1 to 1000000",
+        ),
+        (
+            &["serve", "--tcp", "127.0.0.1:0", "--queue-limit", "50"][..],
+            "--queue-limit goes with --mqtt or --stomp",
+        ),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_bmlr"))
             .args(args)

@@ -277,16 +277,11 @@ impl Gait {
         1.0 + (ahead - AHEAD_FREE).max(0.0) / AHEAD_PER_CADENCE
     }
 
-    /// Whether planted foot `k` is further than [`OUT_OF_REACH`] (or three quarters of a
-    /// stride, when walking fast) from where it would stand beside the body: further than any
-    /// step leaves it.
-    fn out_of_reach(&self, k: usize, body: Body) -> bool {
-        match self.feet[k] {
-            Foot::Planted { at, .. } => {
-                at.distance(standing_spot(body, k)) > OUT_OF_REACH.max(0.75 * self.stride())
-            }
-            Foot::Swing { .. } => false,
-        }
+    /// Whether foot `k`, planted `at`, is further than [`OUT_OF_REACH`] (or three quarters of
+    /// a stride, when walking fast) from where it would stand beside the body: further than
+    /// any step leaves it.
+    fn out_of_reach(&self, k: usize, at: Vec2, body: Body) -> bool {
+        at.distance(standing_spot(body, k)) > OUT_OF_REACH.max(0.75 * self.stride())
     }
 
     /// Whether the walker stands: both feet planted where they belong and no speed.
@@ -353,7 +348,7 @@ impl Gait {
             match self.feet[k] {
                 // a planted foot the body has left out of the leg's reach (pushed in a press of
                 // people) lifts at once and steps after it, while the other foot stands
-                Foot::Planted { at, yaw } if other_planted && self.out_of_reach(k, body) => {
+                Foot::Planted { at, yaw } if other_planted && self.out_of_reach(k, at, body) => {
                     self.feet[k] = Foot::Swing {
                         from: at,
                         from_yaw: yaw,

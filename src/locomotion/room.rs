@@ -14,7 +14,6 @@ use glam::Vec2;
 use super::gait::{forward, Body};
 use super::{Obstacles, Walk};
 use crate::crowd::negotiate::{self, STEP_SPEED, TRIGGER};
-
 use crate::crowd::{Agent, Crowd};
 
 /// How long after the last ask one who stepped aside stays there at least (s): a walker's ask

@@ -239,24 +239,10 @@ fn check_starts(nets: &[Net]) -> Result<(), String> {
 /// The shortest cycle from `start` back to it: its nodes in order, `start` first and last
 /// (just `start` if it lies on none).
 fn cycle_through(graph: &petgraph::graphmap::DiGraphMap<usize, ()>, start: usize) -> Vec<usize> {
-    // (breadth first, remembering where each node was first reached from)
-    let mut reached_from = BTreeMap::new();
-    let mut queue = std::collections::VecDeque::from([start]);
-    while let Some(n) = queue.pop_front() {
-        for m in graph.neighbors(n) {
-            if m == start {
-                let mut path = vec![start, n];
-                while let Some(&p) = reached_from.get(path.last().expect("not empty")) {
-                    path.push(p);
-                }
-                path.reverse();
-                return path;
-            }
-            if let std::collections::btree_map::Entry::Vacant(e) = reached_from.entry(m) {
-                e.insert(n);
-                queue.push_back(m);
-            }
-        }
-    }
-    vec![start]
+    let back = |from: usize| petgraph::algo::astar(graph, from, |n| n == start, |_| 1, |_| 0);
+    (graph.neighbors(start).filter_map(back))
+        .min_by_key(|(steps, _)| *steps)
+        .map_or(vec![start], |(_, path)| {
+            std::iter::once(start).chain(path).collect()
+        })
 }

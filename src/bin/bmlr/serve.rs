@@ -63,9 +63,9 @@ pub struct ServeArgs {
     #[arg(long, value_name = "CH,CH2", value_delimiter = ',')]
     pub(crate) ipaaca: Vec<String>,
     /// With --mqtt or --stomp: blocks that may wait for one character; beyond, the newest are
-    /// dropped and its feedback says how many (1 to 1 000 000).
-    #[arg(long, value_name = "N", default_value_t = crate::brokered::QUEUE_LIMIT)]
-    pub(crate) queue_limit: usize,
+    /// dropped and its feedback says how many (1 to 1 000 000; 10 000 by default).
+    #[arg(long, value_name = "N")]
+    pub(crate) queue_limit: Option<usize>,
     /// With --mqtt or --stomp: stop after this many seconds.
     #[arg(long, value_name = "SECS")]
     pub(crate) until: Option<f64>,
@@ -118,7 +118,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         eprintln!("bmlr serve: --fps must be a positive number");
         return ExitCode::from(2);
     }
-    if !(1..=crate::brokered::MAX_QUEUE_LIMIT).contains(&args.queue_limit) {
+    if (args.queue_limit).is_some_and(|n| !(1..=crate::brokered::MAX_QUEUE_LIMIT).contains(&n)) {
         eprintln!(
             "bmlr serve: --queue-limit must be from 1 to {}",
             crate::brokered::MAX_QUEUE_LIMIT
@@ -149,7 +149,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
         ),
         (
             "--queue-limit",
-            args.queue_limit != crate::brokered::QUEUE_LIMIT,
+            args.queue_limit.is_some(),
             brokered,
             "--mqtt or --stomp",
         ),

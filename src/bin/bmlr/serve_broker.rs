@@ -109,7 +109,7 @@ pub fn brokered(args: &ServeArgs, realizer: &Realizer) -> Result<Brokered, Strin
         characters: args.characters.iter().cloned().collect(),
         format: args.format.unwrap_or(crate::setup::FormatArg::Xml).into(),
         period: Duration::from_secs_f64(1.0 / args.fps),
-        queue_limit: args.queue_limit,
+        queue_limit: args.queue_limit.unwrap_or(crate::brokered::QUEUE_LIMIT),
         until,
         frames,
     })
