@@ -170,6 +170,14 @@ fn bad_broker_flags_are_named_with_the_reason() {
             "--queue-limit must be from 1 to 1000000",
         ),
         (
+            &["serve", "--mqtt", "mqtt://x", "--cell", "0.5"][..],
+            "--cell '0.5' is not a cell size (1 to 1000000 metres)",
+        ),
+        (
+            &["serve", "--stdio", "--cell", "5"][..],
+            "--cell goes with --mqtt or --stomp",
+        ),
+        (
             &["serve", "--tcp", "127.0.0.1:0", "--queue-limit", "50"][..],
             "--queue-limit goes with --mqtt or --stomp",
         ),
@@ -210,11 +218,11 @@ fn conformance_tests_pass_through_the_broker_on_both_fixtures() {
     }
 }
 
-/// The last state of each character heard on `bml/world/+`, per arrival: (character, x, z).
+/// The last state of each character heard on `bml/world/+/+` (the cell, then the character), per arrival: (character, x, z).
 fn states(heard: &[(String, String)]) -> Vec<(String, f32, f32)> {
     (heard.iter())
         .filter_map(|(t, p)| {
-            let c = t.strip_prefix("bml/world/")?;
+            let (_cell, c) = t.strip_prefix("bml/world/")?.split_once('/')?;
             let s = bml_realizer::broker::RootState::from_json(p.as_bytes()).ok()?;
             Some((c.to_string(), s.position[0], s.position[2]))
         })
@@ -240,7 +248,7 @@ fn walkers_served_by_two_realizers_go_round_each_other_and_both_arrive() {
     let mut p = planner_on(
         &broker,
         "planner",
-        &["bml/+/feedback", "bml/realizers/+", "bml/world/+"],
+        &["bml/+/feedback", "bml/realizers/+", "bml/world/+/+"],
     );
     until_online(&p, &["ra", "rb"]);
     // crossing at the origin at the same moment, unless they see each other

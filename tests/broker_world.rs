@@ -128,7 +128,7 @@ fn a_walker_held_back_by_another_realizer_s_row_asks_and_one_of_them_steps_aside
     let mut p = planner_on(
         &broker,
         "planner",
-        &["bml/+/feedback", "bml/realizers/+", "bml/world/+"],
+        &["bml/+/feedback", "bml/realizers/+", "bml/world/+/+"],
     );
     until_online(&p, &["rw", "rs"]);
     // (both have heard each other's states)
@@ -146,7 +146,7 @@ fn a_walker_held_back_by_another_realizer_s_row_asks_and_one_of_them_steps_aside
     heard.extend(hear(&p, 4.0, |_| false));
     let states: Vec<(String, bml_realizer::broker::RootState)> = (heard.iter())
         .filter_map(|(t, m)| {
-            let id = t.strip_prefix("bml/world/")?;
+            let (_cell, id) = t.strip_prefix("bml/world/")?.split_once('/')?;
             Some((
                 id.to_string(),
                 bml_realizer::broker::RootState::from_json(m.as_bytes()).ok()?,

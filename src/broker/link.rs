@@ -6,11 +6,15 @@
 //! through an outbox of one lane per topic, handed to rumqttc's small request queue a message
 //! of each lane in turn (so that one character's flood of feedback does not hold up another's),
 //! at most [`OUTBOX_LIMIT`] messages in all, beyond which the oldest of the longest lane are
-//! dropped and counted ([`Link::take_dropped`]). TCP_NODELAY is set: without it small messages wait for the
+//! dropped and counted ([`Link::take_dropped`]). States that a newer one replaces (a
+//! character's place, 20 times a second) go at QoS 0 and only the newest of a topic waits
+//! ([`Link::publish_state`]); subscriptions may change while connected ([`Link::subscribe`],
+//! [`Link::unsubscribe`]). TCP_NODELAY is set: without it small messages wait for the
 //! previous one's acknowledgement (Nagle's algorithm, ~40 ms stalls).
 
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::mpsc::{self, Receiver, SyncSender};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use rumqttc::{Client, ClientError, Event, LastWill, MqttOptions, Packet, QoS, Request};
@@ -74,6 +78,24 @@ pub struct Link {
     waiting: usize,
     dropped: u64,
     presence: Option<String>,
+    /// The newest state of each topic not yet handed over, and the topics in the order they
+    /// first waited.
+    states: BTreeMap<String, Vec<u8>>,
+    state_turns: VecDeque<String>,
+    /// The subscriptions now (renewed on every connection) and the changes not yet handed
+    /// to rumqttc (its queue was full).
+    subscriptions: Subscriptions,
+    changes: VecDeque<Change>,
+}
+
+/// Topic filters subscribed to and at which QoS, shared with the polling thread.
+type Subscriptions = Arc<Mutex<BTreeMap<String, QoS>>>;
+
+/// A change of subscription waiting for room in rumqttc's queue.
+#[derive(Debug, Clone)]
+enum Change {
+    Subscribe(String, QoS),
+    Unsubscribe(String),
 }
 
 impl Link {
@@ -93,9 +115,14 @@ impl Link {
         connection.eventloop.set_network_options(network);
         let (tx, inbox) = mpsc::sync_channel(options.inbox.max(1));
         let (ready_tx, ready) = mpsc::channel::<Result<(), String>>();
+        let subscriptions: Subscriptions = Arc::new(Mutex::new(
+            (options.subscriptions.iter())
+                .map(|s| (s.clone(), QoS::AtLeastOnce))
+                .collect(),
+        ));
         let poller = Poller {
             client: client.clone(),
-            subscriptions: options.subscriptions.clone(),
+            subscriptions: subscriptions.clone(),
             presence: options.presence.clone(),
             tx,
         };
@@ -110,6 +137,10 @@ impl Link {
                 waiting: 0,
                 dropped: 0,
                 presence: options.presence,
+                states: BTreeMap::new(),
+                state_turns: VecDeque::new(),
+                subscriptions,
+                changes: VecDeque::new(),
             }),
             Ok(Err(e)) => Err(format!("cannot reach the broker at {}: {e}", options.url)),
             Err(_) => Err(format!("cannot reach the broker at {}", options.url)),
@@ -147,9 +178,74 @@ impl Link {
         self.flush();
     }
 
-    /// Hands waiting messages to rumqttc, a message of each topic in turn, as far as its queue
-    /// has room.
+    /// Sends `payload` on `topic` at QoS 0, replacing what waits on that topic: a state that
+    /// the next one makes old (lost on the way, the next one comes).
+    pub fn publish_state(&mut self, topic: &str, payload: Vec<u8>) {
+        if self.states.insert(topic.to_string(), payload).is_none() {
+            self.state_turns.push_back(topic.to_string());
+        }
+        self.flush();
+    }
+
+    /// Subscribes to `filter` at QoS 0 (now and on every connection after), if not already:
+    /// states that the next one makes old.
+    pub fn subscribe(&mut self, filter: &str) {
+        let mut now = self.subscriptions.lock().unwrap_or_else(|e| e.into_inner());
+        if now.insert(filter.to_string(), QoS::AtMostOnce).is_none() {
+            drop(now);
+            self.changes
+                .push_back(Change::Subscribe(filter.to_string(), QoS::AtMostOnce));
+            self.flush();
+        }
+    }
+
+    /// Ends the subscription to `filter`.
+    pub fn unsubscribe(&mut self, filter: &str) {
+        let mut now = self.subscriptions.lock().unwrap_or_else(|e| e.into_inner());
+        if now.remove(filter).is_some() {
+            drop(now);
+            self.changes
+                .push_back(Change::Unsubscribe(filter.to_string()));
+            self.flush();
+        }
+    }
+
+    /// Hands waiting changes of subscription, messages (a message of each topic in turn) and
+    /// then states to rumqttc, as far as its queue has room.
     pub fn flush(&mut self) {
+        while let Some(change) = self.changes.pop_front() {
+            let handed = match &change {
+                Change::Subscribe(f, qos) => self.client.try_subscribe(f, *qos),
+                Change::Unsubscribe(f) => self.client.try_unsubscribe(f),
+            };
+            if handed.is_err() {
+                self.changes.push_front(change);
+                return;
+            }
+        }
+        if self.flush_messages() {
+            self.flush_states();
+        }
+    }
+
+    /// Hands over the newest states, oldest waiting first; false when rumqttc is full.
+    fn flush_states(&mut self) {
+        while let Some(topic) = self.state_turns.pop_front() {
+            let Some(payload) = self.states.remove(&topic) else {
+                continue;
+            };
+            if let Err(e) = (self.client).try_publish(&topic, QoS::AtMostOnce, false, payload) {
+                if let Some((_, payload, _)) = unsent(e) {
+                    self.states.insert(topic.clone(), payload);
+                    self.state_turns.push_front(topic);
+                }
+                return;
+            }
+        }
+    }
+
+    /// Hands over waiting messages a topic in turn; false when rumqttc is full.
+    fn flush_messages(&mut self) -> bool {
         while let Some(topic) = self.turns.pop_front() {
             let Some(lane) = self.outbox.get_mut(&topic) else {
                 continue;
@@ -178,10 +274,11 @@ impl Link {
                     } else {
                         self.turns.push_front(topic);
                     }
-                    return;
+                    return false;
                 }
             }
         }
+        true
     }
 
     /// Messages waiting in the outbox.
@@ -213,7 +310,7 @@ impl Link {
             self.publish(&p, b"offline".to_vec(), true);
         }
         let until = Instant::now() + linger;
-        while self.waiting > 0 && Instant::now() < until {
+        while (self.waiting > 0 || !self.states.is_empty()) && Instant::now() < until {
             self.flush();
             std::thread::sleep(Duration::from_millis(5));
         }
@@ -237,7 +334,7 @@ fn unsent(e: ClientError) -> Option<(String, Vec<u8>, bool)> {
 /// The thread that polls the connection.
 struct Poller {
     client: Client,
-    subscriptions: Vec<String>,
+    subscriptions: Subscriptions,
     presence: Option<String>,
     tx: SyncSender<Inbound>,
 }
@@ -309,8 +406,12 @@ impl Poller {
     /// Subscribes and says it is online (on every connection); false when rumqttc's queue
     /// had no room for all of it (subscribing again to a topic is harmless).
     fn renew(&self) -> bool {
-        let subscribed = (self.subscriptions.iter())
-            .all(|s| self.client.try_subscribe(s, QoS::AtLeastOnce).is_ok());
+        let now = self
+            .subscriptions
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
+        let subscribed = (now.iter()).all(|(s, qos)| self.client.try_subscribe(s, *qos).is_ok());
         let online = self.presence.as_ref().is_none_or(|p| {
             (self.client)
                 .try_publish(p, QoS::AtLeastOnce, true, "online")

@@ -1,10 +1,14 @@
-//! A character's root state as realizers sharing one world publish it on `PREFIX/world/ID`:
-//! JSON `{"time": s, "position": [x, y, z], "velocity": [x, y, z], "facing": degrees}` and,
-//! while a walker held back asks someone to make room, `"asks": ID` (world
+//! A character's root state as realizers sharing one world publish it on
+//! `PREFIX/world/CELL/ID`: JSON `{"time": s, "position": [x, y, z], "velocity": [x, y, z],
+//! "facing": degrees}`; while a walker held back asks someone to make room, `"asks": ID`; and
+//! once, on the topic of the cell a character has just left, `"moved": CELL` (the cell it is in
+//! now: a realizer that does not listen to that one lets the character go) (world
 //! frame, metres, y up; `facing` about +y from +z, as in the world file; `time` is the sender's
 //! clock, for reading only: clocks of different realizers have different origins, so a
 //! receiver ages a state from when it arrived). A state is moved on along its velocity for at
-//! most [`EXTRAPOLATE`] seconds; older, the character stands where that left it.
+//! most [`EXTRAPOLATE`] seconds; older, the character stands where that left it, and one not
+//! heard of for [`STALE`] seconds is taken out of the world (its realizer is gone, or it walked
+//! out of the cells listened to).
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -13,6 +17,9 @@ use crate::world::Placement;
 
 /// The longest a state is moved on along its velocity (s).
 pub const EXTRAPOLATE: f64 = 0.5;
+
+/// How long a character of another realizer stays in the world after its last state (s).
+pub const STALE: f64 = 3.0;
 
 /// How often a realizer publishes its characters' states (s): 20 Hz.
 pub const PUBLISH_PERIOD: f64 = 0.05;
@@ -32,6 +39,9 @@ pub struct RootState {
     /// that moves that one has it step aside as if a walker of its own asked.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub asks: Option<String>,
+    /// On the topic of the cell the character has just left: the cell it is in now.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moved: Option<String>,
 }
 
 impl RootState {
@@ -43,6 +53,7 @@ impl RootState {
             velocity: velocity.to_array(),
             facing: at.facing.to_degrees(),
             asks: None,
+            moved: None,
         }
     }
 

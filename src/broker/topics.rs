@@ -1,9 +1,12 @@
 //! Topic names and the broker's address. With prefix `bml` (the default): blocks come in on
 //! `bml/CHARACTER/bml`, feedback goes out on `bml/CHARACTER/feedback`, a realizer's presence is
-//! `bml/realizers/NAME` and a character's root state `bml/world/CHARACTER`. The character `_`
-//! is the realizer's default character (blocks without a `characterId`).
+//! `bml/realizers/NAME` and a character's root state `bml/world/CELL/CHARACTER` (`CELL` the
+//! floor cell it stands in, [`Cell`]). The character `_` is the realizer's default character
+//! (blocks without a `characterId`).
 
 use std::fmt;
+
+use super::cells::Cell;
 
 /// The character name in topics of the default character.
 pub const DEFAULT_CHARACTER: &str = "_";
@@ -118,21 +121,33 @@ impl Topics {
         format!("{}{s}{}{s}bml", self.prefix, self.any, s = self.sep)
     }
 
-    /// Where `character`'s root state goes (realizers sharing one world).
-    pub fn world(&self, character: &str) -> String {
-        format!("{}{s}world{s}{character}", self.prefix, s = self.sep)
+    /// Where the root state of `character`, standing in `cell`, goes (realizers sharing one
+    /// world).
+    pub fn world(&self, cell: Cell, character: &str) -> String {
+        format!(
+            "{}{s}world{s}{cell}{s}{character}",
+            self.prefix,
+            s = self.sep
+        )
     }
 
-    /// Every character's root state (a subscription).
-    pub fn all_world(&self) -> String {
-        format!("{}{s}world{s}{}", self.prefix, self.any, s = self.sep)
+    /// The root states of every character in `cell` (a subscription).
+    pub fn world_cell(&self, cell: Cell) -> String {
+        format!(
+            "{}{s}world{s}{cell}{s}{}",
+            self.prefix,
+            self.any,
+            s = self.sep
+        )
     }
 
-    /// The character a root-state topic is about, if `topic` is one.
-    pub fn world_character<'t>(&self, topic: &'t str) -> Option<&'t str> {
+    /// The cell and character a root-state topic is about, if `topic` is one.
+    pub fn world_character<'t>(&self, topic: &'t str) -> Option<(Cell, &'t str)> {
         let rest = topic.strip_prefix(&self.prefix)?.strip_prefix(self.sep)?;
-        let character = rest.strip_prefix("world")?.strip_prefix(self.sep)?;
-        (level_ok(character) && !character.contains(self.sep)).then_some(character)
+        let rest = rest.strip_prefix("world")?.strip_prefix(self.sep)?;
+        let (cell, character) = rest.split_once(self.sep)?;
+        let ok = level_ok(character) && !character.contains(self.sep);
+        Some((Cell::parse(cell)?, character)).filter(|_| ok)
     }
 
     /// The character a block topic is for, if `topic` is one.
@@ -190,19 +205,23 @@ mod tests {
         assert_eq!(t.bml_character("bml/a/b/bml"), None);
         assert_eq!(t.bml_character("bmlx/alice/bml"), None);
         assert_eq!(t.bml_character("bml/realizers/bml"), None);
-        assert_eq!(t.world("a"), "bml/world/a");
-        assert_eq!(t.world_character("bml/world/a"), Some("a"));
-        assert_eq!(t.world_character("bml/world/a/b"), None);
+        let c = Cell { i: -1, j: 2 };
+        assert_eq!(t.world(c, "a"), "bml/world/-1_2/a");
+        assert_eq!(t.world_cell(c), "bml/world/-1_2/+");
+        assert_eq!(t.world_character("bml/world/-1_2/a"), Some((c, "a")));
+        assert_eq!(t.world_character("bml/world/a"), None);
+        assert_eq!(t.world_character("bml/world/1_2/a/b"), None);
+        assert_eq!(t.world_character("bml/world/x/a"), None);
         assert_eq!(t.world_character("bml/a/bml"), None);
         let deep = Topics::new("/site/one/").unwrap();
         assert_eq!(deep.bml("bob"), "site/one/bob/bml");
         assert!(Topics::new("a/+/b").is_err());
         let dotted = Topics::dotted("bml").unwrap();
-        assert_eq!(dotted.world("a"), "bml.world.a");
-        assert_eq!(dotted.all_world(), "bml.world.*");
+        assert_eq!(dotted.world(c, "a"), "bml.world.-1_2.a");
+        assert_eq!(dotted.world_cell(c), "bml.world.-1_2.*");
         assert_eq!(dotted.presence("r"), "bml.realizers.r");
-        assert_eq!(dotted.world_character("bml.world.a"), Some("a"));
-        assert_eq!(dotted.world_character("bml.world.a.b"), None);
+        assert_eq!(dotted.world_character("bml.world.-1_2.a"), Some((c, "a")));
+        assert_eq!(dotted.world_character("bml.world.-1_2.a.b"), None);
         assert!(Topics::dotted("a.b").is_err());
         assert!(Topics::new("").is_err());
     }

@@ -1,5 +1,6 @@
 //! What a serving loop needs of a broker link, whichever protocol carries it (MQTT's [`Link`],
-//! STOMP's [`StompLink`]): hear, send, flush, count what was dropped, close. The loop above it
+//! STOMP's [`StompLink`]): hear, send (messages, and states that the next one makes old),
+//! listen to more or fewer topics, flush, count what was dropped, close. The loop above it
 //! (`bmlr serve --mqtt | --stomp`) is written once against this.
 
 use std::time::Duration;
@@ -14,6 +15,14 @@ pub trait Wire {
     fn try_recv(&self) -> Option<Inbound>;
     /// Sends `payload` on `topic` (with `headers` where the protocol has them: STOMP).
     fn send(&mut self, topic: &str, payload: Vec<u8>, headers: &[(String, String)]);
+    /// Sends a state on `topic` that the next state on it makes old: on MQTT at QoS 0, only the
+    /// newest waiting; on STOMP as any message.
+    fn send_state(&mut self, topic: &str, payload: Vec<u8>);
+    /// Listens to `filter` too (a topic filter; a STOMP destination), now and after every
+    /// reconnection.
+    fn listen(&mut self, filter: &str);
+    /// Stops listening to `filter`.
+    fn unlisten(&mut self, filter: &str);
     /// Hands on what waits, as far as the connection takes it.
     fn flush(&mut self);
     /// Messages dropped since last asked (the outbox was full while the broker was away).
@@ -31,6 +40,15 @@ impl Wire for Link {
     }
     fn send(&mut self, topic: &str, payload: Vec<u8>, _headers: &[(String, String)]) {
         self.publish(topic, payload, false);
+    }
+    fn send_state(&mut self, topic: &str, payload: Vec<u8>) {
+        self.publish_state(topic, payload);
+    }
+    fn listen(&mut self, filter: &str) {
+        self.subscribe(filter);
+    }
+    fn unlisten(&mut self, filter: &str) {
+        self.unsubscribe(filter);
     }
     fn flush(&mut self) {
         Link::flush(self);
@@ -53,6 +71,15 @@ impl Wire for StompLink {
     fn send(&mut self, topic: &str, payload: Vec<u8>, headers: &[(String, String)]) {
         StompLink::send(self, topic, payload, headers);
         StompLink::flush(self);
+    }
+    fn send_state(&mut self, topic: &str, payload: Vec<u8>) {
+        StompLink::send(self, topic, payload, &[]);
+    }
+    fn listen(&mut self, filter: &str) {
+        self.subscribe(filter);
+    }
+    fn unlisten(&mut self, filter: &str) {
+        self.unsubscribe(filter);
     }
     fn flush(&mut self) {
         StompLink::flush(self);

@@ -45,6 +45,21 @@ impl Realizer {
         Some(crowd.id(asked))
     }
 
+    /// Takes character `id`, which another realizer moves (or which the world file placed
+    /// for another realizer), out of this realizer's world: nothing has been heard of it for a
+    /// while. Refused for a character this realizer has.
+    pub fn forget_remote(&mut self, id: &str) -> Result<(), String> {
+        if self.characters.contains_key(id) {
+            return Err(format!(
+                "character '{id}' is one of this realizer's: it stays in the world"
+            ));
+        }
+        self.world_mut().unplace(id);
+        self.remote.remove(id);
+        self.remote_asks.remove(id);
+        Ok(())
+    }
+
     /// Whether character `id` is moved by another realizer ([`place_remote`](Self::place_remote)).
     pub fn is_remote(&self, id: &str) -> bool {
         self.remote.contains(id)

@@ -269,6 +269,13 @@ impl World {
         Ok(())
     }
 
+    /// Takes character `id` out of the world (it stands nowhere, and is no one's obstacle).
+    pub fn unplace(&mut self, id: &str) {
+        if self.characters.contains_key(id) {
+            Arc::make_mut(&mut self.characters).remove(id);
+        }
+    }
+
     /// Where character `id` stands (the origin facing +z unless placed).
     pub fn placement(&self, id: &str) -> Placement {
         let at = self.characters.get(id).copied().unwrap_or_default();

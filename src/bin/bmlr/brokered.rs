@@ -6,9 +6,7 @@
 //! topic's character is answered with a warning on the character's feedback topic (a payload
 //! that is a JSON object is a stream message for the topic's character); a block for
 //! a character this realizer does not serve is left to the realizer that does. Realizers on one
-//! broker share one world: each publishes where its characters stand on `PREFIX/world/CHARACTER`
-//! (20 Hz; `PREFIX.world.CHARACTER` on STOMP) and places the others' characters in its own
-//! world (`Realizer::place_remote`), so that its walkers go round them.
+//! broker share one world by area (`world_share.rs`).
 
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::process::ExitCode;
@@ -17,13 +15,14 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use bml_realizer::bml::Checked;
-use bml_realizer::broker::{Inbound, RootState, Topics, Wire, DEFAULT_CHARACTER, PUBLISH_PERIOD};
+use bml_realizer::broker::{Cells, Inbound, Topics, Wire, DEFAULT_CHARACTER};
 use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
 use bml_realizer::realizer::{Realizer, NO_ID};
 
 use crate::dialect::{block_character, Arrived, Dialect, Lane, Out};
 use crate::live_frames::LiveFrames;
+use crate::world_share::Sharing;
 
 /// Blocks performed in one frame at most (the rest wait for the next frames, so that a flood
 /// cannot hold the clock up).
@@ -47,6 +46,8 @@ pub struct Brokered {
     pub url: String,
     /// The topics of presence and the shared world.
     pub topics: Topics,
+    /// The cells the shared world is cut into.
+    pub cells: Cells,
     /// Topics are STOMP destinations under `/topic/`.
     pub stomp: bool,
     /// How blocks and feedback travel.
@@ -72,13 +73,12 @@ pub fn serve(args: Brokered, realizer: Realizer) -> ExitCode {
     for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         let _ = signal_hook::flag::register(signal, stop.clone());
     }
+    let sharing = Sharing::new(&args, &realizer);
     let mut s = Server {
         realizer,
         clock: WallClock::new(),
         args,
-        others: BTreeMap::new(),
-        published: f64::NEG_INFINITY,
-        bad_states: BTreeSet::new(),
+        sharing,
         waiting: BTreeMap::new(),
     };
     if let Dialect::Ipaaca(ip, _) = &s.args.dialect {
@@ -86,6 +86,7 @@ pub fn serve(args: Brokered, realizer: Realizer) -> ExitCode {
         s.send_raw(hello.into_iter().map(|(t, p)| (t, p, Vec::new())));
     }
     s.run(&stop);
+    eprintln!("bmlr serve: world: {}", s.sharing.counts);
     let Server { args, .. } = s;
     let Brokered {
         mut wire,
@@ -108,16 +109,12 @@ pub fn serve(args: Brokered, realizer: Realizer) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-struct Server {
-    realizer: Realizer,
-    clock: WallClock,
-    args: Brokered,
-    /// The other realizers' characters: their last state and when it arrived (local clock).
-    others: BTreeMap<String, (RootState, f64)>,
-    /// When this realizer last published its characters' states.
-    published: f64,
-    /// Characters whose state could not be read (said once each on stderr).
-    bad_states: BTreeSet<String>,
+pub(crate) struct Server {
+    pub(crate) realizer: Realizer,
+    pub(crate) clock: WallClock,
+    pub(crate) args: Brokered,
+    /// The world shared with other realizers.
+    pub(crate) sharing: Sharing,
     /// Blocks waiting (and the request IU that asked for each), per character served (taken
     /// in turns: one character's flood does not hold up the others), and how many were
     /// dropped since last said.
@@ -186,26 +183,13 @@ impl Server {
 
     fn tick(&mut self) {
         let now = self.clock.now().min(self.args.until);
-        // the others' characters where they are now, as far as their states tell
-        for (id, (state, heard)) in &self.others {
-            let placed = self
-                .realizer
-                .place_remote(id, state.placement_after(now - heard));
-            if placed.is_ok() {
-                // (an ask heard more than a second ago is over: its realizer may be gone)
-                let asks = state.asks.as_deref().filter(|_| now - heard < 1.0);
-                let _ = self.realizer.remote_asks(id, asks);
-            }
-        }
+        self.place_others(now);
         let frame = self.realizer.tick(now);
         if let Some(f) = self.args.frames.as_mut() {
             f.push(frame.time, &frame.poses);
         }
         self.send(frame.feedback, None);
-        if now - self.published >= PUBLISH_PERIOD {
-            self.published = now;
-            self.publish_states(now);
-        }
+        self.share(now);
         let dropped = self.args.wire.take_dropped();
         if dropped > 0 {
             eprintln!("bmlr serve: the broker was away too long: {dropped} feedback messages were dropped");
@@ -226,7 +210,7 @@ impl Server {
             true => topic.strip_prefix("/topic/").unwrap_or(&topic).to_string(),
             false => topic,
         };
-        if let Some(character) = self.args.topics.world_character(&topic) {
+        if let Some((_, character)) = self.args.topics.world_character(&topic) {
             let character = character.to_string();
             return self.hear_state(character, &payload);
         }
@@ -281,73 +265,10 @@ impl Server {
     /// without them, any character no other realizer moves.
     fn serves(&self, character: &str) -> bool {
         if self.args.characters.is_empty() {
-            !self.others.contains_key(character)
+            !self.sharing.others.contains_key(character)
         } else {
             self.args.characters.contains(character)
         }
-    }
-
-    /// Keeps another realizer's state of `character` (not one served here).
-    fn hear_state(&mut self, character: String, payload: &[u8]) {
-        if self.args.characters.contains(&character) || self.is_ours(&character) {
-            return;
-        }
-        match RootState::from_json(payload) {
-            Ok(state) => {
-                self.others.insert(character, (state, self.clock.now()));
-            }
-            Err(e) => {
-                if self.bad_states.insert(character.clone()) {
-                    let topic = self.args.topics.world(&character);
-                    eprintln!("bmlr serve: {topic}: not a root state ({e}); ignored");
-                }
-            }
-        }
-    }
-
-    /// Whether `character` (a topic level) is one this realizer has made.
-    fn is_ours(&self, character: &str) -> bool {
-        let id = if character == DEFAULT_CHARACTER {
-            ""
-        } else {
-            character
-        };
-        self.realizer.character(id).is_some() && !self.realizer.is_remote(id)
-    }
-
-    /// Publishes where this realizer's characters stand: those it has made, and the
-    /// `--characters` the world places.
-    fn publish_states(&mut self, now: f64) {
-        let world = self.realizer.world();
-        let mut ours: BTreeSet<String> = (self.realizer.characters())
-            .map(|(id, _)| id.to_string())
-            .filter(|id| !id.is_empty() && !self.realizer.is_remote(id))
-            .collect();
-        ours.extend(
-            (self.args.characters.iter())
-                .filter(|c| world.is_placed(c))
-                .cloned(),
-        );
-        let crowd = world.crowd();
-        let states: Vec<Out> = (ours.into_iter())
-            .filter(|id| world.is_placed(id))
-            .map(|id| {
-                let velocity = crowd.index(&id).map_or(glam::Vec3::ZERO, |i| {
-                    let v = crowd.agent(i).velocity;
-                    glam::Vec3::new(v.x, 0.0, v.y)
-                });
-                let state = RootState {
-                    asks: self.realizer.asks(&id).map(str::to_string),
-                    ..RootState::new(now, world.placement(&id), velocity)
-                };
-                (
-                    self.args.topics.world(&id),
-                    state.to_json().into_bytes(),
-                    Vec::new(),
-                )
-            })
-            .collect();
-        self.send_raw(states);
     }
 
     /// Performs a block from `lane`; what it produces at once without a character (a block
@@ -479,14 +400,19 @@ impl Server {
     }
 
     /// Sends messages as they are (topics made STOMP destinations where needed).
-    fn send_raw(&mut self, out: impl IntoIterator<Item = Out>) {
+    pub(crate) fn send_raw(&mut self, out: impl IntoIterator<Item = Out>) {
         for (topic, payload, headers) in out {
-            let topic = match self.args.stomp && !topic.starts_with('/') {
-                true => format!("/topic/{topic}"),
-                false => topic,
-            };
+            let topic = self.destination(topic);
             self.args.wire.send(&topic, payload, &headers);
         }
         self.args.wire.flush();
+    }
+
+    /// A topic as the link names it (a STOMP destination under `/topic/`).
+    pub(crate) fn destination(&self, topic: String) -> String {
+        match self.args.stomp && !topic.starts_with('/') {
+            true => format!("/topic/{topic}"),
+            false => topic,
+        }
     }
 }

@@ -30,6 +30,7 @@ mod spool;
 mod tcp;
 mod view;
 mod web;
+mod world_share;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -66,6 +66,11 @@ pub struct ServeArgs {
     /// dropped and its feedback says how many (1 to 1 000 000; 10 000 by default).
     #[arg(long, value_name = "N")]
     pub(crate) queue_limit: Option<usize>,
+    /// With --mqtt or --stomp: the side of the square cells the shared world is cut into
+    /// (metres, 1 to 1 000 000; 10 by default): characters' states go to their cell's topic,
+    /// and this realizer listens to the cells near its own characters.
+    #[arg(long, value_name = "METRES")]
+    pub(crate) cell: Option<f32>,
     /// With --mqtt or --stomp: stop after this many seconds.
     #[arg(long, value_name = "SECS")]
     pub(crate) until: Option<f64>,
@@ -153,6 +158,7 @@ pub fn serve(args: ServeArgs) -> ExitCode {
             brokered,
             "--mqtt or --stomp",
         ),
+        ("--cell", args.cell.is_some(), brokered, "--mqtt or --stomp"),
         (
             "--until",
             args.until.is_some(),

@@ -7,7 +7,8 @@ use std::time::Duration;
 
 use bml_realizer::broker::ipaaca::iu::Requests;
 use bml_realizer::broker::{
-    level_ok, BrokerUrl, Ipaaca, Link, LinkOptions, StompLink, StompOptions, StompUrl, Topics, Wire,
+    level_ok, BrokerUrl, Cells, Ipaaca, Link, LinkOptions, StompLink, StompOptions, StompUrl,
+    Topics, Wire, CELL_SIZE,
 };
 use bml_realizer::realizer::Realizer;
 
@@ -65,9 +66,9 @@ pub fn brokered(args: &ServeArgs, realizer: &Realizer) -> Result<Brokered, Strin
             Dialect::Asap(i, o)
         }
     };
-    let mut subscriptions = dialect.subscriptions(&topics, &args.characters);
-    // (the world the realizers on the broker share)
-    subscriptions.push(topics.all_world());
+    // (the world's cells are listened to as the characters walk)
+    let subscriptions = dialect.subscriptions(&topics, &args.characters);
+    let cells = Cells::new(args.cell.unwrap_or(CELL_SIZE)).map_err(|e| format!("--cell {e}"))?;
     let frames = crate::serve::live_frames(args, realizer).map_err(|e| format!("--frames {e}"))?;
     let (wire, url): (Box<dyn Wire>, String) = match (&args.mqtt, &args.stomp) {
         (Some(url), _) => {
@@ -104,6 +105,7 @@ pub fn brokered(args: &ServeArgs, realizer: &Realizer) -> Result<Brokered, Strin
         wire,
         url,
         topics,
+        cells,
         stomp,
         dialect,
         characters: args.characters.iter().cloned().collect(),

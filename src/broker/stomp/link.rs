@@ -96,9 +96,48 @@ pub struct StompOptions {
 struct Writer {
     stream: Option<TcpStream>,
     last: Instant,
+    /// The destinations subscribed to now, with their subscription ids (renewed on every
+    /// connection).
+    subscriptions: Vec<(String, u64)>,
+    next_id: u64,
 }
 
 impl Writer {
+    /// Subscribes to `destination` (a new id), on this connection if there is one.
+    fn subscribe(&mut self, destination: &str) {
+        if self.subscriptions.iter().any(|(d, _)| d == destination) {
+            return;
+        }
+        let id = self.next_id;
+        self.next_id += 1;
+        self.subscriptions.push((destination.to_string(), id));
+        // (without a connection, the next one subscribes)
+        self.write_subscribe(destination, id);
+    }
+
+    fn write_subscribe(&mut self, destination: &str, id: u64) -> bool {
+        let id = id.to_string();
+        let sub = Frame::new(
+            "SUBSCRIBE",
+            &[("destination", destination), ("id", &id), ("ack", "auto")],
+        );
+        self.write(&sub.encode())
+    }
+
+    /// Ends the subscription to `destination`, if there is one.
+    fn unsubscribe(&mut self, destination: &str) {
+        let Some(k) = self
+            .subscriptions
+            .iter()
+            .position(|(d, _)| d == destination)
+        else {
+            return;
+        };
+        let (_, id) = self.subscriptions.remove(k);
+        let id = id.to_string();
+        self.write(&Frame::new("UNSUBSCRIBE", &[("id", &id)]).encode());
+    }
+
     /// Writes `bytes`, or drops the connection (the reader then connects again).
     fn write(&mut self, bytes: &[u8]) -> bool {
         let Some(s) = self.stream.as_mut() else {
@@ -130,6 +169,8 @@ impl StompLink {
         let writer = Arc::new(Mutex::new(Writer {
             stream: None,
             last: Instant::now(),
+            subscriptions: (options.subscriptions.iter().cloned()).zip(0..).collect(),
+            next_id: options.subscriptions.len() as u64,
         }));
         let stop = Arc::new(AtomicBool::new(false));
         let (tx, inbox) = mpsc::sync_channel(options.inbox.max(1));
@@ -179,6 +220,16 @@ impl StompLink {
             self.dropped += 1;
         }
         self.outbox.push_back(f.encode());
+    }
+
+    /// Subscribes to `destination` (now and on every connection after), if not already.
+    pub fn subscribe(&mut self, destination: &str) {
+        (self.writer.lock().unwrap_or_else(|e| e.into_inner())).subscribe(destination);
+    }
+
+    /// Ends the subscription to `destination`.
+    pub fn unsubscribe(&mut self, destination: &str) {
+        (self.writer.lock().unwrap_or_else(|e| e.into_inner())).unsubscribe(destination);
     }
 
     /// Writes what waits, as far as the connection takes it.
@@ -333,13 +384,8 @@ impl Reader {
         let writing = stream.try_clone().map_err(|e| e.to_string())?;
         let mut w = self.writer.lock().unwrap_or_else(|e| e.into_inner());
         w.stream = Some(writing);
-        for (i, d) in self.options.subscriptions.iter().enumerate() {
-            let id = i.to_string();
-            let sub = Frame::new(
-                "SUBSCRIBE",
-                &[("destination", d), ("id", &id), ("ack", "auto")],
-            );
-            if !w.write(&sub.encode()) {
+        for (d, id) in w.subscriptions.clone() {
+            if !w.write_subscribe(&d, id) {
                 return Err("the connection ended while subscribing".into());
             }
         }
