@@ -171,7 +171,7 @@ fn bad_broker_flags_are_named_with_the_reason() {
         ),
         (
             &["serve", "--mqtt", "mqtt://x", "--cell", "0.5"][..],
-            "--cell '0.5' is not a cell size (1 to 1000000 metres)",
+            "--cell '0.5' is not a cell size (1 to 1000000 metres, or 0 for one cell)",
         ),
         (
             &["serve", "--stdio", "--cell", "5"][..],

@@ -11,13 +11,16 @@ use std::fmt;
 pub const CELL_SIZE: f32 = 10.0;
 
 /// The smallest and largest cell sizes taken (m): a cell much smaller than a walker's
-/// surroundings only multiplies the topics; one as large as the world (a million metres) puts
-/// everyone in one, which is the everyone-to-everyone design.
+/// surroundings only multiplies the topics. Size 0 is taken too: the floor is not cut, everyone
+/// stands in cell `0_0` and every realizer hears every state (the everyone-to-everyone design,
+/// for comparison).
 pub const CELL_SIZES: (f32, f32) = (1.0, 1_000_000.0);
 
 /// How far around its characters a realizer listens (m): the distance within which a walker
-/// avoids others, and 2 m more for the moves it makes before it hears the next cell.
-pub const LISTEN_RADIUS: f32 = crate::crowd::avoid::NEIGHBOUR_RADIUS + 2.0;
+/// avoids others, and 1 m more for the moves it makes before it hears a new cell (a walker
+/// takes 0.7 s for a metre; the subscription is made within 0.05 s and the cell's states come
+/// 20 times a second).
+pub const LISTEN_RADIUS: f32 = crate::crowd::avoid::NEIGHBOUR_RADIUS + 1.0;
 
 /// How much farther than [`LISTEN_RADIUS`] a cell may be before a realizer stops listening to
 /// it (m), so that a character walking along a cell's edge does not subscribe and unsubscribe
@@ -57,24 +60,28 @@ pub struct Cells {
 }
 
 impl Cells {
-    /// Cells of `size` metres; `Err` says why a size is not taken.
+    /// Cells of `size` metres (0: one cell, the whole floor); `Err` says why a size is not
+    /// taken.
     pub fn new(size: f32) -> Result<Cells, String> {
         let (least, most) = CELL_SIZES;
-        if !(least..=most).contains(&size) {
+        if !((least..=most).contains(&size) || size == 0.0) {
             return Err(format!(
-                "'{size}' is not a cell size ({least} to {most} metres)"
+                "'{size}' is not a cell size ({least} to {most} metres, or 0 for one cell)"
             ));
         }
         Ok(Cells { size })
     }
 
-    /// The cell's size (m).
+    /// The cell's size (m; 0: the floor is one cell).
     pub fn size(&self) -> f32 {
         self.size
     }
 
     /// The cell the point (x, z) is in.
     pub fn of(&self, x: f32, z: f32) -> Cell {
+        if self.size == 0.0 {
+            return Cell { i: 0, j: 0 };
+        }
         // (-0.0 and 0.0 are the same cell; coordinates far beyond any floor saturate)
         Cell {
             i: (x / self.size).floor() as i64,
@@ -95,6 +102,9 @@ impl Cells {
 
     /// How far (x, z) is from cell `c` (0 inside it).
     pub fn distance(&self, c: Cell, x: f32, z: f32) -> f32 {
+        if self.size == 0.0 {
+            return 0.0;
+        }
         let gap = |v: f32, k: i64| {
             let (from, to) = (k as f32 * self.size, (k + 1) as f32 * self.size);
             (from - v).max(v - to).max(0.0)
@@ -133,12 +143,17 @@ mod tests {
         assert_eq!(Cell::parse("2_-4"), Some(Cell { i: 2, j: -4 }));
         assert_eq!(Cell::parse("2-4"), None);
         assert_eq!(Cell::parse("a_1"), None);
-        assert!(Cells::new(0.0).is_err());
+        assert!(Cells::new(0.5).is_err());
         assert!(Cells::new(f32::NAN).is_err());
         assert!(Cells::new(2e6).unwrap_err().contains("1 to 1000000 metres"));
-        // one cell as large as the world holds everyone on either side of the origin
-        let world = Cells::new(1e6).unwrap();
-        assert_eq!(world.of(-300.0, 450.0), world.of(0.0, 0.0));
+        assert!(Cells::new(-1.0).is_err());
+        // size 0: one cell, the whole floor; everyone hears everyone
+        let world = Cells::new(0.0).unwrap();
+        let near: Vec<Cell> = world.around(-3e5, 1.0, LISTEN_RADIUS).collect();
+        assert_eq!(near, [Cell { i: 0, j: 0 }]);
+        for (x, z) in [(-300.0, 450.0), (300.0, -450.0), (5e5, 5e5)] {
+            assert_eq!(world.of(x, z), near[0]);
+        }
     }
 
     #[test]
@@ -161,12 +176,14 @@ mod tests {
         let at_start = cells.listened(&[(5.0, 5.0)], &BTreeSet::new());
         assert!(at_start.contains(&Cell { i: 1, j: 1 }));
         assert!(!at_start.contains(&Cell { i: 2, j: 0 }));
-        // 6.5 m on: cell -1_0 is 11.5 m off, beyond the radius but within the margin: kept
-        // (its corner neighbours, 12.5 m off, are let go)
-        let on = cells.listened(&[(11.5, 5.0)], &at_start);
+        // on to where cell -1_0 is beyond the radius but within the margin: kept (its corner
+        // neighbours, farther, are let go)
+        let x = LISTEN_RADIUS + KEEP_MARGIN / 2.0;
+        assert!(LISTEN_RADIUS + KEEP_MARGIN < x.hypot(5.0));
+        let on = cells.listened(&[(x, 5.0)], &at_start);
         assert!(on.contains(&Cell { i: -1, j: 0 }));
         assert!(!on.contains(&Cell { i: -1, j: 1 }));
-        let fresh = cells.listened(&[(11.5, 5.0)], &BTreeSet::new());
+        let fresh = cells.listened(&[(x, 5.0)], &BTreeSet::new());
         assert!(!fresh.contains(&Cell { i: -1, j: 0 }));
         assert_eq!(fresh.len() + 1, on.len());
         // far on, it is let go

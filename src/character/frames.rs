@@ -38,6 +38,10 @@ struct Header<'a> {
     /// Present (true) when the frames carry only where each character stands.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     roots_only: bool,
+    /// The POSIX time (s) of the frames' time 0, where they were taken on a real-time clock
+    /// (a served realizer's), so that frames of several realizers can be put on one clock.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    posix_zero: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -112,6 +116,18 @@ fn quat(q: glam::Quat) -> [f64; 4] {
 /// The header line (without a newline) for frames at `fps` of `characters` on `skeleton`, whose
 /// lines carry `detail`.
 pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str], detail: Detail) -> String {
+    header_on_clock(skeleton, fps, characters, detail, None)
+}
+
+/// The header line of frames taken on a real-time clock whose time 0 was `posix_zero` (POSIX
+/// seconds; `None`: not on one).
+pub fn header_on_clock(
+    skeleton: &Skeleton,
+    fps: f64,
+    characters: &[&str],
+    detail: Detail,
+    posix_zero: Option<f64>,
+) -> String {
     let joints = skeleton.joints();
     let header = Header {
         fps,
@@ -126,6 +142,7 @@ pub fn header(skeleton: &Skeleton, fps: f64, characters: &[&str], detail: Detail
         },
         characters,
         roots_only: detail == Detail::Roots,
+        posix_zero,
     };
     serde_json::to_string(&header).expect("a header always encodes")
 }

@@ -81,6 +81,10 @@ pub fn serve(args: Brokered, realizer: Realizer) -> ExitCode {
         sharing,
         waiting: BTreeMap::new(),
     };
+    let zero = s.posix_zero();
+    if let Some(f) = s.args.frames.as_mut() {
+        f.start_clock(Some(zero));
+    }
     if let Dialect::Ipaaca(ip, _) = &s.args.dialect {
         let hello = ip.notify("new");
         s.send_raw(hello.into_iter().map(|(t, p)| (t, p, Vec::new())));
@@ -395,8 +399,7 @@ impl Server {
 
     /// The POSIX time (s) of the realizer's time 0.
     fn posix_zero(&self) -> f64 {
-        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH);
-        now.map_or(0.0, |d| d.as_secs_f64()) - self.clock.now()
+        crate::live_frames::posix_zero(&self.clock)
     }
 
     /// Sends messages as they are (topics made STOMP destinations where needed).

@@ -4,7 +4,10 @@
 //! second, at `--until` and when the process is told to stop (SIGTERM, SIGINT). The header
 //! names the characters shown, which must be known at the start: the `--characters` served, or
 //! else the world file's characters and the default one (`""`). A character without a pose in a
-//! frame is shown standing where the world places it.
+//! frame is shown standing where the world places it. The header is written when the clock
+//! starts and says the POSIX time of its time 0 (`posix_zero`), so that the frames of several
+//! realizers can be put on one clock; with `--frames-roots` the lines carry only where each
+//! character stands.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -33,6 +36,10 @@ pub struct LiveFrames {
     last: f64,
     /// The first error writing (said at the end; serving goes on).
     failed: Option<String>,
+    /// What each character's line carries.
+    detail: Detail,
+    /// The header, until written (when the clock starts, or at the first frame).
+    header: Option<(Vec<String>, f64)>,
 }
 
 impl LiveFrames {
@@ -43,25 +50,19 @@ impl LiveFrames {
         ids: Vec<String>,
         realizer: &Realizer,
         fps: f64,
+        detail: Detail,
     ) -> Result<LiveFrames, String> {
         let cannot = |e: std::io::Error| format!("{}: cannot write: {e}", path.display());
-        let mut out = BufWriter::new(File::create(path).map_err(cannot)?);
+        let out = BufWriter::new(File::create(path).map_err(cannot)?);
         let skeleton = Skeleton::adult();
-        let names: Vec<&str> = ids.iter().map(String::as_str).collect();
-        writeln!(
-            out,
-            "{}",
-            frames::header(&skeleton, fps, &names, Detail::Full)
-        )
-        .map_err(cannot)?;
-        out.flush().map_err(cannot)?;
         let places = Recording::new(fps).placed(realizer.world());
         let rest = (ids.iter())
-            .map(|id| frames::character(&skeleton, &places.standing(id), Detail::Full))
+            .map(|id| frames::character(&skeleton, &places.standing(id), detail))
             .collect();
         Ok(LiveFrames {
             path: path.to_path_buf(),
             out,
+            header: Some((ids.clone(), fps)),
             ids,
             rest,
             skeleton,
@@ -70,12 +71,28 @@ impl LiveFrames {
             fps,
             last: f64::NEG_INFINITY,
             failed: None,
+            detail,
         })
+    }
+
+    /// Writes the header, saying that the clock's time 0 was `posix_zero` (POSIX seconds) if
+    /// known; the header is written once.
+    pub fn start_clock(&mut self, posix_zero: Option<f64>) {
+        let Some((ids, fps)) = self.header.take() else {
+            return;
+        };
+        let names: Vec<&str> = ids.iter().map(String::as_str).collect();
+        let line = frames::header_on_clock(&self.skeleton, fps, &names, self.detail, posix_zero);
+        let written = writeln!(self.out, "{line}").and_then(|_| self.out.flush());
+        if let Err(e) = written {
+            self.failed = Some(e.to_string());
+        }
     }
 
     /// Writes the frame at `time` from `poses`, unless one was written less than about 1/fps
     /// before.
     pub fn push(&mut self, time: f64, poses: &[CharacterPose]) {
+        self.start_clock(None);
         if self.failed.is_some() || time - self.last < 0.9 / self.fps {
             return;
         }
@@ -86,7 +103,7 @@ impl LiveFrames {
                     .find(|p| p.character.as_deref().unwrap_or("") == id)
                     .map_or_else(
                         || rest.clone(),
-                        |p| frames::character(&self.skeleton, p, Detail::Full),
+                        |p| frames::character(&self.skeleton, p, self.detail),
                     )
             })
             .collect();
@@ -109,6 +126,7 @@ impl LiveFrames {
 
     /// Flushes and says what was written; an error names the file.
     pub fn finish(mut self) -> Result<(), String> {
+        self.start_clock(None);
         if let Some(e) = self.failed.take() {
             return Err(format!("{}: cannot write: {e}", self.path.display()));
         }
@@ -139,4 +157,10 @@ pub fn shown(characters: &[String], realizer: &Realizer) -> Vec<String> {
     ids.sort();
     ids.dedup();
     ids
+}
+
+/// The POSIX time (s) of `clock`'s time 0.
+pub fn posix_zero(clock: &impl bml_realizer::clock::Clock) -> f64 {
+    let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH);
+    now.map_or(0.0, |d| d.as_secs_f64()) - clock.now()
 }

@@ -68,7 +68,8 @@ pub struct ServeArgs {
     pub(crate) queue_limit: Option<usize>,
     /// With --mqtt or --stomp: the side of the square cells the shared world is cut into
     /// (metres, 1 to 1 000 000; 10 by default): characters' states go to their cell's topic,
-    /// and this realizer listens to the cells near its own characters.
+    /// and this realizer listens to the cells near its own characters. 0: one cell, every
+    /// realizer hears every state (everyone to everyone).
     #[arg(long, value_name = "METRES")]
     pub(crate) cell: Option<f32>,
     /// With --mqtt or --stomp: stop after this many seconds.
@@ -78,6 +79,10 @@ pub struct ServeArgs {
     /// "Frames"); flushed at --until and on SIGTERM.
     #[arg(long, value_name = "OUT.jsonl")]
     pub(crate) frames: Option<std::path::PathBuf>,
+    /// With --frames: each frame carries only where each character stands (its root) and its
+    /// foot contacts, for crowds too large to keep every joint.
+    #[arg(long, requires = "frames")]
+    pub(crate) frames_roots: bool,
     /// With --tcp: also serve the viewer's page on this loopback address (e.g. 127.0.0.1:8080;
     /// port 0 picks one, printed on stderr); it shows the character move as blocks arrive.
     #[arg(long, value_name = "ADDR", requires = "tcp")]
@@ -290,7 +295,11 @@ pub(crate) fn live_frames(
         return Ok(None);
     };
     let ids = crate::live_frames::shown(&args.characters, realizer);
-    crate::live_frames::LiveFrames::create(path, ids, realizer, args.fps).map(Some)
+    let detail = match args.frames_roots {
+        true => bml_realizer::character::frames::Detail::Roots,
+        false => bml_realizer::character::frames::Detail::Full,
+    };
+    crate::live_frames::LiveFrames::create(path, ids, realizer, args.fps, detail).map(Some)
 }
 
 /// Whose conventions a STOMP realizer follows.
@@ -321,6 +330,9 @@ fn serve_stdio(
     mut frames: Option<crate::live_frames::LiveFrames>,
 ) -> ExitCode {
     let clock = WallClock::new();
+    if let Some(f) = frames.as_mut() {
+        f.start_clock(Some(crate::live_frames::posix_zero(&clock)));
+    }
     // bounded: the reader waits while the realizer is behind, and the pipe fills (backpressure)
     let (tx, rx) = mpsc::sync_channel::<Option<Line>>(256);
     let limits = *realizer.limits();

@@ -147,6 +147,10 @@ pub fn serve(
     let mut server = Server::new(realizer, per_client, fps);
     server.view = view;
     server.frames = frames;
+    let zero = crate::live_frames::posix_zero(&server.clock);
+    if let Some(f) = server.frames.as_mut() {
+        f.start_clock(Some(zero));
+    }
     let stop = Arc::new(AtomicBool::new(false));
     for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         let _ = signal_hook::flag::register(signal, stop.clone());
