@@ -304,6 +304,23 @@ fn walkers_served_by_two_realizers_go_round_each_other_and_both_arrive() {
 }
 
 #[test]
+fn a_realizer_serving_more_characters_than_its_link_queues_at_once_comes_online() {
+    // (600 topics to subscribe to, more than the link hands the MQTT client at once: the
+    // subscriptions were renewed from the first again and again, and it never said online)
+    let Some(broker) = Broker::start() else {
+        return;
+    };
+    let names: Vec<String> = (0..600).map(|k| format!("c{k}")).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let _r = realizer(&broker, "many", &names, &[]);
+    let mut p = planner(&broker, "planner");
+    until_online(&p, &["many"]);
+    p.publish("bml/c599/bml", block("last").into_bytes(), false);
+    let heard = hear(&p, 10.0, |h| ended(h, "c599", "last"));
+    assert!(ended(&heard, "c599", "last"), "{heard:?}");
+}
+
+#[test]
 fn a_flood_for_one_character_does_not_hold_up_another_s_block() {
     let Some(broker) = Broker::start() else {
         return;

@@ -193,8 +193,9 @@ fn a_walker_held_back_by_another_realizer_s_row_asks_and_one_of_them_steps_aside
     );
     for (k, home) in row.iter().enumerate() {
         let back = last[format!("s{k}").as_str()];
+        // (one pressed less than the crowd's DISPLACED from its place stays where it is)
         assert!(
-            back.distance(Vec2::new(*home, 3.0)) < 0.05,
+            back.distance(Vec2::new(*home, 3.0)) <= bml_realizer::crowd::sim::DISPLACED + 0.002,
             "s{k} is at {back}, not back at its place"
         );
     }

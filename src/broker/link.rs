@@ -2,7 +2,9 @@
 //! connection polled on a thread of its own. Every (re)connection renews the subscriptions and
 //! the presence (retained `online`, with `offline` as the last will), since a broker that
 //! restarted has forgotten both. What arrives waits in a bounded inbox (the polling thread
-//! waits when it is full, and the broker holds back: backpressure); what is sent goes at QoS 1
+//! waits when it is full, and the broker holds back: backpressure; a state heard at QoS 0 is
+//! dropped instead and counted, [`Link::states_dropped`], so that polling and the keep-alive go
+//! on while the reader falls behind); what is sent goes at QoS 1
 //! through an outbox of one lane per topic, handed to rumqttc's small request queue a message
 //! of each lane in turn (so that one character's flood of feedback does not hold up another's),
 //! at most [`OUTBOX_LIMIT`] messages in all, beyond which the oldest of the longest lane are
@@ -13,16 +15,22 @@
 //! previous one's acknowledgement (Nagle's algorithm, ~40 ms stalls).
 
 use std::collections::{BTreeMap, VecDeque};
-use std::sync::mpsc::{self, Receiver, SyncSender};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use rumqttc::{Client, ClientError, Event, LastWill, MqttOptions, Packet, QoS, Request};
+use rumqttc::{
+    Client, ClientError, Event, LastWill, MqttOptions, Packet, QoS, Request, SubscribeFilter,
+};
 
 use super::BrokerUrl;
 
 /// Messages kept while the broker is away, beyond rumqttc's own queue.
 pub const OUTBOX_LIMIT: usize = 100_000;
+
+/// Topic filters in one SUBSCRIBE packet when the subscriptions are renewed.
+const RENEW_BATCH: usize = 64;
 
 /// rumqttc's request queue (messages handed to its event loop, not yet written): small, so
 /// that the lanes of the outbox decide the order.
@@ -86,6 +94,8 @@ pub struct Link {
     /// to rumqttc (its queue was full).
     subscriptions: Subscriptions,
     changes: VecDeque<Change>,
+    /// States heard (QoS 0) dropped because the inbox was full.
+    states_dropped: Arc<AtomicU64>,
 }
 
 /// Topic filters subscribed to and at which QoS, shared with the polling thread.
@@ -120,9 +130,11 @@ impl Link {
                 .map(|s| (s.clone(), QoS::AtLeastOnce))
                 .collect(),
         ));
+        let states_dropped = Arc::new(AtomicU64::new(0));
         let poller = Poller {
             client: client.clone(),
             subscriptions: subscriptions.clone(),
+            states_dropped: states_dropped.clone(),
             presence: options.presence.clone(),
             tx,
         };
@@ -141,6 +153,7 @@ impl Link {
                 state_turns: VecDeque::new(),
                 subscriptions,
                 changes: VecDeque::new(),
+                states_dropped,
             }),
             Ok(Err(e)) => Err(format!("cannot reach the broker at {}: {e}", options.url)),
             Err(_) => Err(format!("cannot reach the broker at {}", options.url)),
@@ -281,6 +294,12 @@ impl Link {
         true
     }
 
+    /// States heard (QoS 0 messages) dropped so far because the inbox was full: the loop
+    /// reading it fell behind.
+    pub fn states_dropped(&self) -> u64 {
+        self.states_dropped.load(Ordering::Relaxed)
+    }
+
     /// Messages waiting in the outbox.
     pub fn waiting(&self) -> usize {
         self.waiting
@@ -337,6 +356,7 @@ struct Poller {
     subscriptions: Subscriptions,
     presence: Option<String>,
     tx: SyncSender<Inbound>,
+    states_dropped: Arc<AtomicU64>,
 }
 
 impl Poller {
@@ -351,10 +371,10 @@ impl Poller {
         let mut wait = Duration::from_millis(100);
         // (renewed at each connection; tried again while rumqttc's queue is full of what
         // waited to be sent)
-        let mut renewing = false;
+        let (mut renewing, mut renewed) = (false, 0);
         loop {
             if renewing {
-                renewing = !self.renew();
+                renewing = !self.renew(&mut renewed);
             }
             let event = match connection.recv() {
                 Ok(e) => e,
@@ -363,7 +383,8 @@ impl Poller {
             match event {
                 Ok(Event::Incoming(Packet::ConnAck(_))) => {
                     (failures, wait) = (0, Duration::from_millis(100));
-                    renewing = !self.renew();
+                    renewed = 0;
+                    renewing = !self.renew(&mut renewed);
                     if let Some(r) = ready.take() {
                         let _ = r.send(Ok(()));
                     } else if lost {
@@ -374,11 +395,25 @@ impl Poller {
                     }
                 }
                 Ok(Event::Incoming(Packet::Publish(p))) => {
+                    let qos = p.qos;
                     let m = Inbound::Message {
                         topic: p.topic,
                         payload: p.payload.to_vec(),
                     };
-                    if self.tx.send(m).is_err() {
+                    // a state (QoS 0) the next one makes old is dropped when the inbox is
+                    // full, rather than stop polling: the connection's keep-alive goes on
+                    let sent = match qos {
+                        QoS::AtMostOnce => match self.tx.try_send(m) {
+                            Err(TrySendError::Disconnected(_)) => Err(()),
+                            Err(TrySendError::Full(_)) => {
+                                self.states_dropped.fetch_add(1, Ordering::Relaxed);
+                                Ok(())
+                            }
+                            Ok(()) => Ok(()),
+                        },
+                        _ => self.tx.send(m).map_err(|_| ()),
+                    };
+                    if sent.is_err() {
                         return;
                     }
                 }
@@ -403,20 +438,29 @@ impl Poller {
         }
     }
 
-    /// Subscribes and says it is online (on every connection); false when rumqttc's queue
-    /// had no room for all of it (subscribing again to a topic is harmless).
-    fn renew(&self) -> bool {
+    /// Subscribes and says it is online (on every connection), [`RENEW_BATCH`] filters a
+    /// packet, from the `renewed`th filter on; false when rumqttc's queue had no room for all
+    /// of it (it goes on from where it stopped: a queue smaller than the filters would
+    /// otherwise be filled with the first ones again and again).
+    fn renew(&self, renewed: &mut usize) -> bool {
         let now = self
             .subscriptions
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .clone();
-        let subscribed = (now.iter()).all(|(s, qos)| self.client.try_subscribe(s, *qos).is_ok());
-        let online = self.presence.as_ref().is_none_or(|p| {
+        let filters: Vec<SubscribeFilter> = (now.into_iter())
+            .map(|(path, qos)| SubscribeFilter::new(path, qos))
+            .collect();
+        for batch in filters[(*renewed).min(filters.len())..].chunks(RENEW_BATCH) {
+            if self.client.try_subscribe_many(batch.to_vec()).is_err() {
+                return false;
+            }
+            *renewed += batch.len();
+        }
+        self.presence.as_ref().is_none_or(|p| {
             (self.client)
                 .try_publish(p, QoS::AtLeastOnce, true, "online")
                 .is_ok()
-        });
-        subscribed && online
+        })
     }
 }

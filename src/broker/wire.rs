@@ -25,6 +25,11 @@ pub trait Wire {
     fn unlisten(&mut self, filter: &str);
     /// Hands on what waits, as far as the connection takes it.
     fn flush(&mut self);
+    /// States heard but dropped so far because the reader fell behind (MQTT; 0 on STOMP,
+    /// whose link holds the broker back instead).
+    fn states_dropped(&self) -> u64 {
+        0
+    }
     /// Messages dropped since last asked (the outbox was full while the broker was away).
     fn take_dropped(&mut self) -> u64;
     /// Says it is offline, hands over what waits (for up to `linger`) and disconnects.
@@ -52,6 +57,9 @@ impl Wire for Link {
     }
     fn flush(&mut self) {
         Link::flush(self);
+    }
+    fn states_dropped(&self) -> u64 {
+        Link::states_dropped(self)
     }
     fn take_dropped(&mut self) -> u64 {
         Link::take_dropped(self)

@@ -437,6 +437,15 @@ impl Realizer {
         }
     }
 
+    /// The feedback sent since the last frame (what performing a block or a message said at
+    /// once), taken without moving time: the next frame does not hold it again. A server
+    /// answers each block with it, instead of a whole frame per block.
+    pub fn take_feedback(&mut self) -> Vec<Feedback> {
+        let feedback = std::mem::take(&mut self.unframed);
+        self.note_progress(&feedback);
+        feedback
+    }
+
     /// Moves time to `now` (never backwards): every character passes the sync points up to then
     /// (characters in id order), engines play, and the frame holds their output and the feedback
     /// sent since the previous frame.

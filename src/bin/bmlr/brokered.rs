@@ -90,6 +90,7 @@ pub fn serve(args: Brokered, realizer: Realizer) -> ExitCode {
         s.send_raw(hello.into_iter().map(|(t, p)| (t, p, Vec::new())));
     }
     s.run(&stop);
+    s.sharing.counts.dropped = s.args.wire.states_dropped();
     eprintln!("bmlr serve: world: {}", s.sharing.counts);
     let Server { args, .. } = s;
     let Brokered {
@@ -179,6 +180,8 @@ impl Server {
                 break;
             }
             done += next.len();
+            // the clock up to date once a round: its blocks are planned at this time
+            self.tick();
             for (c, (payload, request)) in next {
                 self.perform(&c, payload, request);
             }
@@ -278,8 +281,6 @@ impl Server {
     /// Performs a block from `lane`; what it produces at once without a character (a block
     /// that could not be read) is the lane's character's.
     fn perform(&mut self, lane: &Lane, payload: Vec<u8>, request: Option<String>) {
-        // the clock up to date first: the block is planned at this time
-        self.tick();
         let limits = *self.realizer.limits();
         let text = match String::from_utf8(payload) {
             Ok(t) => t,
@@ -335,9 +336,7 @@ impl Server {
     /// Sends what a message from `character`'s lane produced at once; a warning that names no
     /// character (a block or message that could not be read) is the lane's character's.
     fn answer(&mut self, character: &str) {
-        let mut feedback = (self.realizer)
-            .tick(self.clock.now().min(self.args.until))
-            .feedback;
+        let mut feedback = self.realizer.take_feedback();
         let topic_character = (character != DEFAULT_CHARACTER).then(|| character.to_string());
         for fb in &mut feedback {
             if let Feedback::Warning(w) = fb {

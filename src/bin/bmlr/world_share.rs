@@ -29,14 +29,16 @@ pub struct Counts {
     pub published: u64,
     /// The most cells listened to at once.
     pub most_cells: usize,
+    /// States heard but dropped: this realizer fell behind reading them.
+    pub dropped: u64,
 }
 
 impl fmt::Display for Counts {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "heard {} states, published {}, listened to {} cells at most",
-            self.heard, self.published, self.most_cells
+            "heard {} states, published {}, listened to {} cells at most, dropped {}",
+            self.heard, self.published, self.most_cells, self.dropped
         )
     }
 }
