@@ -18,7 +18,7 @@
 //! this example.
 
 use std::io::{BufRead, BufReader, Write};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use bml_realizer::broker::{
@@ -28,13 +28,12 @@ use bml_realizer::broker::{
 // (the tests' ActiveMQ starter, shared rather than copied)
 #[path = "../tests/common/activemq.rs"]
 mod activemq;
-mod kit {
-    /// A port nobody listens on now.
-    pub fn free_port() -> u16 {
-        let l = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
-        l.local_addr().unwrap().port()
-    }
-}
+#[path = "common/process.rs"]
+mod process;
+use process::{bmlr, Kill};
+// (and their mosquitto starter)
+#[path = "../tests/common/mosquitto.rs"]
+mod kit;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 /// Blocks sent at once for the load.
@@ -44,24 +43,6 @@ const ONE_BY_ONE: usize = 300;
 
 fn block(id: &str) -> String {
     format!(r#"<bml {NS} id="{id}"><head id="h" lexeme="NOD" start="0" end="0.2"/></bml>"#)
-}
-
-/// Killed when dropped.
-struct Kill(Child);
-
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn bmlr() -> std::path::PathBuf {
-    let exe = std::env::current_exe().expect("this example's path");
-    exe.parent()
-        .and_then(|d| d.parent())
-        .expect("the target directory")
-        .join("bmlr")
 }
 
 /// A realizer served on a broker, and the planner's link to it.
@@ -83,32 +64,12 @@ fn nodelay() -> bool {
 
 /// mosquitto on a free port, a realizer on it, the planner's link; `None` when not installed.
 fn on_mosquitto() -> Option<Served> {
-    let port = kit::free_port();
     // (mosquitto's own sockets wait for acknowledgements unless told not to: set_tcp_nodelay)
-    let conf = std::env::temp_dir().join(format!("broker_load_{port}.conf"));
-    let settings = format!(
-        "listener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay {}\n",
-        nodelay()
-    );
-    std::fs::write(&conf, settings).unwrap();
-    let spawn = |p: &str| {
-        Command::new(p)
-            .args(["-c", conf.to_str().unwrap()])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-    };
-    let Ok(broker) = spawn("mosquitto").or_else(|_| spawn("/usr/sbin/mosquitto")) else {
-        eprintln!(
-            "broker_load: MQTT left out: mosquitto is not installed (Debian package mosquitto)"
-        );
+    let Some(broker) = kit::Broker::tuned(nodelay()) else {
+        eprintln!("broker_load: MQTT left out (mosquitto is not installed)");
         return None;
     };
-    let broker = Kill(broker);
-    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let url = format!("mqtt://127.0.0.1:{port}");
+    let url = broker.url();
     let realizer = serve(&["--mqtt", &url, "--name", "load"]);
     let link = Link::connect(LinkOptions {
         url: BrokerUrl::parse(&url).unwrap(),

@@ -15,25 +15,22 @@
 //! beside this example.
 
 use std::io::Read;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use bml_realizer::broker::{BrokerUrl, Inbound, Link, LinkOptions};
+
+#[path = "common/process.rs"]
+mod process;
+use process::{bmlr, Kill};
+// (the broker tests' mosquitto starter, shared rather than copied)
+#[path = "../tests/common/mosquitto.rs"]
+mod kit;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 
 /// A district's side (m); walkers keep 2 m from its edges, 1.2 m from each other.
 const DISTRICT: f32 = 70.0;
-
-/// Killed when dropped.
-struct Kill(Child);
-
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// A small deterministic generator (the same scene in both runs).
 struct Lcg(u64);
@@ -45,14 +42,6 @@ impl Lcg {
             .wrapping_add(1442695040888963407);
         (self.0 >> 40) as f32 / (1u64 << 24) as f32
     }
-}
-
-fn bmlr() -> std::path::PathBuf {
-    let exe = std::env::current_exe().expect("this example's path");
-    exe.parent()
-        .and_then(|d| d.parent())
-        .expect("the target directory")
-        .join("bmlr")
 }
 
 /// District `k`'s corner nearest the origin (two rows, as many columns as needed).
@@ -125,31 +114,8 @@ fn run(
     cell: &str,
     secs: f64,
 ) -> Option<(Vec<Measured>, f64)> {
-    let port = std::net::TcpListener::bind("127.0.0.1:0")
-        .ok()?
-        .local_addr()
-        .ok()?
-        .port();
-    let conf = std::env::temp_dir().join(format!("world_load_{port}.conf"));
-    let settings =
-        format!("listener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\n");
-    std::fs::write(&conf, settings).ok()?;
-    let spawn = |p: &str| {
-        Command::new(p)
-            .args(["-c", conf.to_str().unwrap()])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-    };
-    let Ok(broker) = spawn("mosquitto").or_else(|_| spawn("/usr/sbin/mosquitto")) else {
-        eprintln!("world_load: mosquitto is not installed (Debian package mosquitto)");
-        return None;
-    };
-    let broker = Kill(broker);
-    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let url = format!("mqtt://127.0.0.1:{port}");
+    let broker = kit::Broker::tuned(true)?;
+    let url = broker.url();
     let mut realizers: Vec<Kill> = (trips.iter().enumerate())
         .map(|(k, mine)| {
             let ids: Vec<&str> = mine.iter().map(|t| t.0.as_str()).collect();
@@ -216,7 +182,7 @@ fn run(
         }
     }
     println!("(--cell {cell}: {set_off} walks started, {arrived} ended within {secs} s)");
-    let broker_cpu = cpu_seconds(broker.0.id());
+    let broker_cpu = cpu_seconds(broker.pid());
     let cpus: Vec<f64> = realizers.iter().map(|r| cpu_seconds(r.0.id())).collect();
     for r in &realizers {
         let _ = Command::new("kill")
@@ -239,7 +205,6 @@ fn run(
         });
     }
     drop(broker);
-    let _ = std::fs::remove_file(conf);
     Some((out, broker_cpu))
 }
 

@@ -15,6 +15,7 @@
 //! previous one's acknowledgement (Nagle's algorithm, ~40 ms stalls).
 
 use std::collections::{BTreeMap, VecDeque};
+use std::ops::Bound;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
 use std::sync::{Arc, Mutex};
@@ -371,7 +372,7 @@ impl Poller {
         let mut wait = Duration::from_millis(100);
         // (renewed at each connection; tried again while rumqttc's queue is full of what
         // waited to be sent)
-        let (mut renewing, mut renewed) = (false, 0);
+        let (mut renewing, mut renewed) = (false, None);
         loop {
             if renewing {
                 renewing = !self.renew(&mut renewed);
@@ -383,7 +384,7 @@ impl Poller {
             match event {
                 Ok(Event::Incoming(Packet::ConnAck(_))) => {
                     (failures, wait) = (0, Duration::from_millis(100));
-                    renewed = 0;
+                    renewed = None;
                     renewing = !self.renew(&mut renewed);
                     if let Some(r) = ready.take() {
                         let _ = r.send(Ok(()));
@@ -439,23 +440,29 @@ impl Poller {
     }
 
     /// Subscribes and says it is online (on every connection), [`RENEW_BATCH`] filters a
-    /// packet, from the `renewed`th filter on; false when rumqttc's queue had no room for all
-    /// of it (it goes on from where it stopped: a queue smaller than the filters would
-    /// otherwise be filled with the first ones again and again).
-    fn renew(&self, renewed: &mut usize) -> bool {
+    /// packet, in order from the filter after `renewed` (the last one handed on; none at
+    /// first); false when rumqttc's queue had no room for all of it. It goes on from where it
+    /// stopped: a queue smaller than the filters would otherwise be filled with the first ones
+    /// again and again. (Resuming after a name, not a count, skips none when filters were
+    /// added or dropped in between; subscribing again to a topic is harmless.)
+    fn renew(&self, renewed: &mut Option<String>) -> bool {
         let now = self
             .subscriptions
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .clone();
-        let filters: Vec<SubscribeFilter> = (now.into_iter())
-            .map(|(path, qos)| SubscribeFilter::new(path, qos))
+        let after = match renewed.clone() {
+            Some(last) => (Bound::Excluded(last), Bound::Unbounded),
+            None => (Bound::Unbounded, Bound::Unbounded),
+        };
+        let filters: Vec<SubscribeFilter> = (now.range(after))
+            .map(|(path, qos)| SubscribeFilter::new(path.clone(), *qos))
             .collect();
-        for batch in filters[(*renewed).min(filters.len())..].chunks(RENEW_BATCH) {
+        for batch in filters.chunks(RENEW_BATCH) {
             if self.client.try_subscribe_many(batch.to_vec()).is_err() {
                 return false;
             }
-            *renewed += batch.len();
+            *renewed = batch.last().map(|f| f.path.clone());
         }
         self.presence.as_ref().is_none_or(|p| {
             (self.client)

@@ -9,61 +9,11 @@ use bml_realizer::broker::{BrokerUrl, Inbound, Link, LinkOptions};
 
 pub const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 
-/// A mosquitto on a free loopback port, stopped when dropped.
-pub struct Broker {
-    child: Child,
-    /// Its loopback port.
-    pub port: u16,
-}
-
-impl Broker {
-    /// Starts one, or `None` (with a line saying why) when mosquitto is not installed.
-    pub fn start() -> Option<Broker> {
-        let port = free_port();
-        Broker::on(port)
-    }
-
-    pub fn on(port: u16) -> Option<Broker> {
-        // (Debian installs it in /usr/sbin, which a user's PATH may lack)
-        let spawn = |program: &str| {
-            Command::new(program)
-                .args(["-p", &port.to_string()])
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .spawn()
-        };
-        let child = spawn("mosquitto").or_else(|_| spawn("/usr/sbin/mosquitto"));
-        let Ok(child) = child else {
-            eprintln!("skipped: mosquitto is not installed (Debian package mosquitto; .ci/run installs it)");
-            return None;
-        };
-        let until = Instant::now() + Duration::from_secs(5);
-        while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
-            assert!(
-                Instant::now() < until,
-                "mosquitto did not start on port {port}"
-            );
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        Some(Broker { child, port })
-    }
-
-    pub fn url(&self) -> String {
-        format!("mqtt://127.0.0.1:{}", self.port)
-    }
-}
-
-impl Drop for Broker {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-pub fn free_port() -> u16 {
-    let l = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
-    l.local_addr().unwrap().port()
-}
+// (the mosquitto starter is its own file, so that the examples can share it too)
+#[path = "mosquitto.rs"]
+mod mosquitto;
+#[allow(unused_imports)] // (free_port: not every test that shares this kit needs it)
+pub use mosquitto::{free_port, Broker};
 
 /// A realizer process, killed when dropped (also when a test fails).
 pub struct Served(pub Child);
