@@ -208,8 +208,8 @@ fn four_realizers_share_one_world_by_cells_and_everyone_crosses() {
         .map(|t| t.1.as_str())
         .collect();
     assert!(stuck.is_empty(), "not arrived: {stuck:?}\n{warned:?}");
-    // A realizer late on its clock says so (an unoptimised build of four realizers planning 50
-    // walks each on two cores is); that is honest feedback, not a fault of the shared world.
+    // A realizer late on its clock says so (four realizers planning 50 walks each at once on a
+    // loaded two-core machine are); that is honest feedback, not a fault of the shared world.
     // Any other warning is.
     let (late, other): (Vec<_>, Vec<_>) =
         (warned.iter()).partition(|(_, text)| text.contains("the realizer fell behind its clock"));

@@ -29,7 +29,8 @@ ANKLE = 0.085  # m above the floor: the shoes' top (a little above the ankle joi
 # The hairline, over the forehead this far above the eyes (m), falling to the nape behind the ears.
 HAIRLINE_FRONT = 0.06
 HAIRLINE_BACK = -0.085
-LIMB_JOINTS = ("hip", "knee", "talocrural", "metatarsal", "eyeball", "sternoclavicular")
+# The side joints (l_ and r_) that are not an arm's or a hand's.
+NOT_ARM = ("hip", "knee", "talocrural", "metatarsal", "eyeball", "sternoclavicular")
 
 
 def ramp(d, width):
@@ -39,7 +40,7 @@ def ramp(d, width):
 
 def is_arm(joint):
     """Whether a joint moves an arm or a hand (shoulder, elbow, wrist, fingers)."""
-    return joint[:2] in ("l_", "r_") and not any(k in joint for k in LIMB_JOINTS)
+    return joint[:2] in ("l_", "r_") and not any(k in joint for k in NOT_ARM)
 
 
 def body_colours(p, main, joints):

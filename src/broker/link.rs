@@ -446,16 +446,13 @@ impl Poller {
     /// again and again. (Resuming after a name, not a count, skips none when filters were
     /// added or dropped in between; subscribing again to a topic is harmless.)
     fn renew(&self, renewed: &mut Option<String>) -> bool {
-        let now = self
-            .subscriptions
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone();
-        let after = match renewed.clone() {
+        let after = match renewed.as_deref() {
             Some(last) => (Bound::Excluded(last), Bound::Unbounded),
             None => (Bound::Unbounded, Bound::Unbounded),
         };
-        let filters: Vec<SubscribeFilter> = (now.range(after))
+        let filters: Vec<SubscribeFilter> = (self.subscriptions.lock())
+            .unwrap_or_else(|e| e.into_inner())
+            .range::<str, _>(after)
             .map(|(path, qos)| SubscribeFilter::new(path.clone(), *qos))
             .collect();
         for batch in filters.chunks(RENEW_BATCH) {
