@@ -2,7 +2,8 @@
 //! run. One character speaking with a beat, a wave, a nod and a gaze at 60 Hz: the realizer's
 //! tick, and the retargeting of the pose that tick made onto the default avatar (its skeleton is
 //! the realizer's: each bone takes its joint's rotation) and onto a Mixamo one (every bone
-//! aligned and turned) and onto CesiumMan (published, driven by a bone map), as the glTF export
+//! aligned and turned) and onto CesiumMan (published, driven by a bone map) and the Cryptovoxels
+//! VRM 0.x (published, its humanoid map, facing −z), as the glTF export
 //! and the viewer use them. The target: retargeting costs under 10 % of the tick. Also the
 //! loading of each avatar (read, skeleton recognised, rest poses aligned).
 //!
@@ -58,6 +59,12 @@ fn avatar(c: &mut Criterion) {
     g.bench_function("retarget onto CesiumMan", |b| {
         b.iter(|| black_box(retarget.pose(&pose)))
     });
+    // the Cryptovoxels VRM 0.x as published (74 nodes, 57 joints, fingers)
+    let vrm = Model::read(std::path::Path::new(CRYPTOVOXELS)).unwrap();
+    let retarget = Retarget::new(&vrm, &skeleton, None).unwrap();
+    g.bench_function("retarget onto the Cryptovoxels VRM 0.x", |b| {
+        b.iter(|| black_box(retarget.pose(&pose)))
+    });
     g.finish();
     // reading each avatar file and recognising its skeleton (what `--avatar` does once)
     let mut g = c.benchmark_group("loading an avatar");
@@ -74,6 +81,12 @@ fn avatar(c: &mut Criterion) {
             black_box(Retarget::new(&m, &skeleton, Some(&map)).unwrap())
         })
     });
+    g.bench_function("the Cryptovoxels VRM 0.x (238 kB)", |b| {
+        b.iter(|| {
+            let m = Model::read(std::path::Path::new(CRYPTOVOXELS)).unwrap();
+            black_box(Retarget::new(&m, &skeleton, None).unwrap())
+        })
+    });
     g.bench_function("a Mixamo-named GLB (no mesh)", |b| {
         let bytes = avatars::test_avatar(avatars::Kind::Mixamo);
         b.iter(|| {
@@ -85,6 +98,7 @@ fn avatar(c: &mut Criterion) {
 }
 
 const CESIUM_MAN: &str = "fixtures/avatars/cesium-man/CesiumMan.gltf";
+const CRYPTOVOXELS: &str = "fixtures/avatars/cryptovoxels/cryptovoxels.vrm";
 
 /// CesiumMan's bone map (node indices), as `--bone-map` reads it.
 fn cesium_map() -> std::collections::BTreeMap<String, String> {

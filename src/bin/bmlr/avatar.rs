@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use bml_realizer::avatar::{self, Model, Retarget};
 use bml_realizer::body::Skeleton;
-use bml_realizer::world::World;
+use bml_realizer::world::{Placement, World};
 use clap::Args;
 
 /// The avatar options.
@@ -43,11 +43,11 @@ impl Avatar {
         Ok(Avatar { model, retarget })
     }
 
-    /// Its driving for character `id`, standing where `world` places it (its place kept, its
-    /// travel from there scaled by leg length).
-    pub fn placed(&self, world: &World, id: &str) -> Retarget {
+    /// Its driving for a character that stood `at` when its motion began (its place kept,
+    /// its travel from there scaled by leg length).
+    pub fn placed(&self, at: Placement) -> Retarget {
         let mut retarget = self.retarget.clone();
-        retarget.place_in(world, id);
+        retarget.place_at(at);
         retarget
     }
 }

@@ -67,7 +67,10 @@ impl LiveView {
         let drivers: Vec<(String, Driver)> = (shown.iter())
             .map(|&id| {
                 let a = avatars.of(id);
-                (id.to_string(), Driver::new(&a.model, a.placed(world, id)))
+                (
+                    id.to_string(),
+                    Driver::new(&a.model, a.placed(world.placement(id))),
+                )
             })
             .collect();
         let wiring = (drivers.iter())

@@ -64,6 +64,12 @@ impl Recording {
         }
     }
 
+    /// Where character `id` stood when the recording began (the world file's place; the
+    /// origin for a character it does not place).
+    pub fn start_of(&self, id: &str) -> bml_realizer::world::Placement {
+        self.places.get(id).copied().unwrap_or_default()
+    }
+
     /// Notes where `world` places characters (see [`Recording::standing`]).
     pub fn placed(mut self, world: &World) -> Recording {
         self.places = (world.placements())
@@ -178,10 +184,10 @@ impl Recording {
                 .map_err(|e| (1, format!("--gltf: {e}")))?],
         };
         if let ([id], Some(avatars)) = (ids.as_slice(), avatar) {
-            return self.write_avatar(path, id, avatars.of(id), realizer.world());
+            return self.write_avatar(path, id, avatars.of(id));
         }
         if let Some(avatars) = avatar {
-            return self.write_avatars(path, &ids, avatars, realizer.world());
+            return self.write_avatars(path, &ids, avatars);
         }
         let poses: Vec<Vec<CharacterPose>> = ids.iter().map(|c| self.poses_of(c)).collect();
         let frames: Vec<Vec<(f64, &Pose)>> = (poses.iter())
@@ -211,14 +217,8 @@ impl Recording {
     }
 
     /// Writes `avatar` moving as character `id` did.
-    fn write_avatar(
-        &self,
-        path: &Path,
-        id: &str,
-        avatar: &Avatar,
-        world: &World,
-    ) -> Result<(), (u8, String)> {
-        let glb = self.avatar_glb(id, avatar, world);
+    fn write_avatar(&self, path: &Path, id: &str, avatar: &Avatar) -> Result<(), (u8, String)> {
+        let glb = self.avatar_glb(id, avatar);
         write_file(path, &glb)?;
         eprintln!(
             "wrote {} ({} on {}, {} frames at {} fps, {} kB)",
@@ -238,14 +238,13 @@ impl Recording {
         path: &Path,
         ids: &[String],
         avatars: &Avatars,
-        world: &World,
     ) -> Result<(), (u8, String)> {
         let parts = (ids.iter())
             .map(|id| {
                 let avatar = avatars.of(id);
                 let poses = self.poses_of(id);
                 let frames = self.avatar_frames(&poses);
-                let retarget = avatar.placed(world, id);
+                let retarget = avatar.placed(self.start_of(id));
                 let (doc, bin) = animated_document(&avatar.model, &retarget, &frames, id);
                 (id.clone(), doc, bin)
             })
@@ -275,11 +274,16 @@ impl Recording {
     }
 
     /// `avatar` moving as character `id` did, as GLB bytes.
-    pub fn avatar_glb(&self, id: &str, avatar: &Avatar, world: &World) -> Vec<u8> {
+    pub fn avatar_glb(&self, id: &str, avatar: &Avatar) -> Vec<u8> {
         let poses = self.poses_of(id);
         let frames = self.avatar_frames(&poses);
         let name = if id.is_empty() { "bml" } else { id };
-        animated_glb(&avatar.model, &avatar.placed(world, id), &frames, name)
+        animated_glb(
+            &avatar.model,
+            &avatar.placed(self.start_of(id)),
+            &frames,
+            name,
+        )
     }
 
     /// The frames of the one character a BVH or glTF file (`flag`) shows.

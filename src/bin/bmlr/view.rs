@@ -137,7 +137,7 @@ fn realize(args: &ViewArgs) -> Result<(String, String, crate::outcome::Outcome),
     // each character on its avatar, moving as in `bmlr run --gltf`
     let avatars = if characters.len() <= MAX_VIEW_AVATARS {
         (characters.iter())
-            .map(|id| motion.avatar_glb(id, avatars.of(id), run.realizer.world()))
+            .map(|id| motion.avatar_glb(id, avatars.of(id)))
             .collect()
     } else {
         eprintln!(

@@ -36,6 +36,13 @@ impl Driver {
         &self.moving
     }
 
+    /// How the host turns the avatar's whole scene so that it stands in the realizer's world
+    /// (the identity for an avatar made facing the realizer's way; a VRM 0.x is turned half
+    /// round). The frames' rotations and travel are in the avatar's own frame.
+    pub fn stand(&self) -> glam::Quat {
+        self.retarget.stand()
+    }
+
     /// The node whose translation carries the character's travel.
     pub fn hips(&self) -> usize {
         self.retarget.hips()

@@ -1,8 +1,11 @@
 //! An avatar with the realizer's motion, as one binary glTF: the avatar's own file (its JSON
-//! and binary buffer as read, node names and extensions kept) with one animation added — the
+//! and binary buffer as read, node names and extensions kept) with one animation added before
+//! the file's own (viewers play the first) — the
 //! local rotation of every bone that follows a realizer joint, the translation of the node that
 //! carries the root's travel, and the weights of every morph target the face drives — sampled
-//! at the frames' times (linear interpolation between them).
+//! at the frames' times (linear interpolation between them). An avatar made facing another way
+//! than the realizer's characters (a VRM 0.x faces −z, CesiumMan +x) stands in the realizer's
+//! world under one node more that turns it (see [`stand`]).
 
 use serde_json::{json, Value};
 
@@ -55,10 +58,12 @@ pub fn animated_document(
         views: take("bufferViews"),
         accessors: take("accessors"),
     };
+    stand(&mut json, retarget.stand());
     if !frames.is_empty() {
         let animation = animation(&mut buf, model, retarget, frames, name);
+        // first, before the file's own: what viewers play unless told otherwise
         match json["animations"].as_array_mut() {
-            Some(list) => list.push(animation),
+            Some(list) => list.insert(0, animation),
             None => json["animations"] = json!([animation]),
         }
     }
@@ -81,6 +86,36 @@ pub fn animated_document(
         json["accessors"] = Value::Array(buf.accessors);
     }
     (json, buf.bytes)
+}
+
+/// Turns the avatar of document `json` by `turn` into the realizer's world: a node named
+/// `realizer frame` with that rotation over the default scene's roots, but for skinned meshes
+/// (which glTF wants at the root and which ignore their parents' transforms: their joints
+/// carry the turn). Nothing changes when the avatar already faces the realizer's way. The
+/// node is appended, so every node keeps its index.
+fn stand(json: &mut Value, turn: glam::Quat) {
+    if turn.angle_between(glam::Quat::IDENTITY) < 1e-4 {
+        return;
+    }
+    let scene = json["scene"].as_u64().unwrap_or(0) as usize;
+    let Some(roots) = json["scenes"][scene]["nodes"].as_array().cloned() else {
+        return;
+    };
+    let Some(nodes) = json["nodes"].as_array_mut() else {
+        return;
+    };
+    let (skinned, children): (Vec<Value>, Vec<Value>) = roots.into_iter().partition(|n| {
+        let node = n.as_u64().and_then(|n| nodes.get(n as usize));
+        node.is_some_and(|node| node.get("skin").is_some())
+    });
+    let at = nodes.len();
+    nodes.push(
+        json!({"name": "realizer frame", "rotation": turn.to_array(),
+                      "children": children}),
+    );
+    let mut roots = skinned;
+    roots.push(json!(at));
+    json["scenes"][scene]["nodes"] = Value::Array(roots);
 }
 
 /// The animation of `frames` on `model`, its keys appended to `buf`.

@@ -337,9 +337,16 @@ impl Retarget {
 
     /// Places character `id` where `world` has it stand: the avatar stands there, and only
     /// its travel from there is scaled by the ratio of leg lengths (so that its feet do not
-    /// slide), not its place.
+    /// slide), not its place. Give the world as it was when the motion began (a walk moves
+    /// the character's placement; see [`Retarget::place_at`]).
     pub fn place_in(&mut self, world: &crate::world::World, id: &str) {
-        self.anchor = world.placement(id).to_world(self.root_rest);
+        self.place_at(world.placement(id));
+    }
+
+    /// Places the avatar where the character stood when its motion began: its travel from
+    /// there is scaled by the ratio of leg lengths, its place is not.
+    pub fn place_at(&mut self, at: crate::world::Placement) {
+        self.anchor = at.to_world(self.root_rest);
     }
 
     /// Whether the avatar's skeleton is the realizer's own (each node turns as its joint).
@@ -365,6 +372,14 @@ impl Retarget {
     /// The realizer's frame in the avatar's (its x, y, z: left, up, forward).
     pub fn frame(&self) -> Quat {
         self.frame
+    }
+
+    /// How the avatar's whole scene turns to stand in the realizer's world: the inverse of
+    /// [`Retarget::frame`]. The poses, travel and [`Retarget::world`] are in the avatar's own
+    /// frame; a host showing the avatar beside the world's objects turns it by this (the
+    /// glTF export does it with a node over the avatar's roots).
+    pub fn stand(&self) -> Quat {
+        self.frame.inverse()
     }
 }
 

@@ -2,8 +2,8 @@
 //! character's avatar document (its own JSON and buffer, with its animation) merged into one.
 //! Every index is offset by the items of its kind that came before; the buffers become the one
 //! binary chunk; each character's scene hangs under a node named after the character; the
-//! animations become one, so that every character plays together in a viewer that plays one
-//! animation. Extensions of the whole document (VRM's humanoid, expressions, spring bones, a
+//! realized motions become one animation, the first, so that every character plays together in
+//! a viewer that plays one animation (the avatars' files' own animations are kept after it). Extensions of the whole document (VRM's humanoid, expressions, spring bones, a
 //! light list) describe one avatar and are dropped, with node extensions that point into them;
 //! material and texture extensions are kept.
 
@@ -58,6 +58,8 @@ struct Merge {
     roots: Vec<usize>,
     channels: Vec<Value>,
     samplers: Vec<Value>,
+    /// The avatars' files' own animations.
+    own: Vec<Value>,
     used: Vec<String>,
     required: Vec<String>,
 }
@@ -190,17 +192,30 @@ impl Merge {
                 self.push(kind, x);
             }
         }
-        for a in items("animations", &mut doc) {
-            let first = self.samplers.len();
+        for (k, a) in items("animations", &mut doc).into_iter().enumerate() {
+            // the realized motion (the export puts it first, named after the character) joins
+            // the scene's one animation; the file's own stay animations of their own
+            let realized = k == 0 && a["name"] == name;
+            let (mut samplers, mut channels) = (Vec::new(), Vec::new());
+            let first = if realized { self.samplers.len() } else { 0 };
             for mut s in a["samplers"].as_array().cloned().unwrap_or_default() {
                 shift(s.get_mut("input"), accessors);
                 shift(s.get_mut("output"), accessors);
-                self.samplers.push(s);
+                samplers.push(s);
             }
             for mut c in a["channels"].as_array().cloned().unwrap_or_default() {
                 shift(c.get_mut("sampler"), first);
                 shift(c.pointer_mut("/target/node"), nodes);
-                self.channels.push(c);
+                channels.push(c);
+            }
+            if realized {
+                self.samplers.extend(samplers);
+                self.channels.extend(channels);
+            } else {
+                let mut own = a;
+                own["samplers"] = Value::Array(samplers);
+                own["channels"] = Value::Array(channels);
+                self.own.push(own);
             }
         }
         // the character's node over its scene's roots, but for skinned meshes, which glTF
@@ -266,6 +281,7 @@ pub fn scene_glb(parts: Vec<(String, Value, Vec<u8>)>, animation: &str) -> Vec<u
         roots: Vec::new(),
         channels: Vec::new(),
         samplers: Vec::new(),
+        own: Vec::new(),
         used: Vec::new(),
         required: Vec::new(),
     };
@@ -279,11 +295,13 @@ pub fn scene_glb(parts: Vec<(String, Value, Vec<u8>)>, animation: &str) -> Vec<u
     );
     out.insert("scene".into(), json!(0));
     out.insert("scenes".into(), json!([{"nodes": m.roots}]));
+    let mut animations = m.own;
     if !m.channels.is_empty() {
-        out.insert(
-            "animations".into(),
-            json!([{"name": animation, "samplers": m.samplers, "channels": m.channels}]),
-        );
+        let realized = json!({"name": animation, "samplers": m.samplers, "channels": m.channels});
+        animations.insert(0, realized);
+    }
+    if !animations.is_empty() {
+        out.insert("animations".into(), Value::Array(animations));
     }
     if !m.bin.is_empty() {
         out.insert("buffers".into(), json!([{"byteLength": m.bin.len()}]));
@@ -308,8 +326,9 @@ pub fn scene_glb(parts: Vec<(String, Value, Vec<u8>)>, animation: &str) -> Vec<u
 mod tests {
     use super::*;
 
-    /// A document with one skinned, textured mesh and an animation of its one joint.
-    fn part() -> (Value, Vec<u8>) {
+    /// A document with one skinned, textured mesh and the realized animation of its one joint
+    /// (named `name`, as the export names it), then the file's own animation of it.
+    fn part(name: &str) -> (Value, Vec<u8>) {
         let doc = json!({
             "asset": {"version": "2.0"},
             "extensionsUsed": ["VRMC_vrm", "KHR_materials_unlit"],
@@ -329,16 +348,19 @@ mod tests {
             "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 4},
                             {"buffer": 0, "byteOffset": 4, "byteLength": 2}],
             "buffers": [{"byteLength": 6}],
-            "animations": [{"samplers": [{"input": 0, "output": 1}],
-                            "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}}]}],
+            "animations": [
+                {"name": name, "samplers": [{"input": 0, "output": 1}],
+                 "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}}]},
+                {"name": "Walk", "samplers": [{"input": 0, "output": 2}],
+                 "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}}]}],
         });
         (doc, vec![1, 2, 3, 4, 5, 6])
     }
 
     #[test]
     fn two_documents_merge_with_every_index_offset() {
-        let (a, bin_a) = part();
-        let (b, bin_b) = part();
+        let (a, bin_a) = part("A");
+        let (b, bin_b) = part("B");
         let glb = scene_glb(vec![("A".into(), a, bin_a), ("B".into(), b, bin_b)], "bml");
         let len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
         let doc: Value = serde_json::from_slice(&glb[20..20 + len]).unwrap();
@@ -365,11 +387,19 @@ mod tests {
         assert_eq!(doc["bufferViews"][2]["byteOffset"], 8);
         assert_eq!(doc["bufferViews"][3]["byteOffset"], 12);
         assert_eq!(doc["buffers"], json!([{"byteLength": 16}]));
-        // one animation: B's channel on B's joint with B's sampler
+        // the realized motions, first and as one: B's channel on B's joint with B's sampler
         let anim = &doc["animations"][0];
         assert_eq!(anim["channels"][1]["sampler"], 1);
         assert_eq!(anim["channels"][1]["target"]["node"], 3);
         assert_eq!(anim["samplers"][1], json!({"input": 3, "output": 4}));
+        assert_eq!(anim["channels"].as_array().unwrap().len(), 2);
+        // the files' own animations after it, each on its own, A's then B's
+        let own = &doc["animations"][2];
+        assert_eq!(own["name"], "Walk");
+        assert_eq!(own["channels"][0]["sampler"], 0);
+        assert_eq!(own["channels"][0]["target"]["node"], 3);
+        assert_eq!(own["samplers"][0], json!({"input": 3, "output": 5}));
+        assert_eq!(doc["animations"].as_array().unwrap().len(), 3);
         // VRM's document extension dropped, the material's kept
         assert!(doc.get("extensions").is_none());
         assert_eq!(doc["extensionsUsed"], json!(["KHR_materials_unlit"]));
