@@ -169,3 +169,37 @@ fn animation(
     }
     json!({"name": name, "samplers": samplers, "channels": channels})
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn document() -> Value {
+        json!({
+            "scene": 0,
+            "scenes": [{"nodes": [0, 1]}],
+            "nodes": [{"name": "hips", "children": [2]}, {"name": "body", "mesh": 0, "skin": 0},
+                      {"name": "spine"}],
+        })
+    }
+
+    #[test]
+    fn an_avatar_facing_another_way_stands_under_one_turned_node() {
+        let mut json = document();
+        let half = glam::Quat::from_rotation_y(std::f32::consts::PI);
+        stand(&mut json, half);
+        // appended, so that every node keeps its index; the skinned mesh stays at the root
+        assert_eq!(json["nodes"][3]["name"], "realizer frame");
+        assert_eq!(json["nodes"][3]["children"], json!([0]));
+        assert_eq!(json["scenes"][0]["nodes"], json!([1, 3]));
+        let turn: Vec<f32> = (json["nodes"][3]["rotation"].as_array().unwrap().iter())
+            .map(|x| x.as_f64().unwrap() as f32)
+            .collect();
+        let turn = glam::Quat::from_slice(&turn);
+        assert!(turn.angle_between(half) < 1e-6, "{turn:?}");
+        // one already facing the realizer's way is left as it is
+        let mut same = document();
+        stand(&mut same, glam::Quat::IDENTITY);
+        assert_eq!(same, document());
+    }
+}
