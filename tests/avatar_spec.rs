@@ -18,7 +18,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use avatar_mesh::{gltf_embedded, gltf_two_files, with_mesh, Case, CASES};
-use avatars::{glb_json, glb_with, limb_errors, random_pose, test_avatar, Kind, LIMBS};
+use avatars::{floats_of, glb_json, glb_with, limb_errors, random_pose, test_avatar, Kind, LIMBS};
 use bml_realizer::avatar::{Model, Retarget};
 use bml_realizer::body::pose::Pose;
 use bml_realizer::body::skeleton::Skeleton;
@@ -210,20 +210,6 @@ fn what_cannot_be_driven_is_refused_with_a_sentence_that_says_what_to_do() {
             assert!(err.contains(&s), "{file}: '{s}' not in {err}");
         }
     }
-}
-
-/// The floats of accessor `a` of a GLB (tightly packed, as the export writes them).
-fn floats_of(bytes: &[u8], json: &Value, a: usize) -> Vec<f32> {
-    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let bin = &bytes[20 + length + 8..];
-    let acc = &json["accessors"][a];
-    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
-    let start = (view["byteOffset"].as_u64().unwrap_or(0) + acc["byteOffset"].as_u64().unwrap_or(0))
-        as usize;
-    let n = acc["count"].as_u64().unwrap() as usize * if acc["type"] == "SCALAR" { 1 } else { 4 };
-    (0..n)
-        .map(|k| f32::from_le_bytes(bin[start + 4 * k..start + 4 * k + 4].try_into().unwrap()))
-        .collect()
 }
 
 #[test]

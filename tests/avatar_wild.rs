@@ -19,7 +19,7 @@ use std::collections::BTreeMap;
 use serde_json::json;
 use std::path::Path;
 
-use avatars::{glb_json, limb_errors_by, random_pose};
+use avatars::{floats_of, glb_json, limb_errors_by, random_pose};
 use bml_realizer::avatar::{humanoid, Model, Retarget};
 use bml_realizer::body::pose::Pose;
 use bml_realizer::body::skeleton::Skeleton;
@@ -204,21 +204,6 @@ fn the_cryptovoxels_vrm_0_x_follows_every_limb_and_beats() {
     assert!(rise > 0.1, "the right hand rose {rise} m for the beat");
 }
 
-/// The VEC3 floats of accessor `a` of a GLB (tightly packed, as the export writes them).
-fn vec3s(bytes: &[u8], json: &serde_json::Value, a: usize) -> Vec<glam::Vec3> {
-    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let bin = &bytes[20 + length + 8..];
-    let acc = &json["accessors"][a];
-    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
-    let at = |key: &str, v: &serde_json::Value| v[key].as_u64().unwrap_or(0) as usize;
-    let start = at("byteOffset", view) + at("byteOffset", acc);
-    let f =
-        |k: usize| f32::from_le_bytes(bin[start + 4 * k..start + 4 * k + 4].try_into().unwrap());
-    (0..at("count", acc))
-        .map(|i| glam::Vec3::new(f(3 * i), f(3 * i + 1), f(3 * i + 2)))
-        .collect()
-}
-
 /// A node's transform relative to its parent, from its JSON.
 fn local(node: &serde_json::Value) -> glam::Mat4 {
     let floats = |key: &str| -> Option<Vec<f32>> {
@@ -244,7 +229,8 @@ fn travel_in_scene(glb: &[u8]) -> (glam::Vec3, glam::Vec3) {
         .unwrap();
     let hips = channel["target"]["node"].as_u64().unwrap() as usize;
     let sampler = &animation["samplers"][channel["sampler"].as_u64().unwrap() as usize];
-    let keys = vec3s(glb, &json, sampler["output"].as_u64().unwrap() as usize);
+    let keys = floats_of(glb, &json, sampler["output"].as_u64().unwrap() as usize);
+    let keys: Vec<glam::Vec3> = keys.chunks(3).map(glam::Vec3::from_slice).collect();
     let nodes = json["nodes"].as_array().unwrap();
     let parent_of = |i: usize| {
         (nodes.iter()).position(|n| {

@@ -213,6 +213,26 @@ pub fn glb_with(json: &Value, bin: &[u8]) -> Vec<u8> {
     out
 }
 
+/// The floats of accessor `a` of a GLB whose JSON is `json` (tightly packed, as the export
+/// writes them): count × the components of its type.
+pub fn floats_of(bytes: &[u8], json: &Value, a: usize) -> Vec<f32> {
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let bin = &bytes[20 + length + 8..];
+    let acc = &json["accessors"][a];
+    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let at = |key: &str, v: &Value| v[key].as_u64().unwrap_or(0) as usize;
+    let start = at("byteOffset", view) + at("byteOffset", acc);
+    let components = match acc["type"].as_str().unwrap() {
+        "SCALAR" => 1,
+        "VEC2" => 2,
+        "VEC3" => 3,
+        _ => 4,
+    };
+    (0..at("count", acc) * components)
+        .map(|k| f32::from_le_bytes(bin[start + 4 * k..start + 4 * k + 4].try_into().unwrap()))
+        .collect()
+}
+
 /// The JSON chunk of a GLB.
 pub fn glb_json(bytes: &[u8]) -> Value {
     let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;

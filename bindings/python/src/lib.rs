@@ -36,6 +36,9 @@ struct State {
     frame: Option<Frame>,
     /// Every tick's characters, when recording (for `write_glb`).
     recorded: Option<Vec<(f64, Vec<CharacterPose>)>>,
+    /// Where the world placed each character when the realizer was made: an avatar's travel
+    /// is scaled by leg length from there (its placement moves as it walks).
+    start: std::collections::HashMap<String, bml_realizer::world::Placement>,
     /// The frame rate of `step`, and the steps taken.
     fps: f64,
     steps: u64,
@@ -164,8 +167,12 @@ impl Realizer {
         }
         let (realizer, fps) = bml_realizer::realizer::from_options(&options.to_string())
             .map_err(PyValueError::new_err)?;
+        let start = (realizer.world().placements())
+            .map(|(id, at)| (id.to_string(), at))
+            .collect();
         Ok(Realizer {
             state: Mutex::new(State {
+                start,
                 realizer,
                 frame: None,
                 recorded: record.then(Vec::new),
@@ -367,7 +374,7 @@ impl Realizer {
             let model = default_model();
             let mut retarget =
                 Retarget::new(&model, &Skeleton::adult(), None).map_err(|e| e.to_string())?;
-            retarget.place_in(s.realizer.world(), character);
+            retarget.place_at(s.start.get(character).copied().unwrap_or_default());
             let poses: Vec<(f64, &CharacterPose)> = (recorded.iter())
                 .filter_map(|(t, ps)| {
                     let p = ps

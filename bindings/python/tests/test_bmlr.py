@@ -151,6 +151,33 @@ def test_run_yields_frames_and_write_glb_writes_an_avatar(tmp_path):
         bmlr.Realizer().write_glb(out)
 
 
+def test_write_glb_puts_a_walker_s_avatar_where_it_stood(tmp_path):
+    # a walk of 2.5 m from the world's place: the avatar starts there (its travel is scaled by
+    # leg length from where it stood, not from where the walk ended: that put it 14 cm off)
+    world = {"characters": {"Alice": {"position": [1.0, 0.0, 2.0]}}}
+    r = bmlr.Realizer(world=world, record=True)
+    r.perform(
+        '<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="a" characterId="Alice">'
+        '<locomotion id="w" target="3.5,2"/></bml>'
+    )
+    for k in range(8 * 30):
+        r.tick(k / 30)
+    out = tmp_path / "walk.glb"
+    r.write_glb(out, "Alice")
+    data = out.read_bytes()
+    length = int.from_bytes(data[12:16], "little")
+    doc = json.loads(data[20 : 20 + length])
+    binary = data[20 + length + 8 :]
+    animation = doc["animations"][0]
+    channel = next(c for c in animation["channels"] if c["target"]["path"] == "translation")
+    accessor = doc["accessors"][animation["samplers"][channel["sampler"]]["output"]]
+    view = doc["bufferViews"][accessor["bufferView"]]
+    start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+    keys = np.frombuffer(binary, np.float32, 3 * accessor["count"], start).reshape(-1, 3)
+    assert np.hypot(keys[0][0] - 1.0, keys[0][2] - 2.0) < 0.05, keys[0]
+    assert keys[-1][0] - keys[0][0] > 2.0, (keys[0], keys[-1])
+
+
 def test_step_advances_a_frame_at_fps():
     r = bmlr.Realizer(fps=30)
     r.perform(WELCOME.read_text())

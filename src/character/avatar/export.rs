@@ -89,33 +89,38 @@ pub fn animated_document(
 }
 
 /// Turns the avatar of document `json` by `turn` into the realizer's world: a node named
-/// `realizer frame` with that rotation over the default scene's roots, but for skinned meshes
-/// (which glTF wants at the root and which ignore their parents' transforms: their joints
-/// carry the turn). Nothing changes when the avatar already faces the realizer's way. The
-/// node is appended, so every node keeps its index.
+/// `realizer frame` with that rotation over the default scene's roots (see [`hang_roots`]).
+/// Nothing changes when the avatar already faces the realizer's way.
 fn stand(json: &mut Value, turn: glam::Quat) {
     if turn.angle_between(glam::Quat::IDENTITY) < 1e-4 {
         return;
     }
     let scene = json["scene"].as_u64().unwrap_or(0) as usize;
-    let Some(roots) = json["scenes"][scene]["nodes"].as_array().cloned() else {
-        return;
-    };
+    let roots: Vec<usize> = (json["scenes"][scene]["nodes"]
+        .as_array()
+        .into_iter()
+        .flatten())
+    .filter_map(|n| Some(n.as_u64()? as usize))
+    .collect();
     let Some(nodes) = json["nodes"].as_array_mut() else {
         return;
     };
-    let (skinned, children): (Vec<Value>, Vec<Value>) = roots.into_iter().partition(|n| {
-        let node = n.as_u64().and_then(|n| nodes.get(n as usize));
-        node.is_some_and(|node| node.get("skin").is_some())
-    });
-    let at = nodes.len();
-    nodes.push(
-        json!({"name": "realizer frame", "rotation": turn.to_array(),
-                      "children": children}),
-    );
-    let mut roots = skinned;
-    roots.push(json!(at));
-    json["scenes"][scene]["nodes"] = Value::Array(roots);
+    let node = json!({"name": "realizer frame", "rotation": turn.to_array()});
+    let roots = hang_roots(nodes, &roots, node);
+    json["scenes"][scene]["nodes"] = json!(roots);
+}
+
+/// Appends `node` to `nodes` as the parent of the scene's `roots`, but for skinned meshes,
+/// which glTF wants at the root (a skinned mesh ignores its parents' transforms: its joints
+/// carry them); returns the scene's new roots: the skinned meshes, then `node`. Every node
+/// keeps its index.
+pub(super) fn hang_roots(nodes: &mut Vec<Value>, roots: &[usize], mut node: Value) -> Vec<usize> {
+    let (mut skinned, children): (Vec<usize>, Vec<usize>) =
+        (roots.iter()).partition(|&&n| nodes.get(n).is_some_and(|node| node.get("skin").is_some()));
+    node["children"] = json!(children);
+    skinned.push(nodes.len());
+    nodes.push(node);
+    skinned
 }
 
 /// The animation of `frames` on `model`, its keys appended to `buf`.

@@ -335,14 +335,6 @@ impl Retarget {
         world
     }
 
-    /// Places character `id` where `world` has it stand: the avatar stands there, and only
-    /// its travel from there is scaled by the ratio of leg lengths (so that its feet do not
-    /// slide), not its place. Give the world as it was when the motion began (a walk moves
-    /// the character's placement; see [`Retarget::place_at`]).
-    pub fn place_in(&mut self, world: &crate::world::World, id: &str) {
-        self.place_at(world.placement(id));
-    }
-
     /// Places the avatar where the character stood when its motion began: its travel from
     /// there is scaled by the ratio of leg lengths, its place is not.
     pub fn place_at(&mut self, at: crate::world::Placement) {

@@ -3,12 +3,14 @@
 //! Every index is offset by the items of its kind that came before; the buffers become the one
 //! binary chunk; each character's scene hangs under a node named after the character; the
 //! realized motions become one animation, the first, so that every character plays together in
-//! a viewer that plays one animation (the avatars' files' own animations are kept after it). Extensions of the whole document (VRM's humanoid, expressions, spring bones, a
-//! light list) describe one avatar and are dropped, with node extensions that point into them;
-//! material and texture extensions are kept.
+//! a viewer that plays one animation (the avatars' files' own animations are kept after it).
+//! Extensions of the whole document (VRM's humanoid, expressions, spring bones, a light list)
+//! describe one avatar and are dropped, with node extensions that point into them; material and
+//! texture extensions are kept.
 
 use serde_json::{json, Map, Value};
 
+use super::export::hang_roots;
 use crate::body::gltf::glb;
 
 /// The kinds of top-level items whose indices are offset.
@@ -218,19 +220,19 @@ impl Merge {
                 self.own.push(own);
             }
         }
-        // the character's node over its scene's roots, but for skinned meshes, which glTF
-        // wants at the root (a skinned mesh ignores its parents' transforms)
+        // the character's node over its scene's roots, skinned meshes apart
         let scene = doc["scene"].as_u64().unwrap_or(0) as usize;
-        let (skinned, children): (Vec<usize>, Vec<usize>) = (doc["scenes"][scene]["nodes"]
+        let roots: Vec<usize> = (doc["scenes"][scene]["nodes"]
             .as_array()
             .into_iter()
             .flatten())
-        .filter_map(Value::as_u64)
-        .map(|n| n as usize + nodes)
-        .partition(|&n| self.out["nodes"][n].get("skin").is_some());
-        self.roots.extend(skinned);
-        self.roots.push(self.len("nodes"));
-        self.push("nodes", json!({"name": name, "children": children}));
+        .filter_map(|n| Some(n.as_u64()? as usize + nodes))
+        .collect();
+        let all = self.out.entry("nodes").or_insert_with(|| json!([]));
+        if let Some(all) = all.as_array_mut() {
+            self.roots
+                .extend(hang_roots(all, &roots, json!({"name": name})));
+        }
         for (key, list) in [
             ("extensionsUsed", &mut self.used),
             ("extensionsRequired", &mut self.required),
