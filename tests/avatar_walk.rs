@@ -1,7 +1,8 @@
 //! The avatars walk as the realizer's skeleton does: while the realizer plants a foot, the
 //! avatar's ankle stands at its own rest height and does not slide. Checked on the default
 //! avatar (its skeleton is the realizer's) and on a Mixamo-named T-pose in centimetres (every
-//! bone aligned and turned, the travel scaled by the ratio of leg lengths) — a test of what the
+//! bone aligned and turned, the travel scaled by the ratio of leg lengths) and on a published
+//! VRM 0.x (`fixtures/avatars/cryptovoxels/`, facing −z) — a test of what the
 //! pictures show: feet on the floor, not skating.
 
 #[path = "common/avatars.rs"]
@@ -110,5 +111,15 @@ fn a_walking_avatar_s_planted_feet_stay_on_the_floor_and_do_not_slide() {
     assert!(
         height < 0.015 && slide < 0.02,
         "Mixamo avatar: {height} m high, {slide} m slid"
+    );
+    // a VRM 0.x someone published (facing −z, shorter legs: its travel scaled by about 0.77)
+    let path = std::path::Path::new("fixtures/avatars/cryptovoxels/cryptovoxels.vrm");
+    let vrm = Model::read(path).unwrap();
+    let feet = [["Left ankle", "Left toe"], ["Right ankle", "Right toe"]];
+    let (height, slide) = planted(&vrm, feet, &frames);
+    eprintln!("published VRM 0.x: planted feet {height:.4} m off the floor, slide {slide:.4} m");
+    assert!(
+        height < 0.015 && slide < 0.02,
+        "published VRM 0.x: {height} m high, {slide} m slid"
     );
 }
