@@ -1,176 +1,144 @@
-//! The realized gait measured as gait laboratories measure people: a straight walk at STROLL,
-//! WALK and RUN realized at 240 frames a second, each frame's joint places by forward
-//! kinematics, the left leg's sagittal angles (knee flexion, hip flexion against the pelvis,
-//! ankle dorsiflexion against its rest) over the gait cycles of the steady part of the walk,
-//! cycles cut at the left foot's contact. Prints, per manner, the values the published norms
-//! give (knee at contact, loading peak, least stance flexion, swing peak and when; hip at
-//! contact, greatest extension, range; ankle at contact, in loading, greatest stance
-//! dorsiflexion, at toe-off; the pelvis's rise; the stance fraction), averaged over cycles.
+//! The realized gait measured as gait laboratories measure people (see `tests/common/gait_lab.rs`):
+//! a straight walk at STROLL, WALK and RUN realized at 240 frames a second, the left leg's
+//! sagittal angles, the pelvis and the contacts over the steady cycles; prints each measure's
+//! mean beside its published band, and draws the mean knee, hip and ankle curves of each manner
+//! over the bands' key values into `docs/gait-curves.svg`.
 //!
 //! Run: `cargo run --release --example gait_norms`
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::realizer::Realizer;
-use glam::{Quat, Vec3};
+#[path = "../tests/common/gait_lab.rs"]
+mod gait_lab;
+
+use gait_lab::{bands, cycles, mean_curves, means, record, Band, MEASURES};
+use std::fmt::Write;
 
 const FPS: f64 = 240.0;
 
-/// One frame's measures of the left leg.
-#[derive(Clone, Copy, Debug)]
-struct Sample {
-    knee: f32,
-    hip: f32,
-    ankle: f32,
-    pelvis_y: f32,
-    contact: bool,
-}
+/// One manner's plot: its name, mean knee, hip and ankle curves, and its bands.
+type Plot<'a> = (&'a str, [Vec<f32>; 3], &'a [Band]);
 
 fn main() {
-    let skeleton = Skeleton::adult();
-    let j = |n: &str| skeleton.joint(n).unwrap();
-    let (hip, knee, ankle, ball) = (
-        j("l_hip"),
-        j("l_knee"),
-        j("l_talocrural"),
-        j("l_metatarsal"),
-    );
-    let rest = Pose::rest(&skeleton).world(&skeleton);
-    let rest_ankle_angle = sagittal_angle(
-        rest.positions[ankle] - rest.positions[knee],
-        rest.positions[ball] - rest.positions[ankle],
-    );
-    let rest_ball_y = rest.positions[ball].y;
-    // the heel: under the ankle on the floor, 5 cm behind it, at rest (in the foot's frame)
-    let heel_offset =
-        rest.orientations[ankle].inverse() * Vec3::new(0.0, -rest.positions[ankle].y, -0.05);
-    for (manner, distance) in [("STROLL", 20), ("WALK", 30), ("RUN", 60)] {
-        let bml = format!(
-            r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><locomotion id="w" target="0,{distance}" manner="{manner}"/></bml>"#
-        );
-        let mut r = Realizer::new().with_idle(false);
-        r.perform_bml(&bml).unwrap();
-        let mut samples = Vec::new();
-        let seconds = match manner {
-            "RUN" => 16.0,
-            _ => 18.0,
-        };
-        for i in 0..(seconds * FPS) as usize {
-            let t = i as f64 / FPS;
-            let frame = r.tick(t);
-            let world = frame.poses[0].pose.world(&skeleton);
-            let p = |k: usize| world.positions[k];
-            let pelvis = world.orientations[0];
-            let heel = p(ankle) + world.orientations[ankle] * heel_offset;
-            // on the ground: the heel or the ball of the foot down
-            let contact = heel.y < 0.02 || p(ball).y < rest_ball_y + 0.01;
-            let thigh = p(knee) - p(hip);
-            let down = pelvis * Vec3::NEG_Y;
-            samples.push(Sample {
-                knee: 180.0
-                    - (p(hip) - p(knee))
-                        .angle_between(p(ankle) - p(knee))
-                        .to_degrees(),
-                hip: signed_forward(down, thigh, pelvis),
-                ankle: rest_ankle_angle - sagittal_angle(p(ankle) - p(knee), p(ball) - p(ankle)),
-                pelvis_y: frame.poses[0].pose.root.y,
-                contact,
-            });
+    let mut plots = Vec::new();
+    for (manner, distance, seconds) in [
+        ("STROLL", 20.0, 18.0),
+        ("WALK", 30.0, 18.0),
+        ("RUN", 60.0, 16.0),
+    ] {
+        let samples = record(manner, distance, seconds, FPS);
+        let cycles = cycles(&samples);
+        let m = means(&cycles, FPS);
+        println!("{manner}: {} cycles", cycles.len());
+        for (k, name) in MEASURES.iter().enumerate() {
+            let band = bands(manner).iter().find(|b| b.0 == k);
+            let verdict = match band {
+                Some(&(_, lo, hi, source)) => {
+                    let ok = if (lo..=hi).contains(&m[k]) {
+                        "in"
+                    } else {
+                        "OUT"
+                    };
+                    format!("{ok:>3} [{lo}, {hi}] {source}")
+                }
+                None => String::new(),
+            };
+            println!("  {name:<36} {:8.2}   {verdict}", m[k]);
         }
-        report(manner, &samples);
+        plots.push((manner, mean_curves(&cycles), bands(manner)));
     }
+    std::fs::write("docs/gait-curves.svg", svg(&plots)).expect("write docs/gait-curves.svg");
+    println!("wrote docs/gait-curves.svg");
 }
 
-/// The angle (degrees) from `a` to `b` in the sagittal (y, z) plane, positive turning
-/// forward (+z) from down.
-fn sagittal_angle(a: Vec3, b: Vec3) -> f32 {
-    let angle = |v: Vec3| v.z.atan2(-v.y);
-    (angle(b) - angle(a)).to_degrees()
+/// Where in the cycle (%) a band's measure belongs, and which joint's plot it goes on
+/// (0 knee, 1 hip, 2 ankle); none for the measures that are not a joint's angle at a moment.
+fn placed(measure: usize, curves: &[Vec<f32>; 3]) -> Option<(usize, f32)> {
+    let argmax = |v: &[f32]| (0..v.len()).fold(0, |m, i| if v[i] > v[m] { i } else { m }) as f32;
+    let argmin = |v: &[f32]| (0..v.len()).fold(0, |m, i| if v[i] < v[m] { i } else { m }) as f32;
+    Some(match measure {
+        0 => (0, 0.0),
+        1 => (0, 12.0),
+        2 => (0, 40.0),
+        3 => (0, argmax(&curves[0])),
+        5 => (1, 0.0),
+        6 => (1, argmin(&curves[1])),
+        9 => (2, 0.0),
+        10 => (2, 7.0),
+        11 => (2, 45.0),
+        12 => (2, 62.0),
+        _ => return None,
+    })
 }
 
-/// How far (degrees) `thigh` points forward of `down`, in the pelvis's sagittal plane.
-fn signed_forward(down: Vec3, thigh: Vec3, pelvis: Quat) -> f32 {
-    let to_pelvis = pelvis.inverse();
-    let (d, t) = (to_pelvis * down, to_pelvis * thigh);
-    sagittal_angle(Vec3::new(0.0, d.y, d.z), Vec3::new(0.0, t.y, t.z))
-}
-
-fn report(manner: &str, s: &[Sample]) {
-    // contacts (heel strikes) of the left foot: down after a tenth of a second in the air
-    let air = (0.1 * FPS) as usize;
-    let strikes: Vec<usize> = (air..s.len())
-        .filter(|&i| s[i].contact && s[i - air..i].iter().all(|x| !x.contact))
-        .collect();
-    // the steady part: drop the first two and the last two cycles
-    if strikes.len() < 6 {
-        println!("{manner}: only {} strikes", strikes.len());
-        return;
+/// Three rows (the manners) of three plots (knee, hip, ankle): the realized mean curve, the
+/// bands' key values as bars.
+fn svg(plots: &[Plot]) -> String {
+    let (w, h, pad) = (300.0f32, 170.0f32, 30.0f32);
+    let ranges = [(-10.0f32, 110.0f32), (-30.0, 60.0), (-40.0, 30.0)];
+    let joints = ["knee flexion", "hip flexion", "ankle dorsiflexion"];
+    let mut out = String::new();
+    let (width, height) = (3.0 * w + pad, plots.len() as f32 * h + pad);
+    let _ = writeln!(
+        out,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" font-size="11"><rect width="100%" height="100%" fill="white"/>"#
+    );
+    for (row, (manner, curves, bands)) in plots.iter().enumerate() {
+        for (col, curve) in curves.iter().enumerate() {
+            let (x0, y0) = (pad + col as f32 * w, pad / 2.0 + row as f32 * h);
+            let (pw, ph) = (w - 50.0, h - 40.0);
+            let (lo, hi) = ranges[col];
+            let y = |v: f32| y0 + 15.0 + ph * (hi - v) / (hi - lo);
+            let x = |pct: f32| x0 + 22.0 + pw * pct / 100.0;
+            let _ = writeln!(
+                out,
+                r##"<text x="{}" y="{}">{manner}: {} (deg) over the cycle</text><rect x="{}" y="{}" width="{pw}" height="{ph}" fill="none" stroke="#999"/><line x1="{}" x2="{}" y1="{}" y2="{}" stroke="#ccc"/>"##,
+                x0 + 10.0,
+                y0 + 10.0,
+                joints[col],
+                x(0.0),
+                y(hi),
+                x(0.0),
+                x(100.0),
+                y(0.0),
+                y(0.0)
+            );
+            for v in [lo, 0.0, hi] {
+                let _ = writeln!(
+                    out,
+                    r##"<text x="{}" y="{}" font-size="9" fill="#555" text-anchor="end">{v}</text>"##,
+                    x(0.0) - 2.0,
+                    y(v) + 3.0
+                );
+            }
+            for &(k, blo, bhi, _) in bands.iter() {
+                if let Some((joint, pct)) = placed(k, curves) {
+                    if joint == col {
+                        let _ = writeln!(
+                            out,
+                            r##"<rect x="{}" y="{}" width="8" height="{}" fill="#8c8" fill-opacity="0.6"/>"##,
+                            x(pct) - 4.0,
+                            y(bhi),
+                            y(blo) - y(bhi)
+                        );
+                    }
+                }
+            }
+            let points: Vec<String> = curve
+                .iter()
+                .enumerate()
+                .map(|(i, v)| format!("{:.1},{:.1}", x(i as f32), y(v.clamp(lo, hi))))
+                .collect();
+            let _ = writeln!(
+                out,
+                r##"<polyline points="{}" fill="none" stroke="#c33" stroke-width="1.5"/>"##,
+                points.join(" ")
+            );
+        }
     }
-    let cycles: Vec<(usize, usize)> = strikes[2..strikes.len() - 2]
-        .windows(2)
-        .map(|w| (w[0], w[1]))
-        .collect();
-    let mut rows: Vec<[f32; 15]> = Vec::new();
-    for &(a, b) in &cycles {
-        let c = &s[a..b];
-        let n = c.len();
-        let at = |f: f32| ((f * n as f32) as usize).min(n - 1);
-        let span = |f0: f32, f1: f32| &c[at(f0)..at(f1).max(at(f0) + 1)];
-        let max = |v: &[Sample], g: fn(&Sample) -> f32| v.iter().map(g).fold(f32::MIN, f32::max);
-        let min = |v: &[Sample], g: fn(&Sample) -> f32| v.iter().map(g).fold(f32::MAX, f32::min);
-        let toe_off = (0..n)
-            .find(|&i| c[i..(i + air).min(n)].iter().all(|x| !x.contact))
-            .unwrap_or(n);
-        let stance = toe_off as f32 / n as f32;
-        let (swing_peak, swing_at) = c
-            .iter()
-            .enumerate()
-            .map(|(i, x)| (x.knee, i))
-            .fold((f32::MIN, 0), |m, v| if v.0 > m.0 { v } else { m });
-        let hips: Vec<f32> = c.iter().map(|x| x.hip).collect();
-        let hip_max = hips.iter().copied().fold(f32::MIN, f32::max);
-        let hip_min = hips.iter().copied().fold(f32::MAX, f32::min);
-        rows.push([
-            c[0].knee,
-            max(span(0.0, 0.2), |x| x.knee),
-            min(span(0.15, stance), |x| x.knee),
-            swing_peak,
-            swing_at as f32 / n as f32 * 100.0,
-            c[0].hip,
-            hip_min,
-            hip_max - hip_min,
-            c[0].ankle,
-            min(span(0.0, 0.15), |x| x.ankle),
-            max(span(0.1, stance), |x| x.ankle),
-            min(span(stance - 0.05, stance + 0.08), |x| x.ankle),
-            max(c, |x| x.pelvis_y) - min(c, |x| x.pelvis_y),
-            stance * 100.0,
-            (b - a) as f32 / FPS as f32,
-        ]);
-    }
-    let names = [
-        "knee at contact (deg)",
-        "knee loading peak",
-        "knee least in stance",
-        "knee swing peak",
-        "  its time (% cycle)",
-        "hip at contact",
-        "hip greatest extension",
-        "hip range",
-        "ankle at contact",
-        "ankle least in loading",
-        "ankle greatest stance dorsiflexion",
-        "ankle at toe-off",
-        "pelvis rise (m)",
-        "stance (% cycle)",
-        "cycle (s)",
-    ];
-    println!("{manner}: {} cycles", rows.len());
-    for (k, name) in names.iter().enumerate() {
-        let v: Vec<f32> = rows.iter().map(|r| r[k]).collect();
-        let mean = v.iter().sum::<f32>() / v.len() as f32;
-        let (lo, hi) = v
-            .iter()
-            .fold((f32::MAX, f32::MIN), |(l, h), &x| (l.min(x), h.max(x)));
-        println!("  {name:<36} {mean:8.3}   ({lo:.3} … {hi:.3})");
-    }
+    let _ = write!(
+        out,
+        r##"<text x="30" y="{}" fill="#555">red: realized mean curve; green bars: published mean ± 2 SD at that moment (docs/locomotion.md)</text>"##,
+        height - 4.0
+    );
+    out.push_str("</svg>\n");
+    out
 }
