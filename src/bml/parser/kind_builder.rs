@@ -84,10 +84,54 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
         }
     }
 
-    /// The behaviour kind of the element being read, from its attributes. Long on purpose: one
-    /// arm per BML element, each a few lines, so the whole attribute grammar reads as one table
-    /// (and beside `Writer::kind_attrs`, which writes it back).
+    /// The behaviour kind of the element being read, from its attributes: a BML 1.0 element or
+    /// an extension's, each family one arm per element, each a few lines, so that its attribute
+    /// grammar reads as one table (and beside `Writer::kind_attrs`, which writes it back).
     pub(super) fn build(&mut self) -> Option<BehaviourKind> {
+        match self.el.name {
+            "interrupt"
+            | "activate"
+            | "parametervaluechange"
+            | "procanimation"
+            | "procanimationgesture"
+            | "keyframe"
+            | "controller"
+            | "audiofile"
+            | "noise"
+            | "facemorph"
+            | "transition" => self.extension(),
+            _ => self.core(),
+        }
+    }
+
+    /// A `faceFacs`: its action unit (required), side and amount.
+    fn face_facs(&mut self) -> Option<FaceFacs> {
+        let au = match self
+            .attrs
+            .items
+            .iter()
+            .flatten()
+            .any(|a| a.ns == Ns::None && a.name == "au")
+        {
+            true => self.u32("au"),
+            false => {
+                self.req("au");
+                None
+            }
+        };
+        let side = self
+            .p
+            .opt_enum(self.attrs, "side", self.on, Side::parse, Side::expected);
+        let amount = self.f64("amount");
+        Some(FaceFacs {
+            au: au?,
+            side,
+            amount,
+        })
+    }
+
+    /// The behaviours of BML 1.0 itself.
+    fn core(&mut self) -> Option<BehaviourKind> {
         let placeholder_posture = || Posture {
             stance: StanceType::Standing,
             poses: Vec::new(),
@@ -149,30 +193,7 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
                 lexeme: self.opt("lexeme").unwrap_or_default(),
                 amount: self.f64("amount"),
             }),
-            "faceFacs" => {
-                let au = match self
-                    .attrs
-                    .items
-                    .iter()
-                    .flatten()
-                    .any(|a| a.ns == Ns::None && a.name == "au")
-                {
-                    true => self.u32("au"),
-                    false => {
-                        self.req("au");
-                        None
-                    }
-                };
-                let side =
-                    self.p
-                        .opt_enum(self.attrs, "side", self.on, Side::parse, Side::expected);
-                let amount = self.f64("amount");
-                BehaviourKind::FaceFacs(FaceFacs {
-                    au: au?,
-                    side,
-                    amount,
-                })
-            }
+            "faceFacs" => BehaviourKind::FaceFacs(self.face_facs()?),
             "posture" => BehaviourKind::Posture(placeholder_posture()),
             "postureShift" => BehaviourKind::PostureShift(placeholder_posture()),
             "locomotion" => {
@@ -186,6 +207,13 @@ impl<'a, 'i> KindBuilder<'a, 'i> {
             "wait" => BehaviourKind::Wait(Wait {
                 max_wait: self.f64("max-wait"),
             }),
+            _ => return None,
+        })
+    }
+
+    /// The behaviours of the BMLA and BMLT extensions.
+    fn extension(&mut self) -> Option<BehaviourKind> {
+        Some(match self.el.name {
             "interrupt" => {
                 let target = self.req("target");
                 let include = self.list("include");

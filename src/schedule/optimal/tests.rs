@@ -1,5 +1,6 @@
 //! The unit tests of `optimal`.
 
+use super::fast::{at_preferred_timing, pinned_apart};
 use super::*;
 use crate::bml;
 use crate::schedule::links::resolve;
