@@ -7,15 +7,15 @@
 
 use glam::{Vec2, Vec3};
 
+use super::{
+    footstep_mode, turn_toward, Active, Moments, Others, Walker, HALT_DECELERATION, NEAR_ENOUGH,
+    REPLAN_EVERY, STEP, STOP_RADIUS, TURN_EASE, TURN_FIRST, TURN_ON_THE_SPOT, TURN_RATE,
+};
 use crate::locomotion::among::{neighbours, Near};
 use crate::locomotion::gait::{angle_diff, forward};
 use crate::locomotion::obstacles::Obstacles;
 use crate::locomotion::path;
 use crate::locomotion::steering::{flat, Behaviour, Context};
-use super::{
-    footstep_mode, turn_toward, Active, Moments, Others, Walker, HALT_DECELERATION, NEAR_ENOUGH,
-    REPLAN_EVERY, STEP, STOP_RADIUS, TURN_EASE, TURN_FIRST, TURN_ON_THE_SPOT, TURN_RATE,
-};
 
 impl Walker {
     /// One step; the moments when the walk ends in it.
@@ -53,7 +53,7 @@ impl Walker {
         others: Option<Others<'_>>,
     ) {
         let time = self.time;
-        let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+        let here = self.body().at;
         let to_goal = a.walk.goal - here;
         // the point sought now (not the route's first: one pushed past it and slowed down
         // turned back to it on the spot)
@@ -128,7 +128,7 @@ impl Walker {
         others: Option<Others<'_>>,
     ) {
         let time = self.time;
-        let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+        let here = self.body().at;
         let to_goal = a.walk.goal - here;
         let Some(plan) = a.plan.as_mut() else {
             return;
@@ -188,7 +188,7 @@ impl Walker {
         route: &[Vec2],
         left: f32,
     ) {
-        let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+        let here = self.body().at;
         let f = a.steering.force(
             &mut self.vehicle,
             Context {
@@ -258,14 +258,14 @@ impl Walker {
         self.vehicle.position.y = 0.0;
         self.vehicle.velocity.y = 0.0;
         if let Some(o) = others {
-            let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+            let here = self.body().at;
             // (bodies never pass through each other, seen or not)
             let everyone = Others { known: None, ..o };
             let near = neighbours(everyone, self.time, here, self.radius + 1.0);
             let out = crate::crowd::contact::pushed_out(here, self.radius, near, dt);
             self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
         }
-        let here = Vec2::new(self.vehicle.position.x, self.vehicle.position.z);
+        let here = self.body().at;
         let out = obstacles.push_out(here, self.radius);
         if out != here {
             self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
