@@ -8,8 +8,8 @@
 
 use glam::{Vec2, Vec3};
 
-pub use super::among::Others;
 use super::among::neighbours;
+pub use super::among::Others;
 use super::gait::{angle_diff, Body, Gait};
 use super::obstacles::Obstacles;
 use super::path::{self, PathError};
