@@ -210,19 +210,45 @@ impl Writer {
         }
     }
 
-    /// The attributes of a behaviour kind. Long on purpose: one arm per BML element, the mirror
-    /// of the parser's `build`, kept as one table so that the two compare side by side.
+    /// The attributes of a behaviour kind: a BML 1.0 element's or an extension's, each family
+    /// one arm per element, the mirror of the parser's kind builder, so that the two compare
+    /// side by side.
     fn kind_attrs(&mut self, kind: &BehaviourKind) {
-        let opt = |w: &mut Writer, name: &str, v: &Option<String>| {
-            if let Some(v) = v {
-                w.attr(name, v);
-            }
-        };
-        let optf = |w: &mut Writer, name: &str, v: Option<f64>| {
-            if let Some(v) = v {
-                w.attr(name, &num(v));
-            }
-        };
+        use BehaviourKind as K;
+        match kind {
+            K::Speech(_)
+            | K::Text(_)
+            | K::Gesture(_)
+            | K::Pointing(_)
+            | K::Head(_)
+            | K::HeadDirectionShift { .. }
+            | K::Gaze(_)
+            | K::GazeShift(_)
+            | K::Face(_)
+            | K::FaceLexeme(_)
+            | K::FaceShift(_)
+            | K::FaceFacs(_)
+            | K::Posture(_)
+            | K::PostureShift(_)
+            | K::Locomotion(_)
+            | K::Wait(_) => self.core_attrs(kind),
+            K::Interrupt(_)
+            | K::Activate(_)
+            | K::ParameterValueChange(_)
+            | K::ProcAnimation(_)
+            | K::ProcAnimationGesture(_)
+            | K::Keyframe(_)
+            | K::Controller(_)
+            | K::AudioFile { .. }
+            | K::Noise(_)
+            | K::FaceMorph(_)
+            | K::Transition(_)
+            | K::Unknown(_) => self.extension_attrs(kind),
+        }
+    }
+
+    /// The attributes of BML 1.0's own behaviours.
+    fn core_attrs(&mut self, kind: &BehaviourKind) {
         match kind {
             BehaviourKind::Speech(_) | BehaviourKind::Text(_) => {}
             BehaviourKind::Gesture(g) => {
@@ -242,7 +268,7 @@ impl Writer {
                 if let Some(r) = h.repetition {
                     self.attr("repetition", &r.to_string());
                 }
-                optf(self, "amount", h.amount);
+                self.opt_num("amount", h.amount);
             }
             BehaviourKind::HeadDirectionShift { target } => self.attr("target", target),
             BehaviourKind::Gaze(g) | BehaviourKind::GazeShift(g) => {
@@ -250,38 +276,45 @@ impl Writer {
                 if let Some(i) = g.influence {
                     self.attr("influence", i.as_str());
                 }
-                optf(self, "offsetAngle", g.offset_angle);
+                self.opt_num("offsetAngle", g.offset_angle);
                 if let Some(d) = g.offset_direction {
                     self.attr("offsetDirection", d.as_str());
                 }
             }
             BehaviourKind::Face(f) => {
-                opt(self, "lexeme", &f.lexeme);
+                self.opt_attr("lexeme", &f.lexeme);
                 if let Some(au) = f.au {
                     self.attr("au", &au.to_string());
                 }
                 if let Some(s) = f.side {
                     self.attr("side", s.as_str());
                 }
-                optf(self, "amount", f.amount);
+                self.opt_num("amount", f.amount);
             }
             BehaviourKind::FaceLexeme(f) | BehaviourKind::FaceShift(f) => {
                 self.attr("lexeme", &f.lexeme);
-                optf(self, "amount", f.amount);
+                self.opt_num("amount", f.amount);
             }
             BehaviourKind::FaceFacs(f) => {
                 self.attr("au", &f.au.to_string());
                 if let Some(s) = f.side {
                     self.attr("side", s.as_str());
                 }
-                optf(self, "amount", f.amount);
+                self.opt_num("amount", f.amount);
             }
             BehaviourKind::Posture(_) | BehaviourKind::PostureShift(_) => {}
             BehaviourKind::Locomotion(l) => {
                 self.attr("target", &l.target);
-                opt(self, "manner", &l.manner);
+                self.opt_attr("manner", &l.manner);
             }
-            BehaviourKind::Wait(w) => optf(self, "max-wait", w.max_wait),
+            BehaviourKind::Wait(w) => self.opt_num("max-wait", w.max_wait),
+            _ => {}
+        }
+    }
+
+    /// The attributes of the BMLA and BMLT extensions' behaviours.
+    fn extension_attrs(&mut self, kind: &BehaviourKind) {
+        match kind {
             BehaviourKind::Interrupt(i) => {
                 self.attr("target", &i.target);
                 self.list("include", &i.include);
@@ -299,12 +332,12 @@ impl Writer {
             BehaviourKind::ProcAnimation(a)
             | BehaviourKind::ProcAnimationGesture(a)
             | BehaviourKind::Keyframe(a) => {
-                opt(self, "name", &a.name);
-                opt(self, "fileName", &a.file_name);
+                self.opt_attr("name", &a.name);
+                self.opt_attr("fileName", &a.file_name);
             }
             BehaviourKind::Controller(c) => {
                 self.attr("class", &c.class);
-                opt(self, "name", &c.name);
+                self.opt_attr("name", &c.name);
             }
             BehaviourKind::AudioFile { file_name } => self.attr("fileName", file_name),
             BehaviourKind::Noise(n) => {
@@ -313,12 +346,27 @@ impl Writer {
             }
             BehaviourKind::FaceMorph(f) => {
                 self.attr("targetname", &f.target_name);
-                optf(self, "intensity", f.intensity);
+                self.opt_num("intensity", f.intensity);
             }
             BehaviourKind::Transition(t) => self.attr("class", &t.class),
             BehaviourKind::Unknown(u) => {
                 self.foreign(&u.attrs);
             }
+            _ => {}
+        }
+    }
+
+    /// `name="v"` where there is a value.
+    fn opt_attr(&mut self, name: &str, v: &Option<String>) {
+        if let Some(v) = v {
+            self.attr(name, v);
+        }
+    }
+
+    /// `name="v"` (a number) where there is a value.
+    fn opt_num(&mut self, name: &str, v: Option<f64>) {
+        if let Some(v) = v {
+            self.attr(name, &num(v));
         }
     }
 
