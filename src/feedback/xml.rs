@@ -26,7 +26,7 @@ fn attr(out: &mut String, name: &str, value: &str) {
 }
 
 /// Encodes one message as a single line of XML (no trailing newline). One arm per feedback
-/// element, written attribute by attribute in the order of docs/cli.md: long, but a flat table.
+/// element, written attribute by attribute in the order of docs/cli.md.
 pub fn to_xml(fb: &Feedback) -> String {
     let mut o = String::with_capacity(160);
     match fb {
@@ -73,49 +73,7 @@ pub fn to_xml(fb: &Feedback) -> String {
             }
             o.push_str("/>");
         }
-        Feedback::Prediction(p) => {
-            open(
-                &mut o,
-                "predictionFeedback",
-                p.blocks.iter().any(|b| b.status.is_some()),
-            );
-            if let Some(c) = &p.character_id {
-                attr(&mut o, "characterId", c);
-            }
-            if p.blocks.is_empty() && p.behaviours.is_empty() {
-                o.push_str("/>");
-                return o;
-            }
-            o.push('>');
-            for b in &p.blocks {
-                o.push_str("<bml");
-                attr(&mut o, "id", &b.id);
-                if let Some(v) = b.global_start {
-                    attr(&mut o, "globalStart", &t(v));
-                }
-                if let Some(v) = b.global_end {
-                    attr(&mut o, "globalEnd", &t(v));
-                }
-                if let Some(s) = b.status {
-                    attr(&mut o, "bmla:status", s.as_str());
-                }
-                o.push_str("/>");
-            }
-            for b in &p.behaviours {
-                let _ = write!(o, "<{}", b.kind);
-                attr(&mut o, "id", &format!("{}:{}", b.block, b.behaviour));
-                for (name, v) in &b.attributes {
-                    attr(&mut o, name, v);
-                }
-                // (a repeated head's later strokes, `stroke:1` …, are no XML attribute names:
-                // their times come in syncPointProgress and in the JSON form)
-                for (sync, v) in b.syncs.iter().filter(|(s, _)| !s.contains(':')) {
-                    attr(&mut o, sync, &t(*v));
-                }
-                o.push_str("/>");
-            }
-            o.push_str("</predictionFeedback>");
-        }
+        Feedback::Prediction(p) => prediction_to_xml(&mut o, p),
         Feedback::World(w) => return w.to_xml(),
         Feedback::Warning(w) => {
             open(&mut o, "warningFeedback", false);
@@ -135,6 +93,51 @@ pub fn to_xml(fb: &Feedback) -> String {
         }
     }
     o
+}
+
+/// A `predictionFeedback`: its blocks' and behaviours' predicted times as child elements.
+fn prediction_to_xml(o: &mut String, p: &PredictionFeedback) {
+    open(
+        o,
+        "predictionFeedback",
+        p.blocks.iter().any(|b| b.status.is_some()),
+    );
+    if let Some(c) = &p.character_id {
+        attr(o, "characterId", c);
+    }
+    if p.blocks.is_empty() && p.behaviours.is_empty() {
+        o.push_str("/>");
+        return;
+    }
+    o.push('>');
+    for b in &p.blocks {
+        o.push_str("<bml");
+        attr(o, "id", &b.id);
+        if let Some(v) = b.global_start {
+            attr(o, "globalStart", &t(v));
+        }
+        if let Some(v) = b.global_end {
+            attr(o, "globalEnd", &t(v));
+        }
+        if let Some(s) = b.status {
+            attr(o, "bmla:status", s.as_str());
+        }
+        o.push_str("/>");
+    }
+    for b in &p.behaviours {
+        let _ = write!(o, "<{}", b.kind);
+        attr(o, "id", &format!("{}:{}", b.block, b.behaviour));
+        for (name, v) in &b.attributes {
+            attr(o, name, v);
+        }
+        // (a repeated head's later strokes, `stroke:1` …, are no XML attribute names:
+        // their times come in syncPointProgress and in the JSON form)
+        for (sync, v) in b.syncs.iter().filter(|(s, _)| !s.contains(':')) {
+            attr(o, sync, &t(*v));
+        }
+        o.push_str("/>");
+    }
+    o.push_str("</predictionFeedback>");
 }
 
 /// Attributes of one element: (is BMLA, local name, value).
