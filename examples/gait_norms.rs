@@ -9,7 +9,7 @@
 #[path = "../tests/common/gait_lab.rs"]
 mod gait_lab;
 
-use gait_lab::{bands, cycles, mean_curves, means, record, Band, MEASURES};
+use gait_lab::{bands, cycles, mean_curves, means, record, Band, MEASURES, WALKS};
 use std::fmt::Write;
 
 const FPS: f64 = 240.0;
@@ -19,11 +19,7 @@ type Plot<'a> = (&'a str, [Vec<f32>; 3], &'a [Band]);
 
 fn main() {
     let mut plots = Vec::new();
-    for (manner, distance, seconds) in [
-        ("STROLL", 20.0, 18.0),
-        ("WALK", 30.0, 18.0),
-        ("RUN", 60.0, 16.0),
-    ] {
+    for (manner, distance, seconds) in WALKS {
         let samples = record(manner, distance, seconds, FPS);
         let cycles = cycles(&samples);
         let m = means(&cycles, FPS);

@@ -8,7 +8,7 @@
 mod gait_lab;
 
 use bml_realizer::body::{Pose, Skeleton};
-use gait_lab::{bands, cycles, means, record, sample, MEASURES};
+use gait_lab::{bands, cycles, means, record, sample, MEASURES, WALKS};
 use glam::Quat;
 
 const FPS: f64 = 120.0;
@@ -58,11 +58,7 @@ fn the_laboratory_finds_the_realizer_s_stance_and_cadence() {
 #[ignore = "fails today: knees bent ~20 deg through the stance, swing peak late, hip range 70 deg, no push-off (ankle dorsiflexed at toe-off), the run barely rises; run with --ignored"]
 fn the_gait_is_within_people_s_norms_at_stroll_walk_and_run() {
     let mut out = Vec::new();
-    for (manner, distance, seconds) in [
-        ("STROLL", 20.0, 18.0),
-        ("WALK", 30.0, 18.0),
-        ("RUN", 60.0, 16.0),
-    ] {
+    for (manner, distance, seconds) in WALKS {
         let m = means(&cycles(&record(manner, distance, seconds, FPS)), FPS);
         for &(k, lo, hi, source) in bands(manner) {
             if !(lo..=hi).contains(&m[k]) {

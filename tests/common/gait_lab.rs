@@ -113,6 +113,14 @@ pub fn cycles(s: &[Sample]) -> Vec<&[Sample]> {
         .collect()
 }
 
+/// The walks measured: manner, distance (m) and how long it is recorded (s), long enough for
+/// eight steady cycles or more.
+pub const WALKS: [(&str, f32, f64); 3] = [
+    ("STROLL", 20.0, 18.0),
+    ("WALK", 30.0, 18.0),
+    ("RUN", 60.0, 16.0),
+];
+
 /// The measures, in the order of [`MEASURES`].
 pub const MEASURES: [&str; 22] = [
     "knee at contact (deg)",

@@ -84,7 +84,7 @@ impl Walker {
                 None => path::length(&route),
             };
             if a.plan.is_some() {
-                self.follow_footsteps(a, dt, obstacles, others);
+                self.follow_footsteps(a, dt, obstacles, others, here);
             } else if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
                 self.turn_first(a, wanted, dt);
             } else {
@@ -118,17 +118,17 @@ impl Walker {
         }
     }
 
-    /// A footstep walk: the velocity its steps ask for, or standing when it has closed its
-    /// feet at the goal or no step leads anywhere better.
+    /// A footstep walk from `here`: the velocity its steps ask for, or standing when it has
+    /// closed its feet at the goal or no step leads anywhere better.
     fn follow_footsteps(
         &mut self,
         a: &mut Active,
         dt: f32,
         obstacles: &Obstacles,
         others: Option<Others<'_>>,
+        here: Vec2,
     ) {
         let time = self.time;
-        let here = self.body().at;
         let to_goal = a.walk.goal - here;
         let Some(plan) = a.plan.as_mut() else {
             return;
