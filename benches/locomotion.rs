@@ -12,8 +12,9 @@ use bml_realizer::locomotion::posing::{pose_gait, GaitJoints};
 use bml_realizer::locomotion::steering::{
     ArriveParams, Behaviour, Combine, Context, Part, Steering, Vehicle,
 };
-use bml_realizer::locomotion::{path, Obstacle, Obstacles, Shape, Walk, Walker};
+use bml_realizer::locomotion::{Walk, Walker};
 use bml_realizer::realizer::Realizer;
+use bml_realizer::space::{path, Obstacle, Obstacles, Shape};
 use bml_realizer::world::{Placement, World};
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{Vec2, Vec3};

@@ -74,7 +74,7 @@ fn walk(mut crowd: impl Stepped, scene: &Scene) -> Quality {
             t.gave_up = m.gave_up;
         }
     }
-    let walls = bml_realizer::locomotion::Obstacles::new(scene.walls.clone());
+    let walls = bml_realizer::space::Obstacles::new(scene.walls.clone());
     measure(&tracks, DT, &walls, &scene.spaces)
 }
 

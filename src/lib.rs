@@ -70,6 +70,7 @@ pub mod realizer;
 pub mod rng;
 pub mod schedule;
 pub mod sound;
+pub mod space;
 #[cfg(test)]
 mod testrand;
 pub mod timeline;

@@ -6,7 +6,14 @@
 
 use std::sync::Arc;
 
-use crate::voice::Audio;
+/// Audio: mono 16-bit samples at a rate (what a voice synthesizes, a clip holds, a run mixes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Audio {
+    /// Samples per second.
+    pub rate: u32,
+    /// 16-bit samples.
+    pub samples: Vec<i16>,
+}
 
 /// A sound playing in a frame.
 #[derive(Debug, Clone, PartialEq)]

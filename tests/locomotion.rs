@@ -653,8 +653,8 @@ fn a_walk_to_another_character_stops_at_social_distance_facing_them() {
 }
 
 mod routes {
-    use bml_realizer::locomotion::path::{self, PathError};
-    use bml_realizer::locomotion::{Obstacle, Obstacles, Shape};
+    use bml_realizer::space::path::{self, PathError};
+    use bml_realizer::space::{Obstacle, Obstacles, Shape};
     use glam::Vec2;
     use proptest::prelude::*;
 

@@ -13,6 +13,7 @@
 
 mod constraints;
 mod diagnostic;
+mod id;
 mod kinds;
 mod limits;
 mod model;

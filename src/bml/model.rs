@@ -5,9 +5,7 @@
 use super::diagnostic::Pos;
 use super::syncref::SyncRef;
 
-/// An id (of a block, behaviour, sync point or anticipator): immutable, cheap to clone, stored
-/// inline without allocation up to 23 bytes.
-pub type Id = smol_str::SmolStr;
+pub use super::id::Id;
 
 /// Namespace of BML 1.0 core elements and of feedback messages.
 pub const NS_BML: &str = "http://www.bml-initiative.org/bml/bml-1.0";

@@ -4,7 +4,7 @@
 use std::fmt;
 
 use super::diagnostic::Code;
-use super::model::Id;
+use super::id::Id;
 
 /// The reserved first part of an anticipator reference (`anticipators:ID:SYNC`).
 pub const ANTICIPATORS: &str = "anticipators";

@@ -20,8 +20,8 @@ use glam::Vec2;
 use super::contact::{time_to_contact, Approach};
 use super::profile::Profile;
 use super::snapshot::Agent;
-use crate::locomotion::Obstacles;
 use crate::rng::Rng;
+use crate::space::Obstacles;
 
 /// Spacing of the headings sampled (rad): the 4.5° of Karamouzas and Overmars.
 pub const HEADING_STEP: f32 = 0.078;
@@ -467,7 +467,7 @@ mod tests {
 
     #[test]
     fn into_a_wall_is_toward_it_not_along_one_already_touched() {
-        use crate::locomotion::obstacles::{Obstacle, Shape};
+        use crate::space::obstacles::{Obstacle, Shape};
         let wall = Obstacles::new(vec![Obstacle {
             shape: Shape::Segment {
                 a: Vec2::new(-5.0, 0.0),

@@ -12,7 +12,7 @@
 use glam::Vec2;
 
 use super::{Agent, Crowd};
-use crate::locomotion::Obstacles;
+use crate::space::Obstacles;
 
 /// How far ahead along its way a walker looks for someone standing in it (m).
 pub const LOOKAHEAD: f32 = 2.0;
@@ -154,8 +154,8 @@ mod tests {
         let far = standing(&[(-0.8, 2.5), (0.0, 2.5), (0.8, 2.5)]);
         assert_eq!(blocker(at, way, 0.25, &far, &walls, false), None);
         // a wall beside one person shuts the way too
-        let wall = Obstacles::new(vec![crate::locomotion::Obstacle {
-            shape: crate::locomotion::Shape::Box {
+        let wall = Obstacles::new(vec![crate::space::Obstacle {
+            shape: crate::space::Shape::Box {
                 min: Vec2::new(0.3, 0.0),
                 max: Vec2::new(3.0, 3.0),
             },

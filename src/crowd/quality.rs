@@ -10,7 +10,7 @@
 use glam::Vec2;
 
 use super::group::Space;
-use crate::locomotion::Obstacles;
+use crate::space::Obstacles;
 
 /// SteerBench's energy per second of standing (e_s) and per m²/s² (e_w).
 pub const E_S: f32 = 2.23;

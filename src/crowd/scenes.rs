@@ -8,7 +8,7 @@
 use glam::Vec2;
 
 use super::group::Space;
-use crate::locomotion::obstacles::{Obstacle, Obstacles, Shape};
+use crate::space::obstacles::{Obstacle, Obstacles, Shape};
 
 /// A scene: who walks where, among which walls, round which conversing groups.
 #[derive(Debug, Clone, PartialEq)]

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use super::avoid::{progress, DECIDE_PERIOD, NEIGHBOUR_RADIUS};
 use super::negotiate::{self, Standing};
 use super::{Agent, Avoider, Crowd, Profile};
-use crate::locomotion::{path, Obstacles};
+use crate::space::{path, Obstacles};
 
 /// Most a mover's velocity changes in a second (m/s²), as a walker's steering allows.
 pub const MAX_ACCELERATION: f32 = 2.0;

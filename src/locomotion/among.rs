@@ -5,12 +5,12 @@
 
 use glam::{Vec2, Vec3};
 
-use super::obstacles::Obstacles;
 use super::steering::{flat, Vehicle};
-use super::walker::STEP;
+use super::STEP;
 use crate::crowd::avoid::NEIGHBOUR_RADIUS;
 use crate::crowd::negotiate::{self, Standing};
 use crate::crowd::{Agent, Avoider, Crowd, Profile};
+use crate::space::Obstacles;
 
 /// The others a walker shares the ground with: the frame's crowd and its own place in it.
 #[derive(Debug, Clone, Copy)]

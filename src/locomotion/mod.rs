@@ -1,23 +1,28 @@
 //! Walking: how a character gets from one place to another. [`steering`] is Reynolds' vehicle
 //! model with the steering behaviours and combiners of the IViHumans platform (usable on its
-//! own); [`obstacles`] the world's circles, boxes and walls; [`path`] routes around them (A* on
-//! a grid, pulled tight); [`gait`] a procedural human gait driven by the distance walked, with
-//! planted feet; [`posing`] that gait as a pose of the skeleton; [`targets`] where a walk goes;
-//! [`walker`] one walking
-//! character that puts them together at a fixed step. The locomotion engine
-//! (`engines::locomotion`) realizes BML `<locomotion>` with them; `docs/locomotion.md` explains
-//! the whole.
+//! own), round the obstacles and along the routes of [`crate::space`]; [`gait`] a procedural
+//! human gait driven by the distance walked, with planted feet; [`posing`] that gait as a pose
+//! of the skeleton; [`walker`] one walking character that puts them together at a fixed step.
+//! The locomotion engine (`engines::locomotion`, which also resolves where a walk goes) realizes
+//! BML `<locomotion>` with them; `docs/locomotion.md` explains the whole.
+
+/// The walker's fixed step (s), which the crowd around a walker is also moved on by.
+pub const STEP: f64 = 1.0 / 240.0;
 
 pub mod among;
 pub mod footsteps;
 pub mod gait;
-pub mod obstacles;
-pub mod path;
 pub mod posing;
 pub mod room;
 pub mod steering;
-pub mod targets;
 pub mod walker;
 
-pub use obstacles::{Obstacle, Obstacles, Shape};
+/// Obstacles and routes moved to [`crate::space`], below locomotion; these keep the old paths
+/// compiling for one release.
+pub use crate::space::{obstacles, path, Obstacle, Obstacles, Shape};
 pub use walker::{Moments, Walk, Walker};
+
+/// Where a walk goes moved to the locomotion engine, the one user that reads the world; this
+/// keeps the old path compiling for one release.
+#[doc(hidden)]
+pub use crate::engines::locomotion::targets;

@@ -11,7 +11,7 @@
 pub use crate::rng::Rng;
 use glam::{Vec2, Vec3};
 
-use super::obstacles::Obstacles;
+use crate::space::Obstacles;
 
 /// The horizontal part of `v` (y = 0).
 pub fn flat(v: Vec3) -> Vec3 {

@@ -13,7 +13,7 @@
 
 use glam::Vec2;
 
-use crate::locomotion::Obstacles;
+use crate::space::Obstacles;
 
 /// Where an agent is and what is around it, as sensors read it.
 #[derive(Debug, Clone, Copy)]
@@ -268,7 +268,7 @@ fn sense(s: &Sensor, env: &Surroundings) -> (f32, f32) {
     match s {
         Sensor::Location(p) => bearing(env, *p),
         Sensor::Line(a, b) => {
-            let (_, p) = crate::locomotion::obstacles::point_segment(env.at, *a, *b);
+            let (_, p) = crate::space::distance::point_segment(env.at, *a, *b);
             bearing(env, p)
         }
         Sensor::Obstacles { range, half_field } => {

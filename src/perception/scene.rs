@@ -10,8 +10,8 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 
 use crate::body::{Pose, Skeleton};
-use crate::locomotion::obstacles::{Obstacle, Shape};
-use crate::locomotion::Obstacles;
+use crate::space::obstacles::{Obstacle, Shape};
+use crate::space::Obstacles;
 
 /// The radius of a named point as something to see (m).
 pub const POINT_RADIUS: f32 = 0.1;

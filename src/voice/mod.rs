@@ -57,14 +57,8 @@ pub struct Word {
     pub end: f64,
 }
 
-/// Synthesized audio: mono samples at a rate.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Audio {
-    /// Samples per second.
-    pub rate: u32,
-    /// 16-bit samples.
-    pub samples: Vec<i16>,
-}
+/// Sound samples live in [`crate::sound`], below the voices that make them.
+pub use crate::sound::Audio;
 
 /// What a TTS makes of a speech: phones, words, the inline syncs' times, the end, and audio if
 /// it synthesizes sound.

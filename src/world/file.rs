@@ -24,7 +24,7 @@ struct WorldFile {
     #[serde(default)]
     characters: BTreeMap<String, CharacterFile>,
     #[serde(default)]
-    obstacles: Vec<crate::locomotion::obstacles::ObstacleFile>,
+    obstacles: Vec<crate::space::obstacles::ObstacleFile>,
     #[serde(default)]
     profiles: BTreeMap<String, crate::crowd::Profile>,
     #[serde(default)]
@@ -150,10 +150,10 @@ impl World {
                 Arc::make_mut(&mut w.combiners).insert(name.clone(), combine);
             }
         }
-        if file.obstacles.len() > crate::locomotion::obstacles::MAX_OBSTACLES {
+        if file.obstacles.len() > crate::space::obstacles::MAX_OBSTACLES {
             return Err(format!(
                 "obstacles: at most {} obstacles, not {}",
-                crate::locomotion::obstacles::MAX_OBSTACLES,
+                crate::space::obstacles::MAX_OBSTACLES,
                 file.obstacles.len()
             ));
         }
@@ -166,7 +166,7 @@ impl World {
             w.vision = Some(Arc::new(v));
         }
         let n = list.len();
-        w.set_obstacles(crate::locomotion::Obstacles::new(list));
+        w.set_obstacles(crate::space::Obstacles::new(list));
         w.add_groups(file.groups)?;
         Ok((w, n))
     }

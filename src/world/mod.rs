@@ -75,7 +75,7 @@ pub struct World {
     /// How the steering of characters the world file gives a combiner combines.
     combiners: Arc<BTreeMap<String, crate::locomotion::steering::Combine>>,
     /// Obstacles, in world coordinates (a view from a character has none).
-    obstacles: Arc<crate::locomotion::Obstacles>,
+    obstacles: Arc<crate::space::Obstacles>,
     /// The avoidance profile of characters the world file gives one.
     profiles: Arc<BTreeMap<String, crate::crowd::Profile>>,
     /// The avatar file of characters the world file gives one (as written there).
@@ -121,9 +121,7 @@ pub const MAX_CHARACTERS: usize = crate::crowd::snapshot::MAX_AGENTS;
 /// Longest list of keys a path may have.
 pub const MAX_PATH_KEYS: usize = 100_000;
 
-/// Largest coordinate a world file may give (metres): far beyond any scene, and far enough from
-/// `f32::MAX` that turning a point into a character's frame stays finite.
-pub const MAX_COORDINATE: f64 = 1e9;
+pub use crate::space::MAX_COORDINATE;
 
 impl World {
     /// A world without points.
@@ -187,12 +185,12 @@ impl World {
     }
 
     /// The obstacles (world coordinates).
-    pub fn obstacles(&self) -> &crate::locomotion::Obstacles {
+    pub fn obstacles(&self) -> &crate::space::Obstacles {
         &self.obstacles
     }
 
     /// The obstacles (shared).
-    pub fn obstacles_shared(&self) -> &Arc<crate::locomotion::Obstacles> {
+    pub fn obstacles_shared(&self) -> &Arc<crate::space::Obstacles> {
         &self.obstacles
     }
 
@@ -200,8 +198,8 @@ impl World {
     /// it is not in, as those groups stand now (each a circle through its members' far sides),
     /// but for a space it already stands in (it walks out of that one; taken as an obstacle,
     /// it threw the character out of it 0.5 m in one frame).
-    pub fn obstacles_for(&self, id: &str) -> Arc<crate::locomotion::Obstacles> {
-        use crate::locomotion::obstacles::{Obstacle, Shape};
+    pub fn obstacles_for(&self, id: &str) -> Arc<crate::space::Obstacles> {
+        use crate::space::obstacles::{Obstacle, Shape};
         let p = self.placement(id).position;
         let (here, radius) = (glam::Vec2::new(p.x, p.z), self.radius(id));
         let spaces: Vec<Obstacle> = (self.groups.iter())
@@ -227,11 +225,11 @@ impl World {
         }
         let mut all = self.obstacles.all().to_vec();
         all.extend(spaces);
-        Arc::new(crate::locomotion::Obstacles::new(all))
+        Arc::new(crate::space::Obstacles::new(all))
     }
 
     /// Sets the obstacles.
-    pub fn set_obstacles(&mut self, obstacles: crate::locomotion::Obstacles) {
+    pub fn set_obstacles(&mut self, obstacles: crate::space::Obstacles) {
         self.obstacles = Arc::new(obstacles);
     }
 

@@ -295,7 +295,7 @@ fn metres(p: glam::Vec3) -> [f64; 3] {
 
 /// The world's points, paths and obstacles.
 fn world_data(w: &World) -> Value {
-    use bml_realizer::locomotion::Shape;
+    use bml_realizer::space::Shape;
     let obstacles: Vec<Value> = (w.obstacles().all().iter())
         .map(|o| {
             let m = |v: f32| (f64::from(v) * 1e6).round() / 1e6;

@@ -12,7 +12,27 @@
 use glam::{Mat4, Quat, Vec3};
 use serde_json::Value;
 
-use super::file::Node;
+/// One node of the avatar's scene graph at rest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// Its name (`""` when it has none).
+    pub name: String,
+    /// Its parent node.
+    pub parent: Option<usize>,
+    /// Its rest translation, relative to its parent.
+    pub translation: Vec3,
+    /// Its rest rotation, relative to its parent.
+    pub rotation: Quat,
+    /// Its rest scale.
+    pub scale: Vec3,
+}
+
+impl Node {
+    /// Its rest transform relative to its parent.
+    pub fn local(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation)
+    }
+}
 
 /// Extensions an avatar may require: the ones that change nothing the realizer reads, and that
 /// the viewer's three.js and the Khronos validator understand.

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use glam::{Mat4, Quat, Vec3};
+use glam::Mat4;
 use serde_json::Value;
 
 use super::{buffers, document};
@@ -35,27 +35,7 @@ impl AvatarError {
     }
 }
 
-/// One node of the avatar's scene graph at rest.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Node {
-    /// Its name (`""` when it has none).
-    pub name: String,
-    /// Its parent node.
-    pub parent: Option<usize>,
-    /// Its rest translation, relative to its parent.
-    pub translation: Vec3,
-    /// Its rest rotation, relative to its parent.
-    pub rotation: Quat,
-    /// Its rest scale.
-    pub scale: Vec3,
-}
-
-impl Node {
-    /// Its rest transform relative to its parent.
-    pub fn local(&self) -> Mat4 {
-        Mat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation)
-    }
-}
+pub use super::document::Node;
 
 /// An avatar file read: its nodes, skin and morph targets, and the file's JSON and binary
 /// buffer as they were.

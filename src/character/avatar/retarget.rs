@@ -15,7 +15,7 @@ use glam::{Mat3, Mat4, Quat, Vec3};
 
 use super::file::{AvatarError, Model};
 use super::humanoid::{self, BONES};
-use super::twist;
+use super::twist::{self, TwistBone};
 use crate::body::pose::Pose;
 use crate::body::skeleton::Skeleton;
 
@@ -54,15 +54,8 @@ pub(super) enum Drive {
         to: usize,
         after: Quat,
     },
-    /// An arm twist bone: it turns about `axis` (in its parent's frame) by `share` of the
-    /// realizer joint `joint`'s twist about the realizer's limb segment (`about`, in the
-    /// joint's parent's frame).
-    Twist {
-        joint: usize,
-        about: Vec3,
-        axis: Vec3,
-        share: f32,
-    },
+    /// An arm twist bone (see [`TwistBone`]).
+    Twist(TwistBone),
 }
 
 /// How one avatar is driven by one realizer skeleton.
@@ -226,8 +219,8 @@ impl Retarget {
             steps: Vec::new(),
         };
         let mut drives: Vec<Drive> = (0..n).map(|i| plan.follow(i)).collect();
-        for (i, drive) in twist::drives(model, skeleton, &source, &pre, &rest.positions, &world) {
-            drives[i] = drive;
+        for (i, bone) in twist::bones(model, skeleton, &source, &pre, &rest.positions, &world) {
+            drives[i] = Drive::Twist(bone);
         }
         Ok(Retarget {
             steps: plan.steps,
@@ -299,12 +292,12 @@ impl Retarget {
                     }
                     *rotation = (q * after).normalize();
                 }
-                Drive::Twist {
+                Drive::Twist(TwistBone {
                     joint,
                     about,
                     axis,
                     share,
-                } => {
+                }) => {
                     let angle = twist::angle(turn(joint), about);
                     *rotation = Quat::from_axis_angle(axis, share * angle) * *rotation;
                 }

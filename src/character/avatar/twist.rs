@@ -14,8 +14,18 @@
 use glam::{Mat4, Quat, Vec3};
 
 use super::file::Model;
-use super::retarget::Drive;
 use crate::body::skeleton::Skeleton;
+
+/// An arm twist bone: it turns about `axis` (in its parent's frame) by `share` of the realizer
+/// joint `joint`'s twist about the realizer's limb segment (`about`, in the joint's parent's
+/// frame).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct TwistBone {
+    pub joint: usize,
+    pub about: Vec3,
+    pub axis: Vec3,
+    pub share: f32,
+}
 
 /// A limb segment with twist bones: the joints at its start and end, the joint whose twist
 /// about the segment the twist bones share, and the share its own bone keeps.
@@ -41,15 +51,15 @@ const SEGMENTS: [Segment; 2] = [
     },
 ];
 
-/// The twist drives of `model`'s arm twist bones (node, drive).
-pub(super) fn drives(
+/// The twist bones of `model`'s arms, each with its node.
+pub(super) fn bones(
     model: &Model,
     skeleton: &Skeleton,
     source: &[Option<usize>],
     pre: &[Quat],
     rest: &[Vec3],
     world: &[Mat4],
-) -> Vec<(usize, Drive)> {
+) -> Vec<(usize, TwistBone)> {
     let node_of = |j: usize| source.iter().position(|&s| s == Some(j));
     let place = |i: usize| world[i].w_axis.truncate();
     let named = |i: usize| {
@@ -92,7 +102,7 @@ pub(super) fn drives(
                     let s = share(child);
                     out.push((
                         child,
-                        Drive::Twist {
+                        TwistBone {
                             joint: twisting,
                             about,
                             axis,

@@ -29,11 +29,13 @@ use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitK
 use crate::feedback::KnownWarning;
 use crate::locomotion::posing::{lead_the_turn, pose_gait, GaitJoints};
 use crate::locomotion::room::Room;
-use crate::locomotion::targets::{resolve, Pursuit};
-use crate::locomotion::{walker, Moments, Obstacles, Walk, Walker};
+use crate::locomotion::{walker, Moments, Walk, Walker};
+use crate::space::Obstacles;
 use crate::timing::{SyncName, TimingModel, TimingModels};
 use crate::world::{Placement, World};
+use targets::{resolve, Pursuit};
 
+pub mod targets;
 mod travel;
 
 /// Fastest `bmlt:speed` taken (m/s).
@@ -193,7 +195,7 @@ impl LocomotionEngine {
         &self,
         walker: &Walker,
         walk: &Walk,
-        obstacles: &crate::locomotion::Obstacles,
+        obstacles: &crate::space::Obstacles,
     ) -> Result<Moments, String> {
         if let Some((w, k, m)) = self.rehearsed.borrow().as_ref() {
             if w == walker && k == walk {

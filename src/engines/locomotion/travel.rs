@@ -4,10 +4,10 @@
 
 use glam::{Vec2, Vec3};
 
+use super::targets::resolve;
 use super::LocomotionEngine;
 use crate::engine::{Revising, Revision, Travel, UnitKey};
 use crate::locomotion::room::make_room;
-use crate::locomotion::targets::resolve;
 use crate::locomotion::walker;
 use crate::world::{Placement, World};
 

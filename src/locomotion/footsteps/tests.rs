@@ -1,7 +1,7 @@
 //! The seed's wall-and-goal scene, walked by footsteps; the budget and the stagger.
 
 use super::*;
-use crate::locomotion::{Obstacle, Obstacles, Shape};
+use crate::space::{Obstacle, Obstacles, Shape};
 
 /// The scene of the seed's figure 1: the goal beyond a wall, the straight way to it blocked
 /// near the wall's end.

@@ -13,8 +13,8 @@ use glam::Vec2;
 
 use crate::locomotion::footsteps::{self, Fan, Feet, Footstep};
 use crate::locomotion::gait;
-use crate::locomotion::Obstacles;
 use crate::nets::behaviour::{BehaviourNet, Surroundings};
+use crate::space::Obstacles;
 
 /// Samples the walkers of a crowd may take together in one 60 Hz frame.
 pub const BUDGET: usize = 1500;

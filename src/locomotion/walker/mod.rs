@@ -11,13 +11,12 @@ use glam::{Vec2, Vec3};
 use super::among::neighbours;
 pub use super::among::Others;
 use super::gait::{angle_diff, Body, Gait};
-use super::obstacles::Obstacles;
-use super::path::{self, PathError};
 use super::steering::{ArriveParams, Behaviour, Combine, Part, Steering, Vehicle};
 use crate::crowd::{Avoider, Profile};
+use crate::space::path::{self, PathError};
+use crate::space::Obstacles;
 
-/// The walker's fixed step (s).
-pub const STEP: f64 = 1.0 / 240.0;
+pub use super::STEP;
 /// How often a walker among others checks that the point its route seeks is still in sight
 /// (steps: once a second).
 pub const REPLAN_EVERY: i64 = 240;

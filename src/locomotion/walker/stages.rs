@@ -13,9 +13,9 @@ use super::{
 };
 use crate::locomotion::among::{neighbours, Near};
 use crate::locomotion::gait::{angle_diff, forward};
-use crate::locomotion::obstacles::Obstacles;
-use crate::locomotion::path;
 use crate::locomotion::steering::{flat, Behaviour, Context};
+use crate::space::obstacles::Obstacles;
+use crate::space::path;
 
 impl Walker {
     /// One step; the moments when the walk ends in it.

@@ -215,8 +215,8 @@ pub fn length(points: &[Vec2]) -> f32 {
 
 #[cfg(test)]
 mod tests {
+    use super::obstacles::{Obstacle, Shape};
     use super::*;
-    use crate::locomotion::obstacles::{Obstacle, Shape};
 
     fn seg(a: (f32, f32), b: (f32, f32)) -> Obstacle {
         Obstacle {
