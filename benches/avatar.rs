@@ -14,8 +14,8 @@ mod avatars;
 
 use std::hint::black_box;
 
-use bml_realizer::avatar::{default_model, Model, Retarget};
-use bml_realizer::body::Skeleton;
+use bml_realizer::character::avatar::{default_model, Model, Retarget};
+use bml_realizer::character::body::Skeleton;
 use bml_realizer::realizer::Realizer;
 use criterion::{criterion_group, criterion_main, Criterion};
 
@@ -103,7 +103,7 @@ const CRYPTOVOXELS: &str = "fixtures/avatars/cryptovoxels/cryptovoxels.vrm";
 /// CesiumMan's bone map (node indices), as `--bone-map` reads it.
 fn cesium_map() -> std::collections::BTreeMap<String, String> {
     let text = std::fs::read_to_string("fixtures/avatars/cesium-man/bone-map.json").unwrap();
-    bml_realizer::avatar::humanoid::bone_map_from_json(&text).unwrap()
+    bml_realizer::character::avatar::humanoid::bone_map_from_json(&text).unwrap()
 }
 
 criterion_group!(benches, avatar);

@@ -9,7 +9,7 @@ mod orca;
 
 use std::hint::black_box;
 
-use bml_realizer::crowd::sim::{Mover, Sim};
+use bml_realizer::world::crowd::sim::{Mover, Sim};
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::Vec2;
 

@@ -7,14 +7,14 @@
 
 use std::hint::black_box;
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::locomotion::posing::{pose_gait, GaitJoints};
-use bml_realizer::locomotion::steering::{
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::realizer::Realizer;
+use bml_realizer::world::locomotion::posing::{pose_gait, GaitJoints};
+use bml_realizer::world::locomotion::steering::{
     ArriveParams, Behaviour, Combine, Context, Part, Steering, Vehicle,
 };
-use bml_realizer::locomotion::{Walk, Walker};
-use bml_realizer::realizer::Realizer;
-use bml_realizer::space::{path, Obstacle, Obstacles, Shape};
+use bml_realizer::world::locomotion::{Walk, Walker};
+use bml_realizer::world::space::{path, Obstacle, Obstacles, Shape};
 use bml_realizer::world::{Placement, World};
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{Vec2, Vec3};

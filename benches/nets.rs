@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 use std::hint::black_box;
 
-use bml_realizer::nets::{file, Nets, Senses};
+use bml_realizer::world::nets::{file, Nets, Senses};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 /// A world where nobody sees anyone, everyone is 5 m from everything and nothing was reached.
@@ -52,7 +52,7 @@ fn step(c: &mut Criterion) {
     let mut vars = BTreeMap::new();
     vars.insert(
         "light".to_string(),
-        bml_realizer::feedback::world::VarValue::Text("DONT_WALK".into()),
+        bml_realizer::language::feedback::world::VarValue::Text("DONT_WALK".into()),
     );
     let mut nets = Nets::new(list, vars);
     // (the first step starts them; each pedestrian then tries both transitions of its curb

@@ -3,7 +3,7 @@
 //!
 //! Run: `cargo bench --bench parse`
 
-use bml_realizer::bml;
+use bml_realizer::language::bml;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -7,10 +7,10 @@
 use std::hint::black_box;
 use std::sync::Arc;
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::perception::{Perception, Scene, Thing, Vision};
-use bml_realizer::space::obstacles::{Obstacle, Shape};
-use bml_realizer::space::Obstacles;
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::world::perception::{Perception, Scene, Thing, Vision};
+use bml_realizer::world::space::obstacles::{Obstacle, Shape};
+use bml_realizer::world::space::Obstacles;
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{Quat, Vec2, Vec3};
 

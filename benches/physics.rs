@@ -8,9 +8,9 @@
 
 use std::hint::black_box;
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::dynamics::controllers::{Balance, Controller, Drive};
-use bml_realizer::dynamics::sim::{Simulation, STEP};
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::character::dynamics::controllers::{Balance, Controller, Drive};
+use bml_realizer::character::dynamics::sim::{Simulation, STEP};
 use bml_realizer::realizer::Realizer;
 use criterion::{criterion_group, criterion_main, Criterion};
 

@@ -8,10 +8,10 @@ mod common;
 
 use std::hint::black_box;
 
-use bml_realizer::bml;
-use bml_realizer::schedule::diff::DiffSystem;
-use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy, SortedGreedy};
-use bml_realizer::timing::DefaultTimingModels;
+use bml_realizer::language::bml;
+use bml_realizer::planning::schedule::diff::DiffSystem;
+use bml_realizer::planning::schedule::{NoExternal, Optimal, SchedulingStrategy, SortedGreedy};
+use bml_realizer::planning::timing::DefaultTimingModels;
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
 
 fn chain(n: usize) -> DiffSystem {
@@ -90,8 +90,8 @@ fn optimal(c: &mut Criterion) {
 }
 
 fn anticipator_move(c: &mut Criterion) {
-    use bml_realizer::plan::pegs::PegBoard;
-    use bml_realizer::plan::to_pegs::{invalid, plan_block, Anticipators, BoardTimes};
+    use bml_realizer::planning::plan::pegs::PegBoard;
+    use bml_realizer::planning::plan::to_pegs::{invalid, plan_block, Anticipators, BoardTimes};
     let src = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="bml1">
         <head id="nod1" lexeme="NOD" start="anticipators:beat:b1"/>
         <gesture id="g1" lexeme="BEAT" stroke="anticipators:beat:b1+0.5"/>
@@ -152,8 +152,8 @@ fn chained_blocks(c: &mut Criterion) {
 /// times known to the next (all blocks at start 0, so block-local times are global). No block
 /// lifecycle, engines or feedback.
 fn chained_core(c: &mut Criterion) {
-    use bml_realizer::bml::SyncPoint;
-    use bml_realizer::schedule::{BlockSchedule, ExternalTimes};
+    use bml_realizer::language::bml::SyncPoint;
+    use bml_realizer::planning::schedule::{BlockSchedule, ExternalTimes};
     use std::collections::HashMap;
 
     /// The schedules so far, by block id.

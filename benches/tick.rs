@@ -10,7 +10,7 @@
 
 use std::hint::black_box;
 
-use bml_realizer::feedback::Feedback;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 use criterion::{criterion_group, criterion_main, Criterion};
 

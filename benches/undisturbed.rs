@@ -18,10 +18,10 @@ mod common;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use bml_realizer::bml;
+use bml_realizer::language::bml;
+use bml_realizer::planning::schedule::{NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::planning::timing::DefaultTimingModels;
 use bml_realizer::realizer::Realizer;
-use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy};
-use bml_realizer::timing::DefaultTimingModels;
 
 /// The shortest of `batches` timings of `run`.
 fn best(batches: usize, mut run: impl FnMut() -> Duration) -> Duration {

@@ -11,10 +11,10 @@
 
 use std::hint::black_box;
 
-use bml_realizer::bml::{Id, TextPart};
+use bml_realizer::character::voice::{builtin::Builtin, lipsync, Tts};
+use bml_realizer::language::bml::{Id, TextPart};
+use bml_realizer::planning::timing::{SpeechTiming, Voice};
 use bml_realizer::realizer::Realizer;
-use bml_realizer::timing::{SpeechTiming, Voice};
-use bml_realizer::voice::{builtin::Builtin, lipsync, Tts};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 const SENTENCE: &str =
@@ -38,7 +38,7 @@ fn voice(c: &mut Criterion) {
         })
     });
     own_sound(c);
-    let flite = bml_realizer::voice::flite::Flite::default();
+    let flite = bml_realizer::character::voice::flite::Flite::default();
     if flite.check().is_err() {
         eprintln!("voice/flite-perform-to-pending: skipped, flite is not installed (apt-get install flite)");
         return;
@@ -62,9 +62,12 @@ fn voice(c: &mut Criterion) {
 }
 
 /// 30 s of espeak-ng's sentence (the fixture, repeated) and its text.
-fn thirty_seconds() -> (std::sync::Arc<bml_realizer::voice::Audio>, String) {
+fn thirty_seconds() -> (
+    std::sync::Arc<bml_realizer::character::voice::Audio>,
+    String,
+) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/voice/espeak-bob.wav");
-    let one = bml_realizer::sound::read_wav(std::path::Path::new(path)).unwrap();
+    let one = bml_realizer::character::sound::read_wav(std::path::Path::new(path)).unwrap();
     let mut samples = Vec::new();
     while samples.len() < 30 * one.rate as usize {
         samples.extend(&one.samples);
@@ -72,7 +75,7 @@ fn thirty_seconds() -> (std::sync::Arc<bml_realizer::voice::Audio>, String) {
     samples.truncate(30 * one.rate as usize);
     let sentence =
         "Bob may bring a big map to the market, maybe. Please buy more apples and pears. ";
-    let audio = bml_realizer::voice::Audio {
+    let audio = bml_realizer::character::voice::Audio {
         rate: one.rate,
         samples,
     };
@@ -80,7 +83,7 @@ fn thirty_seconds() -> (std::sync::Arc<bml_realizer::voice::Audio>, String) {
 }
 
 fn own_sound(c: &mut Criterion) {
-    use bml_realizer::voice::{listen, marks, recorded};
+    use bml_realizer::character::voice::{listen, marks, recorded};
     let (audio, text) = thirty_seconds();
     // Polly marks: a word every 0.35 s, a viseme every 70 ms
     let words: Vec<&str> = text.split_whitespace().collect();

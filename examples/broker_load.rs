@@ -21,7 +21,7 @@ use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use bml_realizer::broker::{
+use bml_realizer::ports::broker::{
     BrokerUrl, Inbound, Link, LinkOptions, StompLink, StompOptions, StompUrl, Wire,
 };
 

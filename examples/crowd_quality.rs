@@ -9,9 +9,9 @@ mod orca;
 
 use std::sync::Arc;
 
-use bml_realizer::crowd::quality::{measure, Quality, Track};
-use bml_realizer::crowd::scenes::{self, Scene, Walk};
-use bml_realizer::crowd::sim::{Mover, Sim};
+use bml_realizer::world::crowd::quality::{measure, Quality, Track};
+use bml_realizer::world::crowd::scenes::{self, Scene, Walk};
+use bml_realizer::world::crowd::sim::{Mover, Sim};
 
 const DT: f32 = 1.0 / 30.0;
 const LIMIT: f64 = 120.0;
@@ -74,7 +74,7 @@ fn walk(mut crowd: impl Stepped, scene: &Scene) -> Quality {
             t.gave_up = m.gave_up;
         }
     }
-    let walls = bml_realizer::space::Obstacles::new(scene.walls.clone());
+    let walls = bml_realizer::world::space::Obstacles::new(scene.walls.clone());
     measure(&tracks, DT, &walls, &scene.spaces)
 }
 

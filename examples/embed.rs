@@ -3,7 +3,7 @@
 //!
 //! Run: `cargo run --example embed`
 
-use bml_realizer::feedback::{Feedback, Format};
+use bml_realizer::language::feedback::{Feedback, Format};
 use bml_realizer::realizer::Realizer;
 
 const GREETING: &str = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="greet">

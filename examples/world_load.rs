@@ -18,7 +18,7 @@ use std::io::Read;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use bml_realizer::broker::{BrokerUrl, Inbound, Link, LinkOptions};
+use bml_realizer::ports::broker::{BrokerUrl, Inbound, Link, LinkOptions};
 
 #[path = "common/process.rs"]
 mod process;

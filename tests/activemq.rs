@@ -21,7 +21,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use amq::ActiveMq;
-use bml_realizer::broker::{Inbound, StompLink, StompOptions, StompUrl};
+use bml_realizer::ports::broker::{Inbound, StompLink, StompOptions, StompUrl};
 use kit::{block, free_port, Served};
 
 /// `bmlr serve --stomp URL` with `extra` flags.

@@ -1,9 +1,9 @@
 //! Motion, measured on the body the realizer moves (headless numeric tests): a nod
 //! through the whole realizer at 60 Hz.
 
-use bml_realizer::body::Skeleton;
+use bml_realizer::character::body::Skeleton;
 use bml_realizer::engines::head::{DEFAULT_AMOUNT, NOD_DEGREES};
-use bml_realizer::feedback::Feedback;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 
 /// A realizer without the idle layer: these tests measure each engine's motion exactly, from the
@@ -118,7 +118,7 @@ use glam::Quat;
 
 /// Angle (degrees) between each eye's line of sight (+z of the eye joint) and the direction to
 /// `target`, the larger of the two eyes.
-fn eye_error(skeleton: &Skeleton, pose: &bml_realizer::body::Pose, target: Vec3) -> f64 {
+fn eye_error(skeleton: &Skeleton, pose: &bml_realizer::character::body::Pose, target: Vec3) -> f64 {
     let w = pose.world(skeleton);
     ["l_eyeball_joint", "r_eyeball_joint"]
         .iter()
@@ -130,7 +130,7 @@ fn eye_error(skeleton: &Skeleton, pose: &bml_realizer::body::Pose, target: Vec3)
         .fold(0.0, f64::max)
 }
 
-fn eye_angles(skeleton: &Skeleton, pose: &bml_realizer::body::Pose) -> Vec<(f32, f32)> {
+fn eye_angles(skeleton: &Skeleton, pose: &bml_realizer::character::body::Pose) -> Vec<(f32, f32)> {
     ["l_eyeball_joint", "r_eyeball_joint"]
         .iter()
         .map(|e| {
@@ -546,7 +546,7 @@ fn a_sitting_shift_folds_the_legs_and_stays_a_posture_returns() {
 /// A run recorded by [`record`]: every frame's (time, pose), the sync times
 /// ("block:behaviour:sync") and the warnings ("TYPE text").
 struct Recording {
-    frames: Vec<(f64, bml_realizer::body::Pose)>,
+    frames: Vec<(f64, bml_realizer::character::body::Pose)>,
     syncs: Vec<(String, f64)>,
     warnings: Vec<String>,
 }
@@ -590,7 +590,7 @@ impl Recording {
     }
 
     /// The pose of the frame at time `t` (a multiple of 1/60 s).
-    fn at(&self, t: f64) -> &bml_realizer::body::Pose {
+    fn at(&self, t: f64) -> &bml_realizer::character::body::Pose {
         &self
             .frames
             .iter()
@@ -934,7 +934,7 @@ fn a_posture_pose_holds_the_arms_akimbo_with_its_stance_and_lets_go_by_its_end()
     // back at rest by the end
     let skeleton = Skeleton::adult();
     let wrist = skeleton.joint("r_wrist").unwrap();
-    let rest = bml_realizer::body::Pose::rest(&skeleton)
+    let rest = bml_realizer::character::body::Pose::rest(&skeleton)
         .joint_world(&skeleton, wrist)
         .0;
     assert!((at(&right, 2.5) - rest).length() < 1e-4);
@@ -955,7 +955,7 @@ fn a_head_direction_shift_turns_the_face_to_its_target_and_keeps_it_there() {
     let skeleton = Skeleton::adult();
     let skull = skeleton.joint("skullbase").unwrap();
     let eyes: Vec3 = {
-        let w = bml_realizer::body::Pose::rest(&skeleton).world(&skeleton);
+        let w = bml_realizer::character::body::Pose::rest(&skeleton).world(&skeleton);
         (w.positions[skeleton.joint("l_eyeball_joint").unwrap()]
             + w.positions[skeleton.joint("r_eyeball_joint").unwrap()])
             / 2.0
@@ -1023,12 +1023,12 @@ fn a_murml_keyframed_gesture_turns_its_joints_exactly_at_its_frames() {
 
 #[test]
 fn every_motion_behaviour_declares_the_joints_it_steers() {
-    use bml_realizer::engine::MotionKind;
     use bml_realizer::engines::default_registry;
-    use bml_realizer::timing::DefaultTimingModels;
+    use bml_realizer::engines::interface::MotionKind;
+    use bml_realizer::planning::timing::DefaultTimingModels;
     let skeleton = Skeleton::adult();
     let mut registry = default_registry(DefaultTimingModels::default());
-    let block = bml_realizer::bml::load(&format!(
+    let block = bml_realizer::language::bml::load(&format!(
         r#"<bml {BMLT} xmlns:m="http://www.techfak.uni-bielefeld.de/ags/soa/murml" id="b">
         <head id="nod" lexeme="NOD"/>
         <headDirectionShift id="hd" target="user"/>
@@ -1097,7 +1097,7 @@ fn the_eyes_saccade_in_an_amplitude_dependent_time_then_the_head_catches_up() {
     let skeleton = Skeleton::adult();
     let target = Vec3::new(0.6, 1.2, 1.2); // bluebox
     let eyes_rest = {
-        let w = bml_realizer::body::Pose::rest(&skeleton).world(&skeleton);
+        let w = bml_realizer::character::body::Pose::rest(&skeleton).world(&skeleton);
         (w.positions[skeleton.joint("l_eyeball_joint").unwrap()]
             + w.positions[skeleton.joint("r_eyeball_joint").unwrap()])
             / 2.0

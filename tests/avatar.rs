@@ -10,9 +10,9 @@ mod avatars;
 use std::collections::BTreeMap;
 
 use avatars::{glb, limb_errors, random_pose, test_avatar, Kind, LIMBS, TWISTS};
-use bml_realizer::avatar::{self, Model, Retarget};
-use bml_realizer::body::pose::Pose;
-use bml_realizer::body::skeleton::Skeleton;
+use bml_realizer::character::avatar::{self, Model, Retarget};
+use bml_realizer::character::body::pose::Pose;
+use bml_realizer::character::body::skeleton::Skeleton;
 use bml_realizer::rng::Rng;
 use glam::{Mat4, Quat, Vec3};
 use serde_json::json;
@@ -235,8 +235,9 @@ fn the_default_avatar_is_a_skinned_person_standing_in_the_realizer_s_rest() {
     // the 52 ARKit targets by name
     let names: std::collections::BTreeSet<&str> =
         model.morphs[0].iter().map(String::as_str).collect();
-    let arkit: std::collections::BTreeSet<&str> =
-        bml_realizer::face::model::ARKIT.into_iter().collect();
+    let arkit: std::collections::BTreeSet<&str> = bml_realizer::character::face::model::ARKIT
+        .into_iter()
+        .collect();
     assert_eq!(names, arkit);
     // the realizer's rest: arms and legs straight down, limb by limb as the realizer's skeleton
     let skeleton = Skeleton::adult();

@@ -5,7 +5,7 @@
 mod avatars;
 
 use avatars::{glb, test_avatar, Kind};
-use bml_realizer::avatar::{self, Model};
+use bml_realizer::character::avatar::{self, Model};
 use serde_json::Value;
 
 /// `bmlr run --gltf out --avatar avatar fixtures/examples/welcome.xml`: exit code and stderr.

@@ -2,7 +2,7 @@
 //! between the shirt and the skin of the neck runs round the neck as a line, not as the
 //! staircase of the mesh's faces.
 
-use bml_realizer::avatar;
+use bml_realizer::character::avatar;
 use glam::Vec3;
 
 /// The body's places, colours and triangles (its first primitive).

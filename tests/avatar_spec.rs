@@ -19,9 +19,9 @@ use std::path::{Path, PathBuf};
 
 use avatar_mesh::{gltf_embedded, gltf_two_files, with_mesh, Case, CASES};
 use avatars::{floats_of, glb_json, glb_with, limb_errors, random_pose, test_avatar, Kind, LIMBS};
-use bml_realizer::avatar::{Model, Retarget};
-use bml_realizer::body::pose::Pose;
-use bml_realizer::body::skeleton::Skeleton;
+use bml_realizer::character::avatar::{Model, Retarget};
+use bml_realizer::character::body::pose::Pose;
+use bml_realizer::character::body::skeleton::Skeleton;
 use bml_realizer::rng::Rng;
 use common::drive;
 use serde_json::{json, Value};

@@ -9,9 +9,9 @@
 mod avatars;
 
 use avatars::{test_avatar, Kind};
-use bml_realizer::avatar::{default_model, Model, Retarget};
-use bml_realizer::body::pose::Pose;
-use bml_realizer::body::skeleton::Skeleton;
+use bml_realizer::character::avatar::{default_model, Model, Retarget};
+use bml_realizer::character::body::pose::Pose;
+use bml_realizer::character::body::skeleton::Skeleton;
 use bml_realizer::realizer::Realizer;
 use glam::Vec3;
 

@@ -20,9 +20,9 @@ use serde_json::json;
 use std::path::Path;
 
 use avatars::{floats_of, glb_json, limb_errors_by, random_pose};
-use bml_realizer::avatar::{humanoid, Model, Retarget};
-use bml_realizer::body::pose::Pose;
-use bml_realizer::body::skeleton::Skeleton;
+use bml_realizer::character::avatar::{humanoid, Model, Retarget};
+use bml_realizer::character::body::pose::Pose;
+use bml_realizer::character::body::skeleton::Skeleton;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::rng::Rng;
 use common::drive;

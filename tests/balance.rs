@@ -2,9 +2,11 @@
 //! centre of mass over the feet for a minute, with and without gestures playing on the
 //! kinematic arms, recovers from a small push and falls from a large one.
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::dynamics::controllers::{outside, support_polygon, Balance, Controller, Drive};
-use bml_realizer::dynamics::sim::{Simulation, STEP};
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::character::dynamics::controllers::{
+    outside, support_polygon, Balance, Controller, Drive,
+};
+use bml_realizer::character::dynamics::sim::{Simulation, STEP};
 use glam::DVec2;
 
 /// The lower body and the trunk simulated; head and arms kinematic.
@@ -251,7 +253,7 @@ fn a_large_push_makes_it_fall() {
 /// wall time of the 20 s (`cargo test --release --test balance joints -- --nocapture`).
 #[test]
 fn impulse_joints_and_a_multibody_measured_on_the_standing_body() {
-    use bml_realizer::dynamics::sim::Joints;
+    use bml_realizer::character::dynamics::sim::Joints;
     let skeleton = Skeleton::adult();
     let rest = Pose::rest(&skeleton);
     let balance = Balance::default();

@@ -6,8 +6,8 @@
 #[path = "common/motion.rs"]
 mod motion;
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::engine::CharacterPose;
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::engines::interface::CharacterPose;
 use bml_realizer::realizer::Realizer;
 use glam::Vec3;
 use motion::fastest_joint_but_the_eyes;
@@ -520,7 +520,7 @@ fn the_lexicon_pictures_in_the_docs_are_current() {
         r.tick(0.0);
         let pose = r.tick(STROKE).poses[0].pose.clone();
         let title = format!("{} ({mode}) at its stroke", s.lexeme);
-        let svg = bml_realizer::body::sketch::svg(&skeleton, &pose, &title);
+        let svg = bml_realizer::character::body::sketch::svg(&skeleton, &pose, &title);
         let path = format!("docs/lexemes/{}.svg", s.lexeme.to_lowercase());
         if bless {
             std::fs::create_dir_all("docs/lexemes").unwrap();

@@ -1,6 +1,6 @@
 //! `bmlr serve --mqtt` on a real broker: Debian's `mosquitto`, started here on a loopback port
 //! for each test. Without `mosquitto` on the PATH these tests say so and pass (`.ci/run`
-//! installs it). The planner's side is `bml_realizer::broker::Link`, as a host would use it.
+//! installs it). The planner's side is `bml_realizer::ports::broker::Link`, as a host would use it.
 
 #[path = "common/broker.rs"]
 mod kit;
@@ -223,7 +223,7 @@ fn states(heard: &[(String, String)]) -> Vec<(String, f32, f32)> {
     (heard.iter())
         .filter_map(|(t, p)| {
             let (_cell, c) = t.strip_prefix("bml/world/")?.split_once('/')?;
-            let s = bml_realizer::broker::RootState::from_json(p.as_bytes()).ok()?;
+            let s = bml_realizer::ports::broker::RootState::from_json(p.as_bytes()).ok()?;
             Some((c.to_string(), s.position[0], s.position[2]))
         })
         .collect()

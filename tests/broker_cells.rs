@@ -12,7 +12,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use bml_realizer::broker::Inbound;
+use bml_realizer::ports::broker::Inbound;
 use glam::Vec2;
 use kit::{planner_on, until_online, Broker, NS};
 

@@ -144,16 +144,16 @@ fn a_walker_held_back_by_another_realizer_s_row_asks_and_one_of_them_steps_aside
     // (and the one who stepped aside goes back: after a second without asks)
     let mut heard = heard;
     heard.extend(hear(&p, 4.0, |_| false));
-    let states: Vec<(String, bml_realizer::broker::RootState)> = (heard.iter())
+    let states: Vec<(String, bml_realizer::ports::broker::RootState)> = (heard.iter())
         .filter_map(|(t, m)| {
             let (_cell, id) = t.strip_prefix("bml/world/")?.split_once('/')?;
             Some((
                 id.to_string(),
-                bml_realizer::broker::RootState::from_json(m.as_bytes()).ok()?,
+                bml_realizer::ports::broker::RootState::from_json(m.as_bytes()).ok()?,
             ))
         })
         .collect();
-    let at = |s: &bml_realizer::broker::RootState| Vec2::new(s.position[0], s.position[2]);
+    let at = |s: &bml_realizer::ports::broker::RootState| Vec2::new(s.position[0], s.position[2]);
     // the walker asked one of the row (its states say whom), and that one stepped aside
     let asked: Vec<&str> = (states.iter())
         .filter(|(id, _)| id == "w")
@@ -195,7 +195,8 @@ fn a_walker_held_back_by_another_realizer_s_row_asks_and_one_of_them_steps_aside
         let back = last[format!("s{k}").as_str()];
         // (one pressed less than the crowd's DISPLACED from its place stays where it is)
         assert!(
-            back.distance(Vec2::new(*home, 3.0)) <= bml_realizer::crowd::sim::DISPLACED + 0.002,
+            back.distance(Vec2::new(*home, 3.0))
+                <= bml_realizer::world::crowd::sim::DISPLACED + 0.002,
             "s{k} is at {back}, not back at its place"
         );
     }

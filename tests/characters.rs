@@ -2,7 +2,7 @@
 //! world coordinates, it sees the world from where it stands, and a placed character is a
 //! target, so two characters can look at each other.
 
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::body::{Pose, Skeleton};
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::{Placement, CHARACTER_EYES};
 use glam::Vec3;
@@ -34,7 +34,7 @@ fn eyes(skeleton: &Skeleton, pose: &Pose) -> (Vec3, Vec3) {
     (at, look)
 }
 
-fn pose_of(frame: &bml_realizer::engine::Frame, id: &str) -> Pose {
+fn pose_of(frame: &bml_realizer::engines::interface::Frame, id: &str) -> Pose {
     (frame.poses.iter())
         .find(|p| p.character.as_deref() == Some(id))
         .unwrap_or_else(|| panic!("no {id} in the frame"))

@@ -141,9 +141,9 @@ fn run_gives_byte_identical_logs_and_both_formats_carry_the_same_messages() {
     let mut jsonl = vec!["run", "--format", "jsonl"];
     jsonl.extend_from_slice(&args[1..]);
     let (_, j, _) = bmlr(&jsonl);
-    let decode = |text: &str| -> Vec<bml_realizer::feedback::Feedback> {
+    let decode = |text: &str| -> Vec<bml_realizer::language::feedback::Feedback> {
         text.lines()
-            .map(|l| bml_realizer::feedback::from_line(l).unwrap())
+            .map(|l| bml_realizer::language::feedback::from_line(l).unwrap())
             .collect()
     };
     assert_eq!(decode(&a), decode(&j));
@@ -174,9 +174,9 @@ fn serve_stdio_answers_each_line_with_feedback_and_warns_on_garbage() {
     );
     let (code, out, err) = common::bmlr(&["serve", "--stdio"], input);
     assert_eq!((code, err.as_str()), (0, ""));
-    let fb: Vec<bml_realizer::feedback::Feedback> = out
+    let fb: Vec<bml_realizer::language::feedback::Feedback> = out
         .lines()
-        .map(|l| bml_realizer::feedback::from_line(l).unwrap())
+        .map(|l| bml_realizer::language::feedback::from_line(l).unwrap())
         .collect();
     let has = |needle: &str| out.lines().any(|l| l.contains(needle));
     assert!(
@@ -187,7 +187,7 @@ fn serve_stdio_answers_each_line_with_feedback_and_warns_on_garbage() {
     assert!(has(r#"type="PARSING_FAILURE""#), "{out}");
     // wall clock: block and sync progress carry posix times
     assert!(fb.iter().any(|f| matches!(f,
-        bml_realizer::feedback::Feedback::BlockProgress(p) if p.posix_time.is_some())));
+        bml_realizer::language::feedback::Feedback::BlockProgress(p) if p.posix_time.is_some())));
 }
 
 #[test]
@@ -201,8 +201,8 @@ fn run_realtime_reports_on_the_wall_clock_with_posix_times() {
         .unwrap_or_else(|| panic!("{out}"));
     assert!(end.contains(r#""bmla:posixTime":"#), "{end}");
     // the speech lasts 0.2 s on the wall clock (the block starts when it arrives)
-    let fb = bml_realizer::feedback::from_line(end).unwrap();
-    let bml_realizer::feedback::Feedback::BlockProgress(p) = fb else {
+    let fb = bml_realizer::language::feedback::from_line(end).unwrap();
+    let bml_realizer::language::feedback::Feedback::BlockProgress(p) = fb else {
         panic!("{end}")
     };
     assert!(p.global_time >= 0.2, "{}", p.global_time);
@@ -210,13 +210,13 @@ fn run_realtime_reports_on_the_wall_clock_with_posix_times() {
 
 // ---- bmlr diff ---------------------------------------------------------------------------
 
-use bml_realizer::feedback::{Feedback, Format};
+use bml_realizer::language::feedback::{Feedback, Format};
 
 /// The feedback of the greeting example, as messages.
 fn greeting() -> Vec<Feedback> {
     let (_, out, _) = bmlr(&["run", "fixtures/examples/welcome.xml"]);
     out.lines()
-        .map(|l| bml_realizer::feedback::from_line(l).unwrap())
+        .map(|l| bml_realizer::language::feedback::from_line(l).unwrap())
         .collect()
 }
 
@@ -412,7 +412,7 @@ fn run_frames_writes_the_skeleton_and_every_frame_without_changing_the_feedback(
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
-    let skeleton = bml_realizer::body::Skeleton::adult();
+    let skeleton = bml_realizer::character::body::Skeleton::adult();
     let joints = lines[0]["skeleton"]["joints"].as_array().unwrap();
     assert_eq!(joints.len(), skeleton.len());
     assert_eq!(lines[0]["characters"], serde_json::json!([""]));
@@ -424,7 +424,7 @@ fn run_frames_writes_the_skeleton_and_every_frame_without_changing_the_feedback(
         .iter()
         .min_by(|a, b| near(a).total_cmp(&near(b)))
         .unwrap();
-    let mut pose = bml_realizer::body::Pose::rest(&skeleton);
+    let mut pose = bml_realizer::character::body::Pose::rest(&skeleton);
     for (i, j) in skeleton.joints().iter().enumerate() {
         let q = stroke["characters"][""]["joints"][&j.name]
             .as_array()
@@ -556,7 +556,7 @@ fn run_gltf_writes_the_default_avatar_with_the_motion() {
     );
     let glb = std::fs::read(&path).unwrap();
     let (gltf, _) = glb_json(&glb);
-    let skeleton = bml_realizer::body::Skeleton::adult();
+    let skeleton = bml_realizer::character::body::Skeleton::adult();
     assert_eq!(
         gltf["skins"][0]["joints"].as_array().unwrap().len(),
         skeleton.len()

@@ -90,11 +90,12 @@ fn face_and_face_shift_take_the_standards_lexeme_child() {
            <faceShift id="fs"><lexeme lexeme="RAISE_BROWS" amount="0.4"/></faceShift>"#,
     );
     assert_eq!(code, 0, "{out}");
-    let parsed = bml_realizer::bml::load(&format!(
+    let parsed = bml_realizer::language::bml::load(&format!(
         r#"<bml {NS} id="b1"><face id="f"><lexeme lexeme="RAISE_BROWS" amount="0.7"/></face></bml>"#
     ))
     .unwrap();
-    let bml_realizer::bml::BehaviourKind::Face(f) = &parsed.block.behaviours[0].kind else {
+    let bml_realizer::language::bml::BehaviourKind::Face(f) = &parsed.block.behaviours[0].kind
+    else {
         panic!("a face")
     };
     assert_eq!(
@@ -213,7 +214,7 @@ fn a_world_file_gives_named_and_moving_targets_and_unknown_targets_list_them() {
 /// the head to opposite sides.
 #[test]
 fn gaze_follows_a_point_moving_along_its_path() {
-    use bml_realizer::body::Skeleton;
+    use bml_realizer::character::body::Skeleton;
     use bml_realizer::realizer::Realizer;
     let mut r = Realizer::new();
     let text = std::fs::read_to_string("fixtures/examples/world.json").unwrap();

@@ -4,8 +4,8 @@
 //! without a jump when its controller ends, and a compound alone says that nothing holds the
 //! legs.
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::feedback::Feedback;
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 use glam::Vec3;
 

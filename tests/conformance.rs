@@ -2,7 +2,7 @@
 //! clock; and the same suite against a deliberately broken realizer, to show that it catches
 //! timing regressions.
 
-use bml_realizer::conformance::InProcess;
+use bml_realizer::ports::conformance::InProcess;
 use realizer_tests::{run, TESTS};
 
 #[test]

@@ -1,7 +1,7 @@
 //! Constraint extraction: the exact normalised constraint set of the thesis' BML examples 24–30
 //! (translated to BML 1.0 in fixtures/thesis) and of RealizerTester files.
 
-use bml_realizer::bml::{self, Anchor, Relation, Source, SyncPoint};
+use bml_realizer::language::bml::{self, Anchor, Relation, Source, SyncPoint};
 
 fn fixture(path: &str) -> String {
     std::fs::read_to_string(format!("{}/fixtures/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()

@@ -2,11 +2,11 @@
 //! and pulls of several controllers on one joint adding up, one stiffness multiplier for the
 //! balance, and a PD-driven hinge settling without overshoot at critical damping.
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::dynamics::controllers::{
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::character::dynamics::controllers::{
     pd, Balance, Controller, Drive, PoseController, RagDoll,
 };
-use bml_realizer::dynamics::sim::{Simulation, STEP};
+use bml_realizer::character::dynamics::sim::{Simulation, STEP};
 use glam::{DQuat, DVec3};
 
 const WHOLE_BODY: [usize; 15] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14];

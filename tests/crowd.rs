@@ -7,12 +7,12 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use bml_realizer::crowd::quality::{measure, Quality, Track};
-use bml_realizer::crowd::scenes::{self, Scene};
-use bml_realizer::crowd::sim::{Mover, Sim};
-use bml_realizer::feedback::Feedback;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
-use bml_realizer::space::Obstacles;
+use bml_realizer::world::crowd::quality::{measure, Quality, Track};
+use bml_realizer::world::crowd::scenes::{self, Scene};
+use bml_realizer::world::crowd::sim::{Mover, Sim};
+use bml_realizer::world::space::Obstacles;
 use bml_realizer::world::World;
 use glam::Vec2;
 use proptest::prelude::*;

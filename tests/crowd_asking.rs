@@ -3,7 +3,7 @@
 //! way — the gaze engine turns its eyes and head to them — where a walker with an open way looks
 //! along its route.
 
-use bml_realizer::body::Skeleton;
+use bml_realizer::character::body::Skeleton;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
 use glam::Vec3;

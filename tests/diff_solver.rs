@@ -3,7 +3,7 @@
 //! bounds, returns the least solution and ignores constraint order; an injected contradictory cycle
 //! is reported, and the reported set is itself infeasible and minimal.
 
-use bml_realizer::schedule::diff::{DiffSystem, Edge};
+use bml_realizer::planning::schedule::diff::{DiffSystem, Edge};
 use proptest::prelude::*;
 
 #[derive(Debug, Clone)]

@@ -5,8 +5,10 @@
 //! from the links' Jacobians; and gravity as an upward base acceleration against gravity as forces
 //! at the centres of mass.
 
-use bml_realizer::dynamics::rnea::{inverse_dynamics, with_gravity, BaseMotion, JointMotion, Link};
-use bml_realizer::dynamics::GRAVITY;
+use bml_realizer::character::dynamics::rnea::{
+    inverse_dynamics, with_gravity, BaseMotion, JointMotion, Link,
+};
+use bml_realizer::character::dynamics::GRAVITY;
 use glam::{DMat3, DQuat, DVec3};
 
 /// A small deterministic generator (splitmix64).

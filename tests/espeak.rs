@@ -8,12 +8,12 @@
 #[path = "common/espeak_report.rs"]
 mod espeak_report;
 
-use bml_realizer::bml::TextPart;
-use bml_realizer::feedback::Feedback;
+use bml_realizer::character::voice::espeak::{Espeak, VoiceName};
+use bml_realizer::character::voice::Tts;
+use bml_realizer::language::bml::TextPart;
+use bml_realizer::language::feedback::Feedback;
+use bml_realizer::planning::timing::{SpeechTiming, Voice};
 use bml_realizer::realizer::Realizer;
-use bml_realizer::timing::{SpeechTiming, Voice};
-use bml_realizer::voice::espeak::{Espeak, VoiceName};
-use bml_realizer::voice::Tts;
 
 /// espeak-ng's own report of `text` in `voice`: (IPA, start, end) of each phoneme, and its
 /// samples.
@@ -35,7 +35,9 @@ fn reported(voice: &str, text: &str) -> (Vec<(String, f64, f64)>, Vec<i16>) {
     );
     let report = espeak_report::read(&std::fs::read_to_string(&json).unwrap());
     let phones = report.phonemes;
-    let samples = bml_realizer::sound::read_wav(&wav).unwrap().samples;
+    let samples = bml_realizer::character::sound::read_wav(&wav)
+        .unwrap()
+        .samples;
     let _ = std::fs::remove_dir_all(&dir);
     (phones, samples)
 }

@@ -9,8 +9,8 @@ mod random_bml;
 
 use std::collections::BTreeMap;
 
-use bml_realizer::bml::Limits;
-use bml_realizer::feedback::{BlockStatus, Feedback};
+use bml_realizer::language::bml::Limits;
+use bml_realizer::language::feedback::{BlockStatus, Feedback};
 use bml_realizer::realizer::Realizer;
 use proptest::prelude::*;
 

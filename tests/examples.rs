@@ -3,7 +3,7 @@
 
 use std::process::Command;
 
-use bml_realizer::feedback::{self, BlockStatus, Feedback};
+use bml_realizer::language::feedback::{self, BlockStatus, Feedback};
 
 const README: &str = include_str!("../fixtures/examples/README.md");
 
@@ -68,13 +68,17 @@ fn welcome() {
     let fb = run("run fixtures/examples/welcome.xml");
     no_warnings(&fb);
     // the speech as the built-in TTS says it: "welcome" starts at the stress sync
-    use bml_realizer::voice::Tts;
+    use bml_realizer::character::voice::Tts;
     let text = [
-        bml_realizer::bml::TextPart::Text("Hello and ".into()),
-        bml_realizer::bml::TextPart::Sync(bml_realizer::bml::Id::new_static("stress")),
-        bml_realizer::bml::TextPart::Text("welcome to the realizer!".into()),
+        bml_realizer::language::bml::TextPart::Text("Hello and ".into()),
+        bml_realizer::language::bml::TextPart::Sync(bml_realizer::language::bml::Id::new_static(
+            "stress",
+        )),
+        bml_realizer::language::bml::TextPart::Text("welcome to the realizer!".into()),
     ];
-    let u = bml_realizer::voice::builtin::Builtin.speak(&text).unwrap();
+    let u = bml_realizer::character::voice::builtin::Builtin
+        .speak(&text)
+        .unwrap();
     assert_eq!(u.words[2].text, "welcome");
     // the beat's stroke on the stress; its preparation, paced for the hand's travel, needs more
     // time than the speech has before "welcome", so the beat starts the block and the speech

@@ -2,9 +2,9 @@
 //! overlapping expressions without jumps, faceShift's lasting rest expression, action units by
 //! side, blendshapes and the jaw, warnings for what the face model lacks, and blinks.
 
-use bml_realizer::face::mixer::MAX_RATE;
-use bml_realizer::face::{Face, FaceModel};
-use bml_realizer::feedback::Feedback;
+use bml_realizer::character::face::mixer::MAX_RATE;
+use bml_realizer::character::face::{Face, FaceModel};
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 
 const FPS: f64 = 60.0;
@@ -51,9 +51,9 @@ fn au(face: &Face, name: &str) -> f32 {
     let m = FaceModel::default_model();
     let (n, side) = name.split_at(name.len() - 1);
     let side = if side == "L" {
-        bml_realizer::bml::Side::Left
+        bml_realizer::language::bml::Side::Left
     } else {
-        bml_realizer::bml::Side::Right
+        bml_realizer::language::bml::Side::Right
     };
     face.aus.0[m
         .slots(n.trim_start_matches("AU").parse().unwrap(), side)
@@ -208,7 +208,7 @@ fn action_units_by_side_blendshapes_and_the_jaw() {
     );
     let mut r = Realizer::new().with_idle(false);
     r.perform_bml(&bml).unwrap();
-    let skeleton = bml_realizer::body::Skeleton::adult();
+    let skeleton = bml_realizer::character::body::Skeleton::adult();
     let jaw = skeleton.joint("temporomandibular").unwrap();
     let frame = r.tick(0.0);
     let closed = frame.poses[0].pose.rotations[jaw];

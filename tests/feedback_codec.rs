@@ -1,7 +1,7 @@
 //! Feedback decoding rejects malformed lines with a reason, and never accepts a line that it could
 //! not write back (regressions found by the `feedback` fuzz target).
 
-use bml_realizer::feedback::*;
+use bml_realizer::language::feedback::*;
 
 fn err(line: &str) -> String {
     from_line(line).expect_err("line should be rejected").0

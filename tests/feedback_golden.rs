@@ -2,7 +2,7 @@
 //! set (all four elements, BMLA status and posix time, escaping). CI validates every line of the XML
 //! log against bml-schemas/feedback-1.0.xsd. Regenerate with `UPDATE_GOLDEN=1 cargo test`.
 
-use bml_realizer::feedback::*;
+use bml_realizer::language::feedback::*;
 
 fn messages() -> Vec<Feedback> {
     let mut v = vec![

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use bml_realizer::bml::{self, Code, Severity};
+use bml_realizer::language::bml::{self, Code, Severity};
 
 fn xml_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for e in std::fs::read_dir(dir).unwrap() {

@@ -5,7 +5,7 @@
 #[path = "common/feet.rs"]
 mod feet;
 
-use bml_realizer::feedback::Feedback;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
 use feet::Slides;

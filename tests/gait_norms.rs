@@ -7,7 +7,7 @@
 #[path = "common/gait_lab.rs"]
 mod gait_lab;
 
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::body::{Pose, Skeleton};
 use gait_lab::{bands, cycles, means, record, sample, MEASURES, WALKS};
 use glam::Quat;
 

@@ -2,7 +2,7 @@
 //! where it is (no jump back to rest), and a whole-body gaze at a target straight behind ends with
 //! the eyes on it.
 
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::body::{Pose, Skeleton};
 use bml_realizer::realizer::Realizer;
 use glam::Vec3;
 

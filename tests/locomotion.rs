@@ -6,8 +6,8 @@
 #[path = "common/motion.rs"]
 mod motion;
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::feedback::Feedback;
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
 use glam::{Vec2, Vec3};
@@ -653,8 +653,8 @@ fn a_walk_to_another_character_stops_at_social_distance_facing_them() {
 }
 
 mod routes {
-    use bml_realizer::space::path::{self, PathError};
-    use bml_realizer::space::{Obstacle, Obstacles, Shape};
+    use bml_realizer::world::space::path::{self, PathError};
+    use bml_realizer::world::space::{Obstacle, Obstacles, Shape};
     use glam::Vec2;
     use proptest::prelude::*;
 
@@ -743,7 +743,7 @@ fn running_has_a_flight_phase_and_speed_never_jumps() {
 
 #[test]
 fn each_character_s_steering_combiner_comes_from_the_world_file() {
-    use bml_realizer::locomotion::steering::Combine;
+    use bml_realizer::world::locomotion::steering::Combine;
     let json = r#"{"characters": {"A": {"position": [0, 0, 0], "steering": "weighted"},
         "B": {"position": [3, 0, 0], "steering": "dithering"}, "C": {"position": [6, 0, 0]}},
         "obstacles": [{"box": [-0.5, 2, 0.3, 2.5]}, {"box": [2.5, 2, 3.3, 2.5]}, {"box": [5.5, 2, 6.3, 2.5]}]}"#;

@@ -1,7 +1,7 @@
 //! Malformed BML: each problem gets its own diagnostic code at the right line:column, and no input
 //! makes the parser panic.
 
-use bml_realizer::bml::{self, Code, Severity};
+use bml_realizer::language::bml::{self, Code, Severity};
 use proptest::prelude::*;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;

@@ -6,9 +6,9 @@
 //! momentum to a few per cent of the arm's own, and the drift shrinks with the step. Last, the
 //! thesis' lagged coupling is checked to take the connector's acceleration from the step before.
 
-use bml_realizer::body::{Pose, Skeleton};
-use bml_realizer::dynamics::controllers::Drive;
-use bml_realizer::dynamics::sim::{Coupling, Simulation};
+use bml_realizer::character::body::{Pose, Skeleton};
+use bml_realizer::character::dynamics::controllers::Drive;
+use bml_realizer::character::dynamics::sim::{Coupling, Simulation};
 use glam::{DMat3, DVec3, Quat};
 
 /// The lower body and trunk simulated; arms and head kinematic.

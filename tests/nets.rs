@@ -126,9 +126,9 @@ fn a_bad_nets_file_is_refused_with_exit_2_naming_the_file_and_field() {
 
 #[test]
 fn a_sees_guard_makes_a_character_look_at_a_newcomer_only_after_it_appears() {
-    use bml_realizer::feedback::{Feedback, WorldFeedback};
-    use bml_realizer::nets::{file, Nets};
+    use bml_realizer::language::feedback::{Feedback, WorldFeedback};
     use bml_realizer::realizer::Realizer;
+    use bml_realizer::world::nets::{file, Nets};
     use bml_realizer::world::World;
     // b walks out from behind a wall into a's view; a's net looks at b once a sees it
     let world = r#"{"characters": {"a": {"position": [0, 0, 0]}, "b": {"position": [-2.5, 0, 6], "facing": 90}},

@@ -14,8 +14,8 @@ mod espeak_report;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
-use bml_realizer::face::VISEMES;
-use bml_realizer::feedback::Feedback;
+use bml_realizer::character::face::VISEMES;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
@@ -233,7 +233,8 @@ fn webvtt_word_cues_time_the_syncs_and_the_lips() {
 /// frames a second over the sound.
 fn jaw_follows_loudness(run: &Run, length: f64) -> f64 {
     let audio =
-        bml_realizer::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav"))).unwrap();
+        bml_realizer::character::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav")))
+            .unwrap();
     let rate = f64::from(audio.rate);
     let (mut jaw, mut rms) = (Vec::new(), Vec::new());
     for i in 0..(length * 60.0) as usize {

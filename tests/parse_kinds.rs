@@ -1,6 +1,6 @@
 //! Parse tests for every behaviour kind and extension: every attribute value is asserted.
 
-use bml_realizer::bml::*;
+use bml_realizer::language::bml::*;
 
 const HEAD: &str = r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0"
      xmlns:bmla="http://www.asap-project.org/bmla" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt"

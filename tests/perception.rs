@@ -1,10 +1,10 @@
 //! Synthetic vision in a running realizer: what hides, what shows, and when. Character `a`
 //! stands at the origin looking along +z; the others and the obstacles are placed around it.
 
-use bml_realizer::body::Skeleton;
-use bml_realizer::feedback::{Feedback, WorldFeedback};
-use bml_realizer::perception::Vision;
+use bml_realizer::character::body::Skeleton;
+use bml_realizer::language::feedback::{Feedback, WorldFeedback};
 use bml_realizer::realizer::Realizer;
+use bml_realizer::world::perception::Vision;
 use bml_realizer::world::{Placement, World};
 use glam::{Vec2, Vec3};
 
@@ -131,12 +131,12 @@ fn a_character_walking_out_from_behind_a_wall_appears_within_one_period_of_showi
     ))
     .unwrap();
     let skeleton = Skeleton::adult();
-    let eyes = |pose: &bml_realizer::body::Pose| {
+    let eyes = |pose: &bml_realizer::character::body::Pose| {
         let l = skeleton.joint("l_eyeball_joint").unwrap();
         let r = skeleton.joint("r_eyeball_joint").unwrap();
         (pose.joint_world(&skeleton, l).0 + pose.joint_world(&skeleton, r).0) / 2.0
     };
-    let chest = |pose: &bml_realizer::body::Pose| {
+    let chest = |pose: &bml_realizer::character::body::Pose| {
         pose.joint_world(&skeleton, skeleton.joint("vt6").unwrap())
             .0
     };

@@ -2,7 +2,7 @@
 //! junction hidden by a wall, `a` walks exactly as if `b` were not there until it sees `b`;
 //! with the default profile it already makes way for `b`, whom it could not see.
 
-use bml_realizer::feedback::{Feedback, WorldFeedback};
+use bml_realizer::language::feedback::{Feedback, WorldFeedback};
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
 use glam::Vec2;

@@ -2,8 +2,8 @@
 //! host, a fall reported as a warning, parameters changed while the controller runs, and the
 //! body handed back to the kinematic engines when it ends.
 
-use bml_realizer::body::Skeleton;
-use bml_realizer::feedback::Feedback;
+use bml_realizer::character::body::Skeleton;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" xmlns:bmla="http://www.asap-project.org/bmla""#;
@@ -250,7 +250,7 @@ fn an_unknown_controller_class_is_refused_with_the_known_ones() {
 }
 
 /// The largest turn of any joint between two neighbouring frames (radians), and where.
-fn largest_turn(frames: &[(f64, bml_realizer::body::Pose)]) -> (f32, f64, usize) {
+fn largest_turn(frames: &[(f64, bml_realizer::character::body::Pose)]) -> (f32, f64, usize) {
     let mut worst = (0.0f32, 0.0, 0);
     for w in frames.windows(2) {
         for (j, (a, b)) in w[0].1.rotations.iter().zip(&w[1].1.rotations).enumerate() {
@@ -274,7 +274,7 @@ fn switching_the_arms_from_kinematic_to_simulated_is_continuous() {
     );
     let mut r = Realizer::new().with_idle(false);
     r.perform_bml(&bml).unwrap();
-    let frames: Vec<(f64, bml_realizer::body::Pose)> = (0..=(3.0 * FPS) as usize)
+    let frames: Vec<(f64, bml_realizer::character::body::Pose)> = (0..=(3.0 * FPS) as usize)
         .map(|k| {
             let t = k as f64 / FPS;
             (t, r.tick(t).poses[0].pose.clone())

@@ -1,8 +1,8 @@
 //! Round trips: `parse(write(block)) == block` for generated BML models, and
 //! `decode(encode(fb)) == fb` for generated feedback in both codecs (≥ 1000 cases each).
 
-use bml_realizer::bml::*;
-use bml_realizer::feedback::*;
+use bml_realizer::language::bml::*;
+use bml_realizer::language::feedback::*;
 use proptest::collection::vec;
 use proptest::option;
 use proptest::prelude::*;
@@ -49,7 +49,7 @@ fn foreign() -> impl Strategy<Value = Vec<ForeignAttr>> {
 }
 
 /// An id as the model stores it.
-fn sid() -> impl Strategy<Value = bml_realizer::bml::Id> {
+fn sid() -> impl Strategy<Value = bml_realizer::language::bml::Id> {
     id().prop_map(Into::into)
 }
 

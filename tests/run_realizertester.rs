@@ -7,10 +7,12 @@
 
 use std::process::Command;
 
-use bml_realizer::feedback::{self, BlockStatus, Feedback, SyncPointProgress, WarningFeedback};
+use bml_realizer::language::feedback::{
+    self, BlockStatus, Feedback, SyncPointProgress, WarningFeedback,
+};
 
 const EPS: f64 = 0.1;
-use bml_realizer::bml::{
+use bml_realizer::language::bml::{
     FACE_SYNCS as FACE4, GAZE_SYNCS as GAZE4, GESTURE_SYNCS as GESTURE7, START_END as SE,
 };
 

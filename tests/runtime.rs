@@ -5,12 +5,12 @@
 
 use std::sync::{Arc, Mutex};
 
-use bml_realizer::bml::{Behaviour, BehaviourKind, NS_BML};
-use bml_realizer::engine::{Engine, EngineError, KindKey, Unit, UnitKey};
 use bml_realizer::engines::default_registry;
-use bml_realizer::feedback::{BlockStatus, Feedback, Format};
+use bml_realizer::engines::interface::{Engine, EngineError, KindKey, Unit, UnitKey};
+use bml_realizer::language::bml::{Behaviour, BehaviourKind, NS_BML};
+use bml_realizer::language::feedback::{BlockStatus, Feedback, Format};
+use bml_realizer::planning::timing::{DefaultTimingModels, TimingModel};
 use bml_realizer::realizer::Realizer;
-use bml_realizer::timing::{DefaultTimingModels, TimingModel};
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmla="http://www.asap-project.org/bmla" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
 
@@ -35,7 +35,7 @@ fn speech(id: &str, words: usize, sync: Option<(&str, usize)>, attrs: &str) -> S
 
 /// A realizer with the metronome voice.
 fn metronome() -> Realizer {
-    Realizer::new().with_speech_timing(bml_realizer::timing::SpeechTiming::syllables())
+    Realizer::new().with_speech_timing(bml_realizer::planning::timing::SpeechTiming::syllables())
 }
 
 struct Session {
@@ -752,7 +752,10 @@ fn memory_stays_bounded_while_streaming_100000_blocks() {
         (sizes.blocks, sizes.engine_units, sizes.parameter_changes),
         (0, 0, 0)
     );
-    assert_eq!(sizes.finished_ids, bml_realizer::blocks::FINISHED_HISTORY);
+    assert_eq!(
+        sizes.finished_ids,
+        bml_realizer::realizer::blocks::FINISHED_HISTORY
+    );
 }
 
 #[test]
@@ -829,7 +832,7 @@ fn a_new_kind_and_engine_register_from_outside_the_core() {
 
 // ---- anticipators (thesis scenarios 1–3) -------------------------------------------------
 
-use bml_realizer::plan::anticipator::{Metronome, Scripted};
+use bml_realizer::planning::plan::anticipator::{Metronome, Scripted};
 
 #[test]
 fn scenario3_speech_starts_one_second_after_the_last_predicted_end_of_the_users_turn() {

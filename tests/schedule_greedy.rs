@@ -2,12 +2,12 @@
 //! Ex. 27b but not 28b or 29b (thesis §7.3.5); it rejects before/after. Side by side
 //! with `Optimal`, which schedules all of them.
 
-use bml_realizer::bml;
-use bml_realizer::feedback::KnownWarning;
-use bml_realizer::schedule::{
+use bml_realizer::language::bml;
+use bml_realizer::language::feedback::KnownWarning;
+use bml_realizer::planning::schedule::{
     BlockSchedule, NoExternal, Optimal, SchedulingStrategy, SortedGreedy,
 };
-use bml_realizer::timing::DefaultTimingModels;
+use bml_realizer::planning::timing::DefaultTimingModels;
 
 fn run(strategy: &dyn SchedulingStrategy, file: &str) -> BlockSchedule {
     let src =

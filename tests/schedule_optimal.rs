@@ -1,10 +1,10 @@
 //! The `Optimal` strategy on the thesis examples and RealizerTester files (their
 //! expected timings), before/after constraints, conflicts and order invariance.
 
-use bml_realizer::bml;
-use bml_realizer::feedback::KnownWarning;
-use bml_realizer::schedule::{BlockSchedule, NoExternal, Optimal, SchedulingStrategy};
-use bml_realizer::timing::DefaultTimingModels;
+use bml_realizer::language::bml;
+use bml_realizer::language::feedback::KnownWarning;
+use bml_realizer::planning::schedule::{BlockSchedule, NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::planning::timing::DefaultTimingModels;
 
 fn fixture(path: &str) -> String {
     std::fs::read_to_string(format!("{}/fixtures/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
@@ -349,7 +349,7 @@ fn a_persistent_controller_tied_to_a_gesture_does_not_squeeze_it() {
 
 #[test]
 fn an_invalid_engine_timing_model_drops_the_behaviour_instead_of_panicking() {
-    use bml_realizer::timing::{TimingModel, TimingModels};
+    use bml_realizer::planning::timing::{TimingModel, TimingModels};
     struct Broken;
     impl TimingModels for Broken {
         fn model(&self, b: &bml::Behaviour) -> Option<TimingModel> {

@@ -8,11 +8,11 @@
 //! scheduler: for each stretchable behaviour, the least over a uniform scale σ ≥ 0 of
 //! `|σ − 1| · preferred duration + 2 · Σ |phase − σ · preferred phase|`.
 
-use bml_realizer::bml;
-use bml_realizer::schedule::{
+use bml_realizer::language::bml;
+use bml_realizer::planning::schedule::{
     BlockSchedule, LinearProgram, NoExternal, Optimal, SchedulingStrategy,
 };
-use bml_realizer::timing::{DefaultTimingModels, Flexibility, TimingModels};
+use bml_realizer::planning::timing::{DefaultTimingModels, Flexibility, TimingModels};
 use proptest::prelude::*;
 
 const WORDS: &[&str] = &[
@@ -277,12 +277,12 @@ fn beat_times() -> [f64; 3] {
 /// The right wrist of the character realizing the block of the report, in the world, at `t`
 /// seconds (frames from 0 at 60 Hz up to `t`).
 fn beat_wrist_at(times: &[f64]) -> Vec<glam::Vec3> {
-    use bml_realizer::body::Skeleton;
+    use bml_realizer::character::body::Skeleton;
     use bml_realizer::realizer::Realizer;
     // without the idle layer: the wrist moves only with the beat; the metronome voice gives
     // hand-computable times
     let mut r = Realizer::new()
-        .with_speech_timing(bml_realizer::timing::SpeechTiming::syllables())
+        .with_speech_timing(bml_realizer::planning::timing::SpeechTiming::syllables())
         .with_idle(false);
     r.perform_bml(REPORT).unwrap();
     let skeleton = Skeleton::adult();
@@ -357,8 +357,8 @@ fn at_the_stroke_of_a_beat_the_hand_is_in_front_of_the_torso() {
 struct WaveLike;
 
 impl TimingModels for WaveLike {
-    fn model(&self, _: &bml::Behaviour) -> Option<bml_realizer::timing::TimingModel> {
-        Some(bml_realizer::timing::TimingModel::stretchable(&[
+    fn model(&self, _: &bml::Behaviour) -> Option<bml_realizer::planning::timing::TimingModel> {
+        Some(bml_realizer::planning::timing::TimingModel::stretchable(&[
             ("start", 0.0),
             ("ready", 1.0),
             ("strokeStart", 1.1),

@@ -2,11 +2,13 @@
 //! syncs following their behaviour, anticipator moves without rescheduling and the
 //! validity check after them, and before/after as pushing order links.
 
-use bml_realizer::bml;
-use bml_realizer::plan::pegs::{PegBoard, SyncAddr};
-use bml_realizer::plan::to_pegs::{invalid, plan_block, Anticipators, BoardTimes, PlannedBlock};
-use bml_realizer::schedule::{Optimal, SchedulingStrategy};
-use bml_realizer::timing::DefaultTimingModels;
+use bml_realizer::language::bml;
+use bml_realizer::planning::plan::pegs::{PegBoard, SyncAddr};
+use bml_realizer::planning::plan::to_pegs::{
+    invalid, plan_block, Anticipators, BoardTimes, PlannedBlock,
+};
+use bml_realizer::planning::schedule::{Optimal, SchedulingStrategy};
+use bml_realizer::planning::timing::DefaultTimingModels;
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9

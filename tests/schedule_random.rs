@@ -3,9 +3,9 @@
 //! before the block start, keeps each behaviour's sync order, and gives identical times for any
 //! order of the behaviours.
 
-use bml_realizer::bml::{self, Anchor, Relation, SyncPoint};
-use bml_realizer::schedule::{BlockSchedule, NoExternal, Optimal, SchedulingStrategy};
-use bml_realizer::timing::{DefaultTimingModels, Flexibility, TimingModels};
+use bml_realizer::language::bml::{self, Anchor, Relation, SyncPoint};
+use bml_realizer::planning::schedule::{BlockSchedule, NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::planning::timing::{DefaultTimingModels, Flexibility, TimingModels};
 use proptest::prelude::*;
 
 const KINDS: &[&str] = &[

@@ -2,11 +2,11 @@
 //! ungrounded clusters, anticipators), one test each, with the
 //! `Optimal` strategy and the default timing models.
 
-use bml_realizer::bml::{self, SyncPoint};
-use bml_realizer::schedule::{
+use bml_realizer::language::bml::{self, SyncPoint};
+use bml_realizer::planning::schedule::{
     BlockSchedule, ExternalTimes, NoExternal, Optimal, SchedulingStrategy,
 };
-use bml_realizer::timing::DefaultTimingModels;
+use bml_realizer::planning::timing::DefaultTimingModels;
 
 fn block(body: &str) -> String {
     format!(

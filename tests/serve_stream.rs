@@ -19,8 +19,8 @@ use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
 
 use base64::Engine as _;
-use bml_realizer::broker::{Inbound, Link};
-use bml_realizer::feedback::{from_line, Feedback};
+use bml_realizer::language::feedback::{from_line, Feedback};
+use bml_realizer::ports::broker::{Inbound, Link};
 use chunked::sync_time;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
@@ -135,9 +135,9 @@ fn hear_into(link: Link, tx: mpsc::Sender<Feedback>) {
 }
 
 /// espeak-ng's sentence, the sound every test streams.
-fn sound() -> bml_realizer::voice::Audio {
+fn sound() -> bml_realizer::character::voice::Audio {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/voice/espeak-bob.wav");
-    bml_realizer::sound::read_wav(std::path::Path::new(path)).unwrap()
+    bml_realizer::character::sound::read_wav(std::path::Path::new(path)).unwrap()
 }
 
 /// Streams the sentence through `port`, with `bad` as the one bad message; the feedback until

@@ -7,7 +7,7 @@
 #[path = "common/random_bml.rs"]
 mod random_bml;
 
-use bml_realizer::feedback::{Feedback, WarningType};
+use bml_realizer::language::feedback::{Feedback, WarningType};
 use bml_realizer::realizer::Realizer;
 use proptest::prelude::*;
 
@@ -116,7 +116,7 @@ const KINDS: &[&str] = &[
     r#"gaze target="user""#,
 ];
 /// A gesture's or head's sync points, in order.
-const SYNCS: &[&str] = bml_realizer::bml::GESTURE_SYNCS;
+const SYNCS: &[&str] = bml_realizer::language::bml::GESTURE_SYNCS;
 const TIMES: &[&str] = &["0", "0.01", "0.05", "0.2", "1", "1.02", "3"];
 
 /// A behaviour: its kind and (sync, time, tied to an earlier behaviour's sync?) constraints.

@@ -2,7 +2,7 @@
 //! behaviours): the vehicle's truncations, no vertical force, arrive's linear deceleration and
 //! floor speed and its stop, walk-to-velocity's force, stop, follow-points, and the combiners.
 
-use bml_realizer::locomotion::steering::{
+use bml_realizer::world::locomotion::steering::{
     ArriveParams, Behaviour, Combine, Context, Part, Rng, Steering, Vehicle, STOP_EPSILON,
 };
 use glam::Vec3;

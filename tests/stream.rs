@@ -13,8 +13,8 @@ use chunked::sync_time;
 
 use std::sync::{Arc, Mutex};
 
-use bml_realizer::face::VISEMES;
-use bml_realizer::feedback::Feedback;
+use bml_realizer::character::face::VISEMES;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" xmlns:bmla="http://www.asap-project.org/bmla""#;
@@ -58,7 +58,8 @@ fn listen(r: &mut Realizer) -> Arc<Mutex<Vec<Feedback>>> {
 #[test]
 fn a_streamed_speech_moves_the_lips_as_its_whole_file_and_ends_with_its_sound() {
     let audio =
-        bml_realizer::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav"))).unwrap();
+        bml_realizer::character::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav")))
+            .unwrap();
     let length = audio.samples.len() as f64 / f64::from(audio.rate);
     let lines = polly_lines();
     // the whole file with the whole marks, from 0
@@ -175,7 +176,8 @@ fn a_streamed_speech_moves_the_lips_as_its_whole_file_and_ends_with_its_sound() 
 #[test]
 fn an_interrupt_stops_a_stream_s_sound_and_lips_within_a_frame() {
     let audio =
-        bml_realizer::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav"))).unwrap();
+        bml_realizer::character::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav")))
+            .unwrap();
     let mut r = Realizer::new().with_idle(false);
     let log = listen(&mut r);
     let stream = r.open_stream(None, "reply");
@@ -210,7 +212,8 @@ fn an_interrupt_stops_a_stream_s_sound_and_lips_within_a_frame() {
 #[test]
 fn a_streamed_speech_s_inline_syncs_land_on_their_words_as_the_marks_come() {
     let audio =
-        bml_realizer::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav"))).unwrap();
+        bml_realizer::character::sound::read_wav(std::path::Path::new(&fixture("espeak-bob.wav")))
+            .unwrap();
     let length = audio.samples.len() as f64 / f64::from(audio.rate);
     let report = espeak_report::fixture();
     let word = |w: &str| {

@@ -3,8 +3,8 @@
 //! minimum-jerk reach (Flash & Hogan 1985: speed ∝ s²(1 − s)², a peak 1.875 × the mean). The
 //! wrist is placed by forward kinematics every 1/240 s through the whole realizer.
 
-use bml_realizer::body::Skeleton;
-use bml_realizer::feedback::Feedback;
+use bml_realizer::character::body::Skeleton;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
 
 const FPS: f64 = 240.0;

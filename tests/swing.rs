@@ -5,9 +5,9 @@
 //! swing gains amplitude when the lean keeps time with it (much less when the lean is well off
 //! its frequency), and keeps it when the rider sits still.
 
-use bml_realizer::dynamics::coupling::{relative_momentum, Carrier, Composite};
-use bml_realizer::dynamics::mass::{cuboid, MassProperties};
-use bml_realizer::dynamics::rnea::{JointMotion, Link};
+use bml_realizer::character::dynamics::coupling::{relative_momentum, Carrier, Composite};
+use bml_realizer::character::dynamics::mass::{cuboid, MassProperties};
+use bml_realizer::character::dynamics::rnea::{JointMotion, Link};
 use glam::{DQuat, DVec3};
 use rapier3d::prelude::*;
 

@@ -7,7 +7,7 @@
 #[path = "common/motion.rs"]
 mod motion;
 
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::body::{Pose, Skeleton};
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
 use motion::fastest_joint_but_the_eyes;

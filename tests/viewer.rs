@@ -276,12 +276,12 @@ fn the_live_view_streams_frames_and_feedback_as_blocks_arrive() {
             .decode(text)
             .unwrap()
     };
-    let model = bml_realizer::avatar::Model::from_glb("live", &glb).unwrap();
+    let model = bml_realizer::character::avatar::Model::from_glb("live", &glb).unwrap();
     let moving: Vec<String> = (wiring["moving"].as_array().unwrap().iter())
         .map(|i| model.nodes[i.as_u64().unwrap() as usize].name.clone())
         .collect();
-    let skeleton = bml_realizer::body::Skeleton::adult();
-    let retarget = bml_realizer::avatar::Retarget::new(&model, &skeleton, None).unwrap();
+    let skeleton = bml_realizer::character::body::Skeleton::adult();
+    let retarget = bml_realizer::character::avatar::Retarget::new(&model, &skeleton, None).unwrap();
     let targets: u64 = (wiring["morphs"].as_array().unwrap().iter())
         .map(|m| m[1].as_u64().unwrap())
         .sum();
@@ -316,7 +316,7 @@ fn the_live_view_streams_frames_and_feedback_as_blocks_arrive() {
                 assert!(off < 1e-4, "{name}: {node} vs {joint}");
             }
             let c = &frame["characters"][""];
-            let pose = bml_realizer::body::Pose {
+            let pose = bml_realizer::character::body::Pose {
                 root: vec3(&c["root"]),
                 rotations: (skeleton.joints().iter())
                     .map(|j| quat(&c["joints"][&j.name]).normalize())

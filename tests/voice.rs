@@ -1,10 +1,10 @@
 //! The voice through the realizer: the built-in TTS's timing is the speech's timing, and the
 //! lips move with it — the jaw opens most at each vowel and the lips close on every p, b and m.
 
-use bml_realizer::bml::TextPart;
-use bml_realizer::face::VISEMES;
+use bml_realizer::character::face::VISEMES;
+use bml_realizer::language::bml::TextPart;
+use bml_realizer::planning::timing::SpeechTiming;
 use bml_realizer::realizer::Realizer;
-use bml_realizer::timing::SpeechTiming;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 const SENTENCE: &str = "Papa bought the map, Bob made my bomb.";
@@ -15,7 +15,7 @@ const FPS: f64 = 200.0;
 type Mouth = (f64, f32, f32, Option<&'static str>);
 
 /// The mouth every frame of the sentence, and the TTS's utterance.
-fn speak() -> (Vec<Mouth>, bml_realizer::voice::Utterance) {
+fn speak() -> (Vec<Mouth>, bml_realizer::character::voice::Utterance) {
     let mut r = Realizer::new().with_idle(false);
     r.perform_bml(&format!(
         r#"<bml {NS} id="v"><speech id="s"><text>{SENTENCE}</text></speech></bml>"#

@@ -1,7 +1,7 @@
 //! Inputs shared by the benches (the chained blocks and the RealizerTester core files), and the
 //! allocator policy of the chained-block runs.
 
-use bml_realizer::bml;
+use bml_realizer::language::bml;
 
 /// N blocks, each tied to the one before: its speech starts when the previous block's speech
 /// ends, with a beat gesture on its own speech's end.

@@ -11,10 +11,10 @@
 use std::borrow::Cow;
 use std::sync::Arc;
 
-use bml_realizer::crowd::avoid::NEIGHBOUR_RADIUS;
-use bml_realizer::crowd::sim::Mover;
-use bml_realizer::crowd::{Agent, Crowd};
-use bml_realizer::space::{Obstacles, Shape};
+use bml_realizer::world::crowd::avoid::NEIGHBOUR_RADIUS;
+use bml_realizer::world::crowd::sim::Mover;
+use bml_realizer::world::crowd::{Agent, Crowd};
+use bml_realizer::world::space::{Obstacles, Shape};
 use glam::Vec2;
 
 /// ORCA's look-ahead for other agents (s).

@@ -7,9 +7,9 @@
 use glam::{Quat, Vec3};
 
 use super::blink::{Blinker, Eyes};
-use crate::body::{Pose, Skeleton};
-use crate::face::{Face, FaceModel};
-use crate::world::Placement;
+use crate::character::body::Placement;
+use crate::character::body::{Pose, Skeleton};
+use crate::character::face::{Face, FaceModel};
 
 /// How far the jaw joint (temporomandibular) opens at `jawOpen` = 1 (radians, about +x).
 pub const JAW_OPEN: f32 = 0.35; // 20°
@@ -88,7 +88,7 @@ mod tests {
         let s = Skeleton::adult();
         let model = FaceModel::default_model();
         let mut face = Face::neutral(model);
-        let open = crate::face::model::morph_index("jawOpen").unwrap();
+        let open = crate::character::face::model::morph_index("jawOpen").unwrap();
         face.morphs.0[open] = 1.0;
         let mut pose = Pose::rest(&s);
         let down = Quat::from_rotation_x(0.3); // +x turns +z towards −y: down
@@ -100,7 +100,7 @@ mod tests {
         a.finish(0.0, &s, &Placement::default(), &mut pose, &mut face);
         let jaw = pose.rotations[s.joint("temporomandibular").unwrap()];
         assert!((jaw.angle_between(Quat::IDENTITY) - JAW_OPEN).abs() < 1e-4);
-        let lowered = model.slots(43, crate::bml::Side::Left).unwrap()[0];
+        let lowered = model.slots(43, crate::language::bml::Side::Left).unwrap()[0];
         assert!(
             face.aus.0[lowered] > 0.4,
             "lids lowered: {}",

@@ -11,8 +11,8 @@
 
 use glam::Vec3;
 
-use crate::bml::Side;
-use crate::face::model::{Face, FaceModel};
+use crate::character::face::model::{Face, FaceModel};
+use crate::language::bml::Side;
 use crate::rng::{fnv1a, normals, unit};
 
 /// Seconds to close, stay closed, and open again.
@@ -73,11 +73,11 @@ fn closure(t: f64, start: f64) -> f64 {
     if x <= 0.0 || x >= close + hold + open {
         0.0
     } else if x < close {
-        crate::face::mixer::ease(x / close)
+        crate::character::face::mixer::ease(x / close)
     } else if x <= close + hold {
         1.0
     } else {
-        1.0 - crate::face::mixer::ease((x - close - hold) / open)
+        1.0 - crate::character::face::mixer::ease((x - close - hold) / open)
     }
 }
 

@@ -10,9 +10,9 @@
 use indexmap::IndexMap;
 use serde::Serialize;
 
-use crate::body::Skeleton;
-use crate::engine::CharacterPose;
-use crate::face::{Face, FaceModel, ARKIT, VISEMES};
+use super::CharacterPose;
+use crate::character::body::Skeleton;
+use crate::character::face::{Face, FaceModel, ARKIT, VISEMES};
 
 /// Feet on the ground, as a frame writes them.
 #[derive(Serialize)]
@@ -248,7 +248,7 @@ pub fn character(skeleton: &Skeleton, c: &CharacterPose, detail: Detail) -> Stri
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body::Pose;
+    use crate::character::body::Pose;
 
     fn at_rest(pose: Pose, clamped: Vec<usize>, contacts: Option<[bool; 2]>) -> CharacterPose {
         CharacterPose {

@@ -12,8 +12,8 @@ use super::gesture::Lexicon;
 use super::head::HeadLexicon;
 use super::posture::PoseBindings;
 use super::procedural::Library;
-use crate::body::Skeleton;
-use crate::dynamics::compound::CompoundLibrary;
+use crate::character::body::Skeleton;
+use crate::character::dynamics::compound::CompoundLibrary;
 
 /// The data of the motion engines.
 #[derive(Debug, Clone)]

@@ -9,10 +9,12 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::engine::{stop_now, Engine, EngineError, Unit, UnitKey, Units};
-use crate::timing::{DefaultTimingModels, Flexibility, SyncName, TimingModel, TimingModels};
-use crate::voice::Audio;
+use crate::character::voice::Audio;
+use crate::engines::interface::{stop_now, Engine, EngineError, Unit, UnitKey, Units};
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::{
+    DefaultTimingModels, Flexibility, SyncName, TimingModel, TimingModels,
+};
 
 /// The clips built into the realizer, by name (`fixtures/audio/`).
 pub const BUILT_IN: &[(&str, &[u8])] = &[(
@@ -56,9 +58,9 @@ impl AudioEngine {
                     .find(|(name, _)| *name == file && !path.exists());
                 match built_in {
                     Some((_, bytes)) => {
-                        crate::sound::read_wav_from(std::io::Cursor::new(*bytes), file)
+                        crate::character::sound::read_wav_from(std::io::Cursor::new(*bytes), file)
                     }
-                    None => crate::sound::read_wav(path),
+                    None => crate::character::sound::read_wav(path),
                 }
                 .map(Arc::new)
             })
@@ -118,24 +120,24 @@ impl Engine for AudioEngine {
         times
     }
 
-    fn as_sound(&self) -> Option<&dyn crate::engine::Sound> {
+    fn as_sound(&self) -> Option<&dyn crate::engines::interface::Sound> {
         Some(self)
     }
 
-    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engines::interface::Parameters> {
         Some(self)
     }
 }
 
-impl crate::engine::Sound for AudioEngine {
-    fn sounds(&self, now: f64, out: &mut Vec<crate::sound::Playing>) {
+impl crate::engines::interface::Sound for AudioEngine {
+    fn sounds(&self, now: f64, out: &mut Vec<crate::character::sound::Playing>) {
         self.units.playing(now, out, |c| {
             Some((c.audio.clone()?, (c.volume / 100.0) as f32))
         });
     }
 }
 
-impl crate::engine::Parameters for AudioEngine {
+impl crate::engines::interface::Parameters for AudioEngine {
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
         (name == "volume").then(|| self.units.get(key).map(|c| c.volume))?
     }

@@ -4,9 +4,9 @@
 
 use std::collections::HashMap;
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::engine::{Action, Engine, EngineError, ParameterChange, Unit, UnitKey};
-use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::engines::interface::{Action, Engine, EngineError, ParameterChange, Unit, UnitKey};
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::{DefaultTimingModels, TimingModel, TimingModels};
 
 /// What a control unit does when it starts.
 #[derive(Debug, Clone)]
@@ -23,7 +23,7 @@ enum Control {
         param: String,
         initial: Option<f64>,
         target_value: f64,
-        kind: crate::bml::TrajectoryType,
+        kind: crate::language::bml::TrajectoryType,
         end: f64,
     },
 }
@@ -90,12 +90,12 @@ impl Engine for ControlEngine {
         self.units.len()
     }
 
-    fn as_control(&mut self) -> Option<&mut dyn crate::engine::Control> {
+    fn as_control(&mut self) -> Option<&mut dyn crate::engines::interface::Control> {
         Some(self)
     }
 }
 
-impl crate::engine::Control for ControlEngine {
+impl crate::engines::interface::Control for ControlEngine {
     fn sync_passed(&mut self, key: &UnitKey, sync: &str, time: f64, actions: &mut Vec<Action>) {
         if sync != "start" {
             return;

@@ -9,12 +9,12 @@
 //! (`face::mixer`). Lexemes, AUs and blendshapes the face model lacks play their timing only,
 //! with a warning that says so.
 
-use crate::bml::{Behaviour, BehaviourKind, Side};
-use crate::engine::{Engine, EngineError, Unit, UnitKey, Units};
-use crate::face::mixer::{ease, envelope, Fader};
-use crate::face::model::{morph_index, ARKIT};
-use crate::face::{Face, FaceModel};
-use crate::timing::{DefaultTimingModels, SyncName, TimingModel, TimingModels};
+use crate::character::face::mixer::{ease, envelope, Fader};
+use crate::character::face::model::{morph_index, ARKIT};
+use crate::character::face::{Face, FaceModel};
+use crate::engines::interface::{Engine, EngineError, Unit, UnitKey, Units};
+use crate::language::bml::{Behaviour, BehaviourKind, Side};
+use crate::planning::timing::{DefaultTimingModels, SyncName, TimingModel, TimingModels};
 
 /// Amount when a behaviour gives none.
 pub const DEFAULT_AMOUNT: f64 = 1.0;
@@ -242,7 +242,7 @@ impl Engine for FaceEngine {
     }
 
     fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = crate::engine::relax_now(now, syncs);
+        let times = crate::engines::interface::relax_now(now, syncs);
         self.fader.jump(now);
         self.units.retime(key, &times);
         times
@@ -252,16 +252,16 @@ impl Engine for FaceEngine {
         self.units.len()
     }
 
-    fn as_expression(&mut self) -> Option<&mut dyn crate::engine::Expression> {
+    fn as_expression(&mut self) -> Option<&mut dyn crate::engines::interface::Expression> {
         Some(self)
     }
 
-    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engines::interface::Parameters> {
         Some(self)
     }
 }
 
-impl crate::engine::Expression for FaceEngine {
+impl crate::engines::interface::Expression for FaceEngine {
     fn express(&mut self, now: f64, face: &mut Face) {
         self.begin_shifts(now);
         let slots = self.slots();
@@ -298,7 +298,7 @@ impl crate::engine::Expression for FaceEngine {
     }
 }
 
-impl crate::engine::Parameters for FaceEngine {
+impl crate::engines::interface::Parameters for FaceEngine {
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
         let u = self.units.get(key)?;
         matches!(name, "amount" | "intensity").then_some(u.amount)

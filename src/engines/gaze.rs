@@ -28,12 +28,14 @@
 
 use glam::{Quat, Vec3};
 
-use crate::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Attend, Attention, Engine, EngineError, Steering, Unit, UnitKey, Units};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{
+    Attend, Attention, Engine, EngineError, Steering, Unit, UnitKey, Units,
+};
 use crate::engines::motion::{at, envelope, finished_shift};
-use crate::timing::SyncName;
-use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::language::bml::{Behaviour, BehaviourKind, Influence, OffsetDirection};
+use crate::planning::timing::SyncName;
+use crate::planning::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// Saccade duration at zero amplitude (seconds).
@@ -212,7 +214,7 @@ impl Engine for GazeEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("gaze");
-    crate::units_interrupt!(crate::engine::relax_now);
+    crate::units_interrupt!(crate::engines::interface::relax_now);
 
     fn name(&self) -> &'static str {
         "gaze"
@@ -245,11 +247,11 @@ impl Engine for GazeEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+    fn as_resources(&self) -> Option<&dyn crate::engines::interface::Resources> {
         Some(self)
     }
 
@@ -264,7 +266,7 @@ impl Attend for GazeEngine {
     }
 }
 
-impl crate::engine::Motion for GazeEngine {
+impl crate::engines::interface::Motion for GazeEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let (_, influence, _, _) = gaze(behaviour)?;
         let eyes = ["l_eyeball_joint", "r_eyeball_joint"];
@@ -392,7 +394,7 @@ fn share(influence: Influence, j: &str) -> (f32, f32) {
 
 /// `a` turned by whole turns to lie within half a turn of `near`.
 fn unwrap_near(a: f32, near: f32) -> f32 {
-    near + crate::body::limits::wrap(a - near)
+    near + crate::character::body::limits::wrap(a - near)
 }
 
 impl Aim {
@@ -495,7 +497,7 @@ impl Aim {
     }
 }
 
-impl crate::engine::Resources for GazeEngine {
+impl crate::engines::interface::Resources for GazeEngine {
     fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
         matches!(behaviour.kind, BehaviourKind::Gaze(_)).then_some("gaze")
     }

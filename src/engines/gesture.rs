@@ -13,13 +13,13 @@ use std::sync::Arc;
 use glam::{EulerRot, Quat};
 use indexmap::IndexMap;
 
-use crate::bml::{Behaviour, BehaviourKind, Param};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{hands, min_jerk, sides};
 use crate::engines::procedural::{mirror_name, mirror_rotation, Library, ProcUnit};
-use crate::timing::SyncName;
-use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::language::bml::{Behaviour, BehaviourKind, Param};
+use crate::planning::timing::SyncName;
+use crate::planning::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 mod pace;
@@ -386,7 +386,7 @@ impl Engine for GestureEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("gesture");
-    crate::units_interrupt!(crate::engine::relax_now);
+    crate::units_interrupt!(crate::engines::interface::relax_now);
 
     fn name(&self) -> &'static str {
         "gesture"
@@ -453,16 +453,16 @@ impl Engine for GestureEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+    fn as_resources(&self) -> Option<&dyn crate::engines::interface::Resources> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for GestureEngine {
+impl crate::engines::interface::Motion for GestureEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let BehaviourKind::Gesture(g) = &behaviour.kind else {
             return None;
@@ -483,7 +483,7 @@ impl crate::engine::Motion for GestureEngine {
                 joints.dedup();
                 Some(Steering {
                     joints,
-                    kind: crate::engine::MotionKind::Kinematic,
+                    kind: crate::engines::interface::MotionKind::Kinematic,
                     additive: true,
                 })
             }
@@ -514,7 +514,7 @@ impl crate::engine::Motion for GestureEngine {
     }
 }
 
-impl crate::engine::Resources for GestureEngine {
+impl crate::engines::interface::Resources for GestureEngine {
     fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
         match &behaviour.kind {
             BehaviourKind::Gesture(g) => hands(g.mode),

@@ -10,11 +10,11 @@
 
 use glam::{Quat, Vec3};
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
-use crate::timing::SyncName;
-use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{Engine, EngineError, Steering, Unit, Units};
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::SyncName;
+use crate::planning::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// The embedded default head lexicon.
@@ -146,7 +146,7 @@ fn angle(u: &HeadUnit, syncs: &[(SyncName, f64)], t: f64) -> f64 {
     }
     // (in key order: stroke, stroke:1, …)
     let peaks: Vec<f64> = (syncs.iter())
-        .filter(|(name, _)| crate::bml::stroke_iteration_of(name).is_some())
+        .filter(|(name, _)| crate::language::bml::stroke_iteration_of(name).is_some())
         .map(|s| s.1)
         .take(u.cycles.max(1) as usize)
         .collect();
@@ -223,7 +223,7 @@ impl Engine for HeadEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("head");
-    crate::units_interrupt!(crate::engine::relax_now);
+    crate::units_interrupt!(crate::engines::interface::relax_now);
 
     fn name(&self) -> &'static str {
         "head"
@@ -263,16 +263,16 @@ impl Engine for HeadEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+    fn as_resources(&self) -> Option<&dyn crate::engines::interface::Resources> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for HeadEngine {
+impl crate::engines::interface::Motion for HeadEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         matches!(behaviour.kind, BehaviourKind::Head(_))
             .then(|| Steering::kinematic(skeleton, ["vc4", "skullbase"], true))
@@ -293,7 +293,7 @@ impl crate::engine::Motion for HeadEngine {
     }
 }
 
-impl crate::engine::Resources for HeadEngine {
+impl crate::engines::interface::Resources for HeadEngine {
     fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
         &["head"]
     }
@@ -314,7 +314,7 @@ mod tests {
             ("end", 1.6),
         ]
         .iter()
-        .map(|&(n, t)| (crate::bml::Id::new_static(n), t))
+        .map(|&(n, t)| (crate::language::bml::Id::new_static(n), t))
         .collect()
     }
 
@@ -361,13 +361,13 @@ mod tests {
 
     /// A head's syncs with strokes at `strokes`, from `start` 1.0 to `relax` 2.0.
     fn repeated_syncs(strokes: &[f64]) -> Vec<(SyncName, f64)> {
-        let mut s = vec![(crate::bml::Id::new_static("start"), 1.0)];
+        let mut s = vec![(crate::language::bml::Id::new_static("start"), 1.0)];
         s.extend(
             (0..)
                 .zip(strokes)
-                .map(|(n, &t)| (crate::bml::stroke_name(n), t)),
+                .map(|(n, &t)| (crate::language::bml::stroke_name(n), t)),
         );
-        s.push((crate::bml::Id::new_static("relax"), 2.0));
+        s.push((crate::language::bml::Id::new_static("relax"), 2.0));
         s
     }
 

@@ -9,12 +9,12 @@
 
 use glam::{Quat, Vec3};
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
+use crate::character::body::{Pose, Skeleton};
 use crate::engines::gaze::{donders, eyes_at_rest, yaw_pitch};
+use crate::engines::interface::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{envelope, finished_shift};
-use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// (joint, share of the turn).
@@ -40,7 +40,7 @@ impl Engine for HeadDirectionEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("headDirection");
-    crate::units_interrupt!(crate::engine::stop_now);
+    crate::units_interrupt!(crate::engines::interface::stop_now);
 
     fn name(&self) -> &'static str {
         "headDirection"
@@ -69,12 +69,12 @@ impl Engine for HeadDirectionEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for HeadDirectionEngine {
+impl crate::engines::interface::Motion for HeadDirectionEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         matches!(behaviour.kind, BehaviourKind::HeadDirectionShift { .. })
             .then(|| Steering::kinematic(skeleton, SHARES.iter().map(|s| s.0), true))

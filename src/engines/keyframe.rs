@@ -28,13 +28,13 @@ use glam::{Quat, Vec3};
 use quick_xml::events::Event;
 use quick_xml::Reader;
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::body::{Pose, Skeleton};
-use crate::dynamics::butterworth::Butterworth;
-use crate::dynamics::kinematics::same_hemisphere;
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
-use crate::timing::SyncName;
-use crate::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
+use crate::character::body::{Pose, Skeleton};
+use crate::character::dynamics::butterworth::Butterworth;
+use crate::character::dynamics::kinematics::same_hemisphere;
+use crate::engines::interface::{Engine, EngineError, Steering, Unit, Units};
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::SyncName;
+use crate::planning::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
 use crate::world::World;
 
 /// Keys read from a `<SkeletonInterpolator>`.
@@ -358,7 +358,7 @@ impl Engine for KeyframeEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("keyframe");
-    crate::units_interrupt!(crate::engine::stop_now);
+    crate::units_interrupt!(crate::engines::interface::stop_now);
 
     fn name(&self) -> &'static str {
         "keyframe"
@@ -417,16 +417,16 @@ impl Engine for KeyframeEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_prediction(&mut self) -> Option<&mut dyn crate::engine::Prediction> {
+    fn as_prediction(&mut self) -> Option<&mut dyn crate::engines::interface::Prediction> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for KeyframeEngine {
+impl crate::engines::interface::Motion for KeyframeEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let keys = read_keys(content(behaviour)?).ok()?;
         let mut s = Steering::kinematic(skeleton, keys.parts.iter().map(String::as_str), false);
@@ -447,7 +447,7 @@ impl crate::engine::Motion for KeyframeEngine {
     }
 }
 
-impl crate::engine::Prediction for KeyframeEngine {
+impl crate::engines::interface::Prediction for KeyframeEngine {
     fn predict(&self, t: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) -> bool {
         let mut any = false;
         for (syncs, u) in self.units.all() {

@@ -1,6 +1,8 @@
 //! The built-in engines and the default registry that maps every BML 1.0, BMLA and BMLT behaviour
 //! kind to one of them:
 //!
+//! - [`interface`]: what every engine is (the `Engine` trait, its capabilities, units), the
+//!   registry from kinds to engines, and the frame engines write into;
 //! - [`assets`]: the motion data (units and bindings), embedded or read from a directory;
 //! - [`audio`]: BMLT `audiofile` as WAV clips, timed by their length;
 //! - [`control`]: `wait`, `interrupt`, `activate`, `parametervaluechange`;
@@ -22,6 +24,8 @@
 //! - [`procedural`]: BMLT procanimation(gesture) as procedural units from data (expressions, IK);
 //! - [`noise`]: BMLT Perlin noise on a joint, added on top of the other engines;
 //! - [`transition`]: BMLT transitions from the current pose to the predicted one.
+
+pub mod interface;
 
 pub mod assets;
 pub mod audio;
@@ -45,9 +49,9 @@ pub mod speech;
 pub mod timing_only;
 pub mod transition;
 
-use crate::bml::{NS_BML, NS_BMLA, NS_BMLT, NS_CORE_EXT};
-use crate::engine::{KindKey, Registry};
-use crate::timing::DefaultTimingModels;
+use crate::engines::interface::{KindKey, Registry};
+use crate::language::bml::{NS_BML, NS_BMLA, NS_BMLT, NS_CORE_EXT};
+use crate::planning::timing::DefaultTimingModels;
 
 /// Kinds the face engine realizes (namespace, element).
 pub const FACE_KINDS: &[(&str, &str)] = &[

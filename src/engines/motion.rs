@@ -3,9 +3,9 @@
 //! `end` (a shift moves over its whole span and stays), the most recently finished shift, and the
 //! hands a gesture mode occupies.
 
-use crate::bml::Mode;
-use crate::engine::Units;
-use crate::timing::SyncName;
+use crate::engines::interface::Units;
+use crate::language::bml::Mode;
+use crate::planning::timing::SyncName;
 
 /// Minimum-jerk profile: 0 at 0, 1 at 1, zero velocity and acceleration at both ends.
 pub fn min_jerk(u: f64) -> f64 {
@@ -86,7 +86,7 @@ mod tests {
 
     fn syncs(v: &[(&'static str, f64)]) -> Vec<(SyncName, f64)> {
         v.iter()
-            .map(|&(n, t)| (crate::bml::Id::new_static(n), t))
+            .map(|&(n, t)| (crate::language::bml::Id::new_static(n), t))
             .collect()
     }
 

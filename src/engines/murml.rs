@@ -21,11 +21,11 @@ use quick_xml::Reader;
 
 use glam::{EulerRot, Quat, Vec3};
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::keyframe::{play, Interpolation, Keys};
-use crate::timing::TimingModel;
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::TimingModel;
 use crate::world::World;
 
 /// The MURML namespace.
@@ -212,7 +212,7 @@ pub fn morph_keys(content: &str) -> Result<MorphKeys, String> {
         let morphs = (groups(&text)?.into_iter())
             .filter_map(|(name, v)| match v.as_slice() {
                 [percent] => Some((
-                    crate::face::model::morph_index(&name)?,
+                    crate::character::face::model::morph_index(&name)?,
                     (percent / 100.0).clamp(0.0, 1.0),
                 )),
                 _ => None,
@@ -279,7 +279,7 @@ impl Engine for MurmlEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("murml");
-    crate::units_interrupt!(crate::engine::relax_now);
+    crate::units_interrupt!(crate::engines::interface::relax_now);
 
     fn name(&self) -> &'static str {
         "murml"
@@ -321,23 +321,23 @@ impl Engine for MurmlEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+    fn as_resources(&self) -> Option<&dyn crate::engines::interface::Resources> {
         Some(self)
     }
 
-    fn as_expression(&mut self) -> Option<&mut dyn crate::engine::Expression> {
+    fn as_expression(&mut self) -> Option<&mut dyn crate::engines::interface::Expression> {
         Some(self)
     }
 }
 
-impl crate::engine::Expression for MurmlEngine {
+impl crate::engines::interface::Expression for MurmlEngine {
     /// The blendshapes of every `murmlface` playing: its frames laid linearly from `start` to
     /// `end`.
-    fn express(&mut self, now: f64, face: &mut crate::face::Face) {
+    fn express(&mut self, now: f64, face: &mut crate::character::face::Face) {
         for (syncs, u) in self.units.started(now) {
             let (Some(start), Some(end)) = (syncs.first(), syncs.last()) else {
                 continue;
@@ -353,7 +353,7 @@ impl crate::engine::Expression for MurmlEngine {
     }
 }
 
-impl crate::engine::Motion for MurmlEngine {
+impl crate::engines::interface::Motion for MurmlEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let (Kind::Gesture, content) = kind(behaviour)? else {
             return None;
@@ -377,7 +377,7 @@ impl crate::engine::Motion for MurmlEngine {
     }
 }
 
-impl crate::engine::Resources for MurmlEngine {
+impl crate::engines::interface::Resources for MurmlEngine {
     fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
         match kind(behaviour) {
             Some((Kind::Gesture, _)) => &["left_hand", "right_hand"],

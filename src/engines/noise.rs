@@ -18,15 +18,15 @@
 
 use glam::{EulerRot, Quat};
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{
     named_param, named_params, set_named_param, Engine, EngineError, Params, Steering, Unit,
     UnitKey, Units,
 };
 use crate::engines::motion::min_jerk;
 use crate::engines::procedural::perlin;
-use crate::timing::TimingModel;
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::TimingModel;
 use crate::world::World;
 
 /// Parameter names and defaults.
@@ -84,7 +84,7 @@ impl Engine for NoiseEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("noise");
-    crate::units_interrupt!(crate::engine::stop_now);
+    crate::units_interrupt!(crate::engines::interface::stop_now);
 
     fn name(&self) -> &'static str {
         "noise"
@@ -112,16 +112,16 @@ impl Engine for NoiseEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engines::interface::Parameters> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for NoiseEngine {
+impl crate::engines::interface::Motion for NoiseEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let BehaviourKind::Noise(n) = &behaviour.kind else {
             return None;
@@ -159,7 +159,7 @@ impl crate::engine::Motion for NoiseEngine {
     }
 }
 
-impl crate::engine::Parameters for NoiseEngine {
+impl crate::engines::interface::Parameters for NoiseEngine {
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
         named_param(&self.units.get(key)?.params, name)
     }

@@ -30,17 +30,19 @@ use glam::{DVec3, Quat};
 
 use std::sync::Arc;
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::body::{Pose, Skeleton};
-use crate::dynamics::compound::{same_name, Compound, CompoundLibrary, CompoundSpec};
-use crate::dynamics::config::{smallest_covering, Configuration};
-use crate::dynamics::controllers::{Balance, Controller, Drive, PoseController, RagDoll};
-use crate::dynamics::sim::{Simulation, STEP};
-use crate::engine::{
+use crate::character::body::{Pose, Skeleton};
+use crate::character::dynamics::compound::{same_name, Compound, CompoundLibrary, CompoundSpec};
+use crate::character::dynamics::config::{smallest_covering, Configuration};
+use crate::character::dynamics::controllers::{
+    Balance, Controller, Drive, PoseController, RagDoll,
+};
+use crate::character::dynamics::sim::{Simulation, STEP};
+use crate::engines::interface::{
     named_param, named_params, set_named_param, Engine, EngineError, MotionKind, Params, Steering,
     Unit, UnitKey, Units,
 };
-use crate::timing::TimingModel;
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::TimingModel;
 use crate::world::World;
 
 /// The lower body and the trunk (parts of `dynamics::humanoid::PARTS`).
@@ -78,7 +80,7 @@ struct Catalogue {
 
 impl Catalogue {
     fn new(skeleton: &Skeleton) -> Catalogue {
-        let part_of = crate::dynamics::humanoid::Humanoid::new(skeleton)
+        let part_of = crate::character::dynamics::humanoid::Humanoid::new(skeleton)
             .map(|h| h.part_of)
             .unwrap_or_default();
         let mut catalogue = Catalogue {
@@ -594,7 +596,7 @@ impl Engine for PhysicalEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("physical");
-    crate::units_interrupt!(crate::engine::stop_now);
+    crate::units_interrupt!(crate::engines::interface::stop_now);
 
     fn name(&self) -> &'static str {
         "physical"
@@ -641,15 +643,15 @@ impl Engine for PhysicalEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engines::interface::Parameters> {
         Some(self)
     }
 
-    fn as_physics(&mut self) -> Option<&mut dyn crate::engine::Physics> {
+    fn as_physics(&mut self) -> Option<&mut dyn crate::engines::interface::Physics> {
         Some(self)
     }
 
@@ -658,7 +660,7 @@ impl Engine for PhysicalEngine {
     }
 }
 
-impl crate::engine::Motion for PhysicalEngine {
+impl crate::engines::interface::Motion for PhysicalEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let BehaviourKind::Controller(c) = &behaviour.kind else {
             return None;
@@ -668,7 +670,7 @@ impl crate::engine::Motion for PhysicalEngine {
             None if same_name("RagDoll", &c.class) => WHOLE_BODY.to_vec(),
             None => LOWER_BODY.to_vec(),
         };
-        let h = crate::dynamics::humanoid::Humanoid::new(skeleton).ok()?;
+        let h = crate::character::dynamics::humanoid::Humanoid::new(skeleton).ok()?;
         let mut joints: Vec<usize> = (0..skeleton.len())
             .filter(|&j| h.part_of[j].is_some_and(|p| parts.contains(&p)))
             .collect();
@@ -725,7 +727,7 @@ impl crate::engine::Motion for PhysicalEngine {
     }
 }
 
-impl crate::engine::Parameters for PhysicalEngine {
+impl crate::engines::interface::Parameters for PhysicalEngine {
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
         named_param(&self.units.get(key)?.params, name)
     }
@@ -742,7 +744,7 @@ impl crate::engine::Parameters for PhysicalEngine {
     }
 }
 
-impl crate::engine::Physics for PhysicalEngine {
+impl crate::engines::interface::Physics for PhysicalEngine {
     fn push(&mut self, part: &str, impulse: [f64; 3]) -> Result<(), String> {
         let impulse = DVec3::from_array(impulse);
         if !impulse.is_finite() {
@@ -762,13 +764,13 @@ impl crate::engine::Physics for PhysicalEngine {
         Ok(())
     }
 
-    fn balance(&self) -> Result<crate::engine::BalanceReading, String> {
+    fn balance(&self) -> Result<crate::engines::interface::BalanceReading, String> {
         let Some(sim) = self.sim.as_ref() else {
             return Err("no body is simulated now (no controller runs)".into());
         };
         let (steps, outside) = sim.zmp_outside();
-        let support = crate::dynamics::controllers::support_polygon(&sim.contacts());
-        Ok(crate::engine::BalanceReading {
+        let support = crate::character::dynamics::controllers::support_polygon(&sim.contacts());
+        Ok(crate::engines::interface::BalanceReading {
             centre_of_mass: sim.centre_of_mass().0.to_array(),
             zero_moment_point: sim.zero_moment_point().map(|p| p.to_array()),
             support: support.iter().map(|p| p.to_array()).collect(),

@@ -8,12 +8,12 @@
 
 use glam::Vec3;
 
-use crate::bml::{Behaviour, BehaviourKind, Mode};
-use crate::body::ik::{arc, place_limb, LimbRoot, ARM_HINGE, ARM_POLE};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
+use crate::character::body::ik::{arc, place_limb, LimbRoot, ARM_HINGE, ARM_POLE};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{envelope, hands};
-use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::language::bml::{Behaviour, BehaviourKind, Mode};
+use crate::planning::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// How far along its reach the wrist goes.
@@ -84,7 +84,7 @@ impl Engine for PointingEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("pointing");
-    crate::units_interrupt!(crate::engine::relax_now);
+    crate::units_interrupt!(crate::engines::interface::relax_now);
 
     fn name(&self) -> &'static str {
         "pointing"
@@ -114,16 +114,16 @@ impl Engine for PointingEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+    fn as_resources(&self) -> Option<&dyn crate::engines::interface::Resources> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for PointingEngine {
+impl crate::engines::interface::Motion for PointingEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let BehaviourKind::Pointing(p) = &behaviour.kind else {
             return None;
@@ -145,7 +145,7 @@ impl crate::engine::Motion for PointingEngine {
         joints.sort_unstable();
         Some(Steering {
             joints,
-            kind: crate::engine::MotionKind::Kinematic,
+            kind: crate::engines::interface::MotionKind::Kinematic,
             additive: false,
         })
     }
@@ -173,7 +173,7 @@ impl crate::engine::Motion for PointingEngine {
     }
 }
 
-impl crate::engine::Resources for PointingEngine {
+impl crate::engines::interface::Resources for PointingEngine {
     fn resources(&self, behaviour: &Behaviour) -> &'static [&'static str] {
         match &behaviour.kind {
             BehaviourKind::Pointing(p) => hands(p.mode),

@@ -14,12 +14,12 @@ use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 
-use crate::bml::{Behaviour, BehaviourKind, PosePart, StanceType};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::{at, envelope, finished_shift};
 use crate::engines::procedural::{Library, ProcUnit};
-use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::language::bml::{Behaviour, BehaviourKind, PosePart, StanceType};
+use crate::planning::timing::{DefaultTimingModels, TimingModel, TimingModels};
 use crate::world::World;
 
 /// A stance: pitch of the hips and knees and ankles (degrees, about +x), and the root's drop
@@ -233,7 +233,7 @@ impl Engine for PostureEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("posture");
-    crate::units_interrupt!(crate::engine::relax_now);
+    crate::units_interrupt!(crate::engines::interface::relax_now);
 
     fn name(&self) -> &'static str {
         "posture"
@@ -268,16 +268,16 @@ impl Engine for PostureEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+    fn as_resources(&self) -> Option<&dyn crate::engines::interface::Resources> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for PostureEngine {
+impl crate::engines::interface::Motion for PostureEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let poses = match &behaviour.kind {
             BehaviourKind::Posture(p) | BehaviourKind::PostureShift(p) => &p.poses,
@@ -339,7 +339,7 @@ impl crate::engine::Motion for PostureEngine {
     }
 }
 
-impl crate::engine::Resources for PostureEngine {
+impl crate::engines::interface::Resources for PostureEngine {
     fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
         matches!(behaviour.kind, BehaviourKind::Posture(_)).then_some("posture")
     }

@@ -48,16 +48,16 @@ use glam::{EulerRot, Quat, Vec3};
 use indexmap::IndexMap;
 use serde::Deserialize;
 
-use crate::bml::{Behaviour, BehaviourKind, Id, Param};
-use crate::body::ik::{place_limb, LimbRoot, ARM_HINGE, ARM_POLE, LEG_HINGE, LEG_POLE};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{
+use crate::character::body::ik::{place_limb, LimbRoot, ARM_HINGE, ARM_POLE, LEG_HINGE, LEG_POLE};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{
     named_param, named_params, set_named_param, Engine, EngineError, Steering, SyncTimes, Unit,
     UnitKey, Units,
 };
 use crate::engines::motion::min_jerk;
-use crate::timing::SyncName;
-use crate::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
+use crate::language::bml::{Behaviour, BehaviourKind, Id, Param};
+use crate::planning::timing::SyncName;
+use crate::planning::timing::{Flexibility, SyncKey, TimingModel, MIN_DURATION};
 use crate::world::World;
 
 /// The embedded default library.
@@ -323,7 +323,7 @@ impl ProcUnit {
         joints.dedup();
         Steering {
             joints,
-            kind: crate::engine::MotionKind::Kinematic,
+            kind: crate::engines::interface::MotionKind::Kinematic,
             additive: self.additive,
         }
     }
@@ -471,7 +471,7 @@ fn three(e: &[Expr; 3], names: &Names) -> Result<[f64; 3], String> {
     Ok([e[0].eval(&var)?, e[1].eval(&var)?, e[2].eval(&var)?])
 }
 
-pub use crate::body::skeleton::mirror_name;
+pub use crate::character::body::skeleton::mirror_name;
 
 /// A rotation reflected in the mid-sagittal (y-z) plane.
 pub fn mirror_rotation(q: Quat) -> Quat {
@@ -640,7 +640,7 @@ impl Engine for ProceduralEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("procedural");
-    crate::units_interrupt!(crate::engine::stop_now);
+    crate::units_interrupt!(crate::engines::interface::stop_now);
 
     fn name(&self) -> &'static str {
         "procedural"
@@ -664,35 +664,35 @@ impl Engine for ProceduralEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_prediction(&mut self) -> Option<&mut dyn crate::engine::Prediction> {
+    fn as_prediction(&mut self) -> Option<&mut dyn crate::engines::interface::Prediction> {
         Some(self)
     }
 
-    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engines::interface::Parameters> {
         Some(self)
     }
 
-    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+    fn as_resources(&self) -> Option<&dyn crate::engines::interface::Resources> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for ProceduralEngine {
+impl crate::engines::interface::Motion for ProceduralEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let r = self.library.for_behaviour(behaviour)?.ok()?;
         Some(r.unit.steering(skeleton, &[false]))
     }
 
     fn animate(&mut self, now: f64, skeleton: &Skeleton, world: &World, pose: &mut Pose) {
-        crate::engine::Prediction::predict(self, now, skeleton, world, pose);
+        crate::engines::interface::Prediction::predict(self, now, skeleton, world, pose);
     }
 }
 
-impl crate::engine::Prediction for ProceduralEngine {
+impl crate::engines::interface::Prediction for ProceduralEngine {
     fn predict(&self, now: f64, skeleton: &Skeleton, _world: &World, pose: &mut Pose) -> bool {
         // active from start to end; the end frame shows α = 1
         let active: Vec<(&SyncTimes, &Running, f64, f64)> = self
@@ -722,7 +722,7 @@ impl crate::engine::Prediction for ProceduralEngine {
     }
 }
 
-impl crate::engine::Parameters for ProceduralEngine {
+impl crate::engines::interface::Parameters for ProceduralEngine {
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
         named_param(&self.units.get(key)?.params, name)
     }
@@ -742,7 +742,7 @@ impl crate::engine::Parameters for ProceduralEngine {
     }
 }
 
-impl crate::engine::Resources for ProceduralEngine {
+impl crate::engines::interface::Resources for ProceduralEngine {
     fn exclusive_group(&self, behaviour: &Behaviour) -> Option<&str> {
         let name = match &behaviour.kind {
             BehaviourKind::ProcAnimation(a) | BehaviourKind::ProcAnimationGesture(a) => {

@@ -5,10 +5,10 @@
 //! goes to `relax` at once and keeps its retraction; audio stops at once. It moves no joints: the
 //! support table (`docs/bml-support.md`) marks these kinds "timing only".
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::engine::{relax_now, stop_now, Engine, EngineError, Unit, UnitKey, Units};
-use crate::timing::SyncName;
-use crate::timing::{DefaultTimingModels, TimingModel, TimingModels};
+use crate::engines::interface::{relax_now, stop_now, Engine, EngineError, Unit, UnitKey, Units};
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::SyncName;
+use crate::planning::timing::{DefaultTimingModels, TimingModel, TimingModels};
 
 /// The timing-only engine (see the module documentation).
 #[derive(Debug)]

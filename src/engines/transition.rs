@@ -1,7 +1,7 @@
 //! The transition engine: BMLT `transition` units. Given only a start, an end and the
 //! joints to move, a transition starts at the pose the body had when it began and ends at the
 //! pose the animation predictor computes for its end from the predictable units (keyframes,
-//! procedural units: [`Prediction::predict`](crate::engine::Prediction::predict)), so that the motion that follows starts without a jump:
+//! procedural units: [`Prediction::predict`](crate::engines::interface::Prediction::predict)), so that the motion that follows starts without a jump:
 //!
 //! ```xml
 //! <bmlt:transition id="t1" class="SlerpTransition" start="kf1:end" end="p1:start">
@@ -14,11 +14,11 @@
 //! at both ends. Without a `joints` parameter every joint moves. The engine is registered last, so
 //! the pose it starts from is the frame's final pose and its blend overrides the joints it moves.
 
-use crate::bml::{Behaviour, BehaviourKind};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Steering, Unit, Units};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{Engine, EngineError, Steering, Unit, Units};
 use crate::engines::motion::min_jerk;
-use crate::timing::{TimingModel, MIN_DURATION};
+use crate::language::bml::{Behaviour, BehaviourKind};
+use crate::planning::timing::{TimingModel, MIN_DURATION};
 use crate::world::World;
 
 #[derive(Debug, Clone)]
@@ -43,7 +43,7 @@ impl Engine for TransitionEngine {
     crate::units_remove!();
     crate::units_retime_len!();
     crate::units_play!("transition");
-    crate::units_interrupt!(crate::engine::stop_now);
+    crate::units_interrupt!(crate::engines::interface::stop_now);
 
     fn name(&self) -> &'static str {
         "transition"
@@ -82,16 +82,16 @@ impl Engine for TransitionEngine {
         Ok(())
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 
-    fn as_prediction(&mut self) -> Option<&mut dyn crate::engine::Prediction> {
+    fn as_prediction(&mut self) -> Option<&mut dyn crate::engines::interface::Prediction> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for TransitionEngine {
+impl crate::engines::interface::Motion for TransitionEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         let BehaviourKind::Transition(t) = &behaviour.kind else {
             return None;
@@ -101,7 +101,7 @@ impl crate::engine::Motion for TransitionEngine {
             Some(p) => Steering::kinematic(skeleton, p.value.split_whitespace(), false),
             None => Steering {
                 joints: (0..skeleton.len()).collect(),
-                kind: crate::engine::MotionKind::Kinematic,
+                kind: crate::engines::interface::MotionKind::Kinematic,
                 additive: false,
             },
         })
@@ -153,7 +153,7 @@ impl crate::engine::Motion for TransitionEngine {
     }
 }
 
-impl crate::engine::Prediction for TransitionEngine {
+impl crate::engines::interface::Prediction for TransitionEngine {
     fn prediction_times(&self, now: f64) -> Vec<f64> {
         self.units
             .all()

@@ -6,7 +6,7 @@ use super::Realizer;
 
 /// How often walkers among others see where the others are (s): every 0.05 s of global time,
 /// on a grid of its multiples, so that no result depends on the host's frames.
-pub const CROWD_PERIOD: f64 = crate::crowd::snapshot::PERIOD;
+pub const CROWD_PERIOD: f64 = crate::world::crowd::snapshot::PERIOD;
 
 /// The index of the crowd grid time at or before `t` (a time within a millionth of a period
 /// of a grid time counts as on it: `k * 0.1 / 0.1` may fall just short of `k`).
@@ -59,7 +59,7 @@ impl Realizer {
                     before.velocity
                 }
             });
-            let agent = crate::crowd::Agent {
+            let agent = crate::world::crowd::Agent {
                 at: here,
                 velocity,
                 radius: self.world.radius(id),
@@ -67,10 +67,10 @@ impl Realizer {
             (id.to_string(), agent)
         };
         // (those the world does not place stand at the origin)
-        let agents: Vec<(String, crate::crowd::Agent)> = (self.everyone())
+        let agents: Vec<(String, crate::world::crowd::Agent)> = (self.everyone())
             .map(|id| agent(id, self.world.placement(id)))
             .collect();
-        let mut crowd = crate::crowd::Crowd::new(now, agents);
+        let mut crowd = crate::world::crowd::Crowd::new(now, agents);
         let asking: Vec<(usize, glam::Vec2)> = (self.characters.iter_mut())
             .filter_map(|(id, m)| Some((crowd.index(id)?, m.asking()?)))
             .collect();

@@ -2,9 +2,16 @@
 //! frames and feedback. Blocks are routed to characters by `characterId`; each character has its
 //! own engines and [`BlockManager`]. Also the [`RealizerPort`] trait, the string-level port that
 //! the CLI and test harnesses drive.
+//!
+//! It is the realizer floor, above the engines: blocks at run time for one character
+//! ([`blocks`]: lifecycle, composition, the event loop) and the clocks that drive a run
+//! ([`clock`]) sit in it with the facade and its stages (sensing, nets, crowding, streaming).
 
 use std::collections::BTreeMap;
 use std::time::{SystemTime, UNIX_EPOCH};
+
+pub mod blocks;
+pub mod clock;
 
 mod crowding;
 mod netting;
@@ -17,15 +24,15 @@ mod streaming;
 pub use netting::NET_RATE;
 pub use options::from_options;
 
-use crate::blocks::BlockManager;
-use crate::bml::{self, BmlError, Diagnostic};
-use crate::body::Skeleton;
-use crate::engine::{Frame, Registry};
+use crate::character::body::Skeleton;
 use crate::engines::default_registry;
-use crate::feedback::{Feedback, FeedbackListener, KnownWarning, WarningFeedback};
-use crate::plan::anticipator::Anticipator;
-use crate::schedule::{Optimal, SchedulingStrategy};
-use crate::timing::DefaultTimingModels;
+use crate::engines::interface::{Frame, Registry};
+use crate::language::bml::{self, BmlError, Diagnostic};
+use crate::language::feedback::{Feedback, FeedbackListener, KnownWarning, WarningFeedback};
+use crate::planning::plan::anticipator::Anticipator;
+use crate::planning::schedule::{Optimal, SchedulingStrategy};
+use crate::planning::timing::DefaultTimingModels;
+use crate::realizer::blocks::BlockManager;
 use crate::world::World;
 
 /// The id used in warnings about a block whose id could not be read.
@@ -73,7 +80,7 @@ pub struct Realizer {
     /// PaT-Nets, when given (`netting.rs`).
     netting: Option<Box<netting::Netting>>,
     /// The audio streams the host opened, by name (`streaming.rs`).
-    streams: BTreeMap<String, crate::voice::stream::AudioStream>,
+    streams: BTreeMap<String, crate::character::voice::stream::AudioStream>,
 }
 
 impl Default for Realizer {
@@ -116,9 +123,11 @@ impl Realizer {
 
     /// Times speech with `speech` (the built-in TTS by default; `SpeechTiming::syllables()` for
     /// the metronome voice), with the default engines.
-    pub fn with_speech_timing(self, speech: crate::timing::SpeechTiming) -> Self {
+    pub fn with_speech_timing(self, speech: crate::planning::timing::SpeechTiming) -> Self {
         self.with_engines(move || {
-            crate::engines::default_registry(crate::timing::DefaultTimingModels { speech })
+            crate::engines::default_registry(crate::planning::timing::DefaultTimingModels {
+                speech,
+            })
         })
     }
 
@@ -276,7 +285,10 @@ impl Realizer {
     /// centre of mass, zero-moment point, support polygon, and how many physics steps the
     /// zero-moment point lay outside the feet (`dynamics::zmp`). `Err` says why there is no
     /// reading (no such character, no body simulated now: no `bmlt:controller` runs).
-    pub fn balance(&mut self, character: &str) -> Result<crate::engine::BalanceReading, String> {
+    pub fn balance(
+        &mut self,
+        character: &str,
+    ) -> Result<crate::engines::interface::BalanceReading, String> {
         let Some(m) = self.characters.get_mut(character) else {
             return Err(format!("no character '{character}'"));
         };

@@ -7,8 +7,8 @@
 
 use std::collections::{BTreeSet, VecDeque};
 
-use crate::feedback::Feedback;
-use crate::nets::{Nets, Senses};
+use crate::language::feedback::Feedback;
+use crate::world::nets::{Nets, Senses};
 
 use super::Realizer;
 
@@ -133,7 +133,7 @@ impl Realizer {
             return;
         };
         for (character, text) in pending {
-            let mut checked = crate::bml::Checked::new(&text, &self.limits);
+            let mut checked = crate::language::bml::Checked::new(&text, &self.limits);
             if let Some(b) = checked.block.as_mut().filter(|b| b.character_id.is_none()) {
                 b.character_id = character;
             }

@@ -8,7 +8,7 @@
 use serde_json::Value;
 
 use super::Realizer;
-use crate::timing::{SpeechTiming, Voice};
+use crate::planning::timing::{SpeechTiming, Voice};
 
 /// The realizer `options` (JSON, or empty for the defaults) describe and the frame rate they
 /// ask for (60 when they do not), or a sentence saying what is wrong with them.
@@ -43,7 +43,7 @@ pub fn from_options(options: &str) -> Result<(Realizer, f64), String> {
     match o.get("tts").map(|v| v.as_str()) {
         None | Some(Some("builtin")) => {}
         Some(Some("flite")) => {
-            crate::voice::flite::Flite::default()
+            crate::character::voice::flite::Flite::default()
                 .check()
                 .map_err(|e| bad(format!("tts flite: {e}")))?;
             realizer = realizer.with_speech_timing(SpeechTiming {

@@ -5,10 +5,10 @@
 
 use std::collections::BTreeMap;
 
-use crate::body::Pose;
-use crate::engine::Frame;
-use crate::feedback::Feedback;
-use crate::perception::{Perception, Remembered, Scene, Thing, Vision};
+use crate::character::body::Pose;
+use crate::engines::interface::Frame;
+use crate::language::feedback::Feedback;
+use crate::world::perception::{Perception, Remembered, Scene, Thing, Vision};
 
 use super::Realizer;
 

@@ -10,9 +10,9 @@ use base64::Engine as _;
 use serde::Deserialize;
 
 use super::Realizer;
-use crate::feedback::KnownWarning;
-use crate::plan::anticipator::Anticipator;
-use crate::voice::stream::AudioStream;
+use crate::character::voice::stream::AudioStream;
+use crate::language::feedback::KnownWarning;
+use crate::planning::plan::anticipator::Anticipator;
 
 /// An audio stream as an anticipator (`start`, `end`).
 struct StreamAnticipator(AudioStream);
@@ -189,7 +189,7 @@ impl Realizer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::feedback::Feedback;
+    use crate::language::feedback::Feedback;
 
     fn warnings(r: &mut Realizer) -> Vec<String> {
         (r.tick(r.now).feedback.into_iter())

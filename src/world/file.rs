@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3};
 use serde::Deserialize;
 
 use super::{Placement, World, MAX_CHARACTERS, MAX_COORDINATE};
-use crate::crowd::group::{self, Group, GroupFile, Member};
+use crate::world::crowd::group::{self, Group, GroupFile, Member};
 
 /// The world file: `{"points": {"user": [0, 1.6, 1.5]}, "paths": {"walker": {"keys": [[0, [1,
 /// 1.6, 2]], [4, [-1, 1.6, 2]]]}}, "characters": {"Bob": {"position": [1, 0, 2], "facing":
@@ -24,17 +24,17 @@ struct WorldFile {
     #[serde(default)]
     characters: BTreeMap<String, CharacterFile>,
     #[serde(default)]
-    obstacles: Vec<crate::space::obstacles::ObstacleFile>,
+    obstacles: Vec<crate::world::space::obstacles::ObstacleFile>,
     #[serde(default)]
-    profiles: BTreeMap<String, crate::crowd::Profile>,
+    profiles: BTreeMap<String, crate::world::crowd::Profile>,
     #[serde(default)]
-    groups: Vec<crate::crowd::group::GroupFile>,
+    groups: Vec<crate::world::crowd::group::GroupFile>,
     /// How characters see (when sight is on).
     #[serde(default)]
-    vision: Option<crate::perception::Vision>,
+    vision: Option<crate::world::perception::Vision>,
     /// Named world values that nets read and write, with their first values.
     #[serde(default, alias = "lights")]
-    variables: BTreeMap<String, crate::feedback::world::VarValue>,
+    variables: BTreeMap<String, crate::language::feedback::world::VarValue>,
 }
 
 #[derive(Deserialize)]
@@ -136,7 +136,7 @@ impl World {
                 Arc::make_mut(&mut w.radii).insert(name.clone(), r as f32);
             }
             if let Some(c) = c.steering.as_deref() {
-                use crate::locomotion::steering::Combine;
+                use crate::world::locomotion::steering::Combine;
                 let combine = match c {
                     "prioritised" => Combine::Prioritised,
                     "weighted" => Combine::WeightedSum,
@@ -150,10 +150,10 @@ impl World {
                 Arc::make_mut(&mut w.combiners).insert(name.clone(), combine);
             }
         }
-        if file.obstacles.len() > crate::space::obstacles::MAX_OBSTACLES {
+        if file.obstacles.len() > crate::world::space::obstacles::MAX_OBSTACLES {
             return Err(format!(
                 "obstacles: at most {} obstacles, not {}",
-                crate::space::obstacles::MAX_OBSTACLES,
+                crate::world::space::obstacles::MAX_OBSTACLES,
                 file.obstacles.len()
             ));
         }
@@ -166,13 +166,13 @@ impl World {
             w.vision = Some(Arc::new(v));
         }
         let n = list.len();
-        w.set_obstacles(crate::space::Obstacles::new(list));
+        w.set_obstacles(crate::world::space::Obstacles::new(list));
         w.add_groups(file.groups)?;
         Ok((w, n))
     }
 
     /// Adds the world file's declared `groups` and the conversing groups found among the
-    /// characters it places (all of them stand at the start; see [`crate::crowd::group`]); a
+    /// characters it places (all of them stand at the start; see [`crate::world::crowd::group`]); a
     /// character is in one group at most, declared groups first.
     fn add_groups(&mut self, declared: Vec<GroupFile>) -> Result<(), String> {
         if declared.len() > MAX_CHARACTERS / 2 {

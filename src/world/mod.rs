@@ -4,52 +4,27 @@
 //! places it elsewhere; a placed character is itself a target, at its eyes, so characters can
 //! look and point at each other. Each character's engines see the world from where it stands
 //! ([`World::seen_from`]). A world can be read from a JSON world file.
+//!
+//! It is also the floor of what moves and looks in the world, below the engines and above the
+//! characters: the geometry of space ([`space`]: obstacles, routes, distances), walking
+//! ([`locomotion`]), walkers sharing space ([`crowd`]), synthetic vision ([`perception`]) and
+//! the nets that sequence behaviour by watching the world ([`nets`]). The [`World`] itself sits
+//! on top of them: it holds their shared state.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
+
+pub mod crowd;
+pub mod locomotion;
+pub mod nets;
+pub mod perception;
+pub mod space;
 
 mod file;
 
-/// Where a character stands: a place on the ground and the way it faces.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Placement {
-    /// Where its root stands (metres, world).
-    pub position: Vec3,
-    /// Its heading: radians about +y from facing +z (π/2 faces +x).
-    pub facing: f32,
-}
-
-impl Placement {
-    /// Standing at `position`, turned `degrees` about +y from facing +z.
-    pub fn new(position: Vec3, degrees: f32) -> Placement {
-        Placement {
-            position,
-            facing: degrees.to_radians(),
-        }
-    }
-
-    /// Its turn from facing +z.
-    pub fn rotation(&self) -> Quat {
-        Quat::from_rotation_y(self.facing)
-    }
-
-    /// A point of the character's own frame (the origin facing +z) in the world.
-    pub fn to_world(&self, local: Vec3) -> Vec3 {
-        self.position + self.rotation() * local
-    }
-
-    /// A point of the world in the character's own frame.
-    pub fn to_local(&self, world: Vec3) -> Vec3 {
-        self.rotation().inverse() * (world - self.position)
-    }
-
-    /// Whether it is the origin facing +z (the character's frame is the world's).
-    pub fn is_origin(&self) -> bool {
-        *self == Placement::default()
-    }
-}
+pub use crate::character::body::Placement;
 
 /// Where a placed character is as a target: the point between the default adult's eyes, in its
 /// own frame (`gaze::eyes_at_rest` of the adult, to the centimetre).
@@ -73,21 +48,21 @@ pub struct World {
     /// Body radius of characters the world file gives one (m).
     radii: Arc<BTreeMap<String, f32>>,
     /// How the steering of characters the world file gives a combiner combines.
-    combiners: Arc<BTreeMap<String, crate::locomotion::steering::Combine>>,
+    combiners: Arc<BTreeMap<String, crate::world::locomotion::steering::Combine>>,
     /// Obstacles, in world coordinates (a view from a character has none).
-    obstacles: Arc<crate::space::Obstacles>,
+    obstacles: Arc<crate::world::space::Obstacles>,
     /// The avoidance profile of characters the world file gives one.
-    profiles: Arc<BTreeMap<String, crate::crowd::Profile>>,
+    profiles: Arc<BTreeMap<String, crate::world::crowd::Profile>>,
     /// The avatar file of characters the world file gives one (as written there).
     avatars: Arc<BTreeMap<String, String>>,
     /// Groups of characters: declared in the world file or found there.
-    groups: Arc<Vec<crate::crowd::group::Group>>,
+    groups: Arc<Vec<crate::world::crowd::group::Group>>,
     /// Every character as walkers see it this frame, in world coordinates (a view has none).
-    crowd: Arc<crate::crowd::Crowd>,
+    crowd: Arc<crate::world::crowd::Crowd>,
     /// How characters see, if the world file says (`"vision"`).
-    vision: Option<Arc<crate::perception::Vision>>,
+    vision: Option<Arc<crate::world::perception::Vision>>,
     /// World variables' first values (the world file's `"variables"`).
-    variables: Arc<BTreeMap<String, crate::feedback::world::VarValue>>,
+    variables: Arc<BTreeMap<String, crate::language::feedback::world::VarValue>>,
     /// Whom each character has seen or remembers (sorted), for walkers that avoid only those
     /// (written by the realizer's sensing stage).
     known: Arc<BTreeMap<String, Vec<String>>>,
@@ -116,12 +91,12 @@ pub const DEFAULT_RADIUS: f32 = 0.25;
 pub const UNKNOWN_TARGET: &str = "there is no target";
 
 /// Most characters a world file may place (the most a crowd holds).
-pub const MAX_CHARACTERS: usize = crate::crowd::snapshot::MAX_AGENTS;
+pub const MAX_CHARACTERS: usize = crate::world::crowd::snapshot::MAX_AGENTS;
 
 /// Longest list of keys a path may have.
 pub const MAX_PATH_KEYS: usize = 100_000;
 
-pub use crate::space::MAX_COORDINATE;
+pub use crate::world::space::MAX_COORDINATE;
 
 impl World {
     /// A world without points.
@@ -160,37 +135,37 @@ impl World {
     }
 
     /// The world variables' first values (the world file's `"variables"`).
-    pub fn variables(&self) -> &BTreeMap<String, crate::feedback::world::VarValue> {
+    pub fn variables(&self) -> &BTreeMap<String, crate::language::feedback::world::VarValue> {
         &self.variables
     }
 
     /// How characters see: the world file's `"vision"`, else the defaults.
-    pub fn vision(&self) -> crate::perception::Vision {
+    pub fn vision(&self) -> crate::world::perception::Vision {
         self.vision.as_deref().cloned().unwrap_or_default()
     }
 
     /// Character `id`'s avoidance profile (the defaults unless the world file names one).
-    pub fn profile(&self, id: &str) -> crate::crowd::Profile {
+    pub fn profile(&self, id: &str) -> crate::world::crowd::Profile {
         self.profiles.get(id).copied().unwrap_or_default()
     }
 
     /// Every character as walkers see it this frame (world coordinates; empty in a view).
-    pub fn crowd(&self) -> &Arc<crate::crowd::Crowd> {
+    pub fn crowd(&self) -> &Arc<crate::world::crowd::Crowd> {
         &self.crowd
     }
 
     /// Sets the crowd walkers see.
-    pub fn set_crowd(&mut self, crowd: crate::crowd::Crowd) {
+    pub fn set_crowd(&mut self, crowd: crate::world::crowd::Crowd) {
         self.crowd = Arc::new(crowd);
     }
 
     /// The obstacles (world coordinates).
-    pub fn obstacles(&self) -> &crate::space::Obstacles {
+    pub fn obstacles(&self) -> &crate::world::space::Obstacles {
         &self.obstacles
     }
 
     /// The obstacles (shared).
-    pub fn obstacles_shared(&self) -> &Arc<crate::space::Obstacles> {
+    pub fn obstacles_shared(&self) -> &Arc<crate::world::space::Obstacles> {
         &self.obstacles
     }
 
@@ -198,8 +173,8 @@ impl World {
     /// it is not in, as those groups stand now (each a circle through its members' far sides),
     /// but for a space it already stands in (it walks out of that one; taken as an obstacle,
     /// it threw the character out of it 0.5 m in one frame).
-    pub fn obstacles_for(&self, id: &str) -> Arc<crate::space::Obstacles> {
-        use crate::space::obstacles::{Obstacle, Shape};
+    pub fn obstacles_for(&self, id: &str) -> Arc<crate::world::space::Obstacles> {
+        use crate::world::space::obstacles::{Obstacle, Shape};
         let p = self.placement(id).position;
         let (here, radius) = (glam::Vec2::new(p.x, p.z), self.radius(id));
         let spaces: Vec<Obstacle> = (self.groups.iter())
@@ -211,11 +186,13 @@ impl World {
                     .collect();
                 g.space(&members)
             })
-            .filter(|s| here.distance(s.centre) >= s.outer + crate::crowd::group::PASSING + radius)
+            .filter(|s| {
+                here.distance(s.centre) >= s.outer + crate::world::crowd::group::PASSING + radius
+            })
             .map(|s| Obstacle {
                 shape: Shape::Circle {
                     centre: s.centre,
-                    radius: s.outer + crate::crowd::group::PASSING,
+                    radius: s.outer + crate::world::crowd::group::PASSING,
                 },
                 height: 0.0,
             })
@@ -225,11 +202,11 @@ impl World {
         }
         let mut all = self.obstacles.all().to_vec();
         all.extend(spaces);
-        Arc::new(crate::space::Obstacles::new(all))
+        Arc::new(crate::world::space::Obstacles::new(all))
     }
 
     /// Sets the obstacles.
-    pub fn set_obstacles(&mut self, obstacles: crate::space::Obstacles) {
+    pub fn set_obstacles(&mut self, obstacles: crate::world::space::Obstacles) {
         self.obstacles = Arc::new(obstacles);
     }
 
@@ -246,9 +223,9 @@ impl World {
 
     /// How character `id`'s steering behaviours combine (prioritised unless the world file
     /// says otherwise).
-    pub fn combiner(&self, id: &str) -> crate::locomotion::steering::Combine {
+    pub fn combiner(&self, id: &str) -> crate::world::locomotion::steering::Combine {
         (self.combiners.get(id).copied())
-            .unwrap_or(crate::locomotion::steering::Combine::Prioritised)
+            .unwrap_or(crate::world::locomotion::steering::Combine::Prioritised)
     }
 
     /// Places character `id` (the default character is `""`). A point of the same name keeps

@@ -7,9 +7,9 @@
 
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
-use bml_realizer::avatar::{Model, Retarget};
-use bml_realizer::body::pose::Pose;
-use bml_realizer::body::skeleton::Skeleton;
+use bml_realizer::character::avatar::{Model, Retarget};
+use bml_realizer::character::body::pose::Pose;
+use bml_realizer::character::body::skeleton::Skeleton;
 use bml_realizer::rng::Rng;
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{json, Value};

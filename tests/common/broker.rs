@@ -1,11 +1,11 @@
 //! What the broker tests share: a mosquitto started on a free loopback port, realizer
-//! processes killed when dropped, and planners built on `bml_realizer::broker::Link`.
+//! processes killed when dropped, and planners built on `bml_realizer::ports::broker::Link`.
 #![allow(dead_code)]
 
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use bml_realizer::broker::{BrokerUrl, Inbound, Link, LinkOptions};
+use bml_realizer::ports::broker::{BrokerUrl, Inbound, Link, LinkOptions};
 
 pub const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 

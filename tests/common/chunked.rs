@@ -5,7 +5,7 @@
 
 use std::ops::Range;
 
-use bml_realizer::feedback::Feedback;
+use bml_realizer::language::feedback::Feedback;
 
 /// `samples` samples at `rate` cut into `n` chunks: each chunk's sample range and the marks
 /// `lines` (time s, line) that fall in it, joined by line breaks (the last chunk takes any

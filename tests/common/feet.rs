@@ -5,8 +5,8 @@
 
 use std::collections::HashMap;
 
-use bml_realizer::body::Skeleton;
-use bml_realizer::engine::CharacterPose;
+use bml_realizer::character::body::Skeleton;
+use bml_realizer::engines::interface::CharacterPose;
 use glam::Vec2;
 
 /// The planted points watched so far.

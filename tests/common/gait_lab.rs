@@ -7,7 +7,7 @@
 //! `tests/gait_norms.rs` and `examples/gait_norms.rs`.
 #![allow(dead_code)] // the test and the example use their own shares
 
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::body::{Pose, Skeleton};
 use bml_realizer::realizer::Realizer;
 use glam::{Quat, Vec3};
 

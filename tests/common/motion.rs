@@ -1,7 +1,7 @@
 //! How fast the body moves, for the tests that judge motion: the fastest any joint but the eyes
 //! turns from one frame to the next (the eyes' saccades are meant to be fast).
 
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::body::{Pose, Skeleton};
 use glam::Quat;
 
 /// The fastest any joint of `skeleton` but the eyeballs turns between consecutive `frames`

@@ -20,9 +20,9 @@ mod stream;
 use std::collections::VecDeque;
 use std::ffi::{c_char, c_int, CString};
 
-use bml_realizer::body::Skeleton;
-use bml_realizer::engine::{CharacterPose, Frame};
-use bml_realizer::face::ARKIT;
+use bml_realizer::character::body::Skeleton;
+use bml_realizer::character::face::ARKIT;
+use bml_realizer::engines::interface::{CharacterPose, Frame};
 use bml_realizer::realizer::Realizer;
 
 pub use status::bmlr_status;
@@ -63,7 +63,7 @@ impl bmlr_realizer {
         // made a C tick 9.4 µs against the Rust 6.5 µs: benches/tick.rs)
         r.frame = None;
         let frame = r.realizer.tick(now);
-        let format = bml_realizer::feedback::Format::Jsonl;
+        let format = bml_realizer::language::feedback::Format::Jsonl;
         r.feedback
             .extend(frame.feedback.iter().map(|f| format.encode(f)));
         for p in &frame.poses {

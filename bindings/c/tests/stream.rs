@@ -13,7 +13,7 @@ mod espeak_report;
 use std::ffi::{c_char, CStr, CString};
 use std::ptr::{null, null_mut};
 
-use bml_realizer::feedback::Feedback;
+use bml_realizer::language::feedback::Feedback;
 use bmlr::*;
 use chunked::sync_time;
 
@@ -71,7 +71,7 @@ fn tick(r: *mut bmlr_realizer, t: f64, log: &mut Vec<Feedback>) -> Vec<f32> {
                 break;
             }
             let line = CStr::from_ptr(buf.as_ptr()).to_string_lossy();
-            log.push(bml_realizer::feedback::from_json(&line).unwrap());
+            log.push(bml_realizer::language::feedback::from_json(&line).unwrap());
         }
     }
     w
@@ -96,7 +96,7 @@ fn playing(r: *mut bmlr_realizer, sounding: &mut bool) -> bool {
 #[test]
 fn a_c_host_streams_a_speech_that_moves_as_its_whole_file() {
     let wav = root("fixtures/voice/espeak-bob.wav");
-    let audio = bml_realizer::sound::read_wav(std::path::Path::new(&wav)).unwrap();
+    let audio = bml_realizer::character::sound::read_wav(std::path::Path::new(&wav)).unwrap();
     let length = audio.samples.len() as f64 / f64::from(audio.rate);
     let report = std::fs::read_to_string(root("fixtures/voice/espeak-bob.events.json")).unwrap();
     let lines = espeak_report::polly_lines(&espeak_report::read(&report));
@@ -177,7 +177,7 @@ fn a_c_host_streams_a_speech_that_moves_as_its_whole_file() {
             };
             eprintln!(
                 "at {t:.3}: the worst morph ({}) against frames k-1, k, k+1: {:?}",
-                bml_realizer::face::ARKIT[35],
+                bml_realizer::character::face::ARKIT[35],
                 [k.wrapping_sub(1), k, k + 1].map(|k| reference.get(k).map(worst))
             );
         }
@@ -213,7 +213,7 @@ fn a_c_host_streams_a_speech_that_moves_as_its_whole_file() {
 #[test]
 fn an_interrupt_mid_stream_stops_sound_and_lips_in_one_frame() {
     let wav = root("fixtures/voice/espeak-bob.wav");
-    let audio = bml_realizer::sound::read_wav(std::path::Path::new(&wav)).unwrap();
+    let audio = bml_realizer::character::sound::read_wav(std::path::Path::new(&wav)).unwrap();
     let r = realizer(
         &["reply"],
         &format!(

@@ -7,11 +7,11 @@
 
 use std::sync::{Mutex, MutexGuard};
 
-use bml_realizer::avatar::{animated_glb, default_model, Frame as AvatarFrame, Retarget};
-use bml_realizer::body::Skeleton;
-use bml_realizer::engine::{CharacterPose, Frame};
-use bml_realizer::face::ARKIT;
-use bml_realizer::feedback::Format;
+use bml_realizer::character::avatar::{animated_glb, default_model, Frame as AvatarFrame, Retarget};
+use bml_realizer::character::body::Skeleton;
+use bml_realizer::engines::interface::{CharacterPose, Frame};
+use bml_realizer::character::face::ARKIT;
+use bml_realizer::language::feedback::Format;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::create_exception;
@@ -411,7 +411,7 @@ impl Realizer {
 /// code, message. An empty list: the block is valid.
 #[pyfunction]
 fn validate(py: Python<'_>, text: String) -> PyResult<Vec<Bound<'_, PyDict>>> {
-    let (_, diags) = py.detach(|| bml_realizer::bml::check(&text));
+    let (_, diags) = py.detach(|| bml_realizer::language::bml::check(&text));
     diags
         .iter()
         .map(|d| {

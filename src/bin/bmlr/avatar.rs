@@ -5,8 +5,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use bml_realizer::avatar::{self, Model, Retarget};
-use bml_realizer::body::Skeleton;
+use bml_realizer::character::avatar::{self, Model, Retarget};
+use bml_realizer::character::body::Skeleton;
 use bml_realizer::world::{Placement, World};
 use clap::Args;
 
@@ -96,7 +96,7 @@ impl AvatarArgs {
 fn read_map(path: &Path) -> Result<BTreeMap<String, String>, String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("{}: cannot read it: {e}", path.display()))?;
-    bml_realizer::avatar::humanoid::bone_map_from_json(&text).map_err(|e| {
+    bml_realizer::character::avatar::humanoid::bone_map_from_json(&text).map_err(|e| {
         format!(
             "{}: a bone map is a JSON object of bone names to node names or node indices: {e}",
             path.display()

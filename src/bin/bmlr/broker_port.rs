@@ -6,7 +6,7 @@
 
 use std::time::{Duration, Instant};
 
-use bml_realizer::broker::{
+use bml_realizer::ports::broker::{
     BrokerUrl, Inbound, Link, LinkOptions, StompLink, StompOptions, StompUrl, Topics, Wire,
 };
 use realizer_tests::port::replace_setup;

@@ -1,5 +1,5 @@
 //! `bmlr serve --mqtt URL` and `--stomp URL`: the realizer on a message broker
-//! (docs/broker.md). The link (`bml_realizer::broker::Link` or `StompLink`, seen through `Wire`)
+//! (docs/broker.md). The link (`bml_realizer::ports::broker::Link` or `StompLink`, seen through `Wire`)
 //! keeps itself connected; the dialect (`dialect.rs`) says which topics carry blocks and
 //! feedback and in what form; this loop owns the realizer, ticks it on the wall clock, routes
 //! the feedback and writes the frames (`--frames`). A payload that is not a block for that
@@ -14,10 +14,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
-use bml_realizer::bml::Checked;
-use bml_realizer::broker::{Cells, Inbound, Topics, Wire, DEFAULT_CHARACTER};
-use bml_realizer::clock::{Clock, WallClock};
-use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
+use bml_realizer::language::bml::Checked;
+use bml_realizer::language::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
+use bml_realizer::ports::broker::{Cells, Inbound, Topics, Wire, DEFAULT_CHARACTER};
+use bml_realizer::realizer::clock::{Clock, WallClock};
 use bml_realizer::realizer::{Realizer, NO_ID};
 
 use crate::dialect::{block_character, Arrived, Dialect, Lane, Out};
@@ -256,7 +256,7 @@ impl Server {
         if !topic.ends_with("/componentNotify/M") {
             return None;
         }
-        let bml_realizer::broker::ipaaca::Heard::NewComponent { channel } =
+        let bml_realizer::ports::broker::ipaaca::Heard::NewComponent { channel } =
             ip.read(topic, payload)?
         else {
             return None;

@@ -5,7 +5,7 @@ use std::io::Write;
 use std::process::ExitCode;
 use std::time::Duration;
 
-use bml_realizer::conformance::InProcess;
+use bml_realizer::ports::conformance::InProcess;
 use clap::Args;
 use realizer_tests::{run, Outcome, ProcessPort, TestPort};
 

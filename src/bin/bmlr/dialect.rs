@@ -3,7 +3,7 @@
 //! - `Topics` (MQTT, this project's own): blocks on `PREFIX/CHARACTER/bml`, feedback on
 //!   `PREFIX/CHARACTER/feedback`;
 //! - `Ipaaca` (MQTT, as ipaacar speaks it): per channel, `bml` messages and `realizerRequest`
-//!   IUs in, `bmlfeedback` messages out, request IUs updated (`bml_realizer::broker::ipaaca`);
+//!   IUs in, `bmlfeedback` messages out, request IUs updated (`bml_realizer::ports::broker::ipaaca`);
 //! - `Asap` (STOMP, as AsapRealizer's ActiveMQ adapters do): blocks as text on
 //!   `asap.bml.request`, every feedback element as text on `asap.bml.feedback`;
 //! - `Greta` (STOMP, as Greta's ActiveMQ components do): blocks as text on `greta.BML`, block
@@ -13,9 +13,9 @@
 //!
 //! On the STOMP dialects the block's `characterId` names its character (the topics are shared).
 
-use bml_realizer::broker::ipaaca::{self, iu::Requests, Heard};
-use bml_realizer::broker::{Ipaaca, Topics, DEFAULT_CHARACTER};
-use bml_realizer::feedback::{BlockStatus, Feedback, Format};
+use bml_realizer::language::feedback::{BlockStatus, Feedback, Format};
+use bml_realizer::ports::broker::ipaaca::{self, iu::Requests, Heard};
+use bml_realizer::ports::broker::{Ipaaca, Topics, DEFAULT_CHARACTER};
 use quick_xml::events::Event;
 
 /// Whose queue a block waits in (each character's in turn: one character's flood does not

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use bml_realizer::feedback::diff::{diff, Log};
+use bml_realizer::language::feedback::diff::{diff, Log};
 use clap::Args;
 
 /// Arguments of `bmlr diff`.

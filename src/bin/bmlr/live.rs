@@ -10,11 +10,11 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use bml_realizer::avatar::{animated_glb, Driver};
-use bml_realizer::body::Skeleton;
+use bml_realizer::character::avatar::{animated_glb, Driver};
+use bml_realizer::character::body::Skeleton;
 use bml_realizer::character::frames;
-use bml_realizer::engine::CharacterPose;
-use bml_realizer::feedback::Feedback;
+use bml_realizer::engines::interface::CharacterPose;
+use bml_realizer::language::feedback::Feedback;
 use bml_realizer::world::World;
 use serde_json::json;
 

@@ -14,9 +14,9 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use bml_realizer::body::Skeleton;
+use bml_realizer::character::body::Skeleton;
 use bml_realizer::character::frames::{self, Detail};
-use bml_realizer::engine::CharacterPose;
+use bml_realizer::engines::interface::CharacterPose;
 use bml_realizer::realizer::Realizer;
 
 use crate::record::Recording;
@@ -160,7 +160,7 @@ pub fn shown(characters: &[String], realizer: &Realizer) -> Vec<String> {
 }
 
 /// The POSIX time (s) of `clock`'s time 0.
-pub fn posix_zero(clock: &impl bml_realizer::clock::Clock) -> f64 {
+pub fn posix_zero(clock: &impl bml_realizer::realizer::clock::Clock) -> f64 {
     let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH);
     now.map_or(0.0, |d| d.as_secs_f64()) - clock.now()
 }

@@ -35,10 +35,10 @@ mod world_share;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use bml_realizer::bml::{self, Diagnostic, Severity};
-use bml_realizer::engine::Registry;
-use bml_realizer::schedule::check::timing_diagnostics;
-use bml_realizer::timing::DefaultTimingModels;
+use bml_realizer::engines::interface::Registry;
+use bml_realizer::language::bml::{self, Diagnostic, Severity};
+use bml_realizer::planning::schedule::check::timing_diagnostics;
+use bml_realizer::planning::timing::DefaultTimingModels;
 use clap::{Parser, Subcommand};
 
 /// The BML realizer command line.

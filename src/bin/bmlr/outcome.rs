@@ -6,7 +6,7 @@
 use std::collections::BTreeSet;
 use std::process::ExitCode;
 
-use bml_realizer::feedback::{Feedback, KnownWarning, WarningType};
+use bml_realizer::language::feedback::{Feedback, KnownWarning, WarningType};
 
 /// Counts of what went wrong in a run.
 #[derive(Debug, Default)]

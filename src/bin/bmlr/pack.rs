@@ -5,7 +5,7 @@
 //! character is written once per character. The page draws such crowds without faces.
 
 use base64::Engine as _;
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::body::{Pose, Skeleton};
 use serde_json::{json, Value};
 
 /// Frame times and each character's body in every frame (in the order of `ids`).

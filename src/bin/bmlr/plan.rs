@@ -5,10 +5,10 @@ use std::io::Write;
 use std::path::Path;
 use std::process::ExitCode;
 
-use bml_realizer::feedback::Feedback;
+use bml_realizer::language::feedback::Feedback;
+use bml_realizer::planning::timing::SpeechTiming;
+use bml_realizer::ports::timeline::Timeline;
 use bml_realizer::realizer::Realizer;
-use bml_realizer::timeline::Timeline;
-use bml_realizer::timing::SpeechTiming;
 use clap::Args;
 
 use crate::setup::{read_items, with_assets, with_world, Item, LimitArgs};
@@ -75,7 +75,7 @@ pub fn plan(args: PlanArgs) -> ExitCode {
                 let parsed = realizer.perform_bml_from(&text, Some(&path));
                 outcome.unparsed += usize::from(parsed.is_err());
                 feedback.extend(realizer.tick(0.0).feedback);
-                if let Ok(parsed) = bml_realizer::bml::load(&text) {
+                if let Ok(parsed) = bml_realizer::language::bml::load(&text) {
                     blocks.push(parsed.block);
                 }
             }
@@ -178,7 +178,7 @@ pub fn timeline(args: TimelineArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let log = match bml_realizer::feedback::diff::Log::parse(&text) {
+    let log = match bml_realizer::language::feedback::diff::Log::parse(&text) {
         Ok(l) => l,
         Err(e) => {
             eprintln!(

@@ -3,12 +3,12 @@
 
 use std::path::Path;
 
-use bml_realizer::avatar::{animated_document, animated_glb, scene_glb, Frame};
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::avatar::{animated_document, animated_glb, scene_glb, Frame};
+use bml_realizer::character::body::{Pose, Skeleton};
 use bml_realizer::character::frames;
-use bml_realizer::engine::CharacterPose;
+use bml_realizer::character::sound::{SoundEvent, Track};
+use bml_realizer::engines::interface::CharacterPose;
 use bml_realizer::realizer::Realizer;
-use bml_realizer::sound::{SoundEvent, Track};
 use bml_realizer::world::World;
 
 use crate::avatar::{Avatar, Avatars};
@@ -104,7 +104,7 @@ impl Recording {
             self.pending
                 .extend(p.events.iter().map(|e| (p.character.clone(), e.clone())));
         }
-        let playing: Vec<&bml_realizer::sound::Playing> =
+        let playing: Vec<&bml_realizer::character::sound::Playing> =
             poses.iter().flat_map(|p| &p.sounds).collect();
         for s in &playing {
             let cut = (s.stop < s.start + s.length() - 1e-6).then_some(s.stop);
@@ -155,7 +155,7 @@ impl Recording {
         let skeleton = Skeleton::adult();
         write_file(
             path,
-            bml_realizer::body::bvh::write(&skeleton, &poses, self.fps).as_bytes(),
+            bml_realizer::character::body::bvh::write(&skeleton, &poses, self.fps).as_bytes(),
         )?;
         eprintln!(
             "wrote {} ({} frames at {} fps, {} joints)",
@@ -201,7 +201,7 @@ impl Recording {
             .map(|(id, f)| (id.as_str(), f.as_slice()))
             .collect();
         let skeleton = Skeleton::adult();
-        let glb = bml_realizer::body::gltf::write_scene(&skeleton, &scene);
+        let glb = bml_realizer::character::body::gltf::write_scene(&skeleton, &scene);
         write_file(path, &glb)?;
         eprintln!(
             "wrote {} ({} frames at {} fps, {} joints, {} character{}, {} kB)",
@@ -368,12 +368,13 @@ impl Recording {
         let rate = tracks.iter().map(|t| t.audio.rate).max().unwrap_or(16_000);
         let end = (tracks.iter())
             .map(|t| {
-                t.cut
-                    .map_or(t.start + t.length(), |c| c + bml_realizer::sound::CUT_FADE)
+                t.cut.map_or(t.start + t.length(), |c| {
+                    c + bml_realizer::character::sound::CUT_FADE
+                })
             })
             .fold(realizer.now(), f64::max);
-        let samples = bml_realizer::sound::mix(&tracks, rate, end);
-        let bytes = bml_realizer::sound::wav(&samples, rate)?;
+        let samples = bml_realizer::character::sound::mix(&tracks, rate, end);
+        let bytes = bml_realizer::character::sound::wav(&samples, rate)?;
         Ok((
             bytes,
             tracks.len(),
@@ -427,7 +428,9 @@ impl Recording {
             character: Some(character.to_string()),
             pose,
             clamped: Vec::new(),
-            face: bml_realizer::face::Face::neutral(bml_realizer::face::FaceModel::default_model()),
+            face: bml_realizer::character::face::Face::neutral(
+                bml_realizer::character::face::FaceModel::default_model(),
+            ),
             sounds: Vec::new(),
             events: Vec::new(),
             contacts: None,

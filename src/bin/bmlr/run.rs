@@ -6,9 +6,9 @@ use std::process::ExitCode;
 use std::sync::mpsc;
 use std::time::Duration;
 
-use bml_realizer::bml::{BlockStream, StreamItem};
-use bml_realizer::clock::{Clock, WallClock};
-use bml_realizer::feedback::{BlockStatus, Feedback, Format};
+use bml_realizer::language::bml::{BlockStream, StreamItem};
+use bml_realizer::language::feedback::{BlockStatus, Feedback, Format};
+use bml_realizer::realizer::clock::{Clock, WallClock};
 use bml_realizer::realizer::Realizer;
 use clap::Args;
 
@@ -152,14 +152,14 @@ impl VirtualRun {
         self.hear(t, &frame.poses);
     }
 
-    fn record(&mut self, time: f64, poses: Vec<bml_realizer::engine::CharacterPose>) {
+    fn record(&mut self, time: f64, poses: Vec<bml_realizer::engines::interface::CharacterPose>) {
         if let Some(m) = self.motion.as_mut() {
             m.push_frame(time, poses);
         }
     }
 
     /// Lets the recording hear the sounds of every tick (recorded frames and the ticks between).
-    fn hear(&mut self, time: f64, poses: &[bml_realizer::engine::CharacterPose]) {
+    fn hear(&mut self, time: f64, poses: &[bml_realizer::engines::interface::CharacterPose]) {
         if let Some(m) = self.motion.as_mut() {
             m.observe(time, poses);
         }
@@ -183,7 +183,7 @@ impl VirtualRun {
     fn stdin(&mut self) {
         let mut stream = BlockStream::new();
         let max_line = self.realizer.limits().block_bytes;
-        for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
+        for line in bml_realizer::language::bml::lines(std::io::stdin().lock(), max_line) {
             match line {
                 Ok(text) => {
                     stream.push(&text);
@@ -481,7 +481,7 @@ impl RealtimeRun {
         let (tx, rx) = mpsc::sync_channel(256);
         let max_line = self.realizer.limits().block_bytes;
         std::thread::spawn(move || {
-            for line in bml_realizer::bml::lines(std::io::stdin().lock(), max_line) {
+            for line in bml_realizer::language::bml::lines(std::io::stdin().lock(), max_line) {
                 if tx.send(Some(line)).is_err() {
                     return;
                 }

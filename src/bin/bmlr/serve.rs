@@ -7,13 +7,13 @@ use std::process::ExitCode;
 use std::sync::mpsc;
 use std::time::Duration;
 
-use bml_realizer::bml::{BadLine, Checked};
-use bml_realizer::clock::{Clock, WallClock};
 use bml_realizer::engines::assets::Assets;
 use bml_realizer::engines::registry_with;
-use bml_realizer::feedback::{Feedback, Format};
+use bml_realizer::language::bml::{BadLine, Checked};
+use bml_realizer::language::feedback::{Feedback, Format};
+use bml_realizer::planning::timing::{DefaultTimingModels, SpeechTiming};
+use bml_realizer::realizer::clock::{Clock, WallClock};
 use bml_realizer::realizer::Realizer;
-use bml_realizer::timing::{DefaultTimingModels, SpeechTiming};
 use clap::Args;
 
 /// Arguments of `bmlr serve`.
@@ -338,11 +338,12 @@ fn serve_stdio(
     let limits = *realizer.limits();
     std::thread::spawn(move || {
         // a line that is not UTF-8 or too long costs only itself
-        for line in bml_realizer::bml::lines(std::io::stdin().lock(), limits.block_bytes) {
+        for line in bml_realizer::language::bml::lines(std::io::stdin().lock(), limits.block_bytes)
+        {
             let item = match line {
                 Ok(text) if text.trim().is_empty() => continue,
                 // a live port has no use for clock advances: time passes by itself
-                Ok(text) if bml_realizer::bml::advance(text.trim()).is_some() => continue,
+                Ok(text) if bml_realizer::language::bml::advance(text.trim()).is_some() => continue,
                 // a stream message (`Realizer::stream_message`): a JSON object
                 Ok(text) if text.trim_start().starts_with('{') => Line::Stream(text),
                 Ok(text) => Line::Block(Box::new(Checked::new(&text, &limits))),

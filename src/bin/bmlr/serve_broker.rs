@@ -5,8 +5,8 @@
 
 use std::time::Duration;
 
-use bml_realizer::broker::ipaaca::iu::Requests;
-use bml_realizer::broker::{
+use bml_realizer::ports::broker::ipaaca::iu::Requests;
+use bml_realizer::ports::broker::{
     level_ok, BrokerUrl, Cells, Ipaaca, Link, LinkOptions, StompLink, StompOptions, StompUrl,
     Topics, Wire, CELL_SIZE,
 };

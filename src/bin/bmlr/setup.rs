@@ -4,10 +4,10 @@
 
 use std::path::Path;
 
-use bml_realizer::bml::Limits;
-use bml_realizer::feedback::Format;
+use bml_realizer::language::bml::Limits;
+use bml_realizer::language::feedback::Format;
+use bml_realizer::planning::timing::{SpeechTiming, Voice};
 use bml_realizer::realizer::Realizer;
-use bml_realizer::timing::{SpeechTiming, Voice};
 use clap::{Args, ValueEnum};
 
 /// Feedback line format.
@@ -109,7 +109,7 @@ pub struct LimitArgs {
 
 /// A `--max-time` value: a number of seconds above 0 and at most the furthest a schedule may go.
 fn max_time(s: &str) -> Result<f64, String> {
-    let bound = bml_realizer::schedule::strategy::MAX_SCHEDULED_TIME;
+    let bound = bml_realizer::planning::schedule::strategy::MAX_SCHEDULED_TIME;
     match s.parse::<f64>() {
         Ok(t) if t > 0.0 && t <= bound => Ok(t),
         _ => Err(format!("expected seconds above 0 and at most {bound}")),
@@ -145,7 +145,7 @@ pub fn with_assets(
     let assets = bml_realizer::engines::assets::Assets::from_dir(dir)?;
     Ok(realizer.with_engines(move || {
         bml_realizer::engines::registry_with(
-            bml_realizer::timing::DefaultTimingModels { speech },
+            bml_realizer::planning::timing::DefaultTimingModels { speech },
             &assets,
         )
     }))
@@ -169,14 +169,14 @@ impl TtsArg {
     /// espeak-ng, an error if the program is not installed or lacks the voice, and a voice
     /// asked of another TTS is an error too.
     pub fn timing(self, voice: Option<&str>) -> Result<SpeechTiming, String> {
-        use bml_realizer::voice::espeak::{Espeak, VoiceName};
+        use bml_realizer::character::voice::espeak::{Espeak, VoiceName};
         if voice.is_some() && self != TtsArg::Espeak {
             return Err("--voice names an espeak-ng voice: give --tts espeak".into());
         }
         let voice = match self {
             TtsArg::Builtin => Voice::Builtin,
             TtsArg::Flite => {
-                bml_realizer::voice::flite::Flite::default().check()?;
+                bml_realizer::character::voice::flite::Flite::default().check()?;
                 Voice::Flite
             }
             TtsArg::Espeak => {
@@ -206,10 +206,10 @@ pub fn with_sight_and_nets(
     if let Some(path) = nets {
         let at = path.display();
         let text = std::fs::read_to_string(path).map_err(|e| format!("--nets {at}: {e}"))?;
-        let nets = bml_realizer::nets::file::read(&text, realizer.limits())
+        let nets = bml_realizer::world::nets::file::read(&text, realizer.limits())
             .map_err(|e| format!("--nets {at}: {e}"))?;
         let variables = realizer.world().variables().clone();
-        let nets = bml_realizer::nets::Nets::new(nets, variables);
+        let nets = bml_realizer::world::nets::Nets::new(nets, variables);
         realizer.set_nets(Some(nets), true)?;
     }
     Ok(realizer)
@@ -276,7 +276,7 @@ pub fn read_items(items: &[String]) -> Result<Vec<Item>, String> {
             if a == "-" {
                 Ok(Item::Stdin)
             } else if a.starts_with('+') {
-                bml_realizer::bml::advance(a)
+                bml_realizer::language::bml::advance(a)
                     .map(Item::Advance)
                     .ok_or_else(|| {
                         format!(

@@ -10,9 +10,9 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use bml_realizer::body::Skeleton;
+use bml_realizer::character::body::Skeleton;
 use bml_realizer::character::frames::{self, Detail};
-use bml_realizer::engine::CharacterPose;
+use bml_realizer::engines::interface::CharacterPose;
 
 /// Frame lines on their way to a frames file.
 pub struct FrameSpool {
@@ -140,8 +140,8 @@ fn assemble(time: f64, parts: &HashMap<String, String>, ids: &[&str], rest: &[St
 #[cfg(test)]
 mod tests {
     use super::*;
-    use bml_realizer::body::Pose;
-    use bml_realizer::face::{Face, FaceModel};
+    use bml_realizer::character::body::Pose;
+    use bml_realizer::character::face::{Face, FaceModel};
 
     fn posed(id: &str, turn: f32, skeleton: &Skeleton) -> CharacterPose {
         let mut pose = Pose::rest(skeleton);

@@ -21,9 +21,9 @@ use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
 use std::sync::Arc;
 use std::time::Duration;
 
-use bml_realizer::bml::{self, Checked, Limits};
-use bml_realizer::clock::{Clock, WallClock};
-use bml_realizer::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
+use bml_realizer::language::bml::{self, Checked, Limits};
+use bml_realizer::language::feedback::{Feedback, Format, KnownWarning, WarningFeedback};
+use bml_realizer::realizer::clock::{Clock, WallClock};
 use bml_realizer::realizer::{Realizer, NO_ID};
 
 use crate::live::LiveView;

@@ -9,9 +9,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 
-use bml_realizer::body::{mannequin, Skeleton};
-use bml_realizer::feedback::{Feedback, Format};
-use bml_realizer::timeline::Timeline;
+use bml_realizer::character::body::{mannequin, Skeleton};
+use bml_realizer::language::feedback::{Feedback, Format};
+use bml_realizer::ports::timeline::Timeline;
 use bml_realizer::world::World;
 use clap::Args;
 use serde_json::{json, Value};
@@ -239,7 +239,8 @@ impl PageData<'_> {
             .collect();
         let crowd_avatar = self.crowd_avatar.then(|| {
             use base64::Engine as _;
-            base64::engine::general_purpose::STANDARD.encode(bml_realizer::avatar::DEFAULT_GLB)
+            base64::engine::general_purpose::STANDARD
+                .encode(bml_realizer::character::avatar::DEFAULT_GLB)
         });
         let data = json!({
             "avatars": avatars,
@@ -265,7 +266,7 @@ impl PageData<'_> {
 /// the skeleton joint it follows, its mass, its centre of mass in that joint's frame, and for
 /// the feet the corners of the sole.
 fn balance_parts(skeleton: &Skeleton) -> Value {
-    let Ok(h) = bml_realizer::dynamics::humanoid::Humanoid::new(skeleton) else {
+    let Ok(h) = bml_realizer::character::dynamics::humanoid::Humanoid::new(skeleton) else {
         return Value::Array(Vec::new());
     };
     let parts = h.parts.iter().map(|p| {
@@ -295,7 +296,7 @@ fn metres(p: glam::Vec3) -> [f64; 3] {
 
 /// The world's points, paths and obstacles.
 fn world_data(w: &World) -> Value {
-    use bml_realizer::space::Shape;
+    use bml_realizer::world::space::Shape;
     let obstacles: Vec<Value> = (w.obstacles().all().iter())
         .map(|o| {
             let m = |v: f32| (f64::from(v) * 1e6).round() / 1e6;

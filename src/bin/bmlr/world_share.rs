@@ -13,8 +13,8 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 
-use bml_realizer::broker::{Cell, RootState, DEFAULT_CHARACTER, PUBLISH_PERIOD, STALE};
-use bml_realizer::clock::Clock;
+use bml_realizer::ports::broker::{Cell, RootState, DEFAULT_CHARACTER, PUBLISH_PERIOD, STALE};
+use bml_realizer::realizer::clock::Clock;
 use bml_realizer::realizer::Realizer;
 
 use crate::brokered::{Brokered, Server};

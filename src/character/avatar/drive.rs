@@ -7,8 +7,8 @@ use super::file::Model;
 use super::morph::Look;
 use super::morph::MorphMap;
 use super::retarget::Retarget;
-use crate::body::pose::Pose;
-use crate::face::model::Face;
+use crate::character::body::pose::Pose;
+use crate::character::face::model::Face;
 
 /// What moves in one avatar, and its values for a frame.
 #[derive(Debug, Clone)]
@@ -83,19 +83,19 @@ impl Driver {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body::Skeleton;
-    use crate::face::FaceModel;
+    use crate::character::body::Skeleton;
+    use crate::character::face::FaceModel;
 
     #[test]
     fn the_default_avatar_s_moving_nodes_turn_as_their_joints() {
-        let model = crate::avatar::default_model();
+        let model = crate::character::avatar::default_model();
         let skeleton = Skeleton::adult();
         let driver = Driver::new(&model, Retarget::new(&model, &skeleton, None).unwrap());
         let mut pose = Pose::rest(&skeleton);
         let elbow = skeleton.joint("l_elbow").unwrap();
         pose.rotate(elbow, glam::Quat::from_rotation_x(-1.0));
         let mut face = Face::neutral(FaceModel::default_model());
-        let smile = crate::face::model::morph_index("mouthSmileLeft").unwrap();
+        let smile = crate::character::face::model::morph_index("mouthSmileLeft").unwrap();
         face.morphs.0[smile] = 0.75;
         let (mut r, mut w) = (Vec::new(), Vec::new());
         driver.frame(&pose, &face, &mut r, &mut w);

@@ -12,9 +12,9 @@ use serde_json::{json, Value};
 use super::file::Model;
 use super::morph::{Look, MorphMap};
 use super::retarget::Retarget;
-use crate::body::gltf::{glb, Buffer};
-use crate::body::pose::Pose;
-use crate::face::model::Face;
+use crate::character::body::gltf::{glb, Buffer};
+use crate::character::body::pose::Pose;
+use crate::character::face::model::Face;
 
 /// One frame of a character: when, its pose, its face.
 #[derive(Debug, Clone, Copy)]

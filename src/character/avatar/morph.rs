@@ -13,8 +13,8 @@ use glam::Vec3;
 use serde_json::Value;
 
 use super::file::Model;
-use crate::body::pose::Pose;
-use crate::face::model::{morph_index, Face, VISEMES};
+use crate::character::body::pose::Pose;
+use crate::character::face::model::{morph_index, Face, VISEMES};
 
 /// Where the eyes look, in the head's frame: yaw (degrees, + to the character's left) and
 /// pitch (degrees, + up).
@@ -302,7 +302,7 @@ mod tests {
     use serde_json::json;
 
     use super::*;
-    use crate::face::model::{morph_index, Morphs};
+    use crate::character::face::model::{morph_index, Morphs};
 
     fn model(json: Value) -> Model {
         Model {
@@ -428,7 +428,7 @@ mod tests {
     /// A gaze to the character's left turns its eyes left: `Look` says so from the pose.
     #[test]
     fn look_follows_the_realizer_s_eyes() {
-        let skeleton = crate::body::Skeleton::adult();
+        let skeleton = crate::character::body::Skeleton::adult();
         let eyes = skeleton
             .joint("l_eyeball_joint")
             .zip(skeleton.joint("r_eyeball_joint"));

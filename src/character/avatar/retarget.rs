@@ -16,8 +16,8 @@ use glam::{Mat3, Mat4, Quat, Vec3};
 use super::file::{AvatarError, Model};
 use super::humanoid::{self, BONES};
 use super::twist::{self, TwistBone};
-use crate::body::pose::Pose;
-use crate::body::skeleton::Skeleton;
+use crate::character::body::pose::Pose;
+use crate::character::body::skeleton::Skeleton;
 
 /// The joint a realizer joint's bone points at, for aligning rest poses.
 fn points_at(joint: &str) -> Option<String> {
@@ -330,7 +330,7 @@ impl Retarget {
 
     /// Places the avatar where the character stood when its motion began: its travel from
     /// there is scaled by the ratio of leg lengths, its place is not.
-    pub fn place_at(&mut self, at: crate::world::Placement) {
+    pub fn place_at(&mut self, at: crate::character::body::Placement) {
         self.anchor = at.to_world(self.root_rest);
     }
 

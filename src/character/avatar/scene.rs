@@ -11,7 +11,7 @@
 use serde_json::{json, Map, Value};
 
 use super::export::hang_roots;
-use crate::body::gltf::glb;
+use crate::character::body::gltf::glb;
 
 /// The kinds of top-level items whose indices are offset.
 const KINDS: [&str; 10] = [

@@ -14,7 +14,7 @@
 use glam::{Mat4, Quat, Vec3};
 
 use super::file::Model;
-use crate::body::skeleton::Skeleton;
+use crate::character::body::skeleton::Skeleton;
 
 /// An arm twist bone: it turns about `axis` (in its parent's frame) by `share` of the realizer
 /// joint `joint`'s twist about the realizer's limb segment (`about`, in the joint's parent's

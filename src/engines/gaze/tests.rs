@@ -1,7 +1,7 @@
 //! The unit tests of `gaze`.
 
 use super::*;
-use crate::engine::Motion;
+use crate::engines::interface::Motion;
 
 #[test]
 fn yaw_is_toward_the_left_and_pitch_down() {
@@ -58,7 +58,7 @@ fn it_looks_at_whom_the_walk_attends_to_unless_a_bml_gaze_runs() {
     e.attend(None);
     assert!(look(&mut e, 0.0).1.abs() < 1e-4);
     // a BML gaze at someone on the right, once it has turned, wins over the attention
-    let block = crate::bml::load(
+    let block = crate::language::bml::load(
         r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gaze id="g" target="right"/></bml>"#,
     )
     .unwrap()
@@ -90,7 +90,7 @@ fn it_looks_at_whom_the_walk_attends_to_unless_a_bml_gaze_runs() {
 /// A placed character as a target is where the default adult's eyes are.
 #[test]
 fn a_character_target_is_at_the_adult_s_eyes() {
-    let eyes = eyes_at_rest(&crate::body::Skeleton::adult());
+    let eyes = eyes_at_rest(&crate::character::body::Skeleton::adult());
     let d = eyes.distance(crate::world::CHARACTER_EYES);
     assert!(d < 0.01, "{eyes} vs {}", crate::world::CHARACTER_EYES);
 }

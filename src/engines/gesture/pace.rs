@@ -6,7 +6,7 @@
 use glam::Quat;
 
 use super::GestureKeys;
-use crate::body::{Pose, Skeleton};
+use crate::character::body::{Pose, Skeleton};
 
 /// The fastest a hand moves by preference (m/s), at the peak of a minimum-jerk move between a
 /// gesture's keys. Measured conversational gestures peak at about 1–2.5 m/s; 2 keeps a hand
@@ -38,7 +38,7 @@ pub(super) fn paces(keys: &GestureKeys) -> Vec<Pace> {
     let adult = Skeleton::adult();
     let rest: &[(String, Quat)] = &[];
     // the sync points of a gesture, in order
-    let mut chain: Vec<(&'static str, &[(String, Quat)])> = crate::bml::GESTURE_SYNCS
+    let mut chain: Vec<(&'static str, &[(String, Quat)])> = crate::language::bml::GESTURE_SYNCS
         .iter()
         .filter_map(|&sync| keys.iter().find(|k| k.0 == sync).map(|k| (sync, &k.1[..])))
         .collect();

@@ -2,7 +2,7 @@
 
 use super::pace::{wrist_rate, MIN_JERK_PEAK};
 use super::*;
-use crate::bml::Mode;
+use crate::language::bml::Mode;
 use glam::Vec3;
 
 /// A lexeme whose keys barely move the hand keeps the default timing; one that raises the
@@ -16,7 +16,11 @@ fn a_lexeme_is_paced_by_how_far_its_keys_move_the_hand() {
         let src = format!(
             r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b"><gesture id="g" lexeme="{lexeme}"/></bml>"#
         );
-        crate::bml::load(&src).unwrap().block.behaviours.remove(0)
+        crate::language::bml::load(&src)
+            .unwrap()
+            .block
+            .behaviours
+            .remove(0)
     };
     let at = |m: &TimingModel, k: &str| m.keys[m.key(k).unwrap()].at;
     let still =
@@ -74,7 +78,7 @@ fn the_default_lexicon_has_the_gestures_the_issue_names() {
 }
 
 fn gesture(lexeme: &str, mode: Option<Mode>) -> Behaviour {
-    crate::bml::load(&format!(
+    crate::language::bml::load(&format!(
         r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:x="urn:x" id="b"><gesture id="g" lexeme="{lexeme}"{}{}/></bml>"#,
         mode.map_or(String::new(), |m| format!(r#" mode="{}""#, m.as_str())),
         if lexeme == "STYLED" { r#" x:style="big""# } else { "" }

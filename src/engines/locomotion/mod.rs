@@ -23,15 +23,17 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
-use crate::bml::{Behaviour, BehaviourKind, NS_BMLT};
-use crate::body::{Pose, Skeleton};
-use crate::engine::{Engine, EngineError, Revision, Steering, Travel, Unit, UnitKey, Units};
-use crate::feedback::KnownWarning;
-use crate::locomotion::posing::{lead_the_turn, pose_gait, GaitJoints};
-use crate::locomotion::room::Room;
-use crate::locomotion::{walker, Moments, Walk, Walker};
-use crate::space::Obstacles;
-use crate::timing::{SyncName, TimingModel, TimingModels};
+use crate::character::body::{Pose, Skeleton};
+use crate::engines::interface::{
+    Engine, EngineError, Revision, Steering, Travel, Unit, UnitKey, Units,
+};
+use crate::language::bml::{Behaviour, BehaviourKind, NS_BMLT};
+use crate::language::feedback::KnownWarning;
+use crate::planning::timing::{SyncName, TimingModel, TimingModels};
+use crate::world::locomotion::posing::{lead_the_turn, pose_gait, GaitJoints};
+use crate::world::locomotion::room::Room;
+use crate::world::locomotion::{walker, Moments, Walk, Walker};
+use crate::world::space::Obstacles;
 use crate::world::{Placement, World};
 use targets::{resolve, Pursuit};
 
@@ -159,7 +161,7 @@ impl LocomotionEngine {
         let moved_by_host = self.walker.as_ref().is_some_and(|w| {
             let b = w.body();
             b.at.distance(here) > 1e-3
-                || crate::locomotion::gait::angle_diff(b.facing, at.facing).abs() > 1e-3
+                || crate::world::locomotion::gait::angle_diff(b.facing, at.facing).abs() > 1e-3
         });
         if self.walker.is_none() || moved_by_host {
             // on the walker's grid of steps, so that where it is at a time does not depend on
@@ -195,7 +197,7 @@ impl LocomotionEngine {
         &self,
         walker: &Walker,
         walk: &Walk,
-        obstacles: &crate::space::Obstacles,
+        obstacles: &crate::world::space::Obstacles,
     ) -> Result<Moments, String> {
         if let Some((w, k, m)) = self.rehearsed.borrow().as_ref() {
             if w == walker && k == walk {
@@ -379,7 +381,7 @@ impl Engine for LocomotionEngine {
 
     fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
         let o = order(behaviour)?;
-        let fallback = crate::timing::DefaultTimingModels::default().model(behaviour);
+        let fallback = crate::planning::timing::DefaultTimingModels::default().model(behaviour);
         let Some(world) = self.world.as_deref() else {
             return fallback;
         };
@@ -481,7 +483,7 @@ impl Engine for LocomotionEngine {
     fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
         let walking = self.current.as_ref() == Some(key);
         if !walking {
-            let times = crate::engine::stop_now(now, syncs);
+            let times = crate::engines::interface::stop_now(now, syncs);
             self.units.retime(key, &times);
             if let Some((_, u)) = self.units.get_mut(key) {
                 u.started = true;
@@ -516,16 +518,16 @@ impl Engine for LocomotionEngine {
         Some(self)
     }
 
-    fn as_revising(&mut self) -> Option<&mut dyn crate::engine::Revising> {
+    fn as_revising(&mut self) -> Option<&mut dyn crate::engines::interface::Revising> {
         Some(self)
     }
 
-    fn as_motion(&mut self) -> Option<&mut dyn crate::engine::Motion> {
+    fn as_motion(&mut self) -> Option<&mut dyn crate::engines::interface::Motion> {
         Some(self)
     }
 }
 
-impl crate::engine::Motion for LocomotionEngine {
+impl crate::engines::interface::Motion for LocomotionEngine {
     fn steers(&self, behaviour: &Behaviour, skeleton: &Skeleton) -> Option<Steering> {
         order(behaviour)?;
         Some(Steering::kinematic(

@@ -6,9 +6,9 @@ use glam::{Vec2, Vec3};
 
 use super::targets::resolve;
 use super::LocomotionEngine;
-use crate::engine::{Revising, Revision, Travel, UnitKey};
-use crate::locomotion::room::make_room;
-use crate::locomotion::walker;
+use crate::engines::interface::{Revising, Revision, Travel, UnitKey};
+use crate::world::locomotion::room::make_room;
+use crate::world::locomotion::walker;
 use crate::world::{Placement, World};
 
 impl Travel for LocomotionEngine {
@@ -123,7 +123,7 @@ impl Travel for LocomotionEngine {
         Some(
             w.gait
                 .feet
-                .map(|f| matches!(f, crate::locomotion::gait::Foot::Planted { .. })),
+                .map(|f| matches!(f, crate::world::locomotion::gait::Foot::Planted { .. })),
         )
     }
 }
@@ -134,7 +134,7 @@ impl LocomotionEngine {
     fn make_room(&mut self, now: f64, world: &World, id: &str, at: Placement) {
         // (decided on the crowd's grid of times only, as the asks are: the same whatever the
         // host's frames)
-        if !crate::crowd::snapshot::on_grid(now) {
+        if !crate::world::crowd::snapshot::on_grid(now) {
             return;
         }
         if let Some(w) = self.walker.as_mut() {

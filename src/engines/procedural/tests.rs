@@ -1,7 +1,7 @@
 //! The unit tests of `procedural`.
 
 use super::*;
-use crate::engine::Motion;
+use crate::engines::interface::Motion;
 
 fn ids(v: &[(&'static str, f64)]) -> Vec<(Id, f64)> {
     v.iter().map(|&(n, t)| (Id::new_static(n), t)).collect()
@@ -127,7 +127,7 @@ fn engine(units: &str, runs: &[(&str, &str, f64, f64)]) -> ProceduralEngine {
     let mut e = ProceduralEngine::new(Library::from_json(units).unwrap());
     let world = World::default();
     for &(id, name, start, end) in runs {
-        let block = crate::bml::load(&format!(
+        let block = crate::language::bml::load(&format!(
             r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt" id="b"><bmlt:procanimation id="{id}" name="{name}"/></bml>"#
         ))
         .unwrap()

@@ -13,12 +13,12 @@
 //! `relax` sync where the text ends and its `end` after the filler; a chunked successor that
 //! speaks cuts the filler (co-articulation on the voice).
 
-use crate::bml::{Behaviour, BehaviourKind, TextPart};
-use crate::engine::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
-use crate::face::{Face, FaceModel};
-use crate::timing::{SpeechTiming, SyncKey, SyncName, TimingModel, TimingModels};
-use crate::voice::stream::AudioStream;
-use crate::voice::{lipsync, Phone, Utterance};
+use crate::character::face::{Face, FaceModel};
+use crate::character::voice::stream::AudioStream;
+use crate::character::voice::{lipsync, Phone, Utterance};
+use crate::engines::interface::{Engine, EngineError, Frame, Output, Unit, UnitKey, Units};
+use crate::language::bml::{Behaviour, BehaviourKind, TextPart};
+use crate::planning::timing::{SpeechTiming, SyncKey, SyncName, TimingModel, TimingModels};
 use std::sync::Arc;
 
 mod stream;
@@ -38,7 +38,7 @@ pub const FILLER_SECONDS: f64 = 0.5;
 fn own_sound(b: &Behaviour) -> Option<(String, Option<String>)> {
     let attr = |name: &str| {
         (b.foreign_attrs.iter())
-            .find(|a| a.ns == crate::bml::NS_BMLT && a.name == name)
+            .find(|a| a.ns == crate::language::bml::NS_BMLT && a.name == name)
             .map(|a| a.value.trim().to_string())
     };
     Some((attr("audiofile")?, attr("marks")))
@@ -66,7 +66,7 @@ struct Speaking {
     volume: f64,
     rate: f64,
     /// The synthesized sound, if the voice makes any.
-    audio: Option<Arc<crate::voice::Audio>>,
+    audio: Option<Arc<crate::character::voice::Audio>>,
     /// The phones, in the TTS's time (seconds from the speech's start at rate 1).
     phones: Vec<Phone>,
     /// The TTS's time of each sync key, in key order.
@@ -176,11 +176,13 @@ impl SpeechEngine {
     fn voiced(&self, text: &[TextPart], language: Option<&str>) -> Said {
         let mut timing = self.timing;
         let mut warning = None;
-        if let (crate::timing::Voice::Espeak(own), Some(language)) = (timing.voice, language) {
-            use crate::voice::espeak::{Espeak, VoiceName};
+        if let (crate::planning::timing::Voice::Espeak(own), Some(language)) =
+            (timing.voice, language)
+        {
+            use crate::character::voice::espeak::{Espeak, VoiceName};
             match VoiceName::new(language) {
                 Ok(name) if Espeak::new(name).has_voice() => {
-                    timing.voice = crate::timing::Voice::Espeak(name)
+                    timing.voice = crate::planning::timing::Voice::Espeak(name)
                 }
                 _ => {
                     warning = Some(format!(
@@ -206,7 +208,7 @@ impl SpeechEngine {
     /// (`voice::recorded`). An unreadable sound leaves the built-in TTS's timing, silent;
     /// unreadable marks leave the sound to time the text.
     fn own(text: &[TextPart], audio: &str, marks: Option<&str>) -> Said {
-        let sound = match crate::sound::read_wav(std::path::Path::new(audio)) {
+        let sound = match crate::character::sound::read_wav(std::path::Path::new(audio)) {
             Ok(a) => Arc::new(a),
             Err(e) => {
                 return Said {
@@ -218,7 +220,7 @@ impl SpeechEngine {
         let mut problems = Vec::new();
         let marks = marks.and_then(|file| {
             let read = std::fs::read_to_string(file).map_err(|e| format!("{file}: {e}"));
-            match read.and_then(|t| crate::voice::marks::parse(&t, file)) {
+            match read.and_then(|t| crate::character::voice::marks::parse(&t, file)) {
                 Ok(m) => Some(m),
                 Err(e) => {
                     problems.push(format!("its marks are not used ({e})"));
@@ -226,7 +228,8 @@ impl SpeechEngine {
                 }
             }
         });
-        let (utterance, warnings) = crate::voice::recorded::utterance(text, sound, marks.as_ref());
+        let (utterance, warnings) =
+            crate::character::voice::recorded::utterance(text, sound, marks.as_ref());
         problems.extend(warnings);
         Said {
             utterance,
@@ -291,7 +294,7 @@ impl Engine for SpeechEngine {
     }
 
     fn interrupt(&mut self, key: &UnitKey, now: f64, syncs: &[(SyncName, f64)]) -> Vec<f64> {
-        let times = crate::engine::stop_now(now, syncs);
+        let times = crate::engines::interface::stop_now(now, syncs);
         self.units.retime(key, &times);
         times
     }
@@ -314,7 +317,7 @@ impl Engine for SpeechEngine {
                 keys.push(SyncKey::new("end", 1.0));
                 TimingModel {
                     keys,
-                    flexibility: crate::timing::Flexibility::Stretchable {
+                    flexibility: crate::planning::timing::Flexibility::Stretchable {
                         min_duration: 1e-3,
                         max_duration: 1e6,
                     },
@@ -332,9 +335,9 @@ impl Engine for SpeechEngine {
             }
             BehaviourKind::Speech(_) => self.timing.model_of(&self.say(behaviour).utterance),
             // shown text is timed as the built-in voice would say it, and may stretch
-            BehaviourKind::Text(_) => crate::timing::DefaultTimingModels {
+            BehaviourKind::Text(_) => crate::planning::timing::DefaultTimingModels {
                 speech: SpeechTiming {
-                    voice: crate::timing::Voice::Builtin,
+                    voice: crate::planning::timing::Voice::Builtin,
                     ..self.timing
                 },
             }
@@ -378,10 +381,11 @@ impl Engine for SpeechEngine {
 
     fn interprets(&self, ns: &str, name: &str) -> bool {
         (ns == NS_BMLIS && name == "generatefiller")
-            || (ns == crate::bml::NS_BMLT && matches!(name, "audiofile" | "marks" | "stream"))
+            || (ns == crate::language::bml::NS_BMLT
+                && matches!(name, "audiofile" | "marks" | "stream"))
             || (ns == NS_XML
                 && name == "lang"
-                && matches!(self.timing.voice, crate::timing::Voice::Espeak(_)))
+                && matches!(self.timing.voice, crate::planning::timing::Voice::Espeak(_)))
     }
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
@@ -427,27 +431,27 @@ impl Engine for SpeechEngine {
         }
     }
 
-    fn as_parameters(&mut self) -> Option<&mut dyn crate::engine::Parameters> {
+    fn as_parameters(&mut self) -> Option<&mut dyn crate::engines::interface::Parameters> {
         Some(self)
     }
 
-    fn as_resources(&self) -> Option<&dyn crate::engine::Resources> {
+    fn as_resources(&self) -> Option<&dyn crate::engines::interface::Resources> {
         Some(self)
     }
 
-    fn as_expression(&mut self) -> Option<&mut dyn crate::engine::Expression> {
+    fn as_expression(&mut self) -> Option<&mut dyn crate::engines::interface::Expression> {
         Some(self)
     }
 
-    fn as_sound(&self) -> Option<&dyn crate::engine::Sound> {
+    fn as_sound(&self) -> Option<&dyn crate::engines::interface::Sound> {
         Some(self)
     }
 
-    fn as_streams(&mut self) -> Option<&mut dyn crate::engine::Streams> {
+    fn as_streams(&mut self) -> Option<&mut dyn crate::engines::interface::Streams> {
         Some(self)
     }
 
-    fn as_revising(&mut self) -> Option<&mut dyn crate::engine::Revising> {
+    fn as_revising(&mut self) -> Option<&mut dyn crate::engines::interface::Revising> {
         Some(self)
     }
 
@@ -458,17 +462,17 @@ impl Engine for SpeechEngine {
     }
 }
 
-impl crate::engine::Streams for SpeechEngine {
+impl crate::engines::interface::Streams for SpeechEngine {
     fn add_stream(&mut self, stream: AudioStream) {
         self.streams.retain(|s| s.name() != stream.name());
         self.streams.push(stream);
     }
 }
 
-impl crate::engine::Sound for SpeechEngine {
+impl crate::engines::interface::Sound for SpeechEngine {
     /// The synthesized sound of every speech being said, from its start peg at its volume (its
     /// own rate: a rate change moves the lips, not the sound), until its end or interrupt.
-    fn sounds(&self, now: f64, out: &mut Vec<crate::sound::Playing>) {
+    fn sounds(&self, now: f64, out: &mut Vec<crate::character::sound::Playing>) {
         self.units.playing(now, out, |u| {
             let audio = match &u.streamed {
                 Some(s) => s.stream.audio()?,
@@ -479,7 +483,7 @@ impl crate::engine::Sound for SpeechEngine {
     }
 }
 
-impl crate::engine::Expression for SpeechEngine {
+impl crate::engines::interface::Expression for SpeechEngine {
     /// The lips of every speech being said at `now`: its visemes as blendshapes (several
     /// speeches at once combine by maximum), and the strongest viseme.
     fn express(&mut self, now: f64, face: &mut Face) {
@@ -526,7 +530,7 @@ impl crate::engine::Expression for SpeechEngine {
     }
 }
 
-impl crate::engine::Parameters for SpeechEngine {
+impl crate::engines::interface::Parameters for SpeechEngine {
     fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
         let u = self.units.get(key)?;
         match name {
@@ -574,7 +578,7 @@ impl crate::engine::Parameters for SpeechEngine {
     }
 }
 
-impl crate::engine::Resources for SpeechEngine {
+impl crate::engines::interface::Resources for SpeechEngine {
     fn resources(&self, _behaviour: &Behaviour) -> &'static [&'static str] {
         &["voice"]
     }

@@ -9,15 +9,15 @@
 //! are left to it.
 
 use super::{Speaking, SpeechEngine};
-use crate::bml::{Behaviour, TextPart};
-use crate::engine::{Revising, Revision, SyncTimes};
-use crate::voice::stream::AudioStream;
-use crate::voice::{Phone, Tts};
+use crate::character::voice::stream::AudioStream;
+use crate::character::voice::{Phone, Tts};
+use crate::engines::interface::{Revising, Revision, SyncTimes};
+use crate::language::bml::{Behaviour, TextPart};
 
 /// The stream a speech plays (`bmlt:stream`), if it names one.
 pub(super) fn stream_name(b: &Behaviour) -> Option<&str> {
     (b.foreign_attrs.iter())
-        .find(|a| a.ns == crate::bml::NS_BMLT && a.name == "stream")
+        .find(|a| a.ns == crate::language::bml::NS_BMLT && a.name == "stream")
         .map(|a| a.value.trim())
 }
 
@@ -48,7 +48,7 @@ struct Estimate {
 impl Streamed {
     /// A speech of `text` playing `stream`, which is told how long the text is expected to be.
     pub(super) fn new(stream: AudioStream, text: Vec<TextPart>) -> Self {
-        let said = crate::voice::builtin::Builtin
+        let said = crate::character::voice::builtin::Builtin
             .speak(&text)
             .unwrap_or_default();
         let estimate = Estimate {
@@ -92,7 +92,7 @@ impl Streamed {
             self.stream.expect(self.estimate.end * self.pace);
         }
         let marks = (!marks.words.is_empty() || !marks.visemes.is_empty()).then_some(&marks);
-        let u = crate::voice::recorded::utterance(&self.text, audio, marks).0;
+        let u = crate::character::voice::recorded::utterance(&self.text, audio, marks).0;
         self.known = (u.syncs.iter())
             .map(|&(_, t)| {
                 // the word after the sync: its index is the number of words before it

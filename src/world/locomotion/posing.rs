@@ -1,0 +1,218 @@
+//! The gait as a pose of the skeleton, in the character's own frame (its root on the ground at
+//! the origin, facing +z): pelvis height, rotation, list and sway; the trunk's counter-rotation;
+//! the arms' swing against the legs; each leg placed by two-link IK from its hip to its ankle,
+//! the foot turned to its heading and pitch. The pelvis is lowered where a planted foot would
+//! otherwise be out of the leg's reach, so that planted feet stay where they are.
+
+use glam::{Quat, Vec2, Vec3};
+
+use super::gait::{forward, Body, FootPose, Gait, ANKLE_HEIGHT, BALL_AHEAD};
+use crate::character::body::ik::{place_limb, LimbRoot, LEG_HINGE};
+use crate::character::body::{Pose, Skeleton};
+
+/// The joints the gait moves (indices into a skeleton).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaitJoints {
+    legs: [[usize; 3]; 2],
+    spine: [Option<usize>; 2],
+    shoulders: [Option<usize>; 2],
+    elbows: [Option<usize>; 2],
+    /// Neck and skull base (the head turns into a bend ahead).
+    neck: [Option<usize>; 2],
+    /// The legs' full length (hip to ankle), m.
+    reach: f32,
+}
+
+impl GaitJoints {
+    /// The joints of `skeleton` (H-Anim names); `None` without hips, knees and ankles.
+    pub fn of(skeleton: &Skeleton) -> Option<GaitJoints> {
+        let j = |n: &str| skeleton.joint(n);
+        let leg = |s: &str| -> Option<[usize; 3]> {
+            Some([
+                j(&format!("{s}_hip"))?,
+                j(&format!("{s}_knee"))?,
+                j(&format!("{s}_talocrural"))?,
+            ])
+        };
+        let legs = [leg("l")?, leg("r")?];
+        let joints = skeleton.joints();
+        let reach = joints[legs[0][1]].offset.length() + joints[legs[0][2]].offset.length();
+        Some(GaitJoints {
+            legs,
+            spine: [j("vl5"), j("vt6")],
+            shoulders: [j("l_shoulder"), j("r_shoulder")],
+            elbows: [j("l_elbow"), j("r_elbow")],
+            neck: [j("vc4"), j("skullbase")],
+            reach,
+        })
+    }
+
+    /// The names of the joints the gait sets or turns.
+    pub fn names(skeleton: &Skeleton) -> Vec<&str> {
+        let mut v = vec!["HumanoidRoot"];
+        for s in ["l", "r"] {
+            for n in ["hip", "knee", "talocrural", "shoulder", "elbow"] {
+                if let Some(j) = skeleton
+                    .joints()
+                    .iter()
+                    .find(|j| j.name == format!("{s}_{n}"))
+                {
+                    v.push(&j.name);
+                }
+            }
+        }
+        v.extend(["vl5", "vt6", "vc4", "skullbase"]);
+        v
+    }
+}
+
+/// A foot pose turned into the frame of a body standing at `body`.
+fn to_local(f: FootPose, body: Body) -> FootPose {
+    let rot = Quat::from_rotation_y(-body.facing);
+    let rel = f.ankle - Vec3::new(body.at.x, 0.0, body.at.y);
+    FootPose {
+        ankle: rot * rel,
+        yaw: f.yaw - body.facing,
+        ..f
+    }
+}
+
+/// Poses the gait of a body standing at `body` on `pose` (the character's own frame): the
+/// pelvis, trunk and arms on top of what is there, the legs set.
+pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, pose: &mut Pose) {
+    let amount = gait.amount;
+    let tau = std::f32::consts::TAU;
+    let beta = gait.stance();
+    let (psi_l, psi_r) = (gait.foot_phase(0), gait.foot_phase(1));
+    let mid_left = (tau * (psi_l - beta / 2.0)).cos();
+    // pelvis: the swinging side's hip forward, the swing side lower, the weight over the
+    // standing foot; highest at mid-stance when walking, lowest when running
+    let run = gait.running;
+    let yaw = -(if run { 0.1 } else { 0.07 }) * amount * (tau * psi_l).cos();
+    let list = (if run { 0.03 } else { 0.06 }) * amount * mid_left;
+    let sway = (if run { 0.01 } else { 0.02 }) * amount * mid_left;
+    let bob_sign = if run { -1.0 } else { 1.0 };
+    let bob = bob_sign * 0.015 * amount * (2.0 * tau * (psi_l - beta / 2.0)).cos();
+    let rest_y = skeleton.joints()[0].offset.y;
+    pose.root.x = pose.root.x * (1.0 - amount) + sway;
+    pose.root.z *= 1.0 - amount;
+    pose.root.y = rest_y - 0.02 * amount + bob;
+    pose.rotations[0] = Quat::from_rotation_y(yaw) * Quat::from_rotation_z(list);
+    let feet = [0, 1].map(|k| to_local(gait.foot_pose(k, body, amount), body));
+    lower_to_reach(skeleton, j, &feet, pose);
+    for (k, foot) in feet.iter().enumerate() {
+        place_leg(skeleton, j.legs[k], *foot, pose);
+    }
+    // the trunk turns back against the pelvis; the arms swing against the legs
+    for (joint, share) in j.spine.iter().zip([-0.8, -0.6]) {
+        if let Some(i) = *joint {
+            pose.rotate(i, Quat::from_rotation_y(yaw * share));
+        }
+    }
+    let arm = if run { 0.55 } else { 0.3 } * amount;
+    let swing = [(tau * psi_r).cos(), (tau * psi_l).cos()];
+    for ((shoulder, elbow), swing) in j.shoulders.iter().zip(&j.elbows).zip(swing) {
+        if let Some(s) = *shoulder {
+            pose.rotate(s, Quat::from_rotation_x(-(arm * swing + 0.05 * amount)));
+        }
+        if let Some(e) = *elbow {
+            let bend = if run {
+                1.4
+            } else {
+                0.25 + 0.15 * swing.max(0.0)
+            } * amount;
+            pose.rotate(e, Quat::from_axis_angle(Vec3::NEG_X, bend));
+        }
+    }
+}
+
+/// The head leads a turn: turned toward where the way goes `ahead` radians off the facing
+/// (the route a little way ahead), by up to 35°, 40 % at the neck and 60 % at the skull base,
+/// as much as the body walks (`amount`). Gaze behaviours turn the head on top of it.
+pub fn lead_the_turn(j: &GaitJoints, ahead: f32, amount: f32, pose: &mut Pose) {
+    let turn = ahead.clamp(-0.6, 0.6) * amount;
+    for (joint, share) in j.neck.iter().zip([0.4, 0.6]) {
+        if let Some(i) = *joint {
+            pose.rotate(i, Quat::from_rotation_y(turn * share));
+        }
+    }
+}
+
+/// Deepest the pelvis sinks to keep a planted foot in reach (m): a knee bend. A foot further
+/// away is lifted by the gait (`Gait::step`); the pelvis sank to 0.1 m above the floor for a
+/// foot left behind by a body pushed in a jam.
+pub const MAX_SINK: f32 = 0.15;
+
+/// Lowers the root so that each foot is within 98.5 % of the leg's reach (a straight knee
+/// turns fast for little change of length), by [`MAX_SINK`] at most; over both feet, so
+/// that the height changes smoothly as they lift and land.
+fn lower_to_reach(skeleton: &Skeleton, j: &GaitJoints, feet: &[FootPose; 2], pose: &mut Pose) {
+    let reach = j.reach * 0.985;
+    let mut drop = 0.0f32;
+    for (k, foot) in feet.iter().enumerate() {
+        let hip = pose.joint_world(skeleton, j.legs[k][0]).0;
+        let d = hip - foot.ankle;
+        let h = Vec2::new(d.x, d.z).length().min(reach);
+        let vertical = (reach * reach - h * h).sqrt();
+        drop = drop.max(d.y - vertical);
+    }
+    pose.root.y -= drop.min(MAX_SINK);
+}
+
+/// The most the ankle is bent toes-up against the shin (rad; its limit is 20°).
+const MAX_DORSIFLEXION: f32 = 0.28;
+
+/// Puts a leg's ankle at `foot` (hip and knee by IK, knee toward the foot's heading) and turns
+/// the foot to its heading and pitch. Where the shin leans so far over the foot that the ankle
+/// would bend past [`MAX_DORSIFLEXION`], the heel rises instead: a planted foot rolls about the
+/// ball of the foot (which stays on the ground), a swinging one about its ankle.
+fn place_leg(skeleton: &Skeleton, leg: [usize; 3], foot: FootPose, pose: &mut Pose) {
+    let mut foot = foot;
+    for _ in 0..4 {
+        let dorsiflexion = set_leg(skeleton, leg, foot, pose);
+        let excess = dorsiflexion - MAX_DORSIFLEXION;
+        if excess < 1e-3 {
+            return;
+        }
+        let f = forward(foot.yaw);
+        let axis = Vec3::new(f.y, 0.0, -f.x);
+        let turn = Quat::from_axis_angle(axis, excess);
+        if foot.planted {
+            let orientation = Quat::from_rotation_y(foot.yaw) * Quat::from_rotation_x(-foot.pitch);
+            let ball = foot.ankle + orientation * Vec3::new(0.0, -ANKLE_HEIGHT, BALL_AHEAD);
+            foot.ankle = ball + turn * (foot.ankle - ball);
+        }
+        foot.pitch -= excess;
+    }
+}
+
+/// Sets one leg to `foot`; returns how far the ankle is bent toes-up against the shin (rad).
+fn set_leg(
+    skeleton: &Skeleton,
+    [hip, knee, ankle]: [usize; 3],
+    foot: FootPose,
+    pose: &mut Pose,
+) -> f32 {
+    let Some(frame) = LimbRoot::chain(skeleton, pose, hip) else {
+        return 0.0;
+    };
+    let f = forward(foot.yaw);
+    let pole = Vec3::new(f.x, 0.0, f.y);
+    if let Some((h, k)) = place_limb(
+        skeleton,
+        frame,
+        [hip, knee, ankle],
+        foot.ankle,
+        pole,
+        LEG_HINGE,
+    ) {
+        pose.rotations[hip] = h;
+        pose.rotations[knee] = k;
+    }
+    let shin = pose.joint_world(skeleton, knee).1;
+    let wanted = Quat::from_rotation_y(foot.yaw) * Quat::from_rotation_x(-foot.pitch);
+    let local = (shin.inverse() * wanted).normalize();
+    pose.rotations[ankle] = local;
+    // toes-up is a turn about −x
+    -local.to_euler(glam::EulerRot::XYZ).0
+}

@@ -1,0 +1,328 @@
+//! A walker's step, in the order its stages run: the walk under way drives the body (braking
+//! to a halt at its goal, a footstep walk's next velocity, a turn on the spot before setting
+//! off, or steering along the route among others) and marks its moments; then the body is kept
+//! out of other bodies and obstacles, turns to face its way of travel, attends to the one it
+//! asks or watches, and its feet step; the walk ends when the body stands, faces where it
+//! should and has its feet together.
+
+use glam::{Vec2, Vec3};
+
+use super::{
+    footstep_mode, turn_toward, Active, Moments, Others, Walker, HALT_DECELERATION, NEAR_ENOUGH,
+    REPLAN_EVERY, STEP, STOP_RADIUS, TURN_EASE, TURN_FIRST, TURN_ON_THE_SPOT, TURN_RATE,
+};
+use crate::world::locomotion::among::{neighbours, Near};
+use crate::world::locomotion::gait::{angle_diff, forward};
+use crate::world::locomotion::steering::{flat, Behaviour, Context};
+use crate::world::space::obstacles::Obstacles;
+use crate::world::space::path;
+
+impl Walker {
+    /// One step; the moments when the walk ends in it.
+    pub(super) fn step(
+        &mut self,
+        dt: f32,
+        obstacles: &Obstacles,
+        others: Option<Others<'_>>,
+    ) -> Option<Moments> {
+        let time = self.time;
+        if others.is_none() || self.active.as_ref().is_none_or(|a| a.stopped) {
+            self.asking = None;
+        }
+        // among others, who may press it behind an obstacle: once a second on the global grid
+        if others.is_some() && (time / STEP).round() as i64 % REPLAN_EVERY == 0 {
+            self.replan_if_lost(obstacles);
+        }
+        let facing_before = self.facing;
+        if let Some(mut a) = self.active.take() {
+            self.drive(&mut a, dt, obstacles, others);
+            self.active = Some(a);
+        }
+        self.keep_apart(dt, obstacles, others);
+        self.face_the_way(dt);
+        self.attend(dt, others);
+        self.step_the_feet(dt, facing_before)
+    }
+
+    /// The walk under way moves the body one step.
+    fn drive(
+        &mut self,
+        a: &mut Active,
+        dt: f32,
+        obstacles: &Obstacles,
+        others: Option<Others<'_>>,
+    ) {
+        let time = self.time;
+        let here = self.body().at;
+        let to_goal = a.walk.goal - here;
+        // the point sought now (not the route's first: one pushed past it and slowed down
+        // turned back to it on the spot)
+        let ahead = a.route_from(here);
+        let next = ahead.get(1).copied().unwrap_or(a.walk.goal);
+        let wanted = (next - here).normalize_or_zero();
+        let behind = wanted != Vec2::ZERO
+            && !a.walk.stepping
+            && angle_diff(wanted.x.atan2(wanted.y), self.facing).abs() > TURN_FIRST;
+        // arriving, the floor speed is braked away where the arrival would stop dead (a
+        // person does not stop from 0.12 m/s in a step; this takes about 0.1 s and 5 mm)
+        let speed = self.vehicle.speed();
+        let braking = speed * speed / (2.0 * HALT_DECELERATION);
+        // (held still within a hand of its goal, it has arrived: a walker 7 cm from its
+        // place, stopped for someone standing a metre beyond it, stood there for half a
+        // minute)
+        let held_near = speed < 0.05 && to_goal.length() < NEAR_ENOUGH;
+        if !a.halting && ((speed < 0.3 && to_goal.length() <= STOP_RADIUS + braking) || held_near) {
+            a.halting = ahead.len() <= 2;
+        }
+        if a.halting && !a.stopped {
+            self.brake(a, dt);
+        } else if !a.stopped {
+            let route = ahead;
+            // (a footstep walk keeps to no route: what is left is the way to the goal)
+            let left = match a.plan {
+                Some(_) => to_goal.length(),
+                None => path::length(&route),
+            };
+            if a.plan.is_some() {
+                self.follow_footsteps(a, dt, obstacles, others, here);
+            } else if behind && self.vehicle.speed() < 0.3 && to_goal.length() > 0.3 {
+                self.turn_first(a, wanted, dt);
+            } else {
+                self.steer(a, dt, obstacles, others, &route, left);
+            }
+            self.mark_moments(a, here, left);
+        }
+        if a.stopped {
+            // the feet close where the body stopped
+            self.gait.stop_at = None;
+            a.moments.ready.get_or_insert(time);
+            a.moments.relax.get_or_insert(time);
+            if let Some(p) = a.walk.face {
+                let d = p - here;
+                if d.length() > 1e-3 {
+                    turn_toward(&mut self.facing, d.x.atan2(d.y), TURN_ON_THE_SPOT * dt);
+                }
+            }
+        }
+    }
+
+    /// Halting: the body slows at a person's deceleration until it stands.
+    fn brake(&mut self, a: &mut Active, dt: f32) {
+        let v = self.vehicle.velocity;
+        let speed = flat(v).length();
+        let slower = (speed - HALT_DECELERATION * dt).max(0.0);
+        self.vehicle.velocity = if speed > 0.0 { v * (slower / speed) } else { v };
+        self.vehicle.position += self.vehicle.velocity * dt;
+        if slower == 0.0 {
+            a.stopped = true;
+        }
+    }
+
+    /// A footstep walk from `here`: the velocity its steps ask for, or standing when it has
+    /// closed its feet at the goal or no step leads anywhere better.
+    fn follow_footsteps(
+        &mut self,
+        a: &mut Active,
+        dt: f32,
+        obstacles: &Obstacles,
+        others: Option<Others<'_>>,
+        here: Vec2,
+    ) {
+        let time = self.time;
+        let to_goal = a.walk.goal - here;
+        let Some(plan) = a.plan.as_mut() else {
+            return;
+        };
+        let walkers: Vec<Vec2> = others
+            .map(|o| {
+                neighbours(o, time, here, 3.0)
+                    .iter()
+                    .map(|n| n.at)
+                    .collect()
+            })
+            .unwrap_or_default();
+        let place = others.map_or(footstep_mode::Place::default(), |o| footstep_mode::Place {
+            index: o.me.unwrap_or(0),
+            count: o.crowd.len(),
+        });
+        match plan.velocity(time, here, obstacles, &walkers, self.radius, place) {
+            Some(v) => {
+                // speeding up and braking as a person does
+                let now = Vec2::new(self.vehicle.velocity.x, self.vehicle.velocity.z);
+                let v = now + (v - now).clamp_length_max(footstep_mode::ACCELERATION * dt);
+                self.vehicle.velocity = Vec3::new(v.x, 0.0, v.y);
+                self.vehicle.position += self.vehicle.velocity * dt;
+            }
+            // arrived (the last step closed the feet) or stuck: it stands
+            None => {
+                if plan.stuck {
+                    self.stuck = Some(to_goal.length());
+                }
+                a.halting = true;
+                a.stopped = true;
+                self.vehicle.velocity = Vec3::ZERO;
+            }
+        }
+    }
+
+    /// The way is behind: it brakes and turns on the spot before setting off.
+    fn turn_first(&mut self, a: &mut Active, wanted: Vec2, dt: f32) {
+        let brake =
+            Behaviour::Stop.force(&mut self.vehicle, Context::default(), &mut a.steering.rng);
+        self.vehicle.step(brake.unwrap_or(Vec3::ZERO), dt);
+        turn_toward(
+            &mut self.facing,
+            wanted.x.atan2(wanted.y),
+            TURN_ON_THE_SPOT * dt,
+        );
+    }
+
+    /// Steering along the route (`left` metres of it), avoiding the others in a crowd; the walk
+    /// stops when its steering has nothing left to follow.
+    fn steer(
+        &mut self,
+        a: &mut Active,
+        dt: f32,
+        obstacles: &Obstacles,
+        others: Option<Others<'_>>,
+        route: &[Vec2],
+        left: f32,
+    ) {
+        let here = self.body().at;
+        let f = a.steering.force(
+            &mut self.vehicle,
+            Context {
+                obstacles: Some(obstacles),
+            },
+        );
+        let f = match others {
+            // (stepping aside for someone, it does not avoid them)
+            Some(o) if o.crowd.len() > 1 && !a.walk.stepping => {
+                let toward =
+                    (route.get(1).copied().unwrap_or(a.walk.goal) - here).normalize_or_zero();
+                let slowing = (left / a.slow_radius()).clamp(0.1, 1.0);
+                let near = Near {
+                    others: o,
+                    time: self.time,
+                    radius: self.radius,
+                    profile: &self.profile,
+                    obstacles,
+                };
+                let desired = toward * a.walk.speed * slowing;
+                near.steer(
+                    &mut self.avoider,
+                    (&mut self.chosen, &mut self.asking),
+                    &self.vehicle,
+                    self.facing,
+                    desired,
+                    a.walk.speed,
+                )
+                .unwrap_or(f)
+            }
+            _ => f,
+        };
+        self.vehicle.step(f, dt);
+        if a.steering.parts().iter().all(|p| {
+            !matches!(
+                p.behaviour,
+                Behaviour::FollowPoints { .. } | Behaviour::Stop
+            )
+        }) {
+            a.stopped = true;
+            self.vehicle.velocity = Vec3::ZERO;
+        }
+    }
+
+    /// The walk's moments: `ready` at cruising speed, `relax` where the final slowing begins
+    /// (`left` metres of the way from `here`, where the body was at the step's start), and
+    /// where the feet will stop.
+    fn mark_moments(&mut self, a: &mut Active, here: Vec2, left: f32) {
+        let time = self.time;
+        let speed = self.vehicle.speed();
+        if a.moments.ready.is_none() && speed >= 0.95 * a.walk.speed {
+            a.moments.ready = Some(time);
+        }
+        if a.moments.relax.is_none() && left < a.slow_radius() && speed > 0.0 {
+            a.moments.relax = Some(time);
+            a.moments.ready.get_or_insert(time);
+        }
+        if a.moments.relax.is_some() && a.plan.is_none() {
+            // where the body will stand: arrived, STOP_RADIUS short of the goal
+            let back = (a.walk.goal - here).normalize_or_zero() * STOP_RADIUS;
+            self.gait.stop_at = Some(a.walk.goal - back);
+        }
+    }
+
+    /// Never into another body, nor into an obstacle.
+    fn keep_apart(&mut self, dt: f32, obstacles: &Obstacles, others: Option<Others<'_>>) {
+        self.vehicle.position.y = 0.0;
+        self.vehicle.velocity.y = 0.0;
+        if let Some(o) = others {
+            let here = self.body().at;
+            // (bodies never pass through each other, seen or not)
+            let everyone = Others { known: None, ..o };
+            let near = neighbours(everyone, self.time, here, self.radius + 1.0);
+            let out = crate::world::crowd::contact::pushed_out(here, self.radius, near, dt);
+            self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
+        }
+        let here = self.body().at;
+        let out = obstacles.push_out(here, self.radius);
+        if out != here {
+            self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
+        }
+    }
+
+    /// Faces the way of travel, never walking backwards (unless stepping aside).
+    fn face_the_way(&mut self, dt: f32) {
+        let v = self.velocity();
+        let stepping = self.active.as_ref().is_some_and(|a| a.walk.stepping);
+        if v.length() > 0.05 && !stepping {
+            turn_toward(&mut self.facing, v.x.atan2(v.y), TURN_RATE * dt);
+            self.facing = self.gait.within_stance_twist(self.facing);
+            let f = forward(self.facing);
+            if v.dot(f) < 0.0 {
+                let keep = v - f * v.dot(f);
+                self.vehicle.velocity = Vec3::new(keep.x, 0.0, keep.y);
+            }
+        }
+    }
+
+    /// Attends to the one it asks for room or watches, or to one holding it back.
+    fn attend(&mut self, dt: f32, others: Option<Others<'_>>) {
+        let held = match self.asking.or(self.watching) {
+            Some(_) => None,
+            None => self.held_back_by(others),
+        };
+        let attended = self.asking.or(self.watching).or(held);
+        if let Some(p) = attended {
+            self.asked_at = p;
+        }
+        let attend = if attended.is_some() { 1.0 } else { 0.0 };
+        self.attention += (attend - self.attention) * (1.0 - (-dt / 0.25).exp());
+    }
+
+    /// The feet step under the body (which faced `facing_before` at the step's start); the
+    /// walk's moments when it ends here.
+    fn step_the_feet(&mut self, dt: f32, facing_before: f32) -> Option<Moments> {
+        let body = self.body();
+        // the rate the feet are turned ahead for, eased over a fifth of a second: when a turn on
+        // the spot ends, the swinging foot's landing heading eases back instead of jumping (it
+        // twisted the hip at 30 rad/s in one frame)
+        let turning = angle_diff(self.facing, facing_before) / dt;
+        self.gait.turn_rate += (turning - self.gait.turn_rate) * (1.0 - (-dt / TURN_EASE).exp());
+        self.gait.step(dt, body, self.velocity());
+        let a = self.active.as_mut()?;
+        let facing_done = a.walk.face.is_none_or(|p| {
+            let d = p - body.at;
+            d.length() < 1e-3 || angle_diff(d.x.atan2(d.y), self.facing).abs() < 0.03
+        });
+        if a.stopped && facing_done && self.gait.at_rest(body) {
+            a.moments.end = Some(self.time);
+            let ended = a.moments;
+            self.active = None;
+            self.gait.stop_at = None;
+            return Some(ended);
+        }
+        None
+    }
+}
