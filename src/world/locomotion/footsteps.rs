@@ -162,6 +162,10 @@ pub fn walking_net(goal: Vec2, arrive: f32, clear: f32, personal: f32) -> (Behav
     (BehaviourNet::new(nodes).expect("a well-formed net"), 6)
 }
 
+/// The node of [`walking_net`] that senses where the walk goes (what a walker following a route
+/// moves along it with [`BehaviourNet::aim`]).
+pub const GOAL_SENSOR: usize = 0;
+
 /// Chooses the next step from `feet` by sampling `samples` places of `fan` (at least its
 /// three lengths straight on; the turns thinned evenly when fewer than the whole fan): the
 /// least energy of `net`'s walk node `walk`, among places that keep `radius` from every

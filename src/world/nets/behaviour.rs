@@ -175,6 +175,18 @@ impl BehaviourNet {
         self.out.iter_mut().for_each(|o| *o = [0.0; 3]);
     }
 
+    /// Moves the fixed point that sensor node `i` senses to `at`; `false` (and nothing
+    /// changes) when node `i` is not a [`Sensor::Location`].
+    pub fn aim(&mut self, i: usize, at: Vec2) -> bool {
+        match self.nodes.get_mut(i) {
+            Some(Node::Sense(Sensor::Location(p))) => {
+                *p = at;
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// Its nodes.
     pub fn nodes(&self) -> &[Node] {
         &self.nodes

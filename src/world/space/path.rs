@@ -213,10 +213,65 @@ pub fn length(points: &[Vec2]) -> f32 {
     points.windows(2).map(|w| w[0].distance(w[1])).sum()
 }
 
+/// The point `ahead` metres further along `route` than the point of it nearest `at`, searching
+/// from segment `from` on (so that progress along the route never goes back), with the
+/// segment that point lies on: a carrot for a walker that follows the route loosely. The
+/// route's last point once less than `ahead` of it is left.
+pub fn carrot(route: &[Vec2], at: Vec2, from: usize, ahead: f32) -> (Vec2, usize) {
+    let Some(&last) = route.last() else {
+        return (at, 0);
+    };
+    if route.len() < 2 {
+        return (last, 0);
+    }
+    // the nearest point from segment `from` on
+    let first = from.min(route.len() - 2);
+    let (mut seg, mut along) = (first, 0.0f32);
+    let mut best = f32::INFINITY;
+    for i in first..route.len() - 1 {
+        let (d, q) = super::distance::point_segment(at, route[i], route[i + 1]);
+        if d < best {
+            (best, seg, along) = (d, i, q.distance(route[i]));
+        }
+    }
+    // then `ahead` on along the route
+    let mut left = ahead + along;
+    for i in seg..route.len() - 1 {
+        let length = route[i].distance(route[i + 1]);
+        if left <= length {
+            return (
+                route[i] + (route[i + 1] - route[i]).normalize_or_zero() * left,
+                seg,
+            );
+        }
+        left -= length;
+    }
+    (last, seg)
+}
+
 #[cfg(test)]
 mod tests {
-    use crate::world::space::{Obstacle, Shape};
     use super::*;
+    use crate::world::space::{Obstacle, Shape};
+
+    #[test]
+    fn the_carrot_runs_ahead_along_the_route_and_never_back() {
+        let route = [Vec2::ZERO, Vec2::new(0.0, 4.0), Vec2::new(3.0, 4.0)];
+        // beside the first leg: 1.5 m on from the nearest point
+        let (p, s) = carrot(&route, Vec2::new(0.5, 1.0), 0, 1.5);
+        assert!(p.distance(Vec2::new(0.0, 2.5)) < 1e-5, "{p}");
+        assert_eq!(s, 0);
+        // round the corner: 3 m from z = 3 is 1 m down the second leg
+        let (p, s) = carrot(&route, Vec2::new(0.0, 3.0), 0, 2.0);
+        assert!(p.distance(Vec2::new(1.0, 4.0)) < 1e-5, "{p}");
+        assert_eq!(s, 0);
+        // once on the second leg, a point nearer the first does not take it back
+        let (p, s) = carrot(&route, Vec2::new(0.0, 1.0), 1, 1.0);
+        assert!(p.distance(Vec2::new(1.0, 4.0)) < 1e-5, "{p}");
+        assert_eq!(s, 1);
+        // near the end: the end
+        assert_eq!(carrot(&route, Vec2::new(2.9, 4.0), 1, 1.0).0, route[2]);
+    }
 
     fn seg(a: (f32, f32), b: (f32, f32)) -> Obstacle {
         Obstacle {

@@ -14,7 +14,7 @@ use glam::Vec2;
 use crate::world::locomotion::footsteps::{self, Fan, Feet, Footstep};
 use crate::world::locomotion::gait;
 use crate::world::nets::behaviour::{BehaviourNet, Surroundings};
-use crate::world::space::Obstacles;
+use crate::world::space::{path, Obstacles};
 
 /// Samples the walkers of a crowd may take together in one 60 Hz frame.
 pub const BUDGET: usize = 1500;
@@ -37,6 +37,10 @@ pub const ACCELERATION: f32 = 2.5;
 /// Most turn of one step (rad).
 pub const MAX_TURN: f32 = 0.8;
 
+/// Where a walk whose route bends round obstacles aims: this far (m) along the route ahead of
+/// the body, so that it starts turning before a corner and spreads the turn over steps.
+pub const LOOKAHEAD: f32 = 2.0;
+
 /// A footstep walk under way.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct Plan {
@@ -45,6 +49,10 @@ pub(super) struct Plan {
     walk_node: usize,
     fan: Fan,
     goal: Vec2,
+    /// The route round the obstacles (planned at the first step) and the segment of it the
+    /// body has reached.
+    route: Option<Vec<Vec2>>,
+    progress: usize,
     /// Where the body is headed now, its heading there, and when it gets there.
     next: Option<(Vec2, f32, f64)>,
     /// Where the body stood after the last step, and its heading.
@@ -89,6 +97,8 @@ impl Plan {
             walk_node,
             fan: Fan::new(step, MAX_TURN, 9),
             goal,
+            route: None,
+            progress: 0,
             next: None,
             last: (body, facing),
             step_time: 60.0 / gait::cadence(speed, running) as f64,
@@ -161,6 +171,7 @@ impl Plan {
     /// The next step: the least energy of the fan, if it is less than standing where the
     /// last step left the body.
     fn choose(&mut self, obstacles: &Obstacles, walkers: &[Vec2], radius: f32) -> Option<Footstep> {
+        self.aim(obstacles, radius);
         let here = Surroundings {
             at: self.last.0,
             heading: self.last.1,
@@ -177,6 +188,22 @@ impl Plan {
             &here,
             radius,
         )
+    }
+
+    /// Points the net's goal sensor where the walk goes next: along a route that bends round
+    /// obstacles, [`LOOKAHEAD`] ahead on it until the body has passed its last bend; else the
+    /// goal itself. (Aimed at the goal across a wall, the walk slid along the wall and swung
+    /// round its end in one step.) A goal no route reaches is aimed at straight, as before.
+    fn aim(&mut self, obstacles: &Obstacles, radius: f32) {
+        let (from, goal) = (self.last.0, self.goal);
+        let route = self.route.get_or_insert_with(|| {
+            path::plan(obstacles, from, goal, radius + CLEAR).unwrap_or_else(|_| vec![from, goal])
+        });
+        let (carrot, segment) = path::carrot(route, from, self.progress, LOOKAHEAD);
+        self.progress = segment;
+        let bends_ahead = segment + 2 < route.len();
+        let at = if bends_ahead { carrot } else { goal };
+        self.net.aim(footsteps::GOAL_SENSOR, at);
     }
 }
 
