@@ -7,6 +7,7 @@ mod feet;
 
 use bml_realizer::language::feedback::Feedback;
 use bml_realizer::realizer::Realizer;
+use bml_realizer::world::crowd::quality::sideways_reversals;
 use bml_realizer::world::World;
 use feet::Slides;
 use glam::Vec2;
@@ -52,18 +53,7 @@ fn reversals(roots: &[Vec2]) -> usize {
     let smooth: Vec<Vec2> = (w..roots.len().saturating_sub(w))
         .map(|k| roots[k - w..k + w].iter().copied().sum::<Vec2>() / (2 * w) as f32)
         .collect();
-    let (mut sign, mut count) = (0.0f32, 0);
-    for p in smooth.windows(2) {
-        let v = (p[1] - p[0]).dot(across) * 60.0;
-        if v.abs() < 0.05 {
-            continue;
-        }
-        if sign != 0.0 && v.signum() != sign {
-            count += 1;
-        }
-        sign = v.signum();
-    }
-    count
+    sideways_reversals(&smooth, across, 0.05 / 60.0)
 }
 
 #[test]

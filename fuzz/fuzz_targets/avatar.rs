@@ -5,7 +5,7 @@
 #![no_main]
 
 use bml_realizer::avatar::{Model, Retarget};
-use bml_realizer::body::{Pose, Skeleton};
+use bml_realizer::character::body::{Pose, Skeleton};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -4,8 +4,8 @@
 //! must be written back by `Frame::encode` and read again as the same frame.
 #![no_main]
 
-use bml_realizer::broker::ipaaca::{iu, Ipaaca};
-use bml_realizer::broker::stomp::frame::{Decoded, Decoder};
+use bml_realizer::ports::broker::ipaaca::{iu, Ipaaca};
+use bml_realizer::ports::broker::stomp::frame::{Decoded, Decoder};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -4,7 +4,7 @@
 //! that loads must only hold definitions that validate, and nets that load must step.
 #![no_main]
 
-use bml_realizer::dynamics::compound::CompoundLibrary;
+use bml_realizer::character::dynamics::compound::CompoundLibrary;
 use bml_realizer::world::World;
 use libfuzzer_sys::fuzz_target;
 
@@ -25,10 +25,10 @@ fuzz_target!(|data: &[u8]| {
             }
         }
     }
-    if let Ok(nets) = bml_realizer::nets::file::read(text, &Default::default()) {
-        let mut nets = bml_realizer::nets::Nets::new(nets, Default::default());
+    if let Ok(nets) = bml_realizer::world::nets::file::read(text, &Default::default()) {
+        let mut nets = bml_realizer::world::nets::Nets::new(nets, Default::default());
         struct Nothing;
-        impl bml_realizer::nets::Senses for Nothing {
+        impl bml_realizer::world::nets::Senses for Nothing {
             fn sees(&self, _: &str, _: &str) -> bool {
                 false
             }

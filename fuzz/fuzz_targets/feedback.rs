@@ -2,7 +2,7 @@
 //! must round-trip through both encoders.
 #![no_main]
 
-use bml_realizer::feedback::{self, Format};
+use bml_realizer::language::feedback::{self, Format};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -2,7 +2,7 @@
 //! write → parse round trip unchanged.
 #![no_main]
 
-use bml_realizer::bml;
+use bml_realizer::language::bml;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -3,9 +3,9 @@
 //! each behaviour's sync order and place nothing before the block start.
 #![no_main]
 
-use bml_realizer::bml::{self, Anchor, Relation, SyncPoint};
-use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy, SortedGreedy};
-use bml_realizer::timing::DefaultTimingModels;
+use bml_realizer::language::bml::{self, Anchor, Relation, SyncPoint};
+use bml_realizer::planning::schedule::{NoExternal, Optimal, SchedulingStrategy, SortedGreedy};
+use bml_realizer::planning::timing::DefaultTimingModels;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -5,9 +5,9 @@
 //! the limits must be refused by a limit, not by running out of stack or time.
 #![no_main]
 
-use bml_realizer::bml::{self, BlockStream, Code};
-use bml_realizer::schedule::{NoExternal, Optimal, SchedulingStrategy};
-use bml_realizer::timing::DefaultTimingModels;
+use bml_realizer::language::bml::{self, BlockStream, Code};
+use bml_realizer::planning::schedule::{NoExternal, Optimal, SchedulingStrategy};
+use bml_realizer::planning::timing::DefaultTimingModels;
 use libfuzzer_sys::arbitrary::Unstructured;
 use libfuzzer_sys::fuzz_target;
 

@@ -26,7 +26,6 @@ use crate::engines::interface::{
 use crate::engines::motion::min_jerk;
 use crate::engines::procedural::perlin;
 use crate::language::bml::{Behaviour, BehaviourKind};
-use crate::planning::timing::TimingModel;
 use crate::world::World;
 
 /// Parameter names and defaults.
@@ -81,19 +80,7 @@ pub struct NoiseEngine {
 }
 
 impl Engine for NoiseEngine {
-    crate::units_remove!();
-    crate::units_retime_len!();
-    crate::units_play!("noise");
-    crate::units_interrupt!(crate::engines::interface::stop_now);
-
-    fn name(&self) -> &'static str {
-        "noise"
-    }
-
-    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        // persistent: it runs until it is ended or replaced
-        matches!(behaviour.kind, BehaviourKind::Noise(_)).then(TimingModel::persistent_span)
-    }
+    crate::units_persistent!("noise", Noise);
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         let BehaviourKind::Noise(n) = &unit.behaviour.kind else {

@@ -25,6 +25,11 @@
 //! (longer from far away), along a Hermite curve that starts with the pose and the speed it had.
 //! The engine registers last: it steps the simulation up to each frame with the kinematic pose
 //! the others made (interpolated between frames) and writes the simulated joints over it.
+//!
+//!
+//! Longer than 600 lines on purpose: the controller catalogue, the choice of configuration, the
+//! warnings and the run loop all work on the running controllers and the one simulation; the
+//! hand-back to the kinematic pose, which stands alone, is `physical/release.rs`.
 
 use glam::{DVec3, Quat};
 
@@ -42,8 +47,8 @@ use crate::engines::interface::{
     Unit, UnitKey, Units,
 };
 use crate::language::bml::{Behaviour, BehaviourKind};
-use crate::planning::timing::TimingModel;
 use crate::world::World;
+use release::{Offset, Release};
 
 /// The lower body and the trunk (parts of `dynamics::humanoid::PARTS`).
 pub const LOWER_BODY: [usize; 8] = [0, 1, 9, 10, 11, 12, 13, 14];
@@ -116,17 +121,6 @@ impl Catalogue {
 /// warns that the simulation hides it (the idle layer's weight shift stays below: it bends the
 /// knee of the leg it unloads by up to about 8°, 0.14 rad, to keep both feet on the floor).
 const HIDDEN: f32 = 0.2;
-
-/// The shortest hand-back to the kinematic pose when the last controller ends (s); a body far
-/// from that pose takes longer, so that the way back keeps under [`RELEASE_SPEED`].
-const RELEASE: f64 = 0.3;
-
-/// The peak speeds of the way back: of the root (m/s) and of any joint (rad/s).
-const RELEASE_SPEED: (f64, f64) = (1.0, 3.0);
-
-/// How far past where it was handed back the way back may carry the body on, as a share of
-/// its distance from the kinematic pose (see `overshoot_capped`).
-const RELEASE_OVERSHOOT: f64 = 0.15;
 
 /// The classes and their parameters (defaults).
 const CLASSES: &[(&str, &[(&str, f64)])] = &[
@@ -452,126 +446,6 @@ impl PhysicalEngine {
     }
 }
 
-/// How far a pose is from the kinematic one at a moment: the root's displacement and each
-/// joint's turn (rotation vectors, kinematic⁻¹ · pose).
-#[derive(Debug, Clone)]
-struct Offset {
-    time: f64,
-    root: glam::Vec3,
-    turns: Vec<glam::Vec3>,
-}
-
-impl Offset {
-    fn between(time: f64, kinematic: &Pose, pose: &Pose) -> Offset {
-        let turns = (kinematic.rotations.iter().zip(&pose.rotations))
-            .map(|(k, p)| {
-                let d = k.inverse() * *p;
-                if d.w < 0.0 { -d } else { d }.to_scaled_axis()
-            })
-            .collect();
-        Offset {
-            time,
-            root: pose.root - kinematic.root,
-            turns,
-        }
-    }
-}
-
-/// The way back from the simulated pose to the kinematic one: the offset eases to nothing along
-/// a cubic Hermite curve, starting at the last simulated offset with its rate of change, so the
-/// body keeps its pose and its speed at the hand-over. It lasts [`RELEASE`] seconds, or longer
-/// for a large offset: the curve's peak rate is 1.5 times the offset over the duration, kept
-/// under [`RELEASE_SPEED`] (a body lying on the floor takes about 1.3 s to stand again).
-#[derive(Debug, Clone)]
-struct Release {
-    from: Offset,
-    /// How long it takes (s).
-    duration: f64,
-    /// The offset's rate of change (per second) at the hand-over.
-    rate: Offset,
-}
-
-impl Release {
-    fn new(last: &Offset, before: Option<&Offset>) -> Release {
-        let dt = before.map_or(0.0, |b| last.time - b.time);
-        let rate = |a: glam::Vec3, b: glam::Vec3| {
-            if dt > 0.0 {
-                (a - b) / dt as f32
-            } else {
-                glam::Vec3::ZERO
-            }
-        };
-        let rate = match before {
-            Some(b) if dt > 0.0 => Offset {
-                time: last.time,
-                root: rate(last.root, b.root),
-                turns: (last.turns.iter().zip(&b.turns))
-                    .map(|(a, b)| rate(*a, *b))
-                    .collect(),
-            },
-            _ => Offset {
-                time: last.time,
-                root: glam::Vec3::ZERO,
-                turns: vec![glam::Vec3::ZERO; last.turns.len()],
-            },
-        };
-        let turn = last
-            .turns
-            .iter()
-            .map(|t| f64::from(t.length()))
-            .fold(0.0, f64::max);
-        let duration = RELEASE
-            .max(1.5 * f64::from(last.root.length()) / RELEASE_SPEED.0)
-            .max(1.5 * turn / RELEASE_SPEED.1);
-        let mut rate = rate;
-        rate.root = overshoot_capped(last.root, rate.root, duration, 0.05);
-        for (r, t) in rate.turns.iter_mut().zip(&last.turns) {
-            *r = overshoot_capped(*t, *r, duration, 0.1);
-        }
-        Release {
-            from: last.clone(),
-            duration,
-            rate,
-        }
-    }
-
-    /// Puts the eased offset on `pose` (the kinematic pose) at `now`; false once it is over.
-    fn apply(&self, now: f64, pose: &mut Pose) -> bool {
-        let s = ((now - self.from.time) / self.duration).clamp(0.0, 1.0);
-        if s >= 1.0 {
-            return false;
-        }
-        // cubic Hermite weights of the start value and the start tangent (the end is zero)
-        let h00 = (2.0 * s * s * s - 3.0 * s * s + 1.0) as f32;
-        let h10 = ((s * s * s - 2.0 * s * s + s) * self.duration) as f32;
-        pose.root += self.from.root * h00 + self.rate.root * h10;
-        for (q, (r, dr)) in pose
-            .rotations
-            .iter_mut()
-            .zip(self.from.turns.iter().zip(&self.rate.turns))
-        {
-            *q = (*q * Quat::from_scaled_axis(*r * h00 + *dr * h10)).normalize();
-        }
-        true
-    }
-}
-
-/// The start rate of a way back from `offset` over `duration`, scaled down so that the curve
-/// goes on past the offset by at most [`RELEASE_OVERSHOOT`] of it, or `least` (m or rad) if
-/// that is more (a body handed back early keeps its speed): a body handed back while it
-/// falls fast would otherwise keep falling, into the floor (from a 3 m/s fall the pelvis went
-/// 0.45 m under it). The Hermite tangent weight peaks at 4/27 (a third of the way).
-fn overshoot_capped(offset: glam::Vec3, rate: glam::Vec3, duration: f64, least: f64) -> glam::Vec3 {
-    let away = rate.dot(offset).max(0.0) / offset.length().max(1e-6);
-    let overshoot = f64::from(away) * duration * 4.0 / 27.0;
-    let allowed = (RELEASE_OVERSHOOT * f64::from(offset.length())).max(least);
-    if overshoot > allowed {
-        rate * (allowed / overshoot) as f32
-    } else {
-        rate
-    }
-}
-
 /// Whether `name` is one of the built-in controller classes (`BalanceController`, …), which a
 /// compound definition may not take.
 pub fn is_built_in_class(name: &str) -> bool {
@@ -593,19 +467,7 @@ fn blend(a: &Pose, b: &Pose, w: f32) -> Pose {
 }
 
 impl Engine for PhysicalEngine {
-    crate::units_remove!();
-    crate::units_retime_len!();
-    crate::units_play!("physical");
-    crate::units_interrupt!(crate::engines::interface::stop_now);
-
-    fn name(&self) -> &'static str {
-        "physical"
-    }
-
-    fn timing(&self, behaviour: &Behaviour) -> Option<TimingModel> {
-        // persistent: it runs until it is ended or replaced
-        matches!(behaviour.kind, BehaviourKind::Controller(_)).then(TimingModel::persistent_span)
-    }
+    crate::units_persistent!("physical", Controller);
 
     fn add(&mut self, unit: Unit<'_>) -> Result<(), EngineError> {
         let BehaviourKind::Controller(c) = &unit.behaviour.kind else {
@@ -779,6 +641,8 @@ impl crate::engines::interface::Physics for PhysicalEngine {
         })
     }
 }
+
+mod release;
 
 #[cfg(test)]
 mod tests;

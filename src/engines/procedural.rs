@@ -40,6 +40,11 @@
 //! The [`ProceduralEngine`] realizes BMLT `procanimation` and `procanimationgesture` with units of
 //! its library (by `name`, or by the stem of `fileName`), `<bmlt:parameter>` children overriding
 //! the defaults; every parameter can change while the unit runs (`parametervaluechange`).
+//!
+//!
+//! Longer than 600 lines on purpose: the library's file form, the unit built from it, its
+//! evaluation each frame and the engine's parameters share the unit type and its expressions;
+//! the expression language itself is `engines::expr`.
 
 use std::collections::HashMap;
 use std::sync::Arc;

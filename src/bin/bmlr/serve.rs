@@ -124,166 +124,123 @@ pub struct ServeArgs {
 
 /// `bmlr serve --stdio` (runs until stdin closes and nothing more is scheduled) or `--tcp`.
 pub fn serve(args: ServeArgs) -> ExitCode {
-    if !(args.fps.is_finite() && args.fps > 0.0) {
-        eprintln!("bmlr serve: --fps must be a positive number");
-        return ExitCode::from(2);
-    }
-    if (args.queue_limit).is_some_and(|n| !(1..=crate::brokered::MAX_QUEUE_LIMIT).contains(&n)) {
-        eprintln!(
-            "bmlr serve: --queue-limit must be from 1 to {}",
-            crate::brokered::MAX_QUEUE_LIMIT
-        );
-        return ExitCode::from(2);
-    }
-    // (clap's `requires` is not checked beside the port group: said here)
-    let brokered = args.mqtt.is_some() || args.stomp.is_some();
-    let misplaced = [
-        (
-            "--prefix",
-            args.prefix.is_some(),
-            brokered,
-            "--mqtt or --stomp",
-        ),
-        ("--name", args.name.is_some(), brokered, "--mqtt or --stomp"),
-        (
-            "--characters",
-            !args.characters.is_empty(),
-            brokered,
-            "--mqtt or --stomp",
-        ),
-        (
-            "--format",
-            args.format.is_some(),
-            brokered,
-            "--mqtt or --stomp",
-        ),
-        (
-            "--queue-limit",
-            args.queue_limit.is_some(),
-            brokered,
-            "--mqtt or --stomp",
-        ),
-        ("--cell", args.cell.is_some(), brokered, "--mqtt or --stomp"),
-        (
-            "--until",
-            args.until.is_some(),
-            brokered,
-            "--mqtt or --stomp",
-        ),
-        (
-            "--ipaaca",
-            !args.ipaaca.is_empty(),
-            args.mqtt.is_some(),
-            "--mqtt",
-        ),
-        (
-            "--flavour",
-            args.flavour.is_some(),
-            args.stomp.is_some(),
-            "--stomp",
-        ),
-        (
-            "--topics",
-            !args.topics.is_empty(),
-            args.stomp.is_some(),
-            "--stomp",
-        ),
-        ("--view", args.view.is_some(), args.tcp.is_some(), "--tcp"),
-        ("--per-client", args.per_client, args.tcp.is_some(), "--tcp"),
-    ];
-    if let Some((flag, _, _, port)) = misplaced.iter().find(|m| m.1 && !m.2) {
-        eprintln!("bmlr serve: {flag} goes with {port}");
-        return ExitCode::from(2);
-    }
-    let voice = match args.tts.timing(None) {
-        Ok(t) => t,
-        Err(e) => {
-            eprintln!("bmlr serve: --tts: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let speech = SpeechTiming {
-        retimable: args.retimable_speech,
-        ..voice
-    };
-    let assets = match args.assets.as_deref().map(Assets::from_dir).transpose() {
-        Ok(a) => a.unwrap_or_default(),
-        Err(e) => {
-            eprintln!("bmlr serve: --assets {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let realizer = Realizer::new()
-        .with_engines(move || registry_with(DefaultTimingModels { speech }, &assets))
-        .with_posix_time(true)
-        .with_idle(!args.no_idle)
-        .with_limits(args.limits.limits());
-    let realizer = match crate::setup::with_world(realizer, args.world.as_deref()) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("bmlr serve: --world {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let realizer =
-        match crate::setup::with_sight_and_nets(realizer, args.perception, args.nets.as_deref()) {
-            Ok(r) => r,
-            Err(e) => {
-                eprintln!("bmlr serve: {e}");
-                return ExitCode::from(2);
-            }
-        };
-    if args.avatar.avatar.is_some() && args.view.is_none() {
-        eprintln!("bmlr serve: --avatar shows the characters in the live view; give --view too");
-        return ExitCode::from(2);
-    }
-    let avatars = match (args.view.is_some())
-        .then(|| (args.avatar).load(realizer.world(), args.world.as_deref()))
-        .transpose()
-    {
-        Ok(a) => a,
+    match start(&args) {
+        Ok(code) => code,
         Err(e) => {
             eprintln!("bmlr serve: {e}");
-            return ExitCode::from(2);
+            ExitCode::from(2)
         }
-    };
+    }
+}
+
+/// Checks the flags, makes the realizer and serves it on the port asked for; an `Err` is a
+/// sentence about the flag at fault (exit code 2).
+fn start(args: &ServeArgs) -> Result<ExitCode, String> {
+    check_flags(args)?;
+    let realizer = realizer(args)?;
+    if args.avatar.avatar.is_some() && args.view.is_none() {
+        return Err("--avatar shows the characters in the live view; give --view too".into());
+    }
+    let avatars = (args.view.is_some())
+        .then(|| (args.avatar).load(realizer.world(), args.world.as_deref()))
+        .transpose()?;
     if let Some(addr) = &args.tcp {
         let view = match (args.view.as_deref())
             .zip(avatars.as_ref())
             .map(|(v, a)| crate::live::LiveView::start(v, realizer.world(), a))
         {
-            Some(Err(e)) => {
-                eprintln!("bmlr serve: --view {e}");
-                return ExitCode::from(2);
-            }
+            Some(Err(e)) => return Err(format!("--view {e}")),
             view => view.and_then(Result::ok),
         };
-        let frames = match live_frames(&args, &realizer) {
-            Ok(f) => f,
-            Err(e) => {
-                eprintln!("bmlr serve: --frames {e}");
-                return ExitCode::from(2);
-            }
-        };
-        return crate::tcp::serve(addr, args.per_client, args.fps, realizer, view, frames);
+        let frames = live_frames(args, &realizer).map_err(|e| format!("--frames {e}"))?;
+        return Ok(crate::tcp::serve(
+            addr,
+            args.per_client,
+            args.fps,
+            realizer,
+            view,
+            frames,
+        ));
     }
     if args.mqtt.is_some() || args.stomp.is_some() {
-        return match crate::serve_broker::brokered(&args, &realizer) {
-            Ok(m) => crate::brokered::serve(m, realizer),
-            Err(e) => {
-                eprintln!("bmlr serve: {e}");
-                ExitCode::from(2)
-            }
-        };
+        let m = crate::serve_broker::brokered(args, &realizer)?;
+        return Ok(crate::brokered::serve(m, realizer));
     }
-    let frames = match live_frames(&args, &realizer) {
-        Ok(f) => f,
-        Err(e) => {
-            eprintln!("bmlr serve: --frames {e}");
-            return ExitCode::from(2);
-        }
+    let frames = live_frames(args, &realizer).map_err(|e| format!("--frames {e}"))?;
+    Ok(serve_stdio(
+        realizer,
+        Duration::from_secs_f64(1.0 / args.fps),
+        frames,
+    ))
+}
+
+/// The flags' values and combinations clap does not check.
+fn check_flags(args: &ServeArgs) -> Result<(), String> {
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        return Err("--fps must be a positive number".into());
+    }
+    if (args.queue_limit).is_some_and(|n| !(1..=crate::brokered::MAX_QUEUE_LIMIT).contains(&n)) {
+        return Err(format!(
+            "--queue-limit must be from 1 to {}",
+            crate::brokered::MAX_QUEUE_LIMIT
+        ));
+    }
+    // (clap's `requires` is not checked beside the port group: said here)
+    let brokered = args.mqtt.is_some() || args.stomp.is_some();
+    let (mqtt, stomp, tcp) = (
+        args.mqtt.is_some(),
+        args.stomp.is_some(),
+        args.tcp.is_some(),
+    );
+    let either = "--mqtt or --stomp";
+    let misplaced = [
+        ("--prefix", args.prefix.is_some(), brokered, either),
+        ("--name", args.name.is_some(), brokered, either),
+        (
+            "--characters",
+            !args.characters.is_empty(),
+            brokered,
+            either,
+        ),
+        ("--format", args.format.is_some(), brokered, either),
+        (
+            "--queue-limit",
+            args.queue_limit.is_some(),
+            brokered,
+            either,
+        ),
+        ("--cell", args.cell.is_some(), brokered, either),
+        ("--until", args.until.is_some(), brokered, either),
+        ("--ipaaca", !args.ipaaca.is_empty(), mqtt, "--mqtt"),
+        ("--flavour", args.flavour.is_some(), stomp, "--stomp"),
+        ("--topics", !args.topics.is_empty(), stomp, "--stomp"),
+        ("--view", args.view.is_some(), tcp, "--tcp"),
+        ("--per-client", args.per_client, tcp, "--tcp"),
+    ];
+    match misplaced.iter().find(|m| m.1 && !m.2) {
+        Some((flag, _, _, port)) => Err(format!("{flag} goes with {port}")),
+        None => Ok(()),
+    }
+}
+
+/// The realizer the flags describe: its voice, motion data, world, sight and nets.
+fn realizer(args: &ServeArgs) -> Result<Realizer, String> {
+    let voice = args.tts.timing(None).map_err(|e| format!("--tts: {e}"))?;
+    let speech = SpeechTiming {
+        retimable: args.retimable_speech,
+        ..voice
     };
-    serve_stdio(realizer, Duration::from_secs_f64(1.0 / args.fps), frames)
+    let assets = (args.assets.as_deref().map(Assets::from_dir).transpose())
+        .map_err(|e| format!("--assets {e}"))?
+        .unwrap_or_default();
+    let realizer = Realizer::new()
+        .with_engines(move || registry_with(DefaultTimingModels { speech }, &assets))
+        .with_posix_time(true)
+        .with_idle(!args.no_idle)
+        .with_limits(args.limits.limits());
+    let realizer = crate::setup::with_world(realizer, args.world.as_deref())
+        .map_err(|e| format!("--world {e}"))?;
+    crate::setup::with_sight_and_nets(realizer, args.perception, args.nets.as_deref())
 }
 
 /// The frames file asked for, started.
@@ -333,28 +290,7 @@ fn serve_stdio(
     if let Some(f) = frames.as_mut() {
         f.start_clock(Some(crate::live_frames::posix_zero(&clock)));
     }
-    // bounded: the reader waits while the realizer is behind, and the pipe fills (backpressure)
-    let (tx, rx) = mpsc::sync_channel::<Option<Line>>(256);
-    let limits = *realizer.limits();
-    std::thread::spawn(move || {
-        // a line that is not UTF-8 or too long costs only itself
-        for line in bml_realizer::language::bml::lines(std::io::stdin().lock(), limits.block_bytes)
-        {
-            let item = match line {
-                Ok(text) if text.trim().is_empty() => continue,
-                // a live port has no use for clock advances: time passes by itself
-                Ok(text) if bml_realizer::language::bml::advance(text.trim()).is_some() => continue,
-                // a stream message (`Realizer::stream_message`): a JSON object
-                Ok(text) if text.trim_start().starts_with('{') => Line::Stream(text),
-                Ok(text) => Line::Block(Box::new(Checked::new(&text, &limits))),
-                Err(bad) => Line::Bad(bad),
-            };
-            if tx.send(Some(item)).is_err() {
-                return;
-            }
-        }
-        let _ = tx.send(None);
-    });
+    let rx = read_stdin(*realizer.limits());
     let mut out = std::io::stdout().lock();
     let mut write = |feedback: Vec<Feedback>| -> bool {
         feedback
@@ -375,23 +311,7 @@ fn serve_stdio(
     }
     let mut open = true;
     let code = 'serve: loop {
-        let mut items = Vec::new();
-        if open {
-            match rx.recv_timeout(period) {
-                Ok(Some(item)) => items.push(item),
-                Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => open = false,
-                Err(mpsc::RecvTimeoutError::Timeout) => {}
-            }
-            // and whatever else has arrived
-            for more in rx.try_iter() {
-                match more {
-                    Some(item) => items.push(item),
-                    None => open = false,
-                }
-            }
-        } else {
-            std::thread::sleep(period);
-        }
+        let items = arrived(&rx, period, &mut open);
         // bring the clock up to date before blocks arrive (they are planned at this time)
         let mut feedback = tick(&mut realizer, &mut frames);
         let mut frame_start = clock.now();
@@ -430,4 +350,53 @@ fn serve_stdio(
         }
         _ => code,
     }
+}
+
+/// A thread reading standard input line by line into what [`serve_stdio`] serves; `None` at
+/// its end. The channel is bounded: the reader waits while the realizer is behind, and the pipe
+/// fills (backpressure).
+fn read_stdin(limits: bml_realizer::language::bml::Limits) -> mpsc::Receiver<Option<Line>> {
+    let (tx, rx) = mpsc::sync_channel::<Option<Line>>(256);
+    std::thread::spawn(move || {
+        // a line that is not UTF-8 or too long costs only itself
+        for line in bml_realizer::language::bml::lines(std::io::stdin().lock(), limits.block_bytes)
+        {
+            let item = match line {
+                Ok(text) if text.trim().is_empty() => continue,
+                // a live port has no use for clock advances: time passes by itself
+                Ok(text) if bml_realizer::language::bml::advance(text.trim()).is_some() => continue,
+                // a stream message (`Realizer::stream_message`): a JSON object
+                Ok(text) if text.trim_start().starts_with('{') => Line::Stream(text),
+                Ok(text) => Line::Block(Box::new(Checked::new(&text, &limits))),
+                Err(bad) => Line::Bad(bad),
+            };
+            if tx.send(Some(item)).is_err() {
+                return;
+            }
+        }
+        let _ = tx.send(None);
+    });
+    rx
+}
+
+/// What has arrived within `period` (waiting for the first line at most that long), and
+/// whatever else is there; `open` turns false at the input's end, after which it only waits.
+fn arrived(rx: &mpsc::Receiver<Option<Line>>, period: Duration, open: &mut bool) -> Vec<Line> {
+    let mut items = Vec::new();
+    if !*open {
+        std::thread::sleep(period);
+        return items;
+    }
+    match rx.recv_timeout(period) {
+        Ok(Some(item)) => items.push(item),
+        Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => *open = false,
+        Err(mpsc::RecvTimeoutError::Timeout) => {}
+    }
+    for more in rx.try_iter() {
+        match more {
+            Some(item) => items.push(item),
+            None => *open = false,
+        }
+    }
+    items
 }

@@ -42,7 +42,7 @@ fn points_at(joint: &str) -> Option<String> {
 
 /// How one node turns each frame.
 #[derive(Debug, Clone, Copy)]
-pub(super) enum Drive {
+pub(super) enum NodeMotion {
     /// It keeps its rest rotation relative to its parent.
     Rest,
     /// It follows a realizer joint: its local rotation is `before · Π steps · after`, where
@@ -70,7 +70,7 @@ pub struct Retarget {
     /// Per node, its rest scale, rotation and translation relative to its parent.
     rest: Vec<(Vec3, Quat, Vec3)>,
     /// Per node, how it turns.
-    drives: Vec<Drive>,
+    drives: Vec<NodeMotion>,
     /// The realizer joints (and whether inverted) the followers' rotations are made of.
     steps: Vec<(usize, bool)>,
     /// The realizer's frame in the avatar's: realizer x (left), y (up), z (forward).
@@ -218,9 +218,9 @@ impl Retarget {
             frame,
             steps: Vec::new(),
         };
-        let mut drives: Vec<Drive> = (0..n).map(|i| plan.follow(i)).collect();
+        let mut drives: Vec<NodeMotion> = (0..n).map(|i| plan.follow(i)).collect();
         for (i, bone) in twist::bones(model, skeleton, &source, &pre, &rest.positions, &world) {
-            drives[i] = Drive::Twist(bone);
+            drives[i] = NodeMotion::Twist(bone);
         }
         Ok(Retarget {
             steps: plan.steps,
@@ -275,8 +275,8 @@ impl Retarget {
         // its joint and its nearest following ancestor's (no world rotations needed)
         for (rotation, drive) in rotations.iter_mut().zip(&self.drives) {
             match *drive {
-                Drive::Rest => {}
-                Drive::Follow {
+                NodeMotion::Rest => {}
+                NodeMotion::Follow {
                     before,
                     from,
                     to,
@@ -292,7 +292,7 @@ impl Retarget {
                     }
                     *rotation = (q * after).normalize();
                 }
-                Drive::Twist(TwistBone {
+                NodeMotion::Twist(TwistBone {
                     joint,
                     about,
                     axis,
@@ -351,7 +351,7 @@ impl Retarget {
 
     /// Whether node `i` turns with the realizer's motion (follows a joint or is a twist bone).
     pub fn moves(&self, i: usize) -> bool {
-        !matches!(self.drives.get(i), None | Some(Drive::Rest))
+        !matches!(self.drives.get(i), None | Some(NodeMotion::Rest))
     }
 
     /// The realizer's frame in the avatar's (its x, y, z: left, up, forward).
@@ -385,9 +385,9 @@ impl Plan<'_> {
     /// its parent, whose world rotation is its nearest following ancestor's times the rest
     /// rotations between them. Joint world rotations cancel down to the realizer's local
     /// rotations on the way between the two joints.
-    fn follow(&mut self, i: usize) -> Drive {
+    fn follow(&mut self, i: usize) -> NodeMotion {
         let Some(j) = self.source[i] else {
-            return Drive::Rest;
+            return NodeMotion::Rest;
         };
         let mut between = Quat::IDENTITY;
         let mut anchor = None;
@@ -415,7 +415,7 @@ impl Plan<'_> {
                 between.inverse() * self.frame
             }
         };
-        Drive::Follow {
+        NodeMotion::Follow {
             before,
             from,
             to: self.steps.len(),

@@ -11,6 +11,10 @@ use super::limits::Limits;
 /// The embedded default adult.
 const ADULT: &str = include_str!("../../../fixtures/skeletons/adult.json");
 
+/// The default adult's spine from the lower back to the skull, in order: the joints between
+/// the pelvis (`sacroiliac`) and the head.
+pub const ADULT_SPINE: [&str; 6] = ["vl5", "vt12", "vt6", "vc7", "vc4", "skullbase"];
+
 /// The other side's joint name: `l_…` ↔ `r_…`; other joints are their own mirror image.
 pub fn mirror_name(joint: &str) -> String {
     if let Some(rest) = joint.strip_prefix("r_") {
@@ -204,12 +208,6 @@ mod tests {
         for name in [
             "HumanoidRoot",
             "sacroiliac",
-            "vl5",
-            "vt12",
-            "vt6",
-            "vc7",
-            "vc4",
-            "skullbase",
             "l_eyeball_joint",
             "r_eyeball_joint",
             "l_shoulder",
@@ -224,7 +222,10 @@ mod tests {
             "l_knee",
             "l_talocrural",
             "r_talocrural",
-        ] {
+        ]
+        .into_iter()
+        .chain(ADULT_SPINE)
+        {
             assert!(s.joint(name).is_some(), "{name}");
         }
         assert_eq!(s.joints()[0].name, "HumanoidRoot");

@@ -121,6 +121,7 @@ pub fn smallest_covering<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::character::body::skeleton::ADULT_SPINE;
 
     fn joints(s: &Skeleton, names: &[&str]) -> Vec<usize> {
         names.iter().map(|n| s.joint(n).unwrap()).collect()
@@ -169,20 +170,8 @@ mod tests {
             .contains("l_knee is in two parts"));
         // a chain of two pieces (the left arm and the right arm without the spine between)
         let mut arms = joints(&s, LEGS);
-        arms.extend(joints(
-            &s,
-            &[
-                "vl5",
-                "vt12",
-                "vt6",
-                "vc7",
-                "vc4",
-                "skullbase",
-                "temporomandibular",
-                "l_eyeball_joint",
-                "r_eyeball_joint",
-            ],
-        ));
+        let head = ["temporomandibular", "l_eyeball_joint", "r_eyeball_joint"];
+        arms.extend(joints(&s, &[&ADULT_SPINE[..], &head].concat()));
         let mut c = Configuration::from_physical("arms", &s, &arms);
         c.validate(&s).unwrap();
         let (a, b) = (c.chains.remove(0), c.chains.remove(0));

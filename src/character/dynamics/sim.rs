@@ -8,6 +8,11 @@
 //! thesis does, as its inverse dynamics' wrench on the connector's acceleration of the step
 //! before); rapier integrates. The kinematic parts are then placed on their connectors as they
 //! are after the step, and the simulated parts' rotations go back into the pose the host sees.
+//!
+//! Longer than 600 lines on purpose: the simulation is one state (rapier's sets, the parts,
+//! their joints and motors, the glued feet, the kinematic chains' carried motion) that every
+//! stage of a step reads and writes; the pieces that stand alone are modules of their own
+//! (`coupling`, `controllers`, `zmp`, `humanoid`).
 
 use std::f32::consts::PI;
 

@@ -254,6 +254,36 @@ macro_rules! units_retime_len {
     };
 }
 
+/// The part of `Engine` shared by engines whose units of one behaviour kind (`$kind`, a
+/// variant of `BehaviourKind`) persist until they are ended or replaced (the noise and physical
+/// engines): `remove`, `retime`, `len`, `play` under the name `$name`, `interrupt` at once,
+/// `name`, and `timing` (a persistent span for that kind, nothing for others).
+#[macro_export]
+macro_rules! units_persistent {
+    ($name:literal, $kind:ident) => {
+        $crate::units_remove!();
+        $crate::units_retime_len!();
+        $crate::units_play!($name);
+        $crate::units_interrupt!($crate::engines::interface::stop_now);
+
+        fn name(&self) -> &'static str {
+            $name
+        }
+
+        fn timing(
+            &self,
+            behaviour: &$crate::language::bml::Behaviour,
+        ) -> Option<$crate::planning::timing::TimingModel> {
+            // persistent: it runs until it is ended or replaced
+            matches!(
+                behaviour.kind,
+                $crate::language::bml::BehaviourKind::$kind(_)
+            )
+            .then($crate::planning::timing::TimingModel::persistent_span)
+        }
+    };
+}
+
 /// `Engine::remove` for an engine that keeps its units in `self.units`.
 #[macro_export]
 macro_rules! units_remove {

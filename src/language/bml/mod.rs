@@ -2,7 +2,7 @@
 //! streaming parser, static validation, constraint extraction and the writer.
 //!
 //! ```
-//! use bml_realizer::bml;
+//! use bml_realizer::language::bml;
 //! let parsed = bml::load(r#"<bml xmlns="http://www.bml-initiative.org/bml/bml-1.0" id="b1">
 //!     <speech id="s1"><text>Hello <sync id="w"/>world</text></speech>
 //!     <gesture id="g1" lexeme="BEAT" stroke="s1:w"/>

@@ -1,6 +1,10 @@
 //! The typed model of a BML block: block attributes (BML 1.0 + BMLA/BMLT), the 15 core behaviours,
 //! the BMLA control behaviours, the BMLT behaviours, unknown extension behaviours, and `<constraint>`
 //! elements as written. Normalised difference constraints live in `constraints.rs`.
+//!
+//! Longer than 600 lines on purpose: it declares every element of the language with its
+//! attributes, one type each, and the types name each other; what is done with them lives in the
+//! files that do it (parser, validation, constraints, writer).
 
 use super::diagnostic::Pos;
 use super::syncref::SyncRef;

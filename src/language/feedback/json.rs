@@ -27,23 +27,11 @@ struct BlockProgressLine {
     id: String,
     #[serde(rename = "globalTime", serialize_with = "ms")]
     global_time: f64,
-    #[serde(
-        rename = "characterId",
-        default,
-        skip_serializing_if = "Option::is_none"
-    )]
+    #[serde(rename = "characterId", default, skip_serializing_if = "none")]
     character_id: Option<String>,
-    #[serde(
-        rename = "bmla:status",
-        default,
-        skip_serializing_if = "Option::is_none"
-    )]
+    #[serde(rename = "bmla:status", default, skip_serializing_if = "none")]
     status: Option<String>,
-    #[serde(
-        rename = "bmla:posixTime",
-        default,
-        skip_serializing_if = "Option::is_none"
-    )]
+    #[serde(rename = "bmla:posixTime", default, skip_serializing_if = "none")]
     posix_time: Option<u64>,
 }
 
@@ -56,17 +44,9 @@ struct SyncPointLine {
     time: f64,
     #[serde(rename = "globalTime", serialize_with = "ms")]
     global_time: f64,
-    #[serde(
-        rename = "characterId",
-        default,
-        skip_serializing_if = "Option::is_none"
-    )]
+    #[serde(rename = "characterId", default, skip_serializing_if = "none")]
     character_id: Option<String>,
-    #[serde(
-        rename = "bmla:posixTime",
-        default,
-        skip_serializing_if = "Option::is_none"
-    )]
+    #[serde(rename = "bmla:posixTime", default, skip_serializing_if = "none")]
     posix_time: Option<u64>,
     #[serde(rename = "bmla:skipped", default, skip_serializing_if = "is_false")]
     skipped: bool,
@@ -75,11 +55,7 @@ struct SyncPointLine {
 #[derive(Serialize, Deserialize)]
 struct PredictionLine {
     feedback: String,
-    #[serde(
-        rename = "characterId",
-        default,
-        skip_serializing_if = "Option::is_none"
-    )]
+    #[serde(rename = "characterId", default, skip_serializing_if = "none")]
     character_id: Option<String>,
     #[serde(default)]
     bml: Vec<BlockLine>,
@@ -93,11 +69,7 @@ struct WarningLine {
     id: String,
     #[serde(rename = "type")]
     kind: String,
-    #[serde(
-        rename = "characterId",
-        default,
-        skip_serializing_if = "Option::is_none"
-    )]
+    #[serde(rename = "characterId", default, skip_serializing_if = "none")]
     character_id: Option<String>,
     #[serde(default)]
     text: String,
@@ -110,16 +82,12 @@ struct BlockLine {
     feedback: String,
     id: String,
     #[serde(rename = "globalStart", default, serialize_with = "opt_ms")]
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "none")]
     global_start: Option<f64>,
     #[serde(rename = "globalEnd", default, serialize_with = "opt_ms")]
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "none")]
     global_end: Option<f64>,
-    #[serde(
-        rename = "bmla:status",
-        default,
-        skip_serializing_if = "Option::is_none"
-    )]
+    #[serde(rename = "bmla:status", default, skip_serializing_if = "none")]
     status: Option<String>,
 }
 
@@ -130,6 +98,11 @@ struct BehaviourLine {
     id: String,
     #[serde(flatten, serialize_with = "syncs_ms")]
     syncs: IndexMap<String, f64>,
+}
+
+/// Whether an optional field is absent (its key is then left out of the line).
+fn none<T>(o: &Option<T>) -> bool {
+    o.is_none()
 }
 
 fn is_false(b: &bool) -> bool {

@@ -54,29 +54,31 @@ pub const PERSISTENT_WEIGHT: f64 = 1e-3;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Optimal;
 
-impl SchedulingStrategy for Optimal {
-    fn name(&self) -> &'static str {
-        "optimal"
-    }
-
-    fn schedule(
-        &self,
-        block: &Block,
-        models: &dyn TimingModels,
-        external: &dyn ExternalTimes,
-    ) -> Result<BlockSchedule, ScheduleError> {
-        schedule(block, models, external, true)
-    }
-}
-
 /// [`Optimal`] without its fast paths: every block that needs any behaviour to stretch goes
 /// through the linear program. The same answers, slower; a reference to check the fast paths by.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct LinearProgram;
 
-impl SchedulingStrategy for LinearProgram {
+/// What tells the two optimal strategies apart: their name and whether the fast paths may
+/// answer. Both schedule through [`schedule`].
+trait Paths {
+    const NAME: &'static str;
+    const FAST: bool;
+}
+
+impl Paths for Optimal {
+    const NAME: &'static str = "optimal";
+    const FAST: bool = true;
+}
+
+impl Paths for LinearProgram {
+    const NAME: &'static str = "linear-program";
+    const FAST: bool = false;
+}
+
+impl<T: Paths + Send> SchedulingStrategy for T {
     fn name(&self) -> &'static str {
-        "linear-program"
+        T::NAME
     }
 
     fn schedule(
@@ -85,7 +87,7 @@ impl SchedulingStrategy for LinearProgram {
         models: &dyn TimingModels,
         external: &dyn ExternalTimes,
     ) -> Result<BlockSchedule, ScheduleError> {
-        schedule(block, models, external, false)
+        schedule(block, models, external, T::FAST)
     }
 }
 

@@ -21,9 +21,9 @@ mod feedback;
 mod interrupt;
 mod lifecycle;
 mod live;
+mod moving;
 mod store;
 mod submit;
-mod travel;
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};

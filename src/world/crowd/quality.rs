@@ -144,6 +144,25 @@ pub fn measure(tracks: &[Track], dt: f32, walls: &Obstacles, spaces: &[Space]) -
     q
 }
 
+/// How often a path's sideways motion (along `across`, a unit vector) changes direction, steps
+/// that move less than `ignore` (m) sideways left out: the zig-zag of a walk that should go
+/// straight.
+pub fn sideways_reversals(path: &[Vec2], across: Vec2, ignore: f32) -> usize {
+    let mut sign = 0.0f32;
+    let mut count = 0;
+    for w in path.windows(2) {
+        let v = (w[1] - w[0]).dot(across);
+        if v.abs() < ignore {
+            continue;
+        }
+        if sign != 0.0 && v.signum() != sign {
+            count += 1;
+        }
+        sign = v.signum();
+    }
+    count
+}
+
 /// Heading reversals along `at`, headings sampled every 0.1 s while moving faster than 0.1 m/s.
 fn reversals(at: &[Vec2], dt: f32) -> usize {
     let every = ((0.1 / dt).round() as usize).max(1);

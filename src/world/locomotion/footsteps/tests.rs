@@ -59,19 +59,7 @@ pub(super) fn walk(obstacles: &Obstacles, samples: usize) -> Vec<Footstep> {
 /// changes direction, ignoring wobbles under 2 cm.
 fn reversals(path: &[Vec2]) -> usize {
     let across = Vec2::new(GOAL.y, -GOAL.x).normalize();
-    let mut sign = 0.0f32;
-    let mut count = 0;
-    for w in path.windows(2) {
-        let v = (w[1] - w[0]).dot(across);
-        if v.abs() < 0.02 {
-            continue;
-        }
-        if sign != 0.0 && v.signum() != sign {
-            count += 1;
-        }
-        sign = v.signum();
-    }
-    count
+    crate::world::crowd::quality::sideways_reversals(path, across, 0.02)
 }
 
 #[test]
