@@ -2,7 +2,7 @@
 //! the spot by stepping (no joint but the eyes faster than 15 rad/s), setting off at a run from
 //! standing (no foot point more than 1 cm below where it stands on the floor, no joint faster
 //! than 25 rad/s), and rounding a wall's end by footsteps (the heading changing by at most 30°
-//! from one step to the next; not met yet, so that test is ignored and says why).
+//! from one step to the next).
 
 #[path = "common/motion.rs"]
 mod motion;
@@ -120,7 +120,6 @@ fn between(a: f32, b: f32) -> f32 {
 }
 
 #[test]
-#[ignore = "fails today: the footstep walker swings 44 deg in one step at the wall's end (its fan turns up to 0.8 rad a step; a fan of 0.5 rad gets stuck at the wall); run with --ignored"]
 fn rounding_a_wall_s_end_by_footsteps_turns_at_most_30_degrees_a_step() {
     let world = r#"{"characters": {"w": {"position": [0, 0, 0], "facing": 0}},
                     "obstacles": [{"segment": [-4, 5, 3, 5], "height": 2.0}]}"#;
