@@ -7,10 +7,12 @@
 
 use std::sync::{Mutex, MutexGuard};
 
-use bml_realizer::character::avatar::{animated_glb, default_model, Frame as AvatarFrame, Retarget};
+use bml_realizer::character::avatar::{
+    animated_glb, default_model, Frame as AvatarFrame, Retarget,
+};
 use bml_realizer::character::body::Skeleton;
-use bml_realizer::engines::interface::{CharacterPose, Frame};
 use bml_realizer::character::face::ARKIT;
+use bml_realizer::engines::interface::{CharacterPose, Frame};
 use bml_realizer::language::feedback::Format;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
