@@ -33,7 +33,11 @@ fuzz_target!(|data: &[u8]| {
     }
     let _ = iu::read_event(bytes);
     let ipaaca = Ipaaca::new(&["default".to_string()], "fuzz").expect("a channel");
-    for topic in ["default/bml/M", "default/realizerRequest/IU/u1", "default/other/M"] {
+    for topic in [
+        "default/bml/M",
+        "default/realizerRequest/IU/u1",
+        "default/other/M",
+    ] {
         let _ = ipaaca.read(topic, bytes);
     }
 });
