@@ -20,8 +20,7 @@ use glam::{EulerRot, Quat};
 
 use crate::character::body::{Pose, Skeleton};
 use crate::engines::interface::{
-    named_param, named_params, set_named_param, Engine, EngineError, Params, Steering, Unit,
-    UnitKey, Units,
+    named_param, named_params, Engine, EngineError, Params, Steering, Unit, Units,
 };
 use crate::engines::motion::min_jerk;
 use crate::engines::procedural::perlin;
@@ -146,19 +145,4 @@ impl crate::engines::interface::Motion for NoiseEngine {
     }
 }
 
-impl crate::engines::interface::Parameters for NoiseEngine {
-    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
-        named_param(&self.units.get(key)?.params, name)
-    }
-
-    fn set_parameter(
-        &mut self,
-        key: &UnitKey,
-        name: &str,
-        value: f64,
-        _now: f64,
-    ) -> Result<Option<Vec<f64>>, EngineError> {
-        let params = self.units.get_mut(key).map(|(_, u)| &mut u.params);
-        set_named_param(key, "noise", params, name, value)
-    }
-}
+crate::units_named_params!(NoiseEngine, "noise");

@@ -43,8 +43,8 @@ use crate::character::dynamics::controllers::{
 };
 use crate::character::dynamics::sim::{Simulation, STEP};
 use crate::engines::interface::{
-    named_param, named_params, set_named_param, Engine, EngineError, MotionKind, Params, Steering,
-    Unit, UnitKey, Units,
+    named_param, named_params, Engine, EngineError, MotionKind, Params, Steering, Unit, UnitKey,
+    Units,
 };
 use crate::language::bml::{Behaviour, BehaviourKind};
 use crate::world::World;
@@ -589,22 +589,7 @@ impl crate::engines::interface::Motion for PhysicalEngine {
     }
 }
 
-impl crate::engines::interface::Parameters for PhysicalEngine {
-    fn parameter(&self, key: &UnitKey, name: &str) -> Option<f64> {
-        named_param(&self.units.get(key)?.params, name)
-    }
-
-    fn set_parameter(
-        &mut self,
-        key: &UnitKey,
-        name: &str,
-        value: f64,
-        _now: f64,
-    ) -> Result<Option<Vec<f64>>, EngineError> {
-        let params = self.units.get_mut(key).map(|(_, u)| &mut u.params);
-        set_named_param(key, "controller", params, name, value)
-    }
-}
+crate::units_named_params!(PhysicalEngine, "controller");
 
 impl crate::engines::interface::Physics for PhysicalEngine {
     fn push(&mut self, part: &str, impulse: [f64; 3]) -> Result<(), String> {

@@ -284,6 +284,35 @@ macro_rules! units_persistent {
     };
 }
 
+/// `Parameters` for an engine whose units keep their named parameters in a `params` field
+/// ([`named_param`](crate::engines::interface::named_param)), its units in `self.units`:
+/// `$owner` names them in errors (`noise`, `controller`).
+#[macro_export]
+macro_rules! units_named_params {
+    ($engine:ty, $owner:literal) => {
+        impl $crate::engines::interface::Parameters for $engine {
+            fn parameter(
+                &self,
+                key: &$crate::engines::interface::UnitKey,
+                name: &str,
+            ) -> Option<f64> {
+                $crate::engines::interface::named_param(&self.units.get(key)?.params, name)
+            }
+
+            fn set_parameter(
+                &mut self,
+                key: &$crate::engines::interface::UnitKey,
+                name: &str,
+                value: f64,
+                _now: f64,
+            ) -> Result<Option<Vec<f64>>, $crate::engines::interface::EngineError> {
+                let params = self.units.get_mut(key).map(|(_, u)| &mut u.params);
+                $crate::engines::interface::set_named_param(key, $owner, params, name, value)
+            }
+        }
+    };
+}
+
 /// `Engine::remove` for an engine that keeps its units in `self.units`.
 #[macro_export]
 macro_rules! units_remove {
