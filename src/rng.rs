@@ -1,6 +1,6 @@
 //! A small deterministic generator (xorshift64) for the motion's randomness — steering's wander
 //! and dithering, the jitter of a walker's avoidance samples — so that the same seed gives the
-//! same motion on every run and machine; and stateless numbers by index ([`unit`]), for the idle
+//! same motion on every run and machine; and stateless numbers by index ([`unit()`]), for the idle
 //! layer's blinks and saccades, whose k-th moment any frame can make on its own.
 
 /// The generator's state (any seed; 0 counts as 1).

@@ -180,7 +180,7 @@ pub fn line(skeleton: &Skeleton, time: f64, characters: &[(&str, &CharacterPose)
 }
 
 /// One frame's line (without a newline) from each character's id and its JSON object made by
-/// [`character`], in order. The same bytes as [`line`] for the same characters.
+/// [`character`], in order. The same bytes as [`line()`] for the same characters.
 pub fn line_of(time: f64, characters: &[(&str, &str)]) -> String {
     let time = (time * 1e6).round() / 1e6;
     let mut out = format!("{{\"time\":{},\"characters\":{{", json(&time));
@@ -200,7 +200,7 @@ fn json<T: Serialize + ?Sized>(value: &T) -> String {
     serde_json::to_string(value).expect("numbers and strings always encode")
 }
 
-/// One character's JSON object in a frame line (see [`line`]), with the `detail` asked for.
+/// One character's JSON object in a frame line (see [`line()`]), with the `detail` asked for.
 pub fn character(skeleton: &Skeleton, c: &CharacterPose, detail: Detail) -> String {
     let CharacterPose {
         pose,

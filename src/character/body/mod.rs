@@ -1,5 +1,5 @@
 //! The body: an H-Anim skeleton ([`skeleton`]), poses with forward kinematics ([`pose`]), BVH
-//! export ([`bvh`]), glTF export ([`gltf`]) of the mannequin ([`mannequin`]), the frames file ([`frames`]), joint limits ([`limits`]), the idle layer
+//! export ([`bvh`]), glTF export ([`gltf`]) of the mannequin ([`mannequin`]), the frames file ([`crate::character::frames`]), joint limits ([`limits`]), the idle layer
 //! ([`idle`]), stick-figure pictures ([`sketch`]) and two-link inverse kinematics ([`ik`]).
 //! Right-handed coordinates, y up, the character facing +z (its left is +x), metres and radians.
 

@@ -21,7 +21,7 @@ use glam::{Quat, Vec2, Vec3};
 /// A planted foot further than this (m) from where it would stand beside the body is out of
 /// the leg's reach (at 1.3 m/s a foot leaves the ground 0.58 m behind).
 pub const OUT_OF_REACH: f32 = 0.7;
-/// A planted foot further behind the body than this (m) … see [`Gait::hurry`].
+/// A planted foot further behind the body than this (m) … see `Gait::hurry`.
 pub const STRAIN_BEHIND: f32 = 0.45;
 /// … and turned against it by more than this (rad) strains the hip.
 pub const STRAIN_TWIST: f32 = 0.3;

@@ -7,7 +7,7 @@
 //! light), and a character may run several. A frame's guards all read the world as the frame
 //! began — the variables as they were, what sensing saw in the previous frame — and the
 //! actions take effect together after every net was tried, so that no result depends on the
-//! order nets are tried in. The file format is read in [`file`].
+//! order nets are tried in. The file format is read in [`mod@file`].
 
 pub mod behaviour;
 pub mod file;
