@@ -121,11 +121,12 @@ fn arrows(src: &Path) -> BTreeMap<(String, String), BTreeSet<String>> {
             _ => &module[..],
         };
         for (path, supers) in paths(&text) {
-            let mut full: Vec<&str> = here[..here.len().saturating_sub(supers)].to_vec();
-            if supers == 0 {
-                full.clear();
-            }
-            full.extend(path);
+            // `crate::` paths start at the root, `super::` ones that many modules up from here
+            let base = match supers {
+                0 => &[][..],
+                n => &here[..here.len().saturating_sub(n)],
+            };
+            let full: Vec<&str> = base.iter().copied().chain(path).collect();
             if let Some(to) = room(src, &full) {
                 if to != from {
                     let at = rel.display().to_string();

@@ -49,9 +49,8 @@ pub(super) struct Plan {
     walk_node: usize,
     fan: Fan,
     goal: Vec2,
-    /// The route round the obstacles (planned at the first step) and the segment of it the
-    /// body has reached.
-    route: Option<Vec<Vec2>>,
+    /// The route round the obstacles and the segment of it the body has reached.
+    route: Vec<Vec2>,
     progress: usize,
     /// Where the body is headed now, its heading there, and when it gets there.
     next: Option<(Vec2, f32, f64)>,
@@ -80,7 +79,8 @@ pub(super) struct Place {
 }
 
 impl Plan {
-    /// A walk from `body` facing `facing` to `goal` at `speed`.
+    /// A walk from `body` facing `facing` to `goal` at `speed`, keeping its distance from
+    /// `obstacles` (a goal no route reaches is aimed at straight).
     pub fn new(
         body: Vec2,
         facing: f32,
@@ -88,6 +88,7 @@ impl Plan {
         speed: f32,
         running: bool,
         radius: f32,
+        obstacles: &Obstacles,
     ) -> Plan {
         let (net, walk_node) = footsteps::walking_net(goal, ARRIVE, radius + CLEAR, PERSONAL);
         let step = gait::step_length(speed, running).max(0.2);
@@ -97,7 +98,8 @@ impl Plan {
             walk_node,
             fan: Fan::new(step, MAX_TURN, 9),
             goal,
-            route: None,
+            route: path::plan(obstacles, body, goal, radius + CLEAR)
+                .unwrap_or_else(|_| vec![body, goal]),
             progress: 0,
             next: None,
             last: (body, facing),
@@ -171,7 +173,7 @@ impl Plan {
     /// The next step: the least energy of the fan, if it is less than standing where the
     /// last step left the body.
     fn choose(&mut self, obstacles: &Obstacles, walkers: &[Vec2], radius: f32) -> Option<Footstep> {
-        self.aim(obstacles, radius);
+        self.aim();
         let here = Surroundings {
             at: self.last.0,
             heading: self.last.1,
@@ -193,16 +195,12 @@ impl Plan {
     /// Points the net's goal sensor where the walk goes next: along a route that bends round
     /// obstacles, [`LOOKAHEAD`] ahead on it until the body has passed its last bend; else the
     /// goal itself. (Aimed at the goal across a wall, the walk slid along the wall and swung
-    /// round its end in one step.) A goal no route reaches is aimed at straight, as before.
-    fn aim(&mut self, obstacles: &Obstacles, radius: f32) {
-        let (from, goal) = (self.last.0, self.goal);
-        let route = self.route.get_or_insert_with(|| {
-            path::plan(obstacles, from, goal, radius + CLEAR).unwrap_or_else(|_| vec![from, goal])
-        });
-        let (carrot, segment) = path::carrot(route, from, self.progress, LOOKAHEAD);
+    /// round its end in one step.)
+    fn aim(&mut self) {
+        let (carrot, segment) = path::carrot(&self.route, self.last.0, self.progress, LOOKAHEAD);
         self.progress = segment;
-        let bends_ahead = segment + 2 < route.len();
-        let at = if bends_ahead { carrot } else { goal };
+        let bends_ahead = segment + 2 < self.route.len();
+        let at = if bends_ahead { carrot } else { self.goal };
         self.net.aim(footsteps::GOAL_SENSOR, at);
     }
 }
@@ -215,7 +213,8 @@ mod tests {
     fn among_many_the_fan_is_thinned_and_walks_set_off_staggered() {
         let obstacles = Obstacles::default();
         let go = |place: Place| {
-            let mut p = Plan::new(Vec2::ZERO, 0.0, Vec2::new(0.0, 10.0), 1.3, false, 0.25);
+            let goal = Vec2::new(0.0, 10.0);
+            let mut p = Plan::new(Vec2::ZERO, 0.0, goal, 1.3, false, 0.25, &obstacles);
             let moving = (0..240).map(|k| k as f64 / 240.0).find(|&t| {
                 p.velocity(t, Vec2::ZERO, &obstacles, &[], 0.25, place)
                     .is_some_and(|v| v.length() > 0.0)

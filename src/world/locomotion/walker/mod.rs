@@ -283,6 +283,7 @@ impl Walker {
                 walk.speed,
                 walk.running,
                 self.radius,
+                obstacles,
             );
             Box::new(p)
         });

@@ -78,7 +78,7 @@ impl Walker {
             self.brake(a, dt);
         } else if !a.stopped {
             let route = ahead;
-            // (a footstep walk keeps to no route: what is left is the way to the goal)
+            // (a footstep walk keeps only loosely to a route: what is left is the way to the goal)
             let left = match a.plan {
                 Some(_) => to_goal.length(),
                 None => path::length(&route),
