@@ -1,13 +1,18 @@
 //! Streaming through `bmlr serve`'s line ports, as a host process does: the stream messages
 //! (`{"open_stream"}`, `{"push_audio"}` with base64 samples and Polly marks, `{"end_audio"}`)
-//! between the `<bml>` blocks, over `--stdio`, over `--tcp` and over `--mqtt` (a real
-//! mosquitto; without it that test says so and passes). espeak-ng's sentence
+//! between the `<bml>` blocks, over `--stdio`, over `--tcp`, over `--mqtt` (a real mosquitto)
+//! and over `--stomp` (a real ActiveMQ, on AsapRealizer's topics); without the broker those two
+//! say "skipped" and pass (`.ci/run` installs both and fails on a skip). espeak-ng's sentence
 //! (`fixtures/voice/espeak-bob.wav`) pushed in 10 chunks on the wall clock: the speech starts
 //! with the first chunk, its end is predicted and revised, it ends with its sound (feedback on
 //! the wall clock), a nod tied to its end follows; a bad message costs one warning that says why.
 
+#[path = "common/activemq.rs"]
+mod amq;
 #[path = "common/broker.rs"]
 mod broker;
+// (the ActiveMQ helper finds the free-port helper as `kit`)
+use broker as kit;
 #[path = "common/chunked.rs"]
 mod chunked;
 #[path = "common/espeak_report.rs"]
@@ -20,7 +25,7 @@ use std::time::{Duration, Instant};
 
 use base64::Engine as _;
 use bml_realizer::language::feedback::{from_line, Feedback};
-use bml_realizer::ports::broker::{Inbound, Link};
+use bml_realizer::ports::broker::{Inbound, Link, StompLink, StompOptions, StompUrl};
 use chunked::sync_time;
 
 const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0" xmlns:bmlt="http://hmi.ewi.utwente.nl/bmlt""#;
@@ -30,7 +35,7 @@ struct Port {
     send: Box<dyn FnMut(&str)>,
     feedback: Receiver<Feedback>,
     _server: Child,
-    _broker: Option<broker::Broker>,
+    _broker: Option<Box<dyn std::any::Any>>,
 }
 
 impl Drop for Port {
@@ -118,7 +123,77 @@ fn mqtt() -> Option<Port> {
         send: Box::new(move |line| host.publish("bml/bob/bml", line.as_bytes().to_vec(), false)),
         feedback,
         _server: server,
-        _broker: Some(broker),
+        _broker: Some(Box::new(broker)),
+    })
+}
+
+/// A realizer on an ActiveMQ (`serve --stomp`, AsapRealizer's topics); the host sends on
+/// `asap.bml.request` and hears `asap.bml.feedback`.
+fn stomp() -> Option<Port> {
+    let broker = amq::ActiveMq::start()?;
+    let server = (Command::new(env!("CARGO_BIN_EXE_bmlr")))
+        .args(["serve", "--no-idle", "--stomp", &broker.stomp_url()])
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let link = |topics: &[&str]| {
+        StompLink::connect(StompOptions {
+            url: StompUrl::parse(&broker.stomp_url()).unwrap(),
+            subscriptions: topics.iter().map(|t| t.to_string()).collect(),
+            presence: None,
+            inbox: 100_000,
+            start_tries: 3,
+        })
+        .expect("the host connects")
+    };
+    let mut host = link(&[]);
+    let ears = link(&["/topic/asap.bml.feedback"]);
+    // (the realizer is there once a block of the host's own has ended)
+    let (tx, feedback) = mpsc::channel();
+    let until = Instant::now() + Duration::from_secs(20);
+    let warmed = loop {
+        assert!(
+            Instant::now() < until,
+            "the realizer never answered on STOMP"
+        );
+        host.send(
+            "/topic/asap.bml.request",
+            broker::block("warmup").into_bytes(),
+            &[],
+        );
+        host.flush();
+        let heard = Instant::now() + Duration::from_secs(1);
+        let mut ended = false;
+        while Instant::now() < heard && !ended {
+            if let Some(Inbound::Message { payload, .. }) =
+                ears.recv_timeout(Duration::from_millis(20))
+            {
+                let text = String::from_utf8_lossy(&payload);
+                ended = text.starts_with("<blockProgress") && text.contains(r#"id="warmup:end""#);
+            }
+        }
+        if ended {
+            break ears;
+        }
+    };
+    std::thread::spawn(move || loop {
+        if let Some(Inbound::Message { payload, .. }) =
+            warmed.recv_timeout(Duration::from_millis(50))
+        {
+            let f = from_line(&String::from_utf8_lossy(&payload)).unwrap();
+            if tx.send(f).is_err() {
+                return;
+            }
+        }
+    });
+    Some(Port {
+        send: Box::new(move |line| {
+            host.send("/topic/asap.bml.request", line.as_bytes().to_vec(), &[]);
+            host.flush();
+        }),
+        feedback,
+        _server: server,
+        _broker: Some(Box::new(broker)),
     })
 }
 
@@ -246,4 +321,11 @@ fn a_host_streams_a_speech_through_serve_mqtt_on_its_character_s_topic() {
         };
         assert_eq!(character, Some("bob"), "{f:?}");
     }
+}
+
+#[test]
+fn a_host_streams_a_speech_through_serve_stomp_on_activemq() {
+    let Some(port) = stomp() else { return };
+    let log = stream_through(port, r#"{"push": "reply"}"#);
+    check(&log, "not a stream message: unknown field `push`");
 }
