@@ -652,6 +652,37 @@ fn a_walk_to_another_character_stops_at_social_distance_facing_them() {
     assert!(Vec2::new(f.x, f.z).normalize().dot(to_bob) > 0.97, "{f}");
 }
 
+#[test]
+fn a_walk_to_a_place_someone_stands_on_stops_beside_them_and_says_so() {
+    // Bob stands where the walk is sent; before, the walker circled him for 20 s and gave up
+    // "has not arrived"
+    let world =
+        obstacle_world(r#"{"characters": {"Bob": {"position": [0, 0, 5], "facing": 180}}}"#);
+    let r = run_in(Some(world), &[&walk(r#"target="0,5""#, "")], 14.0, 60.0);
+    assert!(r.block_ended(), "the walk never ended");
+    // (within 2 m of the place it waits 2 s for him to go)
+    let end = r.sync("b1:w:end");
+    assert!(end < 10.0, "it ended at {end} s");
+    let bob = Vec2::new(0.0, 5.0);
+    let last = r.frames.len() - 1;
+    // beside him, just outside his personal space (the bodies, 0.25 m
+    // each, widened by half as the avoidance widens them: 0.75 m, and 5 cm)
+    let d = r.root(last).distance(bob);
+    assert!((d - 0.8).abs() < 0.1, "it stopped {d} m from him");
+    let closest = (0..=last)
+        .map(|k| r.root(k).distance(bob))
+        .fold(f32::MAX, f32::min);
+    assert!(closest > 0.5, "it came within {closest} m of him");
+    let warnings = r.warnings();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0]
+            .1
+            .contains("'Bob' stands on the walk's goal '0,5'; it stops beside them"),
+        "{warnings:?}"
+    );
+}
+
 mod routes {
     use bml_realizer::world::space::path::{self, PathError};
     use bml_realizer::world::space::{Obstacle, Obstacles, Shape};

@@ -93,6 +93,8 @@ pub struct LocomotionEngine {
     obstacles: Arc<Obstacles>,
     /// Standing, whether it made room for a walker and where it stood before.
     room: Option<Room>,
+    /// Whether the walk under way waits for one standing on its goal or settles beside them.
+    settling: targets::Settling,
 }
 
 /// Reads a locomotion behaviour's order.
@@ -224,12 +226,13 @@ impl LocomotionEngine {
             return;
         };
         let here = self.walker.as_ref().map_or(Vec2::ZERO, |w| w.body().at);
+        self.settling = targets::Settling::default();
         let walk = match resolve(world, &self.id, &u.order.target, here) {
-            Some((goal, face)) => Walk {
-                goal,
+            Some(goal) => Walk {
+                goal: goal.at,
                 speed: u.order.speed,
                 running: u.order.running,
-                face,
+                face: goal.face,
                 stepping: false,
                 footsteps: u.order.footsteps,
             },
@@ -394,14 +397,14 @@ impl Engine for LocomotionEngine {
                 &standing
             }
         };
-        let Some((goal, face)) = resolve(world, &self.id, &o.target, walker.body().at) else {
+        let Some(goal) = resolve(world, &self.id, &o.target, walker.body().at) else {
             return fallback;
         };
         let walk = Walk {
-            goal,
+            goal: goal.at,
             speed: o.speed,
             running: o.running,
-            face,
+            face: goal.face,
             stepping: false,
             footsteps: o.footsteps,
         };

@@ -1,7 +1,8 @@
 //! Where a walk goes: a locomotion target read against the world. A target is `x,z` in world
 //! metres, a placed character (the walk stops [`SOCIAL_DISTANCE`] from them, on the walker's
 //! side, turned to face them), or a point of the world (one moving along a path is where the
-//! path has it now).
+//! path has it now). A place someone has stood on for a while is taken: the walk stops beside
+//! them.
 
 use glam::Vec2;
 
@@ -19,22 +20,148 @@ pub fn coordinates(target: &str) -> Option<Vec2> {
         .then(|| Vec2::new(x, z))
 }
 
+/// Where a walk goes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Goal {
+    /// Where it stops (x, z).
+    pub at: Vec2,
+    /// What it turns to face there, if anything.
+    pub face: Option<Vec2>,
+    /// Who stands on that place now, and where beside them the walk would stop instead.
+    pub taken: Option<Taken>,
+}
+
+/// A walk's goal someone stands on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Taken {
+    /// Who stands there.
+    pub by: String,
+    /// Where beside them the walker would stop (x, z).
+    pub beside: Vec2,
+}
+
+/// How long someone must have stood on a walk's goal before the walker settles beside them
+/// (s): one pausing there in a throng, to let another pass, is waited for.
+pub const PATIENCE: f64 = 2.0;
+
+/// Whether a walk waits for the one on its goal or settles beside them: who has stood there
+/// since when, for the walk under way.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Settling {
+    /// (who, since when) stands on the goal.
+    standing: Option<(String, f64)>,
+    /// Whether the walk has settled beside them.
+    settled: bool,
+}
+
+impl Settling {
+    /// Where the walk goes at `now` for `goal` as resolved now: its place, or beside the one
+    /// standing on it once they have stood there [`PATIENCE`]; and whether it settled just now.
+    pub fn place(&mut self, now: f64, goal: &Goal) -> (Vec2, bool) {
+        let Some(t) = &goal.taken else {
+            *self = Settling::default();
+            return (goal.at, false);
+        };
+        let since = match &self.standing {
+            Some((who, since)) if *who == t.by => *since,
+            _ => {
+                *self = Settling {
+                    standing: Some((t.by.clone(), now)),
+                    settled: false,
+                };
+                now
+            }
+        };
+        if now - since < PATIENCE {
+            return (goal.at, false);
+        }
+        let just = !self.settled;
+        self.settled = true;
+        (t.beside, just)
+    }
+}
+
 /// Where a walk to `target` goes in `world` for walker `me` standing at `from`, and what it
-/// faces there; `None` for a target the world does not have.
-pub fn resolve(world: &World, me: &str, target: &str, from: Vec2) -> Option<(Vec2, Option<Vec2>)> {
+/// faces there; `None` for a target the world does not have. A place (coordinates or a point)
+/// on which someone stands is taken ([`beside_whoever_stands`], [`Settling`]).
+pub fn resolve(world: &World, me: &str, target: &str, from: Vec2) -> Option<Goal> {
     if let Some(p) = coordinates(target) {
-        return Some((p, None));
+        return Some(beside_whoever_stands(world, me, p, from));
     }
     let is_character = target != me && world.is_placed(target) && !world.has_point(target);
     if is_character {
         let p = world.placement(target).position;
         let them = Vec2::new(p.x, p.z);
         let away = (from - them).normalize_or(Vec2::Y);
-        return Some((them + away * SOCIAL_DISTANCE, Some(them)));
+        return Some(Goal {
+            at: them + away * SOCIAL_DISTANCE,
+            face: Some(them),
+            taken: None,
+        });
     }
     let p = world.get(target)?;
-    Some((Vec2::new(p.x, p.z), None))
+    Some(beside_whoever_stands(world, me, Vec2::new(p.x, p.z), from))
 }
+
+/// How far beyond each other's personal space (the bodies widened by the walker's profile,
+/// as its avoidance keeps them) a walker stops beside one standing on its goal (m).
+pub const BESIDE_GAP: f32 = 0.05;
+/// A character on a walk's goal slower than this (m/s) stands there.
+pub const STANDING_SPEED: f32 = 0.2;
+/// A walker looks whether someone stands on its goal once it is this near it (m): from afar,
+/// one standing there now (as everyone does before they set off) may well be gone by then.
+pub const NOTICE: f32 = 2.0;
+
+/// The walk to `goal` of walker `me` coming from `from`, and whether another character stands
+/// so near it that the two bodies would overlap: who, and the place just outside that one's
+/// personal space ([`BESIDE_GAP`]) on the walker's side; looked at only within [`NOTICE`] of
+/// the goal. (Walking round someone who stands on one's goal for ever, a walker
+/// gave up after 20 s with "has not arrived".) Who stands where is read from the crowd the
+/// walkers see (`crowd::snapshot`), which knows how fast each goes.
+fn beside_whoever_stands(world: &World, me: &str, goal: Vec2, from: Vec2) -> Goal {
+    let mine = world.radius(me);
+    let free = Goal {
+        at: goal,
+        face: None,
+        taken: None,
+    };
+    if from.distance(goal) > NOTICE {
+        return free;
+    }
+    let widen = world.profile(me).incr.max(1.0);
+    let crowd = world.crowd();
+    let on_it = |id: &str, at: Vec2, radius: f32, velocity: Vec2| {
+        let reach = mine + radius;
+        (id != me && velocity.length() < STANDING_SPEED && at.distance(goal) < reach)
+            .then(|| (at.distance(goal), id.to_string(), at, reach * widen))
+    };
+    let mut near = Vec::new();
+    crowd.near(goal, mine + MAX_RADIUS, &mut near);
+    let standing = (near.iter())
+        .filter_map(|&i| {
+            let a = crowd.agent(i);
+            on_it(crowd.id(i), a.at, a.radius, a.velocity)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.cmp(&b.1)));
+    match standing {
+        None => free,
+        Some((_, id, them, reach)) => {
+            let away = (from - them).normalize_or((goal - them).normalize_or(Vec2::Y));
+            Goal {
+                taken: Some(Taken {
+                    by: id,
+                    beside: them + away * (reach + BESIDE_GAP),
+                }),
+                ..free
+            }
+        }
+    }
+}
+
+/// The largest body radius of one standing on a goal that is looked for (m): people's are
+/// about 0.25. (A world file may give radii up to 10 m; a wider body on the goal is only gone
+/// round.) Looking further would visit everyone within 10 m of every goal in every frame.
+pub const MAX_RADIUS: f32 = 1.0;
 
 /// Longest lead a pursuit takes (s): a target seen moving is aimed at where it will be in the
 /// time the walker needs to reach it, at most this.
@@ -98,6 +225,36 @@ impl Pursuit {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_walk_settles_beside_one_who_stood_on_its_goal_for_its_patience_and_says_so_once() {
+        let goal = |by: Option<&str>| Goal {
+            at: Vec2::new(0.0, 5.0),
+            face: None,
+            taken: by.map(|b| Taken {
+                by: b.to_string(),
+                beside: Vec2::new(0.0, 4.2),
+            }),
+        };
+        let mut s = Settling::default();
+        assert_eq!(s.place(0.0, &goal(None)), (Vec2::new(0.0, 5.0), false));
+        // Bob stands there from 1 s: waited for until 3 s
+        assert_eq!(s.place(1.0, &goal(Some("Bob"))).0, Vec2::new(0.0, 5.0));
+        assert_eq!(s.place(2.9, &goal(Some("Bob"))).0, Vec2::new(0.0, 5.0));
+        // Carl takes his place at 2.9: the patience starts again
+        assert_eq!(s.place(2.95, &goal(Some("Carl"))).0, Vec2::new(0.0, 5.0));
+        assert_eq!(s.place(4.9, &goal(Some("Carl"))).0, Vec2::new(0.0, 5.0));
+        assert_eq!(
+            s.place(4.95, &goal(Some("Carl"))),
+            (Vec2::new(0.0, 4.2), true)
+        );
+        assert_eq!(
+            s.place(5.0, &goal(Some("Carl"))),
+            (Vec2::new(0.0, 4.2), false)
+        );
+        // he leaves: the place is the walk's again
+        assert_eq!(s.place(5.1, &goal(None)), (Vec2::new(0.0, 5.0), false));
+    }
 
     #[test]
     fn pursuit_learns_a_steady_velocity_and_leads_by_the_time_to_reach() {

@@ -85,10 +85,18 @@ impl Travel for LocomotionEngine {
             (self.current.as_ref()).and_then(|k| self.units.get(k).map(|u| u.order.clone()));
         if let (Some(o), Some(w)) = (order, self.walker.as_mut()) {
             let from = w.body().at;
-            if let Some((goal, face)) = resolve(world, id, &o.target, from) {
-                self.pursuit.observe(now, face.unwrap_or(goal));
-                let aim = self.pursuit.aim(goal, from, o.speed);
-                w.retarget(aim, face, &self.obstacles);
+            if let Some(goal) = resolve(world, id, &o.target, from) {
+                let (place, settled) = self.settling.place(now, &goal);
+                self.pursuit.observe(now, goal.face.unwrap_or(place));
+                let aim = self.pursuit.aim(place, from, o.speed);
+                w.retarget(aim, goal.face, &self.obstacles);
+                if let (true, Some(t), Some(key)) = (settled, &goal.taken, &self.current) {
+                    let why = format!(
+                        "{key}: '{}' stands on the walk's goal '{}'; it stops beside them, outside their personal space",
+                        t.by, o.target
+                    );
+                    self.warnings.push((key.clone(), why));
+                }
             }
         }
         let body = self.walker.as_ref().map(|w| w.body());
