@@ -223,3 +223,48 @@ fn one_standing_in_the_way_steps_aside_for_the_walker_and_goes_back() {
     // bodies of 0.25 m: never closer than their radii less a centimetre
     assert!(closest >= 0.49, "two bodies {closest} m apart");
 }
+
+#[test]
+fn a_walker_wedged_between_two_standing_asks_the_one_ahead_and_arrives() {
+    // Seen in a random square of 300: the walker at the origin on its way to (-6.7, -6.7) stood
+    // among four who had arrived at their places, one 0.56 m ahead and to its left, one 0.7 m to
+    // its right; there was room beside the one ahead, but no way to it that did not touch
+    // someone, so nobody was asked and it stood for 23 s until its walk gave up.
+    let people = [(0.98, -0.26), (-1.66, -0.86), (-0.51, 0.48), (-0.12, -0.55)];
+    let mut chars = vec![r#""w": {"position": [0, 0, 0], "facing": -135}"#.to_string()];
+    for (k, (x, z)) in people.iter().enumerate() {
+        chars.push(format!(
+            r#""s{k}": {{"position": [{x}, 0, {z}], "facing": 0}}"#
+        ));
+    }
+    let json = format!(r#"{{"characters": {{{}}}}}"#, chars.join(", "));
+    let mut r = Realizer::new();
+    *r.world_mut() = World::from_json(&json).unwrap().0;
+    let bml = format!(
+        r#"<bml {NS} id="b" characterId="w"><locomotion id="w" target="-6.72,-6.73"/></bml>"#
+    );
+    r.perform_bml(&bml).unwrap();
+    let mut ended = None;
+    let mut warnings = Vec::new();
+    for i in 0..=(30 * 30) {
+        let t = f64::from(i) / 30.0;
+        for f in r.tick(t).feedback {
+            match f {
+                bml_realizer::language::feedback::Feedback::BlockProgress(p)
+                    if p.block.as_str() == "b" && p.sync.as_str() == "end" =>
+                {
+                    ended = ended.or(Some(t));
+                }
+                bml_realizer::language::feedback::Feedback::Warning(w) => warnings.push(w.text),
+                _ => {}
+            }
+        }
+    }
+    let at = r.world().placement("w").position;
+    let off = glam::Vec2::new(at.x, at.z).distance(glam::Vec2::new(-6.72, -6.73));
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(
+        ended.is_some() && off < 0.3,
+        "ended {ended:?}, {off} m from its goal"
+    );
+}

@@ -59,7 +59,11 @@ impl Near<'_, '_> {
         let regular = tick % DECIDE_EVERY == 0;
         if regular {
             avoider.wait(DECIDE_EVERY as f32 * STEP as f32, velocity, desired, pref);
-            *asking = self.asks(here, velocity, desired, pref);
+            // stuck (fully impatient), it asks whoever stands on its line, room beside them or
+            // not: its avoidance found no way round them (wedged between two people standing,
+            // room beside the one ahead but none to get there, a walker stood for 20 s)
+            let insist = avoider.impatience() >= 1.0;
+            *asking = self.asks(here, velocity, desired, pref, insist);
         }
         // between the regular choices, a course about to touch someone is chosen again at once
         let me = Agent {
@@ -98,9 +102,16 @@ impl Near<'_, '_> {
 
 impl Near<'_, '_> {
     /// Where the person standing (not moving) in the way of a walker at `here`, held back
-    /// below half its preferred speed `pref`, stands, when they shut its way
-    /// ([`negotiate::blocker`]).
-    fn asks(&self, here: Vec2, velocity: Vec2, desired: Vec2, pref: f32) -> Option<Vec2> {
+    /// below half its preferred speed `pref`, stands, when they shut its way (or whenever
+    /// they stand on its line, when it `insist`s: [`negotiate::blocker`]).
+    fn asks(
+        &self,
+        here: Vec2,
+        velocity: Vec2,
+        desired: Vec2,
+        pref: f32,
+        insist: bool,
+    ) -> Option<Vec2> {
         if velocity.length() >= 0.5 * pref || desired.length() < 1e-3 {
             return None;
         }
@@ -114,7 +125,7 @@ impl Near<'_, '_> {
             })
             .collect();
         let way = desired.normalize();
-        negotiate::blocker(here, way, self.radius, &standing, self.obstacles, false)
+        negotiate::blocker(here, way, self.radius, &standing, self.obstacles, insist)
             .map(|i| near[i].at)
     }
 }

@@ -1,0 +1,264 @@
+//! Random crowds, tried as a new user would: N whole-body walkers on random trips in a square,
+//! realized in-process at a host's frame rate and judged from every frame.
+//!
+//! ```sh
+//! cargo run --release --example crowd_random [N [SIDE [FPS [SEED [UNTIL]]]]]
+//! ```
+//!
+//! N walkers (300 by default) start and end at random spots of a SIDE × SIDE m square (30),
+//! starts 0.8 m apart and goals 0.8 m apart, each sent `<locomotion target="x,z"/>` at t = 0;
+//! the realizer is ticked at FPS (10) until every block has ended, or UNTIL seconds (60), with
+//! generator SEED (1). Printed: who did not arrive (within 0.3 m of its goal, its block ended)
+//! and what they said, the closest two roots came, the fastest a root moved between frames, the
+//! largest drop of the hips between frames, and the wall time against the scene's time.
+
+use std::time::Instant;
+
+use bml_realizer::language::feedback::Feedback;
+use bml_realizer::realizer::Realizer;
+use bml_realizer::world::World;
+use glam::{Vec2, Vec3};
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// How far apart starts (and goals) are at least (m).
+const APART: f32 = 0.8;
+/// A walker within this of its goal has arrived (m).
+const ARRIVED: f32 = 0.3;
+
+/// A small deterministic generator (the same scene for the same seed).
+struct Lcg(u64);
+
+impl Lcg {
+    fn unit(&mut self) -> f32 {
+        self.0 = (self.0)
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// `n` spots in a square of `side` m centred on the origin, [`APART`] from each other.
+fn spots(rng: &mut Lcg, n: usize, side: f32) -> Vec<Vec2> {
+    let mut out: Vec<Vec2> = Vec::with_capacity(n);
+    let mut tries = 0;
+    while out.len() < n {
+        tries += 1;
+        assert!(
+            tries < 1000 * n,
+            "{n} spots {APART} m apart do not fit {side} m"
+        );
+        let p = Vec2::new(rng.unit() - 0.5, rng.unit() - 0.5) * side;
+        if out.iter().all(|q| q.distance(p) >= APART) {
+            out.push(p);
+        }
+    }
+    out
+}
+
+fn id(k: usize) -> String {
+    format!("w{k:04}")
+}
+
+fn argument<T: std::str::FromStr>(k: usize, default: T) -> T {
+    std::env::args()
+        .nth(k)
+        .map(|s| (s.parse().ok()).unwrap_or_else(|| panic!("argument {k} '{s}' is not a number")))
+        .unwrap_or(default)
+}
+
+/// What the frames showed.
+#[derive(Default)]
+struct Seen {
+    closest: (f32, usize, usize, f64),
+    fastest: (f32, usize, f64),
+    drop: (f32, usize, f64),
+}
+
+fn main() {
+    let n: usize = argument(1, 300);
+    let side: f32 = argument(2, 30.0);
+    let fps: f64 = argument(3, 10.0);
+    let seed: u64 = argument(4, 1);
+    let until: f64 = argument(5, 60.0);
+    let mut rng = Lcg(seed);
+    let starts = spots(&mut rng, n, side);
+    let goals = spots(&mut rng, n, side);
+
+    let chars: Vec<String> = (0..n)
+        .map(|k| {
+            let (s, g) = (starts[k], goals[k]);
+            let facing = (g - s).x.atan2((g - s).y).to_degrees();
+            format!(
+                r#""{}": {{"position": [{}, 0, {}], "facing": {facing}}}"#,
+                id(k),
+                s.x,
+                s.y
+            )
+        })
+        .collect();
+    let json = format!(r#"{{"characters": {{{}}}}}"#, chars.join(", "));
+    let mut r = Realizer::new();
+    *r.world_mut() = World::from_json(&json).expect("a world").0;
+    for (k, g) in goals.iter().enumerate() {
+        let bml = format!(
+            r#"<bml {NS} id="b{k}" characterId="{}"><locomotion id="w" target="{},{}"/></bml>"#,
+            id(k),
+            g.x,
+            g.y
+        );
+        r.perform_bml(&bml).expect("a block");
+    }
+
+    let clock = Instant::now();
+    let mut seen = Seen {
+        closest: (f32::MAX, 0, 0, 0.0),
+        ..Seen::default()
+    };
+    let mut ended = vec![false; n];
+    let mut said: Vec<Vec<String>> = vec![Vec::new(); n];
+    let mut last: Vec<Option<Vec3>> = vec![None; n];
+    let mut frame = 0u32;
+    let mut time = 0.0;
+    while time <= until {
+        time = f64::from(frame) / fps;
+        frame += 1;
+        let f = r.tick(time);
+        for fb in &f.feedback {
+            let (block, text, end) = match fb {
+                Feedback::BlockProgress(p) => {
+                    (p.block.as_str(), String::new(), p.sync.as_str() == "end")
+                }
+                Feedback::Warning(w) => (w.id.as_str(), w.text.clone(), false),
+                _ => continue,
+            };
+            let k = (block.trim_start_matches('b').split(':').next())
+                .and_then(|s| s.parse::<usize>().ok());
+            if let Some(k) = k.filter(|&k| k < n) {
+                ended[k] |= end;
+                if !text.is_empty() {
+                    said[k].push(text);
+                }
+            }
+        }
+        let roots: Vec<Vec3> = (0..n)
+            .map(|k| f.character(&id(k)).expect("a pose").pose.root)
+            .collect();
+        look(&roots, &mut last, &mut seen, time, fps);
+        trace(&roots, &goals, time, fps);
+        if ended.iter().all(|&e| e) {
+            break;
+        }
+    }
+    let wall = clock.elapsed().as_secs_f64();
+
+    let mut stranded = 0;
+    for k in 0..n {
+        let at = last[k].map_or(Vec2::ZERO, |p| Vec2::new(p.x, p.z));
+        let off = at.distance(goals[k]);
+        if off > ARRIVED || !ended[k] {
+            stranded += 1;
+            println!(
+                "{}: {off:.2} m from its goal {} (ended: {}) {:?}",
+                id(k),
+                goals[k],
+                ended[k],
+                said[k]
+            );
+        }
+    }
+    let (d, a, b, t) = seen.closest;
+    let (v, who, tv) = seen.fastest;
+    let (h, whoh, th) = seen.drop;
+    println!("{n} walkers, {side} m square, {fps} fps, seed {seed}: {stranded} did not arrive");
+    println!(
+        "closest roots {d:.3} m ({} and {} at {t:.1} s)",
+        id(a),
+        id(b)
+    );
+    println!("fastest root {v:.2} m/s ({} at {tv:.1} s)", id(who));
+    println!(
+        "largest hip drop {:.1} cm ({} at {th:.1} s)",
+        h * 100.0,
+        id(whoh)
+    );
+    println!("{time:.1} s of scene in {wall:.1} s wall");
+}
+
+/// With `TRACE=w0001,w0002` in the environment: those walkers' places every second, their
+/// goals and the nearest other body.
+fn trace(roots: &[Vec3], goals: &[Vec2], time: f64, fps: f64) {
+    let Ok(ids) = std::env::var("TRACE") else {
+        return;
+    };
+    if (time * fps).round() as i64 % fps.round().max(1.0) as i64 != 0 {
+        return;
+    }
+    let ground = |p: Vec3| Vec2::new(p.x, p.z);
+    for k in (0..roots.len()).filter(|&k| ids.split(',').any(|s| s == id(k))) {
+        let p = ground(roots[k]);
+        let (d, j) = (0..roots.len())
+            .filter(|&j| j != k)
+            .map(|j| (ground(roots[j]).distance(p), j))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap_or((f32::MAX, k));
+        println!(
+            "{time:5.1} {} at {:6.2},{:6.2} goal {:.2} m; nearest {} {d:.2} m",
+            id(k),
+            p.x,
+            p.y,
+            p.distance(goals[k]),
+            id(j)
+        );
+        if std::env::var("TRACE_NEAR").is_ok() {
+            let g = goals[k] - p;
+            for j in (0..roots.len()).filter(|&j| j != k) {
+                let q = ground(roots[j]) - p;
+                if q.length() < 2.0 {
+                    println!(
+                        "        {} at {:5.2},{:5.2} (ahead {:5.2}) its goal {:.2} m off",
+                        id(j),
+                        q.x,
+                        q.y,
+                        q.dot(g.normalize_or_zero()),
+                        ground(roots[j]).distance(goals[j])
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Judges one frame's roots against the last frame's.
+fn look(roots: &[Vec3], last: &mut [Option<Vec3>], seen: &mut Seen, time: f64, fps: f64) {
+    let ground = |p: Vec3| Vec2::new(p.x, p.z);
+    // pairs by a grid of 1 m cells: only neighbours can be closer than the closest so far
+    let mut cells: std::collections::HashMap<(i32, i32), Vec<usize>> = Default::default();
+    for (k, p) in roots.iter().enumerate() {
+        let c = (p.x.floor() as i32, p.z.floor() as i32);
+        cells.entry(c).or_default().push(k);
+    }
+    for (k, p) in roots.iter().enumerate() {
+        let (cx, cz) = (p.x.floor() as i32, p.z.floor() as i32);
+        for dx in -1..=1 {
+            for dz in -1..=1 {
+                for &j in cells.get(&(cx + dx, cz + dz)).into_iter().flatten() {
+                    let d = ground(*p).distance(ground(roots[j]));
+                    if j > k && d < seen.closest.0 {
+                        seen.closest = (d, k, j, time);
+                    }
+                }
+            }
+        }
+        if let Some(q) = last[k] {
+            let v = ground(*p).distance(ground(q)) * fps as f32;
+            if v > seen.fastest.0 {
+                seen.fastest = (v, k, time);
+            }
+            if q.y - p.y > seen.drop.0 {
+                seen.drop = (q.y - p.y, k, time);
+            }
+        }
+        last[k] = Some(*p);
+    }
+}
