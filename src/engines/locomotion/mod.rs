@@ -93,6 +93,9 @@ pub struct LocomotionEngine {
     obstacles: Arc<Obstacles>,
     /// Standing, whether it made room for a walker and where it stood before.
     room: Option<Room>,
+    /// Where its last walk arrived (cleared when another starts): pressed off it while
+    /// standing, it steps back (`locomotion::room::back_to`).
+    place: Option<crate::world::locomotion::gait::Body>,
     /// Whether the walk under way waits for one standing on its goal or settles beside them.
     settling: targets::Settling,
 }
@@ -227,6 +230,7 @@ impl LocomotionEngine {
         };
         let here = self.walker.as_ref().map_or(Vec2::ZERO, |w| w.body().at);
         self.settling = targets::Settling::default();
+        self.place = None;
         let walk = match resolve(world, &self.id, &u.order.target, here) {
             Some(goal) => Walk {
                 goal: goal.at,
@@ -360,6 +364,7 @@ impl LocomotionEngine {
         }
         if ended.is_some() {
             self.current = None;
+            self.place = self.walker.as_ref().map(|w| w.body());
             if let Some(short) = self.walker.as_mut().and_then(|w| w.stuck.take()) {
                 self.warnings.push((
                     key.clone(),

@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 use super::targets::resolve;
 use super::LocomotionEngine;
 use crate::engines::interface::{Revising, Revision, Travel, UnitKey};
-use crate::world::locomotion::room::make_room;
+use crate::world::locomotion::room::{back_to, make_room};
 use crate::world::locomotion::walker;
 use crate::world::{Placement, World};
 
@@ -166,6 +166,7 @@ impl LocomotionEngine {
                     .is_some_and(|r| p.distance(r.home.at) < 2.5)
             });
         if self.room.is_none() && crowd.askers(me).next().is_none() {
+            self.back_to_place(world, id, at, now);
             return;
         }
         let obstacles = world.obstacles_for(id);
@@ -185,6 +186,26 @@ impl LocomotionEngine {
                 self.obstacles = obstacles;
                 self.walked = true;
             }
+        }
+    }
+
+    /// Standing, asked by nobody, and pressed off the place its last walk arrived at: it steps
+    /// back to it (`locomotion::room::back_to`); such a walk sends no feedback.
+    fn back_to_place(&mut self, world: &World, id: &str, at: Placement, now: f64) {
+        let Some(place) = self.place else {
+            return;
+        };
+        let w = self.walker(at, world, now);
+        if w.moments().is_some() {
+            return;
+        }
+        let Some((room, walk)) = back_to(place, w.body()) else {
+            return;
+        };
+        let obstacles = world.obstacles_for(id);
+        if w.start(walk, &obstacles).is_ok() {
+            self.obstacles = obstacles;
+            self.room = Some(room);
         }
     }
 
