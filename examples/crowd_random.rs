@@ -26,17 +26,10 @@ const APART: f32 = 0.8;
 /// A walker within this of its goal has arrived (m).
 const ARRIVED: f32 = 0.3;
 
-/// A small deterministic generator (the same scene for the same seed).
-struct Lcg(u64);
-
-impl Lcg {
-    fn unit(&mut self) -> f32 {
-        self.0 = (self.0)
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+// (the same scene for the same seed, shared by the examples)
+#[path = "common/lcg.rs"]
+mod lcg;
+use lcg::Lcg;
 
 /// `n` spots in a square of `side` m centred on the origin, [`APART`] from each other.
 fn spots(rng: &mut Lcg, n: usize, side: f32) -> Vec<Vec2> {

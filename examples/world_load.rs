@@ -32,17 +32,10 @@ const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
 /// A district's side (m); walkers keep 2 m from its edges, 1.2 m from each other.
 const DISTRICT: f32 = 70.0;
 
-/// A small deterministic generator (the same scene in both runs).
-struct Lcg(u64);
-
-impl Lcg {
-    fn unit(&mut self) -> f32 {
-        self.0 = (self.0)
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+// (the same scene for the same seed, shared by the examples)
+#[path = "common/lcg.rs"]
+mod lcg;
+use lcg::Lcg;
 
 /// District `k`'s corner nearest the origin (two rows, as many columns as needed).
 fn district(k: usize, count: usize) -> (f32, f32) {
