@@ -178,13 +178,19 @@ fn main() {
     println!("{time:.1} s of scene in {wall:.1} s wall");
 }
 
-/// With `TRACE=w0001,w0002` in the environment: those walkers' places every second, their
-/// goals and the nearest other body.
+/// With `TRACE=w0001,w0002` in the environment: those walkers' places every second (every
+/// frame between `TRACE_FROM` and `TRACE_TO` seconds), their goals and the nearest other body.
 fn trace(roots: &[Vec3], goals: &[Vec2], time: f64, fps: f64) {
     let Ok(ids) = std::env::var("TRACE") else {
         return;
     };
-    if (time * fps).round() as i64 % fps.round().max(1.0) as i64 != 0 {
+    // every frame within TRACE_FROM..TRACE_TO (s), else once a second
+    let window = |name: &str| std::env::var(name).ok().and_then(|s| s.parse::<f64>().ok());
+    let every = match (window("TRACE_FROM"), window("TRACE_TO")) {
+        (Some(a), Some(b)) => (a..=b).contains(&time),
+        _ => false,
+    };
+    if !every && (time * fps).round() as i64 % fps.round().max(1.0) as i64 != 0 {
         return;
     }
     let ground = |p: Vec3| Vec2::new(p.x, p.z);

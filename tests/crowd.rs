@@ -621,3 +621,35 @@ fn one_starting_within_a_found_group_s_space_walks_out_of_it() {
         before = here;
     }
 }
+
+#[test]
+fn a_found_group_that_walks_off_is_not_walked_round() {
+    // two facing each other 1.2 m apart are found as a group; they walk off to either side,
+    // and 4 s later a walker crosses where they stood: no one converses there any more
+    let json = r#"{"characters": {
+        "g0": {"position": [-0.6, 0, 0], "facing": 90},
+        "g1": {"position": [0.6, 0, 0], "facing": -90},
+        "w": {"position": [0, 0, -6], "facing": 0}}}"#;
+    let world = World::from_json(json).expect("a world").0;
+    assert_eq!(world.groups().len(), 1, "{:?}", world.groups());
+    let mut r = Realizer::new();
+    *r.world_mut() = world;
+    for (who, goal, start) in [("g0", "-4,-6", 0.0), ("g1", "4,6", 0.0), ("w", "0,6", 4.0)] {
+        let bml = format!(
+            r#"<bml {NS} id="b_{who}" characterId="{who}"><locomotion id="l" start="{start}" target="{goal}"/></bml>"#
+        );
+        r.perform_bml(&bml).expect("a block");
+    }
+    let (mut widest, mut ended) = (0.0f32, false);
+    for frame in 0..=(20.0 * 30.0) as u32 {
+        let f = r.tick(f64::from(frame) / 30.0);
+        ended |= (f.feedback.iter()).any(
+            |fb| matches!(fb, Feedback::BlockProgress(p) if p.block == "b_w" && p.sync == "end"),
+        );
+        let root = f.character("w").expect("a pose").pose.root;
+        widest = widest.max(root.x.abs());
+    }
+    assert!(ended, "the walk did not end");
+    // (round the space they held at its start, it passed 1.5 m off its line)
+    assert!(widest < 0.3, "the walker strayed {widest} m off its line");
+}

@@ -75,6 +75,10 @@ impl Realizer {
             .filter_map(|(id, m)| Some((crowd.index(id)?, m.asking()?)))
             .collect();
         crowd.set_asks(asking);
+        let going: Vec<usize> = (self.characters.iter_mut())
+            .filter_map(|(id, m)| m.on_its_way().then(|| crowd.index(id)).flatten())
+            .collect();
+        crowd.set_on_their_way(going);
         // (walkers of other realizers asking someone here)
         let remote = (self.remote_asks.iter())
             .filter_map(|(who, asked)| Some((crowd.index(asked)?, crowd.index(who)?)));

@@ -170,15 +170,24 @@ impl World {
     }
 
     /// What character `id` walks round: the obstacles and the space of every conversing group
-    /// it is not in, as those groups stand now (each a circle through its members' far sides),
+    /// it is not in whose members all stand, as those groups stand now (each a circle through
+    /// its members' far sides),
     /// but for a space it already stands in (it walks out of that one; taken as an obstacle,
     /// it threw the character out of it 0.5 m in one frame).
     pub fn obstacles_for(&self, id: &str) -> Arc<crate::world::space::Obstacles> {
         use crate::world::space::obstacles::{Obstacle, Shape};
         let p = self.placement(id).position;
         let (here, radius) = (glam::Vec2::new(p.x, p.z), self.radius(id));
+        // (a member on the move breaks the group up, or it walks on together: no standing
+        // conversation to walk round)
+        let moving = |m: &String| {
+            (self.crowd.index(m)).is_some_and(|i| {
+                self.crowd.agent(i).velocity.length() > crate::world::crowd::group::STILL
+            })
+        };
         let spaces: Vec<Obstacle> = (self.groups.iter())
             .filter(|g| g.members.binary_search_by(|m| m.as_str().cmp(id)).is_err())
+            .filter(|g| !g.members.iter().any(moving))
             .filter_map(|g| {
                 let members: Vec<_> = (g.members.iter())
                     .filter(|m| self.is_placed(m))

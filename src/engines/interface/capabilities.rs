@@ -144,6 +144,12 @@ pub trait Travel {
         false
     }
 
+    /// Whether the character is on a walk of its own (going somewhere: if it stands still
+    /// now, it waits; it does not stand there for good).
+    fn on_its_way(&self) -> bool {
+        false
+    }
+
     /// Where the person stands whom the character, held back, asks to make room (world x, z),
     /// if it asks anyone (`crowd::negotiate`).
     fn asking(&self) -> Option<glam::Vec2> {

@@ -106,7 +106,7 @@ pub fn resolve(world: &World, me: &str, target: &str, from: Vec2) -> Option<Goal
 /// How far beyond each other's personal space (the bodies widened by the walker's profile,
 /// as its avoidance keeps them) a walker stops beside one standing on its goal (m).
 pub const BESIDE_GAP: f32 = 0.05;
-/// A character on a walk's goal slower than this (m/s) stands there.
+/// A character on a walk's goal slower than this (m/s), and on no walk of its own, stands there.
 pub const STANDING_SPEED: f32 = 0.2;
 /// A walker looks whether someone stands on its goal once it is this near it (m): from afar,
 /// one standing there now (as everyone does before they set off) may well be gone by then.
@@ -138,6 +138,8 @@ fn beside_whoever_stands(world: &World, me: &str, goal: Vec2, from: Vec2) -> Goa
     let mut near = Vec::new();
     crowd.near(goal, mine + MAX_RADIUS, &mut near);
     let standing = (near.iter())
+        // (one on a walk of its own that stands there waits: it does not take the place)
+        .filter(|&&i| !crowd.on_its_way(i))
         .filter_map(|&i| {
             let a = crowd.agent(i);
             on_it(crowd.id(i), a.at, a.radius, a.velocity)
@@ -254,6 +256,28 @@ mod tests {
         );
         // he leaves: the place is the walk's again
         assert_eq!(s.place(5.1, &goal(None)), (Vec2::new(0.0, 5.0), false));
+    }
+
+    #[test]
+    fn one_standing_on_the_goal_takes_it_but_one_waiting_on_its_own_walk_does_not() {
+        use crate::world::crowd::{Agent, Crowd};
+        let bob = Agent {
+            at: Vec2::new(0.1, 5.0),
+            velocity: Vec2::ZERO,
+            radius: 0.25,
+        };
+        let mut world = World::default();
+        let mut crowd = Crowd::new(0.0, [("Bob".to_string(), bob)]);
+        world.set_crowd(crowd.clone());
+        let goal = beside_whoever_stands(&world, "w", Vec2::new(0.0, 5.0), Vec2::new(0.0, 3.5));
+        let taken = goal.taken.expect("Bob stands on it");
+        assert_eq!(taken.by, "Bob");
+        assert!(taken.beside.y < 5.0 - 0.5, "{}", taken.beside);
+        // Bob waits there on a walk of his own: the place is still the walk's
+        crowd.set_on_their_way([0]);
+        world.set_crowd(crowd);
+        let goal = beside_whoever_stands(&world, "w", Vec2::new(0.0, 5.0), Vec2::new(0.0, 3.5));
+        assert!(goal.taken.is_none());
     }
 
     #[test]

@@ -2,6 +2,8 @@
 //! (starting the walks that are due, following their moments, pursuing a moving target), and,
 //! standing, making room for a walker that asks (`locomotion::room`).
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3};
 
 use super::targets::resolve;
@@ -99,6 +101,10 @@ impl Travel for LocomotionEngine {
                 }
             }
         }
+        // (on whole seconds, which every host's frames meet alike)
+        if (now - now.round()).abs() < 1e-6 {
+            self.look_round(world);
+        }
         let body = self.walker.as_ref().map(|w| w.body());
         self.at = match body {
             Some(b) => Placement {
@@ -116,6 +122,10 @@ impl Travel for LocomotionEngine {
         self.current.is_some()
             || self.room.is_some()
             || (self.walker.as_ref()).is_some_and(|w| !w.gait.at_rest(w.body()))
+    }
+
+    fn on_its_way(&self) -> bool {
+        self.current.is_some()
     }
 
     fn asking(&self) -> Option<Vec2> {
@@ -206,6 +216,25 @@ impl LocomotionEngine {
         if w.start(walk, &obstacles).is_ok() {
             self.obstacles = obstacles;
             self.room = Some(room);
+        }
+    }
+
+    /// Walking, looks round again at what it walks round (groups stand, walk off and form):
+    /// when that changed since the walk's route was planned, plans it again.
+    fn look_round(&mut self, world: &World) {
+        let Some(w) = self.walker.as_ref() else {
+            return;
+        };
+        let Some(walk) = w.walk().cloned() else {
+            return;
+        };
+        let now = self.round(world, w, &walk);
+        if Arc::ptr_eq(&now, &self.obstacles) || *now == *self.obstacles {
+            return;
+        }
+        let w = self.walker.as_mut().expect("looked at above");
+        if w.reroute(&now) {
+            self.obstacles = now;
         }
     }
 

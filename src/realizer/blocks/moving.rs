@@ -45,6 +45,11 @@ impl BlockManager {
         (self.registry.engines_mut()).any(|e| e.as_travel().is_some_and(|t| t.moving()))
     }
 
+    /// Whether an engine walks the character somewhere of its own.
+    pub fn on_its_way(&mut self) -> bool {
+        (self.registry.engines_mut()).any(|e| e.as_travel().is_some_and(|t| t.on_its_way()))
+    }
+
     /// Where the person stands whom the character asks to make room, if anyone.
     pub fn asking(&mut self) -> Option<glam::Vec2> {
         (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.asking()))

@@ -73,6 +73,18 @@ pub const PUSH_MARGIN: f32 = 0.04;
 /// overlap parts gently, a deep one quickly, and nobody jumps in one step however short the
 /// step (in a press of people, moving out of one body at once may lead into the next).
 pub fn pushed_out(at: Vec2, radius: f32, others: impl IntoIterator<Item = Agent>, dt: f32) -> Vec2 {
+    pushed_out_at_most(at, radius, others, dt, f32::INFINITY)
+}
+
+/// [`pushed_out`], never faster than `fastest` (m/s): a person in a press is moved by its own
+/// feet, not flung; an overlap deeper than that covers takes longer to part.
+pub fn pushed_out_at_most(
+    at: Vec2,
+    radius: f32,
+    others: impl IntoIterator<Item = Agent>,
+    dt: f32,
+    fastest: f32,
+) -> Vec2 {
     let mut push = Vec2::ZERO;
     for o in others {
         let d = at - o.at;
@@ -88,7 +100,34 @@ pub fn pushed_out(at: Vec2, radius: f32, others: impl IntoIterator<Item = Agent>
     }
     let share = 1.0 - (-dt / PUSH_TIME).exp();
     let step = (depth * share).max((PUSH_SPEED * dt).min(depth));
-    at + push / depth * step
+    at + push / depth * step.min(fastest * dt)
+}
+
+/// A move of a body of `radius` at `at` without the part that would take it nearer to anyone
+/// it touches (nearer than their two radii): it slides along them,
+/// as a person in a press does, rather than walking into them to be pushed out again. Several
+/// touches are taken in turn, three rounds, so that one wedged between two all but stops (the
+/// little left is pressed apart again).
+pub fn slid_along(at: Vec2, radius: f32, step: Vec2, others: &[Agent]) -> Vec2 {
+    let mut m = step;
+    for _ in 0..3 {
+        let mut slid = false;
+        for o in others {
+            let d = at - o.at;
+            let l = d.length();
+            if l < radius + o.radius && l > 1e-6 {
+                let into = m.dot(d / l);
+                if into < 0.0 {
+                    m -= d / l * into;
+                    slid = true;
+                }
+            }
+        }
+        if !slid {
+            break;
+        }
+    }
+    m
 }
 
 #[cfg(test)]
@@ -151,5 +190,35 @@ mod tests {
         // squeezed between two: the pushes cancel, nobody is flung out
         let at = pushed_out(Vec2::ZERO, 0.25, [other(0.4), other(-0.4)], dt);
         assert!(at.length() < 1e-6, "{at}");
+        // 24 cm inside: out at once unbounded, at most 0.6 m/s × dt bounded
+        let at = pushed_out(Vec2::ZERO, 0.25, [other(0.3)], 0.1);
+        assert!((at.x + 0.24).abs() < 0.01, "{at}");
+        let at = pushed_out_at_most(Vec2::ZERO, 0.25, [other(0.3)], 0.1, 0.6);
+        assert!((at.x + 0.06).abs() < 1e-6, "{at}");
+    }
+
+    #[test]
+    fn a_move_into_one_touched_slides_along_them_and_a_wedged_one_stops() {
+        let other = |x: f32, z: f32| Agent {
+            at: Vec2::new(x, z),
+            velocity: Vec2::ZERO,
+            radius: 0.25,
+        };
+        let step = Vec2::new(0.01, 0.01);
+        // nobody touched: the move as it was
+        assert_eq!(slid_along(Vec2::ZERO, 0.25, step, &[other(2.0, 0.0)]), step);
+        // one touched on the right (+x): only the move along them is left
+        let m = slid_along(Vec2::ZERO, 0.25, step, &[other(0.49, 0.0)]);
+        assert!(m.x.abs() < 1e-7 && (m.y - 0.01).abs() < 1e-7, "{m}");
+        // moving away from one touched: untouched
+        let away = Vec2::new(-0.01, 0.0);
+        assert_eq!(
+            slid_along(Vec2::ZERO, 0.25, away, &[other(0.49, 0.0)]),
+            away
+        );
+        // wedged between one on the right and one ahead-left: all but stopped
+        let wedge = [other(0.49, 0.0), other(-0.29, 0.39)];
+        let m = slid_along(Vec2::ZERO, 0.25, step, &wedge);
+        assert!(m.length() < 0.1 * step.length(), "{m}");
     }
 }

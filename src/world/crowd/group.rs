@@ -23,6 +23,9 @@ pub const REACH: f32 = 3.0;
 /// Kept beyond a group's space by walkers going round it (m): their personal space, so that
 /// passing the members is not a contact to avoid.
 pub const PASSING: f32 = 0.3;
+/// A member moving faster than this (m/s) is not standing in conversation: its group holds no
+/// space while it moves.
+pub const STILL: f32 = 0.2;
 /// Most members a group may have.
 pub const MAX_MEMBERS: usize = 32;
 /// A group whose members stand further than this from its centre holds no space (m): they have

@@ -51,6 +51,8 @@ pub struct Crowd {
     placed: Vec<Vec2>,
     /// (asked, asking), sorted: who asks whom to make room (`crowd::negotiate`).
     asks: Vec<(u32, u32)>,
+    /// Who is on a walk of its own (indices, sorted): standing still, it only waits.
+    going: Vec<u32>,
 }
 
 fn cell_of(p: Vec2) -> (i32, i32) {
@@ -105,6 +107,7 @@ impl Crowd {
             cells,
             placed,
             asks: Vec::new(),
+            going: Vec::new(),
         }
     }
 
@@ -126,6 +129,19 @@ impl Crowd {
             }
         }
         self.set_ask_pairs(pairs);
+    }
+
+    /// Notes who is on a walk of its own (indices): standing still, such a one waits, and
+    /// does not stand on anyone's goal for good.
+    pub fn set_on_their_way(&mut self, going: impl IntoIterator<Item = usize>) {
+        self.going = going.into_iter().map(|i| i as u32).collect();
+        self.going.sort_unstable();
+        self.going.dedup();
+    }
+
+    /// Whether character `i` is on a walk of its own.
+    pub fn on_its_way(&self, i: usize) -> bool {
+        self.going.binary_search(&(i as u32)).is_ok()
     }
 
     /// Notes who asks whom to make room, as (asked, asking) indices.

@@ -343,6 +343,25 @@ impl Walker {
         self.restart(walk, obstacles);
     }
 
+    /// Plans the walk under way again among `obstacles` (the world's changed: a group that
+    /// stood walked off, or one formed); false if none is under way or it cannot be planned
+    /// there (it then goes on as it was).
+    pub fn reroute(&mut self, obstacles: &Obstacles) -> bool {
+        let Some(a) = self.active.as_ref() else {
+            return false;
+        };
+        if a.halting || a.stopped || a.walk.stepping || !self.can_route(&a.walk, obstacles) {
+            return false;
+        }
+        let walk = a.walk.clone();
+        self.restart(walk, obstacles)
+    }
+
+    /// The walk under way, if any.
+    pub fn walk(&self) -> Option<&Walk> {
+        self.active.as_ref().map(|a| &a.walk)
+    }
+
     /// Plans the walk under way again from where the body stands when the point its route
     /// seeks is out of sight within its radius (others pressed it behind an obstacle's
     /// clearance, where seeking that point only pushes it along the obstacle); true if it did.

@@ -17,6 +17,12 @@ use crate::world::locomotion::steering::{flat, Behaviour, Context};
 use crate::world::space::obstacles::Obstacles;
 use crate::world::space::path;
 
+/// Fastest a body left overlapping another (both moved at once) is moved apart (m/s), on top
+/// of its walk: a quick side step, so that a press never throws a person (uncapped, roots were
+/// shoved at up to 10 m/s between frames; at 0.6 m/s a walker in the plaza, held back longer,
+/// set off later across its feet and dragged one 1.5 cm).
+pub const PRESSED_APART: f32 = 1.0;
+
 impl Walker {
     /// One step; the moments when the walk ends in it.
     pub(super) fn step(
@@ -34,11 +40,12 @@ impl Walker {
             self.replan_if_lost(obstacles);
         }
         let facing_before = self.facing;
+        let before = self.body().at;
         if let Some(mut a) = self.active.take() {
             self.drive(&mut a, dt, obstacles, others);
             self.active = Some(a);
         }
-        self.keep_apart(dt, obstacles, others);
+        self.keep_apart(dt, before, obstacles, others);
         self.face_the_way(dt);
         self.attend(dt, others);
         self.step_the_feet(dt, facing_before)
@@ -253,23 +260,40 @@ impl Walker {
         }
     }
 
-    /// Never into another body, nor into an obstacle.
-    fn keep_apart(&mut self, dt: f32, obstacles: &Obstacles, others: Option<Others<'_>>) {
+    /// Never into another body, nor into an obstacle: the step from `before` slides along
+    /// whoever it touches, and an overlap left (the others moved too) parts no faster than
+    /// [`PRESSED_APART`]; an obstacle pushes the body out, but never into another body (a
+    /// group's space is kept by manners, a body by contact).
+    fn keep_apart(
+        &mut self,
+        dt: f32,
+        before: Vec2,
+        obstacles: &Obstacles,
+        others: Option<Others<'_>>,
+    ) {
+        use crate::world::crowd::contact::{pushed_out_at_most, slid_along};
         self.vehicle.position.y = 0.0;
         self.vehicle.velocity.y = 0.0;
-        if let Some(o) = others {
-            let here = self.body().at;
+        let near = match others {
             // (bodies never pass through each other, seen or not)
-            let everyone = Others { known: None, ..o };
-            let near = neighbours(everyone, self.time, here, self.radius + 1.0);
-            let out = crate::world::crowd::contact::pushed_out(here, self.radius, near, dt);
-            self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
-        }
-        let here = self.body().at;
-        let out = obstacles.push_out(here, self.radius);
-        if out != here {
-            self.vehicle.position = Vec3::new(out.x, 0.0, out.y);
-        }
+            Some(o) => neighbours(
+                Others { known: None, ..o },
+                self.time,
+                before,
+                self.radius + 1.0,
+            ),
+            None => Vec::new(),
+        };
+        let moved = slid_along(before, self.radius, self.body().at - before, &near);
+        let v = slid_along(before, self.radius, self.velocity(), &near);
+        self.vehicle.velocity = Vec3::new(v.x, 0.0, v.y);
+        let at = before + moved;
+        // (pressed out of one, never into another)
+        let out = pushed_out_at_most(at, self.radius, near.iter().copied(), dt, PRESSED_APART);
+        let at = at + slid_along(at, self.radius, out - at, &near);
+        let out = obstacles.push_out(at, self.radius);
+        let at = at + slid_along(at, self.radius, out - at, &near);
+        self.vehicle.position = Vec3::new(at.x, 0.0, at.y);
     }
 
     /// Faces the way of travel, never walking backwards (unless stepping aside).

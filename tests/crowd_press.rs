@@ -1,0 +1,130 @@
+//! A press of whole-body walkers on random trips (the scenes of the `crowd_random` example,
+//! smaller): judged from every frame's roots, as a user would see them. Bodies stay people in
+//! the press: no two roots within 0.45 m, no root moved faster than 2.5 m/s between frames, the
+//! hips never drop 10 cm between frames; and every walker arrives within 0.3 m of its goal.
+//! (Before bodies slid along whoever they touched and were pressed apart at a side step's
+//! speed, roots came within 0.32 m and were shoved at up to 10 m/s.)
+
+use bml_realizer::language::feedback::Feedback;
+use bml_realizer::realizer::Realizer;
+use bml_realizer::world::World;
+use glam::{Vec2, Vec3};
+
+#[path = "../examples/common/lcg.rs"]
+mod lcg;
+use lcg::Lcg;
+
+const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+
+/// `n` spots in a square of `side` m centred on the origin, 0.8 m from each other.
+fn spots(rng: &mut Lcg, n: usize, side: f32) -> Vec<Vec2> {
+    let mut out: Vec<Vec2> = Vec::with_capacity(n);
+    while out.len() < n {
+        let p = Vec2::new(rng.unit() - 0.5, rng.unit() - 0.5) * side;
+        if out.iter().all(|q| q.distance(p) >= 0.8) {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// What the frames of one scene showed.
+struct Seen {
+    closest: f32,
+    fastest: f32,
+    drop: f32,
+    stranded: Vec<String>,
+}
+
+/// `n` walkers in a `side` m square, ticked at `fps` for at most `until` s.
+fn press(n: usize, side: f32, fps: f64, seed: u64, until: f64) -> Seen {
+    let mut rng = Lcg(seed);
+    let (starts, goals) = (spots(&mut rng, n, side), spots(&mut rng, n, side));
+    let id = |k: usize| format!("w{k:03}");
+    let chars: Vec<String> = (0..n)
+        .map(|k| {
+            let (s, g) = (starts[k], goals[k]);
+            let facing = (g - s).x.atan2((g - s).y).to_degrees();
+            format!(
+                r#""{}": {{"position": [{}, 0, {}], "facing": {facing}}}"#,
+                id(k),
+                s.x,
+                s.y
+            )
+        })
+        .collect();
+    let json = format!(r#"{{"characters": {{{}}}}}"#, chars.join(", "));
+    let mut r = Realizer::new();
+    *r.world_mut() = World::from_json(&json).expect("a world").0;
+    for (k, g) in goals.iter().enumerate() {
+        let bml = format!(
+            r#"<bml {NS} id="b{k}" characterId="{}"><locomotion id="w" target="{},{}"/></bml>"#,
+            id(k),
+            g.x,
+            g.y
+        );
+        r.perform_bml(&bml).expect("a block");
+    }
+    let ground = |p: Vec3| Vec2::new(p.x, p.z);
+    let mut seen = Seen {
+        closest: f32::MAX,
+        fastest: 0.0,
+        drop: 0.0,
+        stranded: Vec::new(),
+    };
+    let mut ended = vec![false; n];
+    let mut last: Vec<Option<Vec3>> = vec![None; n];
+    for frame in 0..=(until * fps) as u32 {
+        let f = r.tick(f64::from(frame) / fps);
+        for fb in &f.feedback {
+            if let Feedback::BlockProgress(p) = fb {
+                if p.sync == "end" {
+                    let k: usize = p.block.trim_start_matches('b').parse().expect("bN");
+                    ended[k] = true;
+                }
+            }
+        }
+        let roots: Vec<Vec3> = (0..n)
+            .map(|k| f.character(&id(k)).expect("a pose").pose.root)
+            .collect();
+        for (k, p) in roots.iter().enumerate() {
+            for q in &roots[k + 1..] {
+                seen.closest = seen.closest.min(ground(*p).distance(ground(*q)));
+            }
+            if let Some(q) = last[k] {
+                let v = ground(*p).distance(ground(q)) * fps as f32;
+                seen.fastest = seen.fastest.max(v);
+                seen.drop = seen.drop.max(q.y - p.y);
+            }
+            last[k] = Some(*p);
+        }
+        if ended.iter().all(|&e| e) {
+            break;
+        }
+    }
+    for k in 0..n {
+        let off = last[k].map_or(f32::MAX, |p| ground(p).distance(goals[k]));
+        if off > 0.3 || !ended[k] {
+            seen.stranded.push(format!("{} {off:.2} m off", id(k)));
+        }
+    }
+    seen
+}
+
+#[test]
+fn bodies_in_a_press_stay_people() {
+    for fps in [10.0, 30.0] {
+        let seen = press(60, 10.0, fps, 1, 40.0);
+        let what = format!(
+            "at {fps} fps: closest {:.3} m, fastest {:.2} m/s, hip drop {:.1} cm, stranded {:?}",
+            seen.closest,
+            seen.fastest,
+            seen.drop * 100.0,
+            seen.stranded
+        );
+        eprintln!("{what}");
+        assert!(seen.closest >= 0.45, "{what}");
+        assert!(seen.fastest <= 2.5, "{what}");
+        assert!(seen.drop <= 0.1, "{what}");
+    }
+}
