@@ -624,8 +624,9 @@ fn one_starting_within_a_found_group_s_space_walks_out_of_it() {
 
 #[test]
 fn a_found_group_that_walks_off_is_not_walked_round() {
-    // two facing each other 1.2 m apart are found as a group; they walk off to either side,
-    // and 4 s later a walker crosses where they stood: no one converses there any more
+    // two facing each other 1.2 m apart are found as a group; they turn and walk off to
+    // either side, and a walker sets off at 2.5 s (they are 3.6 m apart) across where they
+    // stood: once they walk, no one converses there any more
     let json = r#"{"characters": {
         "g0": {"position": [-0.6, 0, 0], "facing": 90},
         "g1": {"position": [0.6, 0, 0], "facing": -90},
@@ -634,7 +635,7 @@ fn a_found_group_that_walks_off_is_not_walked_round() {
     assert_eq!(world.groups().len(), 1, "{:?}", world.groups());
     let mut r = Realizer::new();
     *r.world_mut() = world;
-    for (who, goal, start) in [("g0", "-4,-6", 0.0), ("g1", "4,6", 0.0), ("w", "0,6", 4.0)] {
+    for (who, goal, start) in [("g0", "-6,2", 0.0), ("g1", "6,-2", 0.0), ("w", "0,6", 2.5)] {
         let bml = format!(
             r#"<bml {NS} id="b_{who}" characterId="{who}"><locomotion id="l" start="{start}" target="{goal}"/></bml>"#
         );
@@ -651,5 +652,5 @@ fn a_found_group_that_walks_off_is_not_walked_round() {
     }
     assert!(ended, "the walk did not end");
     // (round the space they held at its start, it passed 1.5 m off its line)
-    assert!(widest < 0.3, "the walker strayed {widest} m off its line");
+    assert!(widest < 0.5, "the walker strayed {widest} m off its line");
 }
