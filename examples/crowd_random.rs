@@ -15,43 +15,17 @@
 use std::time::Instant;
 
 use bml_realizer::language::feedback::Feedback;
-use bml_realizer::realizer::Realizer;
-use bml_realizer::world::World;
 use glam::{Vec2, Vec3};
 
-const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
-
-/// How far apart starts (and goals) are at least (m).
-const APART: f32 = 0.8;
 /// A walker within this of its goal has arrived (m).
 const ARRIVED: f32 = 0.3;
 
-// (the same scene for the same seed, shared by the examples)
+// (the same scenes for the same seed, shared with tests/crowd_press.rs)
 #[path = "common/lcg.rs"]
 mod lcg;
-use lcg::Lcg;
-
-/// `n` spots in a square of `side` m centred on the origin, [`APART`] from each other.
-fn spots(rng: &mut Lcg, n: usize, side: f32) -> Vec<Vec2> {
-    let mut out: Vec<Vec2> = Vec::with_capacity(n);
-    let mut tries = 0;
-    while out.len() < n {
-        tries += 1;
-        assert!(
-            tries < 1000 * n,
-            "{n} spots {APART} m apart do not fit {side} m"
-        );
-        let p = Vec2::new(rng.unit() - 0.5, rng.unit() - 0.5) * side;
-        if out.iter().all(|q| q.distance(p) >= APART) {
-            out.push(p);
-        }
-    }
-    out
-}
-
-fn id(k: usize) -> String {
-    format!("w{k:04}")
-}
+#[path = "common/trips.rs"]
+mod trips;
+use trips::{id, trips};
 
 fn argument<T: std::str::FromStr>(k: usize, default: T) -> T {
     std::env::args()
@@ -74,34 +48,7 @@ fn main() {
     let fps: f64 = argument(3, 10.0);
     let seed: u64 = argument(4, 1);
     let until: f64 = argument(5, 60.0);
-    let mut rng = Lcg(seed);
-    let starts = spots(&mut rng, n, side);
-    let goals = spots(&mut rng, n, side);
-
-    let chars: Vec<String> = (0..n)
-        .map(|k| {
-            let (s, g) = (starts[k], goals[k]);
-            let facing = (g - s).x.atan2((g - s).y).to_degrees();
-            format!(
-                r#""{}": {{"position": [{}, 0, {}], "facing": {facing}}}"#,
-                id(k),
-                s.x,
-                s.y
-            )
-        })
-        .collect();
-    let json = format!(r#"{{"characters": {{{}}}}}"#, chars.join(", "));
-    let mut r = Realizer::new();
-    *r.world_mut() = World::from_json(&json).expect("a world").0;
-    for (k, g) in goals.iter().enumerate() {
-        let bml = format!(
-            r#"<bml {NS} id="b{k}" characterId="{}"><locomotion id="w" target="{},{}"/></bml>"#,
-            id(k),
-            g.x,
-            g.y
-        );
-        r.perform_bml(&bml).expect("a block");
-    }
+    let (mut r, goals) = trips(n, side, seed);
 
     let clock = Instant::now();
     let mut seen = Seen {

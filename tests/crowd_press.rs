@@ -9,27 +9,13 @@
 //! of 100 are still on their way or gave up (14 before).
 
 use bml_realizer::language::feedback::Feedback;
-use bml_realizer::realizer::Realizer;
-use bml_realizer::world::World;
 use glam::{Vec2, Vec3};
 
 #[path = "../examples/common/lcg.rs"]
 mod lcg;
-use lcg::Lcg;
-
-const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
-
-/// `n` spots in a square of `side` m centred on the origin, 0.8 m from each other.
-fn spots(rng: &mut Lcg, n: usize, side: f32) -> Vec<Vec2> {
-    let mut out: Vec<Vec2> = Vec::with_capacity(n);
-    while out.len() < n {
-        let p = Vec2::new(rng.unit() - 0.5, rng.unit() - 0.5) * side;
-        if out.iter().all(|q| q.distance(p) >= 0.8) {
-            out.push(p);
-        }
-    }
-    out
-}
+#[path = "../examples/common/trips.rs"]
+mod trips;
+use trips::{id, trips};
 
 /// What the frames of one scene showed.
 struct Seen {
@@ -41,33 +27,7 @@ struct Seen {
 
 /// `n` walkers in a `side` m square, ticked at `fps` for at most `until` s.
 fn press(n: usize, side: f32, fps: f64, seed: u64, until: f64) -> Seen {
-    let mut rng = Lcg(seed);
-    let (starts, goals) = (spots(&mut rng, n, side), spots(&mut rng, n, side));
-    let id = |k: usize| format!("w{k:03}");
-    let chars: Vec<String> = (0..n)
-        .map(|k| {
-            let (s, g) = (starts[k], goals[k]);
-            let facing = (g - s).x.atan2((g - s).y).to_degrees();
-            format!(
-                r#""{}": {{"position": [{}, 0, {}], "facing": {facing}}}"#,
-                id(k),
-                s.x,
-                s.y
-            )
-        })
-        .collect();
-    let json = format!(r#"{{"characters": {{{}}}}}"#, chars.join(", "));
-    let mut r = Realizer::new();
-    *r.world_mut() = World::from_json(&json).expect("a world").0;
-    for (k, g) in goals.iter().enumerate() {
-        let bml = format!(
-            r#"<bml {NS} id="b{k}" characterId="{}"><locomotion id="w" target="{},{}"/></bml>"#,
-            id(k),
-            g.x,
-            g.y
-        );
-        r.perform_bml(&bml).expect("a block");
-    }
+    let (mut r, goals) = trips(n, side, seed);
     let ground = |p: Vec3| Vec2::new(p.x, p.z);
     let mut seen = Seen {
         closest: f32::MAX,
