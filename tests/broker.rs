@@ -304,6 +304,46 @@ fn walkers_served_by_two_realizers_go_round_each_other_and_both_arrive() {
 }
 
 #[test]
+fn one_standing_still_is_said_once_a_second_and_a_walker_twenty_times() {
+    let Some(broker) = Broker::start() else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("bmlr-broker-rest-{}", broker.port));
+    std::fs::create_dir_all(&dir).unwrap();
+    let world = dir.join("world.json");
+    std::fs::write(
+        &world,
+        r#"{"characters": {"s": {"position": [0, 0, 0], "facing": 90}}}"#,
+    )
+    .unwrap();
+    let _r = realizer(&broker, "r", &["s"], &["--world", world.to_str().unwrap()]);
+    let mut p = planner_on(&broker, "planner", &["bml/realizers/+", "bml/world/+/+"]);
+    until_online(&p, &["r"]);
+    // standing: a state a second (not twenty)
+    let standing = states(&hear(&p, 3.0, |_| false)).len();
+    assert!((2..=5).contains(&standing), "{standing} states in 3 s");
+    p.subscribe("bml/s/feedback");
+    let bml = format!(r#"<bml {NS} id="go"><locomotion id="w" target="3,0"/></bml>"#);
+    p.publish("bml/s/bml", bml.into_bytes(), false);
+    let mut heard = hear(&p, 15.0, |h| ended(h, "s", "go"));
+    assert!(ended(&heard, "s", "go"), "{heard:?}");
+    heard.extend(hear(&p, 0.5, |_| false));
+    // walking: every 0.05 s, and the last says where it stopped
+    let walking = states(&heard);
+    assert!(
+        walking.len() >= 30,
+        "{} states on a 3 m walk",
+        walking.len()
+    );
+    let (_, x, z) = walking.last().unwrap();
+    assert!(
+        (x - 3.0).abs() < 0.15 && z.abs() < 0.15,
+        "last said at {x}, {z}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_realizer_serving_more_characters_than_its_link_queues_at_once_comes_online() {
     // (600 topics to subscribe to, more than the link hands the MQTT client at once: the
     // subscriptions were renewed from the first again and again, and it never said online)

@@ -1,6 +1,6 @@
 //! One world over many realizers on a broker, shared by area. The floor is cut into cells
 //! (`--cell`, 10 m); 20 times a second this realizer publishes each of its characters' root
-//! state on the topic of the cell it stands in (`PREFIX/world/CELL/CHARACTER`) and listens to
+//! state (once a second for one standing still) on the topic of the cell it stands in (`PREFIX/world/CELL/CHARACTER`) and listens to
 //! the cells within a walker's avoidance range of its characters, moving its subscriptions as
 //! they walk. The characters of other realizers it hears of are placed in its world
 //! (`Realizer::place_remote`), so that its walkers go round them, look at them and answer their
@@ -13,7 +13,9 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 
-use bml_realizer::ports::broker::{Cell, RootState, DEFAULT_CHARACTER, PUBLISH_PERIOD, STALE};
+use bml_realizer::ports::broker::{
+    Cell, RootState, DEFAULT_CHARACTER, PUBLISH_PERIOD, REST_PERIOD, STALE,
+};
 use bml_realizer::realizer::clock::Clock;
 use bml_realizer::realizer::Realizer;
 
@@ -52,6 +54,8 @@ pub struct Sharing {
     unheard: BTreeSet<String>,
     /// The cell each of this realizer's characters was last published in.
     own_cells: BTreeMap<String, Cell>,
+    /// Each of this realizer's characters' last published state, and when (local clock).
+    sent: BTreeMap<String, (RootState, f64)>,
     /// The cells listened to now.
     listened: BTreeSet<Cell>,
     /// When this realizer last published its characters' states.
@@ -77,6 +81,7 @@ impl Sharing {
             others: BTreeMap::new(),
             unheard,
             own_cells: BTreeMap::new(),
+            sent: BTreeMap::new(),
             listened: BTreeSet::new(),
             published: f64::NEG_INFINITY,
             bad_states: BTreeSet::new(),
@@ -219,7 +224,13 @@ impl Server {
                     ..state.clone()
                 };
                 self.send_state(left, &id, moved);
+            } else if let Some((before, when)) = self.sharing.sent.get(&id) {
+                // (one standing still is said again only every REST_PERIOD)
+                if state.at_rest_as(before) && now - when < REST_PERIOD {
+                    continue;
+                }
             }
+            self.sharing.sent.insert(id.clone(), (state.clone(), now));
             self.send_state(cell, &id, state);
         }
         places

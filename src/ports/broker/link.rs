@@ -1,5 +1,5 @@
-//! A link to an MQTT broker that keeps itself connected: rumqttc's blocking client, its
-//! connection polled on a thread of its own. Every (re)connection renews the subscriptions and
+//! A link to an MQTT broker that keeps itself connected: rumqttc's blocking MQTT 5 client (the
+//! protocol ipaacar's components speak too), its connection polled on a thread of its own. Every (re)connection renews the subscriptions and
 //! the presence (retained `online`, with `offline` as the last will), since a broker that
 //! restarted has forgotten both. What arrives waits in a bounded inbox (the polling thread
 //! waits when it is full, and the broker holds back: backpressure; a state heard at QoS 0 is
@@ -10,8 +10,10 @@
 //! at most [`OUTBOX_LIMIT`] messages in all, beyond which the oldest of the longest lane are
 //! dropped and counted ([`Link::take_dropped`]). States that a newer one replaces (a
 //! character's place, 20 times a second) go at QoS 0 and only the newest of a topic waits
-//! ([`Link::publish_state`]); subscriptions may change while connected ([`Link::subscribe`],
-//! [`Link::unsubscribe`]). TCP_NODELAY is set: without it small messages wait for the
+//! ([`Link::publish_state`]); subscriptions to states may change while connected
+//! ([`Link::subscribe`], [`Link::unsubscribe`]) and are "no local": the broker does not send a
+//! link's own states back to it (MQTT 5 only: under 3.1.1 a realizer listening to the cells its
+//! characters stand in heard every state of its own again). TCP_NODELAY is set: without it small messages wait for the
 //! previous one's acknowledgement (Nagle's algorithm, ~40 ms stalls).
 
 use std::collections::{BTreeMap, VecDeque};
@@ -21,9 +23,9 @@ use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use rumqttc::{
-    Client, ClientError, Event, LastWill, MqttOptions, Packet, QoS, Request, SubscribeFilter,
-};
+use rumqttc::v5::mqttbytes::v5::{Filter, LastWill, Packet};
+use rumqttc::v5::mqttbytes::QoS;
+use rumqttc::v5::{Client, ClientError, Connection, Event, MqttOptions, Request};
 
 use super::BrokerUrl;
 
@@ -114,16 +116,16 @@ impl Link {
     pub fn connect(options: LinkOptions) -> Result<Link, String> {
         let mut mqtt = MqttOptions::new(&options.client_id, &options.url.host, options.url.port);
         mqtt.set_keep_alive(Duration::from_secs(5));
-        mqtt.set_clean_session(true);
-        mqtt.set_max_packet_size(MAX_PACKET, MAX_PACKET);
+        mqtt.set_clean_start(true);
+        mqtt.set_max_packet_size(Some(MAX_PACKET as u32));
         if let Some(p) = &options.presence {
-            mqtt.set_last_will(LastWill::new(p, "offline", QoS::AtLeastOnce, true));
+            mqtt.set_last_will(LastWill::new(p, "offline", QoS::AtLeastOnce, true, None));
         }
-        let (client, mut connection) = Client::new(mqtt, REQUESTS);
-        let mut network = connection.eventloop.network_options();
+        let mut network = mqtt.network_options();
         network.set_tcp_nodelay(true);
         network.set_connection_timeout(5);
-        connection.eventloop.set_network_options(network);
+        mqtt.set_network_options(network);
+        let (client, mut connection) = Client::new(mqtt, REQUESTS);
         let (tx, inbox) = mpsc::sync_channel(options.inbox.max(1));
         let (ready_tx, ready) = mpsc::channel::<Result<(), String>>();
         let subscriptions: Subscriptions = Arc::new(Mutex::new(
@@ -229,7 +231,7 @@ impl Link {
     pub fn flush(&mut self) {
         while let Some(change) = self.changes.pop_front() {
             let handed = match &change {
-                Change::Subscribe(f, qos) => self.client.try_subscribe(f, *qos),
+                Change::Subscribe(f, qos) => self.client.try_subscribe_many([filter(f, *qos)]),
                 Change::Unsubscribe(f) => self.client.try_unsubscribe(f),
             };
             if handed.is_err() {
@@ -340,13 +342,24 @@ impl Link {
     }
 }
 
+/// The filter subscribed to for `path` at `qos`: one at QoS 0 listens to states, and the broker
+/// sends none of this link's own back ("no local").
+fn filter(path: &str, qos: QoS) -> Filter {
+    Filter {
+        nolocal: qos == QoS::AtMostOnce,
+        ..Filter::new(path, qos)
+    }
+}
+
 /// The message a failed `try_publish` did not send (`None`: it was malformed).
 fn unsent(e: ClientError) -> Option<(String, Vec<u8>, bool)> {
     match e {
         ClientError::TryRequest(Request::Publish(p))
-        | ClientError::Request(Request::Publish(p)) => {
-            Some((p.topic, p.payload.to_vec(), p.retain))
-        }
+        | ClientError::Request(Request::Publish(p)) => Some((
+            String::from_utf8_lossy(&p.topic).into_owned(),
+            p.payload.to_vec(),
+            p.retain,
+        )),
         _ => None,
     }
 }
@@ -361,12 +374,7 @@ struct Poller {
 }
 
 impl Poller {
-    fn run(
-        self,
-        connection: &mut rumqttc::Connection,
-        tries: u32,
-        ready: mpsc::Sender<Result<(), String>>,
-    ) {
+    fn run(self, connection: &mut Connection, tries: u32, ready: mpsc::Sender<Result<(), String>>) {
         let mut ready = Some(ready);
         let (mut failures, mut lost) = (0u32, false);
         let mut wait = Duration::from_millis(100);
@@ -398,7 +406,7 @@ impl Poller {
                 Ok(Event::Incoming(Packet::Publish(p))) => {
                     let qos = p.qos;
                     let m = Inbound::Message {
-                        topic: p.topic,
+                        topic: String::from_utf8_lossy(&p.topic).into_owned(),
                         payload: p.payload.to_vec(),
                     };
                     // a state (QoS 0) the next one makes old is dropped when the inbox is
@@ -450,10 +458,10 @@ impl Poller {
             Some(last) => (Bound::Excluded(last), Bound::Unbounded),
             None => (Bound::Unbounded, Bound::Unbounded),
         };
-        let filters: Vec<SubscribeFilter> = (self.subscriptions.lock())
+        let filters: Vec<Filter> = (self.subscriptions.lock())
             .unwrap_or_else(|e| e.into_inner())
             .range::<str, _>(after)
-            .map(|(path, qos)| SubscribeFilter::new(path.clone(), *qos))
+            .map(|(path, qos)| filter(path, *qos))
             .collect();
         for batch in filters.chunks(RENEW_BATCH) {
             if self.client.try_subscribe_many(batch.to_vec()).is_err() {

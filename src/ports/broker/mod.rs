@@ -17,7 +17,7 @@ mod wire;
 pub use cells::{Cell, Cells, CELL_SIZE, CELL_SIZES, KEEP_MARGIN, LISTEN_RADIUS};
 pub use ipaaca::Ipaaca;
 pub use link::{Inbound, Link, LinkOptions, OUTBOX_LIMIT};
-pub use state::{RootState, EXTRAPOLATE, PUBLISH_PERIOD, STALE};
+pub use state::{RootState, EXTRAPOLATE, PUBLISH_PERIOD, REST_PERIOD, STALE};
 pub use stomp::{StompLink, StompOptions, StompUrl};
 pub use topics::{level_ok, BrokerUrl, Topics, DEFAULT_CHARACTER};
 pub use wire::Wire;

@@ -24,6 +24,12 @@ pub const STALE: f64 = 3.0;
 /// How often a realizer publishes its characters' states (s): 20 Hz.
 pub const PUBLISH_PERIOD: f64 = 0.05;
 
+/// How often a character at rest has its state published (s): one standing still where its
+/// last state put it, asking nobody, is said again only this often, to show it is still
+/// there (well within [`STALE`]); any change is published at once, on the next
+/// [`PUBLISH_PERIOD`].
+pub const REST_PERIOD: f64 = 1.0;
+
 /// One character's root state.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RootState {
@@ -69,6 +75,21 @@ impl RootState {
         Ok(s)
     }
 
+    /// Whether this state, sent after `before`, tells a receiver nothing new: the character
+    /// stood still at `before`'s place and facing (within 1 mm and 0.1°) and still does, and
+    /// asks nobody.
+    pub fn at_rest_as(&self, before: &RootState) -> bool {
+        let still = |v: &[f32; 3]| v.iter().all(|c| c.abs() < 1e-3);
+        let near = (self.position.iter().zip(&before.position)).all(|(a, b)| (a - b).abs() < 1e-3);
+        still(&self.velocity)
+            && still(&before.velocity)
+            && near
+            && (self.facing - before.facing).abs() < 0.1
+            && self.asks.is_none()
+            && before.asks.is_none()
+            && self.moved.is_none()
+    }
+
     /// The payload.
     pub fn to_json(&self) -> String {
         serde_json::to_string(self).expect("numbers are finite")
@@ -112,5 +133,33 @@ mod tests {
         assert!(!s.to_json().contains("asks"));
         let nan = br#"{"time": 0, "position": [0, 0, 0], "velocity": [0, 0, 0], "facing": 1e999}"#;
         assert!(RootState::from_json(nan).is_err());
+    }
+
+    #[test]
+    fn only_a_character_standing_where_it_stood_is_at_rest() {
+        let at = Placement::new(Vec3::new(1.0, 0.0, 2.0), 90.0);
+        let still = RootState::new(1.0, at, Vec3::ZERO);
+        let later = RootState {
+            time: 1.5,
+            ..still.clone()
+        };
+        assert!(later.at_rest_as(&still));
+        let walking = RootState::new(1.0, at, Vec3::new(1.0, 0.0, 0.0));
+        assert!(!later.at_rest_as(&walking), "it has just stopped");
+        assert!(!walking.at_rest_as(&still), "it has set off");
+        let stepped = Placement::new(Vec3::new(1.01, 0.0, 2.0), 90.0);
+        assert!(!RootState::new(1.5, stepped, Vec3::ZERO).at_rest_as(&still));
+        let turned = Placement::new(at.position, 91.0);
+        assert!(!RootState::new(1.5, turned, Vec3::ZERO).at_rest_as(&still));
+        let asking = RootState {
+            asks: Some("s3".into()),
+            ..later.clone()
+        };
+        assert!(!asking.at_rest_as(&still), "an ask is said at 20 Hz");
+        let moved = RootState {
+            moved: Some("0_1".into()),
+            ..later
+        };
+        assert!(!moved.at_rest_as(&still));
     }
 }
