@@ -230,7 +230,7 @@ fn main() {
         "{count} realizers x {each} walkers = {} on one mosquitto, {secs} s of wall time each run",
         count * each
     );
-    println!("design | realizer | states heard | published | heard/s | share of all published | cells at most | dropped | CPU s");
+    println!("design | realizer | states heard | published | heard/s | share of the others' states | cells at most | dropped | CPU s");
     for (design, cell) in [("cells of 10 m", "10"), ("everyone (--cell 0)", "0")] {
         let Some((measured, broker_cpu)) = run(&world, &trips, cell, secs) else {
             break;
@@ -242,7 +242,7 @@ fn main() {
                 m.heard,
                 m.published,
                 m.heard / secs,
-                100.0 * m.heard / all,
+                100.0 * m.heard / (all - m.published),
                 m.cells,
                 m.dropped,
                 m.cpu

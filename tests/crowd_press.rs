@@ -91,3 +91,37 @@ fn bodies_in_a_press_stay_people() {
         assert!(seen.drop <= 0.1, "{what}");
     }
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 16, ..Default::default() })]
+
+    /// Small random scenes, any frame rate: everyone arrives within 0.3 m, and bodies stay
+    /// people on the way. Ignored while it fails: its first run found 7 walkers in 8.9 m at
+    /// 10 fps (the case kept in `crowd_press.proptest-regressions`) where w0003, walking up
+    /// behind w0005 standing at its goal 1.2 m short of w0003's own, stops 0.78 m behind it
+    /// and creeps round it at 5 cm/s until its walk gives up 1.67 m short (23.8 s). The same
+    /// two placed there at rest, or with w0005 just arrived, go round in 3 s: what holds the
+    /// walker back is something it carries from its walk up (not found yet). Run it with
+    /// `cargo test --release --test crowd_press -- --ignored`.
+    #[test]
+    #[ignore = "finds a walker stranded behind one standing (see above)"]
+    fn everyone_arrives_in_small_random_scenes(
+        n in 2usize..=10,
+        side in 4.0f32..10.0,
+        fps in proptest::sample::select(vec![10.0, 30.0, 60.0, 120.0]),
+        seed in proptest::prelude::any::<u64>(),
+    ) {
+        let seen = press(n, side, fps, seed, 40.0);
+        let what = format!(
+            "{n} in {side} m at {fps} fps: closest {:.3} m, fastest {:.2} m/s, hip drop {:.1} cm, stranded {:?}",
+            seen.closest,
+            seen.fastest,
+            seen.drop * 100.0,
+            seen.stranded
+        );
+        proptest::prop_assert!(seen.stranded.is_empty(), "{}", what);
+        proptest::prop_assert!(seen.closest >= 0.45, "{}", what);
+        proptest::prop_assert!(seen.fastest <= 2.5, "{}", what);
+        proptest::prop_assert!(seen.drop <= 0.1, "{}", what);
+    }
+}
