@@ -20,6 +20,10 @@ use glam::{Vec2, Vec3};
 /// A walker within this of its goal has arrived (m).
 const ARRIVED: f32 = 0.3;
 
+/// How long the scene goes on after every walk has ended (s): one who stepped aside for a
+/// late walker goes back to its place.
+const SETTLE: f64 = 3.0;
+
 // (the same scenes for the same seed, shared with tests/crowd_press.rs)
 #[path = "common/lcg.rs"]
 mod lcg;
@@ -56,6 +60,7 @@ fn main() {
         ..Seen::default()
     };
     let mut ended = vec![false; n];
+    let mut all_ended = None;
     let mut said: Vec<Vec<String>> = vec![Vec::new(); n];
     let mut last: Vec<Option<Vec3>> = vec![None; n];
     let mut frame = 0u32;
@@ -86,7 +91,8 @@ fn main() {
             .collect();
         look(&roots, &mut last, &mut seen, time, fps);
         trace(&roots, &goals, time, fps);
-        if ended.iter().all(|&e| e) {
+        // (once every walk has ended, those who stepped aside for a late one go back)
+        if ended.iter().all(|&e| e) && *all_ended.get_or_insert(time) + SETTLE <= time {
             break;
         }
     }

@@ -79,6 +79,10 @@ impl Realizer {
             .filter_map(|(id, m)| m.on_its_way().then(|| crowd.index(id)).flatten())
             .collect();
         crowd.set_on_their_way(going);
+        let aside: Vec<usize> = (self.characters.iter_mut())
+            .filter_map(|(id, m)| m.making_room().then(|| crowd.index(id)).flatten())
+            .collect();
+        crowd.set_aside(aside);
         // (walkers of other realizers asking someone here)
         let remote = (self.remote_asks.iter())
             .filter_map(|(who, asked)| Some((crowd.index(asked)?, crowd.index(who)?)));

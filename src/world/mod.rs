@@ -154,8 +154,20 @@ impl World {
         &self.crowd
     }
 
-    /// Sets the crowd walkers see.
+    /// Sets the crowd walkers see; a group found among the characters standing at the start
+    /// breaks up for good once the crowd says one of them is on a walk of its own.
     pub fn set_crowd(&mut self, crowd: crate::world::crowd::Crowd) {
+        // (a group found among people who happened to stand so breaks up for good when one of
+        // them walks off: met again elsewhere, its space was reckoned from where they stood
+        // then, and held one who stood aside for a walker from going back to its place)
+        let left = |g: &crate::world::crowd::group::Group| {
+            g.found
+                && (g.members.iter()).any(|m| crowd.index(m).is_some_and(|i| crowd.on_its_way(i)))
+        };
+        if self.groups.iter().any(left) {
+            let kept = self.groups.iter().filter(|g| !left(g)).cloned().collect();
+            self.groups = Arc::new(kept);
+        }
         self.crowd = Arc::new(crowd);
     }
 

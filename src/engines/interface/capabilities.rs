@@ -150,6 +150,12 @@ pub trait Travel {
         false
     }
 
+    /// Whether the character is off its place to make room for someone (stepping aside,
+    /// standing aside or going back): it goes back, it does not stand there for good.
+    fn making_room(&self) -> bool {
+        false
+    }
+
     /// Where the person stands whom the character, held back, asks to make room (world x, z),
     /// if it asks anyone (`crowd::negotiate`).
     fn asking(&self) -> Option<glam::Vec2> {

@@ -364,7 +364,12 @@ impl LocomotionEngine {
         }
         if ended.is_some() {
             self.current = None;
-            self.place = self.walker.as_ref().map(|w| w.body());
+            // (where it stopped: one pressed on while its feet closed went back only to
+            // where the press had left it, 0.54 m from its goal)
+            self.place = (self.walker.as_ref()).map(|w| crate::world::locomotion::gait::Body {
+                at: w.stopped_at.unwrap_or(w.body().at),
+                ..w.body()
+            });
             if let Some(short) = self.walker.as_mut().and_then(|w| w.stuck.take()) {
                 self.warnings.push((
                     key.clone(),

@@ -138,8 +138,10 @@ fn beside_whoever_stands(world: &World, me: &str, goal: Vec2, from: Vec2) -> Goa
     let mut near = Vec::new();
     crowd.near(goal, mine + MAX_RADIUS, &mut near);
     let standing = (near.iter())
-        // (one on a walk of its own that stands there waits: it does not take the place)
-        .filter(|&&i| !crowd.on_its_way(i))
+        // (one on a walk of its own that stands there waits, and one that stepped aside for
+        // someone goes back: neither takes the place; a walker settled beside one who had
+        // stepped onto its goal for a moment, 0.64 m from it, and stood there when it left)
+        .filter(|&&i| !crowd.on_its_way(i) && !crowd.is_aside(i))
         .filter_map(|&i| {
             let a = crowd.agent(i);
             on_it(crowd.id(i), a.at, a.radius, a.velocity)

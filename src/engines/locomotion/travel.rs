@@ -128,6 +128,10 @@ impl Travel for LocomotionEngine {
         self.current.is_some()
     }
 
+    fn making_room(&self) -> bool {
+        self.current.is_none() && self.room.is_some()
+    }
+
     fn asking(&self) -> Option<Vec2> {
         self.walker.as_ref().and_then(|w| w.asking)
     }

@@ -50,6 +50,11 @@ impl BlockManager {
         (self.registry.engines_mut()).any(|e| e.as_travel().is_some_and(|t| t.on_its_way()))
     }
 
+    /// Whether an engine has the character off its place to make room for someone.
+    pub fn making_room(&mut self) -> bool {
+        (self.registry.engines_mut()).any(|e| e.as_travel().is_some_and(|t| t.making_room()))
+    }
+
     /// Where the person stands whom the character asks to make room, if anyone.
     pub fn asking(&mut self) -> Option<glam::Vec2> {
         (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.asking()))

@@ -52,6 +52,9 @@ pub struct Group {
     pub members: Vec<String>,
     /// Whether they converse (only conversing groups hold a space).
     pub conversing: bool,
+    /// Whether it was found among people who happened to stand so ([`found`]), not declared
+    /// by the world file: such a group breaks up for good when one of them walks off.
+    pub found: bool,
 }
 
 /// A member as the group's space needs it: where it stands, which way it faces (unit x, z), its
@@ -98,6 +101,7 @@ impl GroupFile {
         Ok(Group {
             members,
             conversing: self.conversing,
+            found: false,
         })
     }
 }
@@ -176,6 +180,7 @@ pub fn found(ids: &[String], members: &[Member]) -> Vec<Group> {
             Group {
                 members,
                 conversing: true,
+                found: true,
             }
         })
         .collect()
@@ -235,6 +240,7 @@ mod tests {
         let g = Group {
             members: ids,
             conversing: true,
+            found: true,
         };
         let s = g.space(&facing).unwrap();
         assert!(s.centre.distance(Vec2::new(0.0, 0.6)) < 1e-4, "{s:?}");

@@ -53,6 +53,8 @@ pub struct Crowd {
     asks: Vec<(u32, u32)>,
     /// Who is on a walk of its own (indices, sorted): standing still, it only waits.
     going: Vec<u32>,
+    /// Who stands (or walks) off its place to make room and will go back (indices, sorted).
+    aside: Vec<u32>,
 }
 
 fn cell_of(p: Vec2) -> (i32, i32) {
@@ -108,6 +110,7 @@ impl Crowd {
             placed,
             asks: Vec::new(),
             going: Vec::new(),
+            aside: Vec::new(),
         }
     }
 
@@ -142,6 +145,19 @@ impl Crowd {
     /// Whether character `i` is on a walk of its own.
     pub fn on_its_way(&self, i: usize) -> bool {
         self.going.binary_search(&(i as u32)).is_ok()
+    }
+
+    /// Notes who is off its place to make room for someone (indices): standing there, such a
+    /// one goes back, and does not stand on anyone's goal for good.
+    pub fn set_aside(&mut self, aside: impl IntoIterator<Item = usize>) {
+        self.aside = aside.into_iter().map(|i| i as u32).collect();
+        self.aside.sort_unstable();
+        self.aside.dedup();
+    }
+
+    /// Whether character `i` is off its place to make room.
+    pub fn is_aside(&self, i: usize) -> bool {
+        self.aside.binary_search(&(i as u32)).is_ok()
     }
 
     /// Notes who asks whom to make room, as (asked, asking) indices.

@@ -37,9 +37,10 @@ pub struct Room {
 /// The walk a standing character at `body` (index `me` in `crowd`, radius `radius`, among
 /// `obstacles`) sets off on at `now` to make room or to go back, given what it did so far
 /// (`room`, updated); `None` when it keeps doing what it does. It goes back once nobody has
-/// asked it for [`HOLD`] and the walker it made room for has passed: more than [`TRIGGER`]
-/// from its place, or come to a stop clear of it (a walker that stops near, at its own goal,
-/// would otherwise keep it away from its place for good).
+/// asked it for [`HOLD`] (or only another walker asks, whose way it now shuts) and the walker
+/// it made room for has passed: more than [`TRIGGER`] from its place, or come to a stop clear
+/// of it (a walker that stops near, at its own goal, would otherwise keep it away from its
+/// place for good).
 pub fn make_room(
     room: &mut Option<Room>,
     now: f64,
@@ -55,7 +56,17 @@ pub fn make_room(
         if r.aside {
             let passing = (crowd.index(&r.walker))
                 .is_some_and(|i| in_the_way(crowd.agent(i), r.home.at, radius));
-            if now - r.asked < HOLD || passing {
+            // (asked by another, whose way it now shuts, it goes back: one that stood aside
+            // on a walker's goal, asked by that walker, stayed there until the walk gave up)
+            let (mut theirs, mut another) = (false, false);
+            for i in crowd.askers(me) {
+                match crowd.id(i) == r.walker {
+                    true => theirs = true,
+                    false => another = true,
+                }
+            }
+            let held = now - r.asked < HOLD && (theirs || !another);
+            if held || passing {
                 return None;
             }
             r.aside = false;

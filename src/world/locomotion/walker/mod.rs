@@ -121,6 +121,9 @@ pub struct Walker {
     /// How far short of its goal the last footstep walk stopped, when no step led anywhere
     /// better (taken by whoever reports it).
     pub stuck: Option<f32>,
+    /// Where the body came to a stop on its last walk, before anyone pressed it on (its place
+    /// when the walk has ended: the walk ends only once the feet have closed).
+    pub stopped_at: Option<Vec2>,
 }
 
 /// How far the one it looks at may have moved between two steps for it to be followed (m).
@@ -148,6 +151,7 @@ impl Walker {
             asked_at: at,
             active: None,
             stuck: None,
+            stopped_at: None,
         }
     }
 
@@ -270,6 +274,7 @@ impl Walker {
             params,
         }));
         self.vehicle.max_speed = walk.speed;
+        self.stopped_at = None;
         // the velocity follows the steering within about 0.2 s, speeding up and braking at up
         // to about 2.3 m/s² walking, more running
         self.vehicle.max_force = self.vehicle.mass * (1.6 + 0.6 * walk.speed);
