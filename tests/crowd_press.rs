@@ -5,8 +5,8 @@
 //! were pressed apart at 1 m/s at most, and before groups that walk off held no space, this
 //! scene at 10 fps brought roots within 0.40 m and dropped the hips 6.9 cm in a frame; at
 //! 30 fps roots came within 0.36 m and were shoved at 6.4 m/s.) Who did not arrive within
-//! 0.3 m in 40 s is printed, not yet asserted: in a press this dense (100 in 14 × 14 m) 1 of
-//! 100 gives up at 10 fps, none at 30 (14 before). Smaller random scenes are held to everyone
+//! 0.3 m in 40 s is printed, not yet asserted: in a press this dense (100 in 14 × 14 m) all
+//! 100 arrive at 10 and at 30 fps now (14 did not before). Smaller random scenes are held to everyone
 //! arriving too (the proptest below).
 
 use bml_realizer::language::feedback::Feedback;

@@ -38,6 +38,8 @@ pub(super) struct Near<'a, 'b> {
     pub(super) radius: f32,
     pub(super) profile: &'a Profile,
     pub(super) obstacles: &'a Obstacles,
+    /// Where its walk ends.
+    pub(super) goal: Vec2,
 }
 
 impl Near<'_, '_> {
@@ -127,6 +129,30 @@ impl Near<'_, '_> {
         let way = desired.normalize();
         negotiate::blocker(here, way, self.radius, &standing, self.obstacles, insist)
             .map(|i| near[i].at)
+            .or_else(|| self.aside_on_goal(here))
+    }
+
+    /// Where one who stands aside for someone else (and will go back) stands on this walker's
+    /// goal, if anyone does and the walker is near it: asked, they go back to their place.
+    /// (One aside there, beyond the goal rather than on the walker's line, was never asked,
+    /// and the walk gave up 0.37 m short.)
+    fn aside_on_goal(&self, here: Vec2) -> Option<Vec2> {
+        let crowd = self.others.crowd;
+        if here.distance(self.goal) > negotiate::LOOKAHEAD {
+            return None;
+        }
+        let mut found = Vec::new();
+        crowd.near(self.goal, self.radius + 1.0, &mut found);
+
+        (found.into_iter())
+            .filter(|&i| Some(i) != self.others.me && crowd.is_aside(i))
+            .map(|i| crowd.agent(i))
+            .filter(|a| a.at.distance(self.goal) < self.radius + a.radius)
+            .min_by(|a, b| {
+                let (da, db) = (a.at.distance(here), b.at.distance(here));
+                da.total_cmp(&db)
+            })
+            .map(|a| a.at)
     }
 }
 

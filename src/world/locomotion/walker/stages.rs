@@ -220,6 +220,7 @@ impl Walker {
                     radius: self.radius,
                     profile: &self.profile,
                     obstacles,
+                    goal: a.walk.goal,
                 };
                 let desired = toward * a.walk.speed * slowing;
                 near.steer(
