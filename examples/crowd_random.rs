@@ -20,16 +20,12 @@ use glam::{Vec2, Vec3};
 /// A walker within this of its goal has arrived (m).
 const ARRIVED: f32 = 0.3;
 
-/// How long the scene goes on after every walk has ended (s): one who stepped aside for a
-/// late walker goes back to its place.
-const SETTLE: f64 = 3.0;
-
 // (the same scenes for the same seed, shared with tests/crowd_press.rs)
 #[path = "common/lcg.rs"]
 mod lcg;
 #[path = "common/trips.rs"]
 mod trips;
-use trips::{id, trips};
+use trips::{id, trips, SETTLE};
 
 fn argument<T: std::str::FromStr>(k: usize, default: T) -> T {
     std::env::args()

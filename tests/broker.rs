@@ -229,20 +229,27 @@ fn states(heard: &[(String, String)]) -> Vec<(String, f32, f32)> {
         .collect()
 }
 
+/// A world file of `json` in a directory of its own for this test (`tag`) on this broker:
+/// the directory (removed by the test) and the file.
+fn world_file(broker: &Broker, tag: &str, json: &str) -> (std::path::PathBuf, String) {
+    let dir = std::env::temp_dir().join(format!("bmlr-broker-{tag}-{}", broker.port));
+    std::fs::create_dir_all(&dir).unwrap();
+    let world = dir.join("world.json");
+    std::fs::write(&world, json).unwrap();
+    (dir, world.to_str().unwrap().to_string())
+}
+
 #[test]
 fn walkers_served_by_two_realizers_go_round_each_other_and_both_arrive() {
     let Some(broker) = Broker::start() else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("bmlr-broker-world-{}", broker.port));
-    std::fs::create_dir_all(&dir).unwrap();
-    let world = dir.join("world.json");
-    std::fs::write(
-        &world,
+    let (dir, world) = world_file(
+        &broker,
+        "world",
         r#"{"characters": {"a": {"position": [-4, 0, 0], "facing": 90}, "b": {"position": [0, 0, -4], "facing": 0}}}"#,
-    )
-    .unwrap();
-    let w = world.to_str().unwrap();
+    );
+    let w = world.as_str();
     let _ra = realizer(&broker, "ra", &["a"], &["--world", w]);
     let _rb = realizer(&broker, "rb", &["b"], &["--world", w]);
     let mut p = planner_on(
@@ -308,15 +315,12 @@ fn one_standing_still_is_said_once_a_second_and_a_walker_twenty_times() {
     let Some(broker) = Broker::start() else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("bmlr-broker-rest-{}", broker.port));
-    std::fs::create_dir_all(&dir).unwrap();
-    let world = dir.join("world.json");
-    std::fs::write(
-        &world,
+    let (dir, world) = world_file(
+        &broker,
+        "rest",
         r#"{"characters": {"s": {"position": [0, 0, 0], "facing": 90}}}"#,
-    )
-    .unwrap();
-    let _r = realizer(&broker, "r", &["s"], &["--world", world.to_str().unwrap()]);
+    );
+    let _r = realizer(&broker, "r", &["s"], &["--world", &world]);
     let mut p = planner_on(&broker, "planner", &["bml/realizers/+", "bml/world/+/+"]);
     until_online(&p, &["r"]);
     // standing: a state a second (not twenty)

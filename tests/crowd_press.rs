@@ -16,11 +16,7 @@ use glam::{Vec2, Vec3};
 mod lcg;
 #[path = "../examples/common/trips.rs"]
 mod trips;
-use trips::{id, trips};
-
-/// How long the scene goes on after every walk has ended (s): one who stepped aside for a
-/// late walker goes back to its place.
-const SETTLE: f64 = 3.0;
+use trips::{id, trips, SETTLE};
 
 /// What the frames of one scene showed.
 struct Seen {

@@ -12,6 +12,10 @@ use crate::lcg::Lcg;
 /// How far apart starts (and goals) are at least (m).
 pub const APART: f32 = 0.8;
 
+/// How long a scene goes on after every walk has ended (s): one who stepped aside for a late
+/// walker goes back to its place before the walkers are judged.
+pub const SETTLE: f64 = 3.0;
+
 /// Walker `k`'s id; its block is `b{k}`.
 pub fn id(k: usize) -> String {
     format!("w{k:04}")

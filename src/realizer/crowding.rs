@@ -75,13 +75,18 @@ impl Realizer {
             .filter_map(|(id, m)| Some((crowd.index(id)?, m.asking()?)))
             .collect();
         crowd.set_asks(asking);
-        let going: Vec<usize> = (self.characters.iter_mut())
-            .filter_map(|(id, m)| m.on_its_way().then(|| crowd.index(id)).flatten())
-            .collect();
+        // who walks somewhere of its own, and who is off its place making room
+        let (mut going, mut aside) = (Vec::new(), Vec::new());
+        for (id, m) in self.characters.iter_mut() {
+            let Some(i) = crowd.index(id) else { continue };
+            if m.on_its_way() {
+                going.push(i);
+            }
+            if m.making_room() {
+                aside.push(i);
+            }
+        }
         crowd.set_on_their_way(going);
-        let aside: Vec<usize> = (self.characters.iter_mut())
-            .filter_map(|(id, m)| m.making_room().then(|| crowd.index(id)).flatten())
-            .collect();
         crowd.set_aside(aside);
         // (walkers of other realizers asking someone here)
         let remote = (self.remote_asks.iter())

@@ -1,6 +1,7 @@
 //! One world over many realizers on a broker, shared by area. The floor is cut into cells
 //! (`--cell`, 10 m); 20 times a second this realizer publishes each of its characters' root
-//! state (once a second for one standing still) on the topic of the cell it stands in (`PREFIX/world/CELL/CHARACTER`) and listens to
+//! state (once a second for one standing still) on the topic of the cell it stands in
+//! (`PREFIX/world/CELL/CHARACTER`) and listens to
 //! the cells within a walker's avoidance range of its characters, moving its subscriptions as
 //! they walk. The characters of other realizers it hears of are placed in its world
 //! (`Realizer::place_remote`), so that its walkers go round them, look at them and answer their
@@ -52,9 +53,8 @@ pub struct Sharing {
     /// Characters the world file places for other realizers (not `--characters`) not heard of
     /// yet: let go if none is heard of within [`STALE`] s of the start.
     unheard: BTreeSet<String>,
-    /// The cell each of this realizer's characters was last published in.
-    own_cells: BTreeMap<String, Cell>,
-    /// Each of this realizer's characters' last published state, and when (local clock).
+    /// Each of this realizer's characters' last published state (its cell is where that put
+    /// it), and when (local clock).
     sent: BTreeMap<String, (RootState, f64)>,
     /// The cells listened to now.
     listened: BTreeSet<Cell>,
@@ -80,7 +80,6 @@ impl Sharing {
         Sharing {
             others: BTreeMap::new(),
             unheard,
-            own_cells: BTreeMap::new(),
             sent: BTreeMap::new(),
             listened: BTreeSet::new(),
             published: f64::NEG_INFINITY,
@@ -216,17 +215,20 @@ impl Server {
                 ..RootState::new(now, at, velocity)
             };
             let cell = self.args.cells.of(at.position.x, at.position.z);
-            if let Some(left) =
-                (self.sharing.own_cells.insert(id.clone(), cell)).filter(|c| *c != cell)
-            {
-                let moved = RootState {
-                    moved: Some(cell.to_string()),
-                    ..state.clone()
-                };
-                self.send_state(left, &id, moved);
-            } else if let Some((before, when)) = self.sharing.sent.get(&id) {
-                // (one standing still is said again only every REST_PERIOD)
-                if state.at_rest_as(before) && now - when < REST_PERIOD {
+            // the cell its last state put it in, and whether it has stood still since
+            let last = (self.sharing.sent.get(&id)).map(|(before, when)| {
+                let left = self.args.cells.of(before.position[0], before.position[2]);
+                (left, state.at_rest_as(before) && now - when < REST_PERIOD)
+            });
+            if let Some((left, resting)) = last {
+                if left != cell {
+                    let moved = RootState {
+                        moved: Some(cell.to_string()),
+                        ..state.clone()
+                    };
+                    self.send_state(left, &id, moved);
+                } else if resting {
+                    // (one standing still is said again only every REST_PERIOD)
                     continue;
                 }
             }

@@ -1,5 +1,6 @@
 //! A link to an MQTT broker that keeps itself connected: rumqttc's blocking MQTT 5 client (the
-//! protocol ipaacar's components speak too), its connection polled on a thread of its own. Every (re)connection renews the subscriptions and
+//! protocol ipaacar's components speak too), its connection polled on a thread of its own.
+//! Every (re)connection renews the subscriptions and
 //! the presence (retained `online`, with `offline` as the last will), since a broker that
 //! restarted has forgotten both. What arrives waits in a bounded inbox (the polling thread
 //! waits when it is full, and the broker holds back: backpressure; a state heard at QoS 0 is
@@ -13,7 +14,8 @@
 //! ([`Link::publish_state`]); subscriptions to states may change while connected
 //! ([`Link::subscribe`], [`Link::unsubscribe`]) and are "no local": the broker does not send a
 //! link's own states back to it (MQTT 5 only: under 3.1.1 a realizer listening to the cells its
-//! characters stand in heard every state of its own again). TCP_NODELAY is set: without it small messages wait for the
+//! characters stand in heard every state of its own again). TCP_NODELAY is set: without it
+//! small messages wait for the
 //! previous one's acknowledgement (Nagle's algorithm, ~40 ms stalls).
 
 use std::collections::{BTreeMap, VecDeque};

@@ -57,6 +57,14 @@ pub struct Crowd {
     aside: Vec<u32>,
 }
 
+/// Indices as a sorted set (searched by `binary_search`).
+fn index_set(indices: impl IntoIterator<Item = usize>) -> Vec<u32> {
+    let mut set: Vec<u32> = indices.into_iter().map(|i| i as u32).collect();
+    set.sort_unstable();
+    set.dedup();
+    set
+}
+
 fn cell_of(p: Vec2) -> (i32, i32) {
     let c = |v: f32| (v / CELL).floor().clamp(-1e9, 1e9) as i32;
     (c(p.x), c(p.y))
@@ -137,9 +145,7 @@ impl Crowd {
     /// Notes who is on a walk of its own (indices): standing still, such a one waits, and
     /// does not stand on anyone's goal for good.
     pub fn set_on_their_way(&mut self, going: impl IntoIterator<Item = usize>) {
-        self.going = going.into_iter().map(|i| i as u32).collect();
-        self.going.sort_unstable();
-        self.going.dedup();
+        self.going = index_set(going);
     }
 
     /// Whether character `i` is on a walk of its own.
@@ -150,9 +156,7 @@ impl Crowd {
     /// Notes who is off its place to make room for someone (indices): standing there, such a
     /// one goes back, and does not stand on anyone's goal for good.
     pub fn set_aside(&mut self, aside: impl IntoIterator<Item = usize>) {
-        self.aside = aside.into_iter().map(|i| i as u32).collect();
-        self.aside.sort_unstable();
-        self.aside.dedup();
+        self.aside = index_set(aside);
     }
 
     /// Whether character `i` is off its place to make room.
