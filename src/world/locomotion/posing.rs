@@ -19,8 +19,8 @@ pub struct GaitJoints {
     elbows: [Option<usize>; 2],
     /// Neck and skull base (the head turns into a bend ahead).
     neck: [Option<usize>; 2],
-    /// The legs' full length (hip to ankle), m.
-    reach: f32,
+    /// The thigh's and the shin's lengths, m.
+    links: [f32; 2],
 }
 
 impl GaitJoints {
@@ -36,14 +36,17 @@ impl GaitJoints {
         };
         let legs = [leg("l")?, leg("r")?];
         let joints = skeleton.joints();
-        let reach = joints[legs[0][1]].offset.length() + joints[legs[0][2]].offset.length();
+        let links = [
+            joints[legs[0][1]].offset.length(),
+            joints[legs[0][2]].offset.length(),
+        ];
         Some(GaitJoints {
             legs,
             spine: [j("vl5"), j("vt6")],
             shoulders: [j("l_shoulder"), j("r_shoulder")],
             elbows: [j("l_elbow"), j("r_elbow")],
             neck: [j("vc4"), j("skullbase")],
-            reach,
+            links,
         })
     }
 
@@ -77,6 +80,21 @@ fn to_local(f: FootPose, body: Body) -> FootPose {
     }
 }
 
+/// How far above its standing height the pelvis is held running (m), more than the legs
+/// reach: the legs' least knee bends bring it down to where people's is in the stance.
+const PELVIS_RAISE: f32 = 0.03;
+/// Walking, the pelvis's wave about its standing height (m): its middle, and half its rise and
+/// fall, at 1.3 m/s and faster (less slower); its top a little above where the legs cap it.
+const WALK_DROP: f32 = -0.025;
+/// See [`WALK_DROP`].
+const WALK_BOB: f32 = 0.035;
+/// The pelvis's forward tilt walking at 1.3 m/s and faster (rad; less slower): people's is
+/// about 10° (Kadaba 1990), so that the thigh flexes against the pelvis by that much more than
+/// against the vertical.
+const PELVIS_TILT: f32 = 0.17;
+/// Half the running pelvis's rise and fall beyond what the legs give (m).
+const RUN_BOB: f32 = 0.03;
+
 /// Poses the gait of a body standing at `body` on `pose` (the character's own frame): the
 /// pelvis, trunk and arms on top of what is there, the legs set.
 pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, pose: &mut Pose) {
@@ -91,15 +109,29 @@ pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, p
     let yaw = -(if run { 0.1 } else { 0.07 }) * amount * (tau * psi_l).cos();
     let list = (if run { 0.03 } else { 0.06 }) * amount * mid_left;
     let sway = (if run { 0.01 } else { 0.02 }) * amount * mid_left;
-    let bob_sign = if run { -1.0 } else { 1.0 };
-    let bob = bob_sign * 0.015 * amount * (2.0 * tau * (psi_l - beta / 2.0)).cos();
+    // the pelvis rises over each foot and falls between them, highest at mid-stance walking
+    // and lowest there running; walking, the legs cap it at the top (as high as the knee's least
+    // bend lets it), and its fall, begun on its own, leaves the reaching foot little to pull
+    let wave = (2.0 * tau * (psi_l - beta / 2.0)).cos();
+    let pace = (gait.speed / 1.3).clamp(0.4, 1.0).powi(2);
+    let bob = if run {
+        PELVIS_RAISE - RUN_BOB * wave
+    } else {
+        (WALK_DROP + WALK_BOB * wave) * pace
+    } * amount;
     let rest_y = skeleton.joints()[0].offset.y;
     pose.root.x = pose.root.x * (1.0 - amount) + sway;
     pose.root.z *= 1.0 - amount;
-    pose.root.y = rest_y - 0.02 * amount + bob;
-    pose.rotations[0] = Quat::from_rotation_y(yaw) * Quat::from_rotation_z(list);
+    pose.root.y = rest_y + bob;
+    // (it tilts further the faster the walk)
+    let tilt = Quat::from_rotation_x(PELVIS_TILT * amount * pace);
+    pose.rotations[0] = Quat::from_rotation_y(yaw) * Quat::from_rotation_z(list) * tilt;
+    // (the lower back takes the tilt back: the trunk stays upright)
+    if let Some(i) = j.spine[0] {
+        pose.rotate(i, tilt.inverse());
+    }
     let feet = [0, 1].map(|k| to_local(gait.foot_pose(k, body, amount), body));
-    lower_to_reach(skeleton, j, &feet, pose);
+    lower_to_reach(skeleton, j, &feet, [0, 1].map(|k| gait.least_knee(k)), pose);
     for (k, foot) in feet.iter().enumerate() {
         place_leg(skeleton, j.legs[k], *foot, pose);
     }
@@ -143,15 +175,23 @@ pub fn lead_the_turn(j: &GaitJoints, ahead: f32, amount: f32, pose: &mut Pose) {
 /// foot left behind by a body pushed in a jam.
 pub const MAX_SINK: f32 = 0.15;
 
-/// Lowers the root so that each foot is within 98.5 % of the leg's reach (a straight knee
-/// turns fast for little change of length), by [`MAX_SINK`] at most; over both feet, so
+/// Lowers the root so that each foot is within the reach of its leg with the knee bent by at
+/// least `knee` (rad; the gait's [`Gait::least_knee`]), by [`MAX_SINK`] at most; over both feet, so
 /// that the height changes smoothly as they lift and land.
-fn lower_to_reach(skeleton: &Skeleton, j: &GaitJoints, feet: &[FootPose; 2], pose: &mut Pose) {
-    let reach = j.reach * 0.985;
+fn lower_to_reach(
+    skeleton: &Skeleton,
+    j: &GaitJoints,
+    feet: &[FootPose; 2],
+    knee: [f32; 2],
+    pose: &mut Pose,
+) {
+    let [a, b] = j.links;
     let mut drop = 0.0f32;
     for (k, foot) in feet.iter().enumerate() {
+        let reach = (a * a + b * b + 2.0 * a * b * knee[k].cos()).sqrt();
         let hip = pose.joint_world(skeleton, j.legs[k][0]).0;
         let d = hip - foot.ankle;
+        let reach = soft_reach(d.length(), reach);
         let h = Vec2::new(d.x, d.z).length().min(reach);
         let vertical = (reach * reach - h * h).sqrt();
         drop = drop.max(d.y - vertical);
@@ -159,8 +199,28 @@ fn lower_to_reach(skeleton: &Skeleton, j: &GaitJoints, feet: &[FootPose; 2], pos
     pose.root.y -= drop.min(MAX_SINK);
 }
 
+/// How far short of its reach (m) a leg starts to be held short, softly: see [`soft_reach`].
+const SOFT: f32 = 0.015;
+
+/// The distance (m) a leg reaching for a foot `distance` away is given, at most `reach`: the
+/// distance itself up to [`SOFT`] short of the reach, then nearing the reach ever more slowly
+/// (the pelvis lowered for the rest). A knee near straight turns far for a millimetre of
+/// length; held to a hard reach, a foot coming within it let the knee snap from 22° to 4° in
+/// one frame (19 rad/s), where a soft one straightens it over several.
+fn soft_reach(distance: f32, reach: f32) -> f32 {
+    let knee = reach - SOFT;
+    if distance <= knee {
+        return distance;
+    }
+    knee + SOFT * (1.0 - (-(distance - knee) / SOFT).exp())
+}
+
 /// The most the ankle is bent toes-up against the shin (rad; its limit is 20°).
 const MAX_DORSIFLEXION: f32 = 0.28;
+/// The most a rolling foot is bent toes-down against the shin (rad), 25°: people's push-off
+/// (setting off with short steps, the heel's rise at its full height bent the ankle past its
+/// limit, and the clamped foot slid 1 cm).
+const MAX_PLANTARFLEXION: f32 = 0.44;
 
 /// Puts a leg's ankle at `foot` (hip and knee by IK, knee toward the foot's heading) and turns
 /// the foot to its heading and pitch. Where the shin leans so far over the foot that the ankle
@@ -170,8 +230,16 @@ fn place_leg(skeleton: &Skeleton, leg: [usize; 3], foot: FootPose, pose: &mut Po
     let mut foot = foot;
     for _ in 0..4 {
         let dorsiflexion = set_leg(skeleton, leg, foot, pose);
-        let excess = dorsiflexion - MAX_DORSIFLEXION;
-        if excess < 1e-3 {
+        // (a heel raised further than the ankle bends toes-down is let down as far)
+        let excess = (dorsiflexion - MAX_DORSIFLEXION).max(0.0)
+            + (dorsiflexion + MAX_PLANTARFLEXION).min(0.0);
+        // (never below flat)
+        let excess = if excess < 0.0 {
+            excess.max(foot.pitch.min(0.0))
+        } else {
+            excess
+        };
+        if excess.abs() < 1e-3 {
             return;
         }
         let f = forward(foot.yaw);
