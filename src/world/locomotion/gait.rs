@@ -18,6 +18,8 @@
 
 use glam::{Quat, Vec2, Vec3};
 
+pub use super::knee::{stance_knee, KNEE_RATE, STANDING_KNEE};
+
 /// A planted foot further than this (m) from where it would stand beside the body is out of
 /// the leg's reach (at 1.3 m/s a foot leaves the ground 0.58 m behind).
 pub const OUT_OF_REACH: f32 = 0.7;
@@ -381,81 +383,6 @@ impl Gait {
     }
 }
 
-/// The least knee bend (rad) of a leg standing still or stepping slowly: a leg held at 98.5 %
-/// of its reach, where a straight knee's turn changes the leg's length too little to follow a
-/// foot's small moves.
-pub const STANDING_KNEE: f32 = 0.347;
-/// Fastest the least knee bend follows its curve (rad/s): people's fastest stance change, the
-/// bend toward toe-off, is about 2.5 rad/s walking and 3 running; a faster change (a foot
-/// landing, a body setting off) is spread over frames instead of lifting the pelvis at once.
-pub const KNEE_RATE: f32 = 4.0;
-
-/// The least bend (rad) of a planted knee at `x` of its stance (0 heel strike, 1 toe-off), as
-/// people bend it (Kadaba 1990, Perry 1992, Schwartz 2008 by speed; Novacheck 1998 running):
-/// walking, nearly straight at heel strike, a loading flexion larger with `speed` by a tenth of
-/// the stance, nearly straight again at mid-stance, then bending toward the swing; running,
-/// bent at contact, most bent at mid-stance, less at toe-off.
-pub fn stance_knee(x: f32, running: bool, speed: f32) -> f32 {
-    let keys: &[(f32, f32)] = if running {
-        &[(0.0, 20.0), (0.45, 40.0), (1.0, 22.0)]
-    } else {
-        let loading = 6.0 + 10.0 * (speed / 1.3).clamp(0.0, 1.2);
-        &[(0.0, 0.0), (0.2, loading), (0.6, 0.0), (1.0, 4.0)]
-    };
-    let x = x.clamp(0.0, 1.0);
-    let mut out = keys[0].1;
-    for w in keys.windows(2) {
-        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
-        if x >= x0 {
-            out = y0 + (y1 - y0) * smooth((x - x0) / (x1 - x0));
-        }
-    }
-    out.to_radians()
-}
-
-impl Gait {
-    /// How far foot `k` is through its swing (0 lifting, 1 landing); 0 when planted.
-    pub fn swing_progress(&self, k: usize) -> f32 {
-        match self.feet[k] {
-            Foot::Swing { since, .. } => {
-                ((self.foot_phase(k) - since) / (1.0 - since).max(1e-3)).clamp(0.0, 1.0)
-            }
-            Foot::Planted { .. } => 0.0,
-        }
-    }
-
-    /// The least bend (rad) of knee `k` the pelvis is lowered to: its [`knee`](Self::knee),
-    /// and for a leg in its swing up to [`SWING_KNEE`] more, rising while the foot passes
-    /// under the body and straightening out toward the heel strike: the knee extends at that
-    /// pace as the foot reaches forward (held at the heel strike's bend throughout, the knee
-    /// snapped straight in the frame the foot came to the leg's full reach, at 19 rad/s).
-    pub fn least_knee(&self, k: usize) -> f32 {
-        let s = self.swing_progress(k);
-        let bump = match self.feet[k] {
-            Foot::Swing { .. } if s < 0.6 => smooth((s - 0.3) / 0.3),
-            Foot::Swing { .. } => 1.0 - smooth((s - 0.6) / 0.4),
-            Foot::Planted { .. } => 0.0,
-        };
-        self.knee[k] + SWING_KNEE * self.amount * bump
-    }
-
-    /// Moves each knee's least bend toward its curve: [`stance_knee`] at a planted foot's
-    /// phase, its heel strike's for a swinging one; as much as the body walks (`amount`), the
-    /// standing bend otherwise.
-    fn bend_the_knees(&mut self, dt: f32) {
-        for k in 0..2 {
-            let x = match self.feet[k] {
-                Foot::Planted { .. } => self.foot_phase(k) / self.stance(),
-                Foot::Swing { .. } => 0.0,
-            };
-            let curve = stance_knee(x, self.running, self.speed);
-            let target = STANDING_KNEE + (curve - STANDING_KNEE) * self.amount;
-            let most = KNEE_RATE * dt;
-            self.knee[k] += (target - self.knee[k]).clamp(-most, most);
-        }
-    }
-}
-
 /// Where foot `k` stands when the body stands at `body`.
 pub fn standing_spot(body: Body, k: usize) -> Vec2 {
     body.at + Vec2::new(body.facing.cos(), -body.facing.sin()) * (SIDE[k] * HALF_WIDTH)
@@ -500,7 +427,7 @@ impl Gait {
         let beta = self.stance();
         let (strike, toe_off) = (
             0.25 * amount,
-            if self.running { 0.8 } else { 0.95 } * amount,
+            if self.running { 0.8 } else { 0.85 } * amount,
         );
         match self.feet[k] {
             Foot::Planted { at, yaw } => {
@@ -534,7 +461,10 @@ impl Gait {
                 // (stepping slowly, setting off, it lifts before it goes)
                 let e = smooth(s.powf(1.0 - (1.0 - SWING_LEAD) * amount));
                 let yaw = from_yaw + angle_diff(self.landing_yaw(body), from_yaw) * e;
-                let pitch = -toe_off * (1.0 - smooth(s / 0.35).min(1.0)) + strike * smooth(s);
+                // (rising on a little and held into the first half of the swing: people's
+                // ankle is most toes-down just after the toe-off)
+                let push = 0.5 * (std::f32::consts::PI * (s / 0.3).min(1.0)).sin();
+                let pitch = -toe_off * (1.0 - smooth(s / 0.5) + push) + strike * smooth(s);
                 // the foot rises most early in its swing, while the knee bends (people's knee
                 // peaks at about 70 % of the cycle, a third into the swing), and passes low
                 // (lower slower: people's swing knee bends less at a slow walk; stepping on
@@ -546,7 +476,8 @@ impl Gait {
                     0.11 + (walking - 0.11) * amount
                 };
                 let clearance = lift * swing_lift(s) * (0.3 + 0.7 * amount);
-                let start = rolled(from, from_yaw, -toe_off, BALL_AHEAD);
+                // (the rise on is about the ball, which stays where it left the floor)
+                let start = rolled(from, from_yaw, -toe_off * (1.0 + push), BALL_AHEAD);
                 let end = rolled(to, self.landing_yaw(body), strike, -HEEL_BACK);
                 let flat = start.lerp(end, e);
                 FootPose {
@@ -568,9 +499,6 @@ fn swing_lift(s: f32) -> f32 {
 /// The swinging foot comes forward early: its way along is smoothstep of its progress to this
 /// power (it passes under the hip about 40 % into the swing; halfway, the knee peaked late).
 const SWING_LEAD: f32 = 0.75;
-
-/// Most a swinging leg's least knee bend exceeds its heel strike's (rad), 30°.
-const SWING_KNEE: f32 = 0.0;
 
 /// Smoothstep on [0, 1].
 pub fn smooth(x: f32) -> f32 {

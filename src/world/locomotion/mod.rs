@@ -1,8 +1,9 @@
 //! Walking: how a character gets from one place to another. [`steering`] is Reynolds' vehicle
 //! model with the steering behaviours and combiners of the IViHumans platform (usable on its
-//! own), round the obstacles and along the routes of [`crate::world::space`]; [`gait`] a procedural
-//! human gait driven by the distance walked, with planted feet; [`posing`] that gait as a pose
-//! of the skeleton; [`walker`] one walking character that puts them together at a fixed step.
+//! own), round the obstacles and along the routes of [`crate::world::space`]; [`gait`] a
+//! procedural human gait driven by the distance walked, with planted feet, and [`knee`] its
+//! knees' least bend; [`posing`] that gait as a pose of the skeleton; [`walker`] one walking
+//! character that puts them together at a fixed step.
 //! The locomotion engine (`engines::locomotion`, which also resolves where a walk goes) realizes
 //! BML `<locomotion>` with them; `docs/locomotion.md` explains the whole.
 
@@ -12,6 +13,7 @@ pub const STEP: f64 = 1.0 / 240.0;
 pub mod among;
 pub mod footsteps;
 pub mod gait;
+pub mod knee;
 pub mod posing;
 pub mod room;
 pub mod steering;

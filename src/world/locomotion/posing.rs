@@ -131,7 +131,7 @@ pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, p
         pose.rotate(i, tilt.inverse());
     }
     let feet = [0, 1].map(|k| to_local(gait.foot_pose(k, body, amount), body));
-    lower_to_reach(skeleton, j, &feet, [0, 1].map(|k| gait.least_knee(k)), pose);
+    lower_to_reach(skeleton, j, &feet, gait.knee, pose);
     for (k, foot) in feet.iter().enumerate() {
         place_leg(skeleton, j.legs[k], *foot, pose);
     }
@@ -176,7 +176,7 @@ pub fn lead_the_turn(j: &GaitJoints, ahead: f32, amount: f32, pose: &mut Pose) {
 pub const MAX_SINK: f32 = 0.15;
 
 /// Lowers the root so that each foot is within the reach of its leg with the knee bent by at
-/// least `knee` (rad; the gait's [`Gait::least_knee`]), by [`MAX_SINK`] at most; over both feet, so
+/// least `knee` (rad; the gait's [`Gait::knee`]), by [`MAX_SINK`] at most; over both feet, so
 /// that the height changes smoothly as they lift and land.
 fn lower_to_reach(
     skeleton: &Skeleton,
