@@ -35,6 +35,8 @@ pub const HURRY_SPEED: f32 = 0.6;
 pub const STRAIN_FREE: f32 = 0.011;
 /// Each this much strain beyond [`STRAIN_FREE`] adds one cadence to the stepping.
 pub const STRAIN_PER_CADENCE: f32 = 0.003;
+/// People's own walking speed (m/s), WALK's: the norms the gait's speed-scaled sizes start from.
+pub const OWN_PACE: f32 = 1.3;
 /// The walk ratio (m per step/min).
 pub const WALK_RATIO: f32 = 0.0061;
 /// Slowest cadence of stepping (steps/min): turning on the spot, closing the feet.
@@ -420,6 +422,16 @@ fn rolled(at: Vec2, yaw: f32, pitch: f32, pivot_ahead: f32) -> Vec3 {
 }
 
 impl Gait {
+    /// How far foot `k` is through its swing (0 lifting, 1 landing); 0 when planted.
+    pub fn swing_progress(&self, k: usize) -> f32 {
+        match self.feet[k] {
+            Foot::Swing { since, .. } => {
+                ((self.foot_phase(k) - since) / (1.0 - since).max(1e-3)).clamp(0.0, 1.0)
+            }
+            Foot::Planted { .. } => 0.0,
+        }
+    }
+
     /// Foot `k` in this frame for a body at `body`; `amount` (0–1) scales the heel and toe
     /// rolls (none while stepping slowly).
     pub fn foot_pose(&self, k: usize, body: Body, amount: f32) -> FootPose {
@@ -472,7 +484,7 @@ impl Gait {
                 let lift = if self.running {
                     0.18
                 } else {
-                    let walking = 0.05 + 0.03 * (self.speed / 1.3).min(1.0);
+                    let walking = 0.05 + 0.03 * (self.speed / OWN_PACE).min(1.0);
                     0.11 + (walking - 0.11) * amount
                 };
                 let clearance = lift * swing_lift(s) * (0.3 + 0.7 * amount);

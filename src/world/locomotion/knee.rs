@@ -5,7 +5,7 @@
 //! from the standing bend by how much the body walks, so that setting off, stopping and
 //! stepping on the spot bend the knees as a standing body does.
 
-use super::gait::{smooth, Foot, Gait};
+use super::gait::{smooth, Foot, Gait, OWN_PACE};
 
 /// The least knee bend (rad) of a leg standing still or stepping slowly: a leg held at 98.5 %
 /// of its reach, where a straight knee's turn changes the leg's length too little to follow a
@@ -25,7 +25,7 @@ pub fn stance_knee(x: f32, running: bool, speed: f32) -> f32 {
     let keys: &[(f32, f32)] = if running {
         &[(0.0, 20.0), (0.45, 40.0), (1.0, 22.0)]
     } else {
-        let loading = 6.0 + 10.0 * (speed / 1.3).clamp(0.0, 1.2);
+        let loading = 6.0 + 10.0 * (speed / OWN_PACE).clamp(0.0, 1.2);
         &[(0.0, 0.0), (0.2, loading), (0.6, 0.0), (1.0, 4.0)]
     };
     let x = x.clamp(0.0, 1.0);
@@ -40,16 +40,6 @@ pub fn stance_knee(x: f32, running: bool, speed: f32) -> f32 {
 }
 
 impl Gait {
-    /// How far foot `k` is through its swing (0 lifting, 1 landing); 0 when planted.
-    pub fn swing_progress(&self, k: usize) -> f32 {
-        match self.feet[k] {
-            Foot::Swing { since, .. } => {
-                ((self.foot_phase(k) - since) / (1.0 - since).max(1e-3)).clamp(0.0, 1.0)
-            }
-            Foot::Planted { .. } => 0.0,
-        }
-    }
-
     /// Moves each knee's least bend toward its curve: [`stance_knee`] at a planted foot's
     /// phase, its heel strike's for a swinging one; as much as the body walks (`amount`), the
     /// standing bend otherwise.

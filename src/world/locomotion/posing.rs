@@ -6,7 +6,7 @@
 
 use glam::{Quat, Vec2, Vec3};
 
-use super::gait::{forward, Body, FootPose, Gait, ANKLE_HEIGHT, BALL_AHEAD};
+use super::gait::{forward, Body, FootPose, Gait, ANKLE_HEIGHT, BALL_AHEAD, OWN_PACE};
 use crate::character::body::ik::{place_limb, LimbRoot, LEG_HINGE};
 use crate::character::body::{Pose, Skeleton};
 
@@ -113,7 +113,7 @@ pub fn pose_gait(skeleton: &Skeleton, j: &GaitJoints, gait: &Gait, body: Body, p
     // and lowest there running; walking, the legs cap it at the top (as high as the knee's least
     // bend lets it), and its fall, begun on its own, leaves the reaching foot little to pull
     let wave = (2.0 * tau * (psi_l - beta / 2.0)).cos();
-    let pace = (gait.speed / 1.3).clamp(0.4, 1.0).powi(2);
+    let pace = (gait.speed / OWN_PACE).clamp(0.4, 1.0).powi(2);
     let bob = if run {
         PELVIS_RAISE - RUN_BOB * wave
     } else {
