@@ -1,13 +1,15 @@
 //! The idle layer: what a standing person does while nothing else moves them — breathing (the
 //! chest and the shoulders rise and fall), a slow shift of weight from foot to foot (the pelvis
 //! sways sideways, the spine leans back against it, the feet stay where they stand: the legs
-//! follow by inverse kinematics) and the eyes' small saccades (`saccades`). It is the pose every frame starts from, so
+//! follow by inverse kinematics), the eyes' small saccades (`saccades`) and their look away as
+//! an utterance begins (`aversion`). It is the pose every frame starts from, so
 //! behaviours play on top of it and inverse kinematics and gaze aim from where it put the body.
 //! It is not a behaviour: it has no timing and never shows in the feedback. Deterministic: the
 //! same character (by id) at the same time gets the same pose.
 
 use glam::{Quat, Vec3};
 
+use super::aversion::{Aversion, Utterance};
 use super::pose::Pose;
 use super::saccades::Saccades;
 use super::skeleton::Skeleton;
@@ -42,6 +44,8 @@ pub struct Idle {
     table: [(f32, [Quat; 6]); LEG_TABLE],
     /// The eyes' idle saccades.
     saccades: Saccades,
+    /// The eyes' looks away as an utterance begins.
+    aversion: Aversion,
 }
 
 /// Entries of the legs' table (the solutions differ by well under a millimetre at the feet
@@ -72,6 +76,7 @@ impl Idle {
             }),
             table: [(0.0, [Quat::IDENTITY; 6]); LEG_TABLE],
             saccades: Saccades::new(id, skeleton),
+            aversion: Aversion::new(id),
         };
         for k in 0..LEG_TABLE {
             let shift = -1.0 + 2.0 * k as f32 / (LEG_TABLE - 1) as f32;
@@ -102,10 +107,12 @@ impl Idle {
     }
 
     /// The pose at global time `t`: the rest pose with breathing, the weight shift and the
-    /// eyes' saccades.
-    pub fn pose(&self, skeleton: &Skeleton, t: f64) -> Pose {
+    /// eyes' saccades, looking away at the start of `utterance` (the last one the character
+    /// began, if any).
+    pub fn pose(&self, skeleton: &Skeleton, t: f64, utterance: Option<&Utterance>) -> Pose {
         let mut pose = Pose::rest(skeleton);
-        self.saccades.apply(t, &mut pose);
+        let look = self.aversion.look(t, &self.saccades, utterance);
+        self.saccades.apply(look, &mut pose);
         let t = t as f32 + self.phase;
         let tau = std::f32::consts::TAU;
         // breathing: in for the first part of the cycle, out after (a raised cosine, 0 at rest)
@@ -182,8 +189,8 @@ mod tests {
     fn the_chest_rises_and_falls_every_four_seconds_and_the_pelvis_sways() {
         let s = Skeleton::adult();
         let idle = Idle::new("", &s);
-        let chest = |t: f64| idle.pose(&s, t).world(&s).positions[s.joint("vc7").unwrap()];
-        let root = |t: f64| idle.pose(&s, t).root.x;
+        let chest = |t: f64| idle.pose(&s, t, None).world(&s).positions[s.joint("vc7").unwrap()];
+        let root = |t: f64| idle.pose(&s, t, None).root.x;
         // the breathing repeats every 4 s, and moves the neck base by about a millimetre
         let heights: Vec<f32> = (0..80).map(|i| chest(f64::from(i) * 0.05).z).collect();
         let range = heights.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b))
@@ -198,12 +205,19 @@ mod tests {
         let max = xs.iter().fold(0f32, |a, &b| a.max(b.abs()));
         assert!((max - WEIGHT_SHIFT_M).abs() < 1e-3, "{max}");
         // the feet stay put while the pelvis sways (no more than a tenth of a millimetre)
-        let ankle = |t: f64| idle.pose(&s, t).world(&s).positions[s.joint("l_talocrural").unwrap()];
+        let ankle =
+            |t: f64| idle.pose(&s, t, None).world(&s).positions[s.joint("l_talocrural").unwrap()];
         let moved = (0..140).map(|i| ankle(f64::from(i) * 0.05).distance(ankle(0.0)));
         let most = moved.fold(0f32, f32::max);
         assert!(most < 1e-4, "{most}");
         // deterministic, and another character is out of step
-        assert_eq!(idle.pose(&s, 2.0), Idle::new("", &s).pose(&s, 2.0));
-        assert_ne!(idle.pose(&s, 2.0), Idle::new("anna", &s).pose(&s, 2.0));
+        assert_eq!(
+            idle.pose(&s, 2.0, None),
+            Idle::new("", &s).pose(&s, 2.0, None)
+        );
+        assert_ne!(
+            idle.pose(&s, 2.0, None),
+            Idle::new("anna", &s).pose(&s, 2.0, None)
+        );
     }
 }

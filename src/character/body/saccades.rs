@@ -30,6 +30,11 @@ pub const SPREAD: (f64, f64) = (4.0, 2.5);
 pub const FIELD: (f64, f64) = (10.0, 6.0);
 /// The main sequence: a saccade of amplitude A degrees lasts `A × .0 + .1` seconds.
 pub const MAIN_SEQUENCE: (f64, f64) = (0.0022, 0.021);
+/// The longest idle saccade (seconds): across the whole field (its diagonal, 2·√(10² + 6²)
+/// degrees).
+pub const LONGEST: f64 = MAIN_SEQUENCE.0 * 2.0 * 11.67 + MAIN_SEQUENCE.1;
+/// At most this many saccades in a row are left out (`Saccades::look_without`).
+pub const SKIPPED: usize = 8;
 
 /// The saccades of one character.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,7 +45,7 @@ pub struct Saccades {
 }
 
 /// Minimum jerk from 0 to 1 over 0..1.
-fn minimum_jerk(x: f64) -> f64 {
+pub(super) fn minimum_jerk(x: f64) -> f64 {
     let x = x.clamp(0.0, 1.0);
     x * x * x * (10.0 - 15.0 * x + 6.0 * x * x)
 }
@@ -70,33 +75,52 @@ impl Saccades {
         (yaw, pitch)
     }
 
-    /// How long saccade `k` lasts (seconds): the main sequence for its amplitude.
-    pub fn duration(&self, k: i64) -> f64 {
-        let ((y0, p0), (y1, p1)) = (self.fixation(k - 1), self.fixation(k));
-        let amplitude = (y1 - y0).hypot(p1 - p0);
-        MAIN_SEQUENCE.0 * amplitude + MAIN_SEQUENCE.1
+    /// How long a saccade from `from` to `to` (yaw, pitch; degrees) lasts (seconds): the main
+    /// sequence for its amplitude.
+    pub fn main_sequence(from: (f64, f64), to: (f64, f64)) -> f64 {
+        MAIN_SEQUENCE.0 * (to.0 - from.0).hypot(to.1 - from.1) + MAIN_SEQUENCE.1
+    }
+
+    /// The last saccade started by `t` (the one under way then, if any is).
+    pub fn last(&self, t: f64) -> i64 {
+        // the last one started is the one of t's slot or its neighbour (starts keep their
+        // order: each within ±40 % of its slot)
+        let slot = (t / MEAN_INTERVAL).floor() as i64;
+        (slot - 1..=slot + 1)
+            .rev()
+            .find(|&k| self.start(k) <= t)
+            .unwrap_or(slot - 1)
     }
 
     /// Where the eyes look at `t` (yaw left, pitch up; degrees).
     pub fn look(&self, t: f64) -> (f64, f64) {
-        // the saccade under way at t is the last one started: the one of t's slot or its
-        // neighbour (starts keep their order: each within ±40 % of its slot)
-        let slot = (t / MEAN_INTERVAL).floor() as i64;
-        let k = (slot - 1..=slot + 1)
-            .rev()
-            .find(|&k| self.start(k) <= t)
-            .unwrap_or(slot - 1);
-        let ((y0, p0), (y1, p1)) = (self.fixation(k - 1), self.fixation(k));
-        let f = minimum_jerk((t - self.start(k)) / self.duration(k));
-        (y0 + (y1 - y0) * f, p0 + (p1 - p0) * f)
+        self.look_without(t, |_| false)
     }
 
-    /// Turns the eyes of `pose` to where they look at `t`.
-    pub fn apply(&self, t: f64, pose: &mut Pose) {
+    /// Where the eyes look at `t` (yaw left, pitch up; degrees) when the saccades `skip` names
+    /// are left out (the eyes stay where they were instead; at most [`SKIPPED`] in a row).
+    pub fn look_without(&self, t: f64, skip: impl Fn(i64) -> bool) -> (f64, f64) {
+        let made = |mut k: i64| {
+            for _ in 0..SKIPPED {
+                if !skip(k) {
+                    break;
+                }
+                k -= 1;
+            }
+            k
+        };
+        let k = made(self.last(t));
+        let (from, to) = (self.fixation(made(k - 1)), self.fixation(k));
+        let f = minimum_jerk((t - self.start(k)) / Saccades::main_sequence(from, to));
+        (from.0 + (to.0 - from.0) * f, from.1 + (to.1 - from.1) * f)
+    }
+
+    /// Turns the eyes of `pose` to `look` (yaw left, pitch up; degrees).
+    pub fn apply(&self, look: (f64, f64), pose: &mut Pose) {
         let Some((l, r)) = self.eyes else {
             return;
         };
-        let (yaw, pitch) = self.look(t);
+        let (yaw, pitch) = look;
         let turn = Quat::from_rotation_y(yaw.to_radians() as f32)
             * Quat::from_rotation_x(-pitch.to_radians() as f32);
         for e in [l, r] {

@@ -2,7 +2,7 @@
 //! part in animation prediction ([`Prediction`]), parameters that change while a unit runs
 //! ([`Parameters`]), body resources and exclusive groups ([`Resources`]), actions on the plan
 //! ([`Control`]), moving about the world ([`Travel`]) and looking at whom the walk attends to
-//! ([`Attend`]), sound streamed in by the host ([`Streams`]). An engine offers one by returning itself from the matching `as_…` method of
+//! ([`Attend`]), sound streamed in by the host ([`Streams`]), speaking ([`Speaking`]). An engine offers one by returning itself from the matching `as_…` method of
 //! [`Engine`](super::Engine).
 
 use super::{EngineError, ParameterChange, UnitKey};
@@ -33,6 +33,13 @@ pub trait Expression {
 pub trait Streams {
     /// Takes `stream` (a handle shared with the host).
     fn add_stream(&mut self, stream: crate::character::voice::stream::AudioStream);
+}
+
+/// An engine that speaks: the idle layer's eyes look away as an utterance begins
+/// (`character::body::aversion`).
+pub trait Speaking {
+    /// Of the utterances being said at `now`, the one that began last.
+    fn utterance(&self, now: f64) -> Option<crate::character::body::aversion::Utterance>;
 }
 
 /// An engine that makes sound (synthesized speech, audio clips).

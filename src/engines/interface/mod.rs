@@ -17,7 +17,7 @@ use std::fmt;
 
 pub use capabilities::{
     Action, Attend, Attention, BalanceReading, Control, Expression, Motion, MotionKind, Parameters,
-    Physics, Prediction, Resources, Revising, Revision, Sound, Steering, Streams, Travel,
+    Physics, Prediction, Resources, Revising, Revision, Sound, Speaking, Steering, Streams, Travel,
 };
 pub use frame::{CharacterPose, Frame, Output};
 pub use params::{named_param, named_params, set_named_param, ParameterChange, Params};
@@ -186,6 +186,11 @@ pub trait Engine: Send {
 
     /// Its sound, if it makes any.
     fn as_sound(&self) -> Option<&dyn Sound> {
+        None
+    }
+
+    /// Its utterances, if it speaks.
+    fn as_speaking(&self) -> Option<&dyn Speaking> {
         None
     }
 

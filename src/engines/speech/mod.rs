@@ -447,6 +447,10 @@ impl Engine for SpeechEngine {
         Some(self)
     }
 
+    fn as_speaking(&self) -> Option<&dyn crate::engines::interface::Speaking> {
+        Some(self)
+    }
+
     fn as_streams(&mut self) -> Option<&mut dyn crate::engines::interface::Streams> {
         Some(self)
     }
@@ -466,6 +470,17 @@ impl crate::engines::interface::Streams for SpeechEngine {
     fn add_stream(&mut self, stream: AudioStream) {
         self.streams.retain(|s| s.name() != stream.name());
         self.streams.push(stream);
+    }
+}
+
+impl crate::engines::interface::Speaking for SpeechEngine {
+    /// The speech being said at `now` that began last: from its start to its end.
+    fn utterance(&self, now: f64) -> Option<crate::character::body::aversion::Utterance> {
+        (self.units.started(now))
+            .filter_map(|(syncs, _)| Some((syncs.first()?.1, syncs.last()?.1)))
+            .filter(|&(_, end)| now < end)
+            .map(|(start, end)| crate::character::body::aversion::Utterance { start, end })
+            .last()
     }
 }
 

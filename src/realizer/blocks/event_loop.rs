@@ -156,6 +156,7 @@ impl BlockManager {
         self.now = to;
         self.update_anticipators(to);
         self.apply_changes(to);
+        self.hear_utterance(to);
         self.predict_poses(to);
         self.attend();
         let mut pose = self.base_pose(to);

@@ -100,6 +100,9 @@ pub struct BlockManager {
     assembler: crate::character::Assembler,
     /// The sounds that played in the last frame (ids).
     playing: Vec<String>,
+    /// The utterance the character began last (the idle layer's eyes look away as it begins;
+    /// kept after it ends, so that the look back completes).
+    utterance: Option<crate::character::body::aversion::Utterance>,
     /// The world as of the last advance (shared with the realizer).
     shared: std::sync::Arc<World>,
     /// That world as this character sees it, from where it stands (what its engines get).
@@ -141,6 +144,7 @@ impl BlockManager {
             idle: Some(idle),
             assembler,
             playing: Vec::new(),
+            utterance: None,
             shared: std::sync::Arc::new(World::default()),
             world: std::sync::Arc::new(World::default()),
             placement: crate::world::Placement::default(),
@@ -183,10 +187,21 @@ impl BlockManager {
         self.assembler.set_idle(id, on);
     }
 
+    /// Notes the utterance being said at `now` that began last, if the engines say one (the
+    /// last one noted stays until another begins).
+    fn hear_utterance(&mut self, now: f64) {
+        let said = (self.registry.engines())
+            .filter_map(|e| e.as_speaking()?.utterance(now))
+            .max_by(|a, b| a.start.total_cmp(&b.start));
+        if said.is_some() {
+            self.utterance = said;
+        }
+    }
+
     /// The pose a frame at `t` starts from: the idle layer's, or the rest pose.
     fn base_pose(&self, t: f64) -> Pose {
         match &self.idle {
-            Some(idle) => idle.pose(&self.skeleton, t),
+            Some(idle) => idle.pose(&self.skeleton, t, self.utterance.as_ref()),
             None => Pose::rest(&self.skeleton),
         }
     }
