@@ -96,6 +96,16 @@ fn bodies_in_a_press_stay_people() {
     }
 }
 
+#[test]
+fn one_near_its_goal_with_someone_standing_beyond_it_walks_on() {
+    // found by the proptest below: w0000, 0.35 m from its goal, foresaw running into w0002
+    // standing 1.3 m beyond it, and stood still until its walk gave up (its contacts now end
+    // where it stops)
+    let seen = press(10, 6.497674, 10.0, 13523512388356260687, 40.0);
+    assert!(seen.stranded.is_empty(), "stranded {:?}", seen.stranded);
+    assert!(seen.closest >= 0.45, "closest {}", seen.closest);
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig { cases: 16, ..Default::default() })]
 

@@ -17,7 +17,7 @@
 
 use glam::Vec2;
 
-use super::contact::{time_to_contact, Approach};
+use super::contact::Approach;
 use super::profile::Profile;
 use super::snapshot::Agent;
 use crate::rng::Rng;
@@ -48,6 +48,8 @@ pub const PATIENCE: f32 = 3.0;
 const FLOOR_MARGIN: f32 = 1e-3;
 /// How often a walker chooses its velocity among others (s).
 pub const DECIDE_PERIOD: f64 = 0.1;
+/// Slower than this (m/s), someone counts as standing.
+pub const STANDING_SPEED: f32 = 0.05;
 /// How far a walker looks for others (m).
 pub const NEIGHBOUR_RADIUS: f32 = 8.0;
 /// Between two regular choices, a course that touches someone sooner than this (s) is chosen
@@ -82,6 +84,8 @@ pub struct Avoider {
     contacts: Vec<(f32, Agent)>,
     /// The radii's widening to a personal space for this choice.
     incr: f32,
+    /// How far the walker still goes before it stands at its goal (m; unbounded by default).
+    way_left: f32,
 }
 
 impl Avoider {
@@ -94,6 +98,7 @@ impl Avoider {
             rng: Rng(seed),
             contacts: Vec::new(),
             incr: 1.0,
+            way_left: f32::INFINITY,
         }
     }
 
@@ -113,6 +118,29 @@ impl Avoider {
         } else {
             (self.waited - 2.0 * dt).max(0.0)
         };
+    }
+
+    /// Tells it how far it still goes (m) before it stands at its goal: a contact with someone
+    /// standing that would come only after it stopped there is none (a
+    /// walker 0.35 m from its place, with someone standing a metre beyond it, foresaw running
+    /// into them and stood still for good).
+    pub fn set_way_left(&mut self, way_left: f32) {
+        self.way_left = way_left.max(0.0);
+    }
+
+    /// The approach of `me` going at `v` to `o`, and, when `o` stands, the one from where `me`
+    /// stands once it has gone its way left (from the time it gets there).
+    fn course(&self, me: Agent, v: Vec2, o: &Agent) -> Course {
+        let now = Approach::new(o.at - me.at, o.velocity - v);
+        let speed = v.length();
+        let stop =
+            (self.way_left.is_finite() && speed > 1e-6 && o.velocity.length() < STANDING_SPEED)
+                .then(|| {
+                    let t = self.way_left / speed;
+                    let there = me.at + v * t;
+                    (t, Approach::new(o.at + o.velocity * t - there, o.velocity))
+                });
+        Course { now, stop }
     }
 
     /// How impatient it is, from 0 to 1: a walker kept waiting weighs the risk of contacts
@@ -281,7 +309,7 @@ impl Avoider {
                 continue;
             }
             let reach = (me.radius + o.radius) * self.incr;
-            if let Some(t) = time_to_contact(dx, o.velocity - desired, reach) {
+            if let Some(t) = self.course(me, desired, &o).time_to(reach) {
                 if t < p.tc_max {
                     self.contacts.push((t, o));
                 }
@@ -366,7 +394,7 @@ impl Avoider {
         let (mut soonest, mut touch) = (p.tc_max, f32::INFINITY);
         for &(_, o) in &self.contacts {
             let reach = (me.radius + o.radius) * self.incr;
-            let approach = Approach::new(o.at - me.at, o.velocity - v);
+            let approach = self.course(me, v, &o);
             // the bodies' reach is within the personal one: no personal contact, no touch
             if let Some(t) = approach.time_to(reach) {
                 soonest = soonest.min(t);
@@ -383,6 +411,24 @@ impl Avoider {
     }
 }
 
+/// A walker's approach to another going at a candidate velocity, and after it has stopped at its
+/// goal: (the time it stops, the approach from then on).
+struct Course {
+    now: Approach,
+    stop: Option<(f32, Approach)>,
+}
+
+impl Course {
+    /// The first time they come within `reach` (s): on the way, or after it stopped.
+    fn time_to(&self, reach: f32) -> Option<f32> {
+        match (self.now.time_to(reach), self.stop) {
+            (Some(t), Some((stop, _))) if t <= stop => Some(t),
+            (_, Some((stop, after))) => after.time_to(reach).map(|t| stop + t),
+            (t, None) => t,
+        }
+    }
+}
+
 /// Whether going at `v` for [`BODY_HORIZON`] brings `me`'s body into a wall, or nearer one it
 /// already touches (walking along a wall it touches is not walking into it).
 fn into_wall(me: Agent, v: Vec2, walls: &Obstacles) -> bool {
@@ -393,6 +439,7 @@ fn into_wall(me: Agent, v: Vec2, walls: &Obstacles) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::world::crowd::contact::time_to_contact;
 
     /// `a`'s choice for `me` wanting `desired`, looking along `heading`, at 1.3 m/s preferred,
     /// among `others` and no walls.
@@ -450,6 +497,30 @@ mod tests {
         };
         let v = choose(&mut a, going, d, 0.0, [nudged].into_iter(), &p);
         assert!(v.x < 0.0, "{v}");
+    }
+
+    #[test]
+    fn one_near_its_goal_walks_on_to_it_with_someone_standing_beyond() {
+        // standing still, 0.35 m from its goal; someone stands 1.3 m beyond the goal, in line
+        let p = Profile::default();
+        let me = agent(0.0, 0.0, 0.0, 0.0);
+        let beyond = agent(0.0, 1.65, 0.0, 0.0);
+        let d = Vec2::new(0.0, 0.35);
+        // not told where it stops, it foresees running into them and does not go straight on
+        let mut a = Avoider::new(5);
+        let v = choose(&mut a, me, d, 0.0, [beyond].into_iter(), &p);
+        assert!(a.avoiding && v != d, "{v}");
+        // told, it walks on to its goal
+        let mut a = Avoider::new(5);
+        a.set_way_left(0.35);
+        let v = choose(&mut a, me, d, 0.0, [beyond].into_iter(), &p);
+        assert_eq!(v, d);
+        // but someone standing on the goal itself is still avoided
+        let mut a = Avoider::new(5);
+        a.set_way_left(0.35);
+        let on = agent(0.0, 0.6, 0.0, 0.0);
+        let v = choose(&mut a, me, d, 0.0, [on].into_iter(), &p);
+        assert!(a.avoiding && v != d, "{v}");
     }
 
     #[test]

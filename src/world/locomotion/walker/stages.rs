@@ -221,6 +221,7 @@ impl Walker {
                     profile: &self.profile,
                     obstacles,
                     goal: a.walk.goal,
+                    left,
                 };
                 let desired = toward * a.walk.speed * slowing;
                 near.steer(
