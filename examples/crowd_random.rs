@@ -3,6 +3,7 @@
 //!
 //! ```sh
 //! cargo run --release --example crowd_random [N [SIDE [FPS [SEED [UNTIL]]]]]
+//! cargo run --release --example crowd_random door|corridor [FPS [UNTIL]]
 //! ```
 //!
 //! N walkers (300 by default) start and end at random spots of a SIDE × SIDE m square (30),
@@ -11,6 +12,10 @@
 //! generator SEED (1). Printed: who did not arrive (within 0.3 m of its goal, its block ended)
 //! and what they said, the closest two roots came, the fastest a root moved between frames, the
 //! largest drop of the hips between frames, and the wall time against the scene's time.
+//!
+//! `door`: a wall with a 0.9 m door, 30 walkers on each side crossing to the other; `corridor`:
+//! a 4 m wide corridor, 100 walking each way (UNTIL 150 s). Printed besides: how near a root
+//! came to a wall.
 
 use std::time::Instant;
 
@@ -25,7 +30,7 @@ const ARRIVED: f32 = 0.3;
 mod lcg;
 #[path = "common/trips.rs"]
 mod trips;
-use trips::{id, trips, SETTLE};
+use trips::{id, passage, trips, walking, SETTLE};
 
 fn argument<T: std::str::FromStr>(k: usize, default: T) -> T {
     std::env::args()
@@ -40,19 +45,46 @@ struct Seen {
     closest: (f32, usize, usize, f64),
     fastest: (f32, usize, f64),
     drop: (f32, usize, f64),
+    /// The nearest a root came to a wall (m), who, when.
+    wall: (f32, usize, f64),
 }
 
 fn main() {
-    let n: usize = argument(1, 300);
-    let side: f32 = argument(2, 30.0);
-    let fps: f64 = argument(3, 10.0);
-    let seed: u64 = argument(4, 1);
-    let until: f64 = argument(5, 60.0);
-    let (mut r, goals) = trips(n, side, seed);
+    let scene = std::env::args()
+        .nth(1)
+        .filter(|a| a.parse::<f64>().is_err());
+    let (mut r, goals, walls, what, fps, until) = match scene.as_deref() {
+        Some(name) => {
+            let Some(trips::Passage {
+                starts,
+                goals,
+                walls,
+            }) = passage(name)
+            else {
+                eprintln!("crowd_random: no scene '{name}' (door or corridor)");
+                std::process::exit(2);
+            };
+            let r = walking(&starts, &goals, &walls);
+            let fps: f64 = argument(2, 10.0);
+            let what = format!("{} walkers, {name}, {fps} fps", goals.len());
+            (r, goals, walls, what, fps, argument(3, 150.0))
+        }
+        None => {
+            let n: usize = argument(1, 300);
+            let side: f32 = argument(2, 30.0);
+            let fps: f64 = argument(3, 10.0);
+            let seed: u64 = argument(4, 1);
+            let (r, goals) = trips(n, side, seed);
+            let what = format!("{n} walkers, {side} m square, {fps} fps, seed {seed}");
+            (r, goals, Vec::new(), what, fps, argument(5, 60.0))
+        }
+    };
+    let n = goals.len();
 
     let clock = Instant::now();
     let mut seen = Seen {
         closest: (f32::MAX, 0, 0, 0.0),
+        wall: (f32::MAX, 0, 0.0),
         ..Seen::default()
     };
     let mut ended = vec![false; n];
@@ -86,6 +118,7 @@ fn main() {
             .map(|k| f.character(&id(k)).expect("a pose").pose.root)
             .collect();
         look(&roots, &mut last, &mut seen, time, fps);
+        near_walls(&roots, &walls, &mut seen, time);
         trace(&roots, &goals, time, fps);
         // (once every walk has ended, those who stepped aside for a late one go back)
         if ended.iter().all(|&e| e) && *all_ended.get_or_insert(time) + SETTLE <= time {
@@ -112,7 +145,7 @@ fn main() {
     let (d, a, b, t) = seen.closest;
     let (v, who, tv) = seen.fastest;
     let (h, whoh, th) = seen.drop;
-    println!("{n} walkers, {side} m square, {fps} fps, seed {seed}: {stranded} did not arrive");
+    println!("{what}: {stranded} did not arrive");
     println!(
         "closest roots {d:.3} m ({} and {} at {t:.1} s)",
         id(a),
@@ -124,7 +157,26 @@ fn main() {
         h * 100.0,
         id(whoh)
     );
+    if !walls.is_empty() {
+        let (d, who, t) = seen.wall;
+        println!("nearest a wall {d:.3} m ({} at {t:.1} s)", id(who));
+    }
     println!("{time:.1} s of scene in {wall:.1} s wall");
+}
+
+/// Notes the nearest any of `roots` came to one of `walls` (segments [x1, z1, x2, z2]).
+fn near_walls(roots: &[Vec3], walls: &[[f32; 4]], seen: &mut Seen, time: f64) {
+    for (k, p) in roots.iter().enumerate() {
+        let p = Vec2::new(p.x, p.z);
+        for &[x1, z1, x2, z2] in walls {
+            let (a, b) = (Vec2::new(x1, z1), Vec2::new(x2, z2));
+            let along = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            let d = p.distance(a + (b - a) * along);
+            if d < seen.wall.0 {
+                seen.wall = (d, k, time);
+            }
+        }
+    }
 }
 
 /// With `TRACE=w0001,w0002` in the environment: those walkers' places every second (every

@@ -1,6 +1,7 @@
-//! Random trips for whole-body walkers, the scenes of the `crowd_random` example and of
+//! Trips for whole-body walkers, the scenes of the `crowd_random` example and of
 //! `tests/crowd_press.rs`: N walkers start and end at random spots of a square (starts
-//! [`APART`] from each other, goals too), each sent `<locomotion target="x,z"/>` at t = 0.
+//! [`APART`] from each other, goals too), or cross through a door or along a corridor
+//! ([`passage`]), each sent `<locomotion target="x,z"/>` at t = 0.
 //! Needs the crate root to hold `mod lcg` (`common/lcg.rs`).
 
 use bml_realizer::realizer::Realizer;
@@ -42,13 +43,18 @@ fn spots(rng: &mut Lcg, n: usize, side: f32) -> Vec<Vec2> {
 /// A realizer with `n` walkers on random trips in a `side` m square (generator `seed`), every
 /// walk sent; and the goals.
 pub fn trips(n: usize, side: f32, seed: u64) -> (Realizer, Vec<Vec2>) {
-    const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
     let mut rng = Lcg(seed);
     let starts = spots(&mut rng, n, side);
     let goals = spots(&mut rng, n, side);
-    let chars: Vec<String> = (0..n)
-        .map(|k| {
-            let (s, g) = (starts[k], goals[k]);
+    (walking(&starts, &goals, &[]), goals)
+}
+
+/// A realizer with walkers `w0000`, `w0001`, … standing at `starts`, facing their `goals`,
+/// among `walls` (segments [x1, z1, x2, z2]), each sent `<locomotion target="x,z"/>`.
+pub fn walking(starts: &[Vec2], goals: &[Vec2], walls: &[[f32; 4]]) -> Realizer {
+    const NS: &str = r#"xmlns="http://www.bml-initiative.org/bml/bml-1.0""#;
+    let chars: Vec<String> = (starts.iter().zip(goals).enumerate())
+        .map(|(k, (&s, &g))| {
             let facing = (g - s).x.atan2((g - s).y).to_degrees();
             format!(
                 r#""{}": {{"position": [{}, 0, {}], "facing": {facing}}}"#,
@@ -58,7 +64,14 @@ pub fn trips(n: usize, side: f32, seed: u64) -> (Realizer, Vec<Vec2>) {
             )
         })
         .collect();
-    let json = format!(r#"{{"characters": {{{}}}}}"#, chars.join(", "));
+    let walls: Vec<String> = (walls.iter())
+        .map(|[a, b, c, d]| format!(r#"{{"segment": [{a}, {b}, {c}, {d}]}}"#))
+        .collect();
+    let json = format!(
+        r#"{{"characters": {{{}}}, "obstacles": [{}]}}"#,
+        chars.join(", "),
+        walls.join(", ")
+    );
     let mut r = Realizer::new();
     *r.world_mut() = World::from_json(&json).expect("a world").0;
     for (k, g) in goals.iter().enumerate() {
@@ -70,5 +83,62 @@ pub fn trips(n: usize, side: f32, seed: u64) -> (Realizer, Vec<Vec2>) {
         );
         r.perform_bml(&bml).expect("a block");
     }
-    (r, goals)
+    r
+}
+
+/// A scene of walls and walkers crossing.
+#[allow(dead_code)] // (the example's; the proptest's scenes are random squares)
+pub struct Passage {
+    /// Where the walkers start.
+    pub starts: Vec<Vec2>,
+    /// Where they go.
+    pub goals: Vec<Vec2>,
+    /// The walls: segments [x1, z1, x2, z2].
+    pub walls: Vec<[f32; 4]>,
+}
+
+/// A passage scene: `door`, a 0.9 m door in a wall with 30 walkers on each side crossing;
+/// `corridor`, a 4 m wide corridor with 100 walking each way. `None` for another name.
+#[allow(dead_code)] // (the example's; the proptest's scenes are random squares)
+pub fn passage(name: &str) -> Option<Passage> {
+    let grid = |x0: f32, cols: usize, z0: f32, rows: usize| -> Vec<Vec2> {
+        (0..cols)
+            .flat_map(|i| {
+                (0..rows).map(move |j| Vec2::new(x0 + APART * i as f32, z0 + APART * j as f32))
+            })
+            .collect()
+    };
+    match name {
+        "door" => {
+            // the wall along x = 0, its door from z = -0.45 to 0.45
+            let walls = vec![[0.0, -12.0, 0.0, -0.45], [0.0, 0.45, 0.0, 12.0]];
+            let left = grid(-5.2, 5, -2.0, 6);
+            let right = grid(2.0, 5, -2.0, 6);
+            let starts: Vec<Vec2> = left.iter().chain(&right).copied().collect();
+            // each crosses to 4 m beyond where the other side started
+            let goals = (left.iter().map(|p| *p + Vec2::new(11.2, 0.0)))
+                .chain(right.iter().map(|p| *p - Vec2::new(11.2, 0.0)))
+                .collect();
+            Some(Passage {
+                starts,
+                goals,
+                walls,
+            })
+        }
+        "corridor" => {
+            let walls = vec![[-45.0, -2.0, 45.0, -2.0], [-45.0, 2.0, 45.0, 2.0]];
+            let west = grid(-36.0, 20, -1.6, 5);
+            let east = grid(20.8, 20, -1.6, 5);
+            let starts: Vec<Vec2> = west.iter().chain(&east).copied().collect();
+            let goals = (west.iter().map(|p| *p + Vec2::new(56.8, 0.0)))
+                .chain(east.iter().map(|p| *p - Vec2::new(56.8, 0.0)))
+                .collect();
+            Some(Passage {
+                starts,
+                goals,
+                walls,
+            })
+        }
+        _ => None,
+    }
 }

@@ -130,10 +130,15 @@ fn beside_whoever_stands(world: &World, me: &str, goal: Vec2, from: Vec2) -> Goa
     }
     let widen = world.profile(me).incr.max(1.0);
     let crowd = world.crowd();
-    let on_it = |id: &str, at: Vec2, radius: f32, velocity: Vec2| {
-        let reach = mine + radius;
-        (id != me && velocity.length() < STANDING_SPEED && at.distance(goal) < reach)
-            .then(|| (at.distance(goal), id.to_string(), at, reach * widen))
+    let on_it = |id: &str, them: crate::world::crowd::Agent| {
+        let reach = mine + them.radius;
+        let off = them.at.distance(goal);
+        (id != me && them.velocity.length() < STANDING_SPEED && off < reach).then(|| OnGoal {
+            off,
+            by: id.to_string(),
+            at: them.at,
+            reach: reach * widen,
+        })
     };
     let mut near = Vec::new();
     crowd.near(goal, mine + MAX_RADIUS, &mut near);
@@ -142,24 +147,30 @@ fn beside_whoever_stands(world: &World, me: &str, goal: Vec2, from: Vec2) -> Goa
         // someone goes back: neither takes the place; a walker settled beside one who had
         // stepped onto its goal for a moment, 0.64 m from it, and stood there when it left)
         .filter(|&&i| !crowd.on_its_way(i) && !crowd.is_aside(i))
-        .filter_map(|&i| {
-            let a = crowd.agent(i);
-            on_it(crowd.id(i), a.at, a.radius, a.velocity)
-        })
-        .min_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.cmp(&b.1)));
+        .filter_map(|&i| on_it(crowd.id(i), crowd.agent(i)))
+        .min_by(|a, b| a.off.total_cmp(&b.off).then_with(|| a.by.cmp(&b.by)));
     match standing {
         None => free,
-        Some((_, id, them, reach)) => {
-            let away = (from - them).normalize_or((goal - them).normalize_or(Vec2::Y));
+        Some(on) => {
+            let away = (from - on.at).normalize_or((goal - on.at).normalize_or(Vec2::Y));
             Goal {
                 taken: Some(Taken {
-                    by: id,
-                    beside: them + away * (reach + BESIDE_GAP),
+                    beside: on.at + away * (on.reach + BESIDE_GAP),
+                    by: on.by,
                 }),
                 ..free
             }
         }
     }
+}
+
+/// One standing on a walker's goal: how far from it (m), who, where, and how far the walker
+/// keeps from them (the two radii, widened to the walker's personal space).
+struct OnGoal {
+    off: f32,
+    by: String,
+    at: Vec2,
+    reach: f32,
 }
 
 /// The largest body radius of one standing on a goal that is looked for (m): people's are

@@ -172,7 +172,7 @@ impl LocomotionEngine {
         };
         // (making room, it watches the walker it makes room for while that one is near)
         let watched = (self.room.as_ref())
-            .and_then(|r| crowd.index(&r.walker))
+            .and_then(|r| crowd.index(r.walker.as_deref()?))
             .map(|i| crowd.agent(i).at)
             .filter(|p| {
                 self.room

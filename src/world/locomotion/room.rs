@@ -27,9 +27,8 @@ pub struct Room {
     pub home: Body,
     /// Whether it stands (or walks) aside; false once it walks back.
     pub aside: bool,
-    /// The walker it made room for (its id; empty when it was pressed off its place), and
-    /// when that one last asked.
-    pub walker: String,
+    /// The walker it made room for (its id; `None` when it was pressed off its place).
+    pub walker: Option<String>,
     /// When it was last asked (s).
     pub asked: f64,
 }
@@ -54,13 +53,13 @@ pub fn make_room(
             r.asked = now;
         }
         if r.aside {
-            let passing = (crowd.index(&r.walker))
+            let passing = (r.walker.as_deref().and_then(|w| crowd.index(w)))
                 .is_some_and(|i| in_the_way(crowd.agent(i), r.home.at, radius));
             // (asked by another, whose way it now shuts, it goes back: one that stood aside
             // on a walker's goal, asked by that walker, stayed there until the walk gave up)
             let (mut theirs, mut another) = (false, false);
             for i in crowd.askers(me) {
-                match crowd.id(i) == r.walker {
+                match r.walker.as_deref() == Some(crowd.id(i)) {
                     true => theirs = true,
                     false => another = true,
                 }
@@ -79,7 +78,7 @@ pub fn make_room(
     *room = Some(Room {
         home,
         aside: true,
-        walker: crowd.id(near?).to_string(),
+        walker: Some(crowd.id(near?).to_string()),
         asked: now,
     });
     Some(walk_to(spot, home))
@@ -99,7 +98,7 @@ pub fn back_to(place: Body, body: Body) -> Option<(Room, Walk)> {
         let room = Room {
             home: place,
             aside: false,
-            walker: String::new(),
+            walker: None,
             asked: f64::NEG_INFINITY,
         };
         (room, walk_to(place.at, place))
