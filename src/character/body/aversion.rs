@@ -54,7 +54,9 @@ impl Aversion {
     /// Where the eyes look away to (yaw left, pitch up; degrees) at the start of an utterance
     /// that begins at `start`, if they do.
     pub fn away(&self, start: f64) -> Option<(f64, f64)> {
-        let k = start.to_bits();
+        // (the utterance by its start to the millisecond, as the stream's indices are meant:
+        // consecutive whole numbers)
+        let k = (start * 1000.0).round() as i64 as u64;
         let draw = |salt: u64| unit(self.seed ^ salt, k);
         if draw(0) >= CHANCE {
             return None;
