@@ -20,6 +20,7 @@
 use std::time::Instant;
 
 use bml_realizer::language::feedback::Feedback;
+use bml_realizer::world::space::distance::point_segment;
 use glam::{Vec2, Vec3};
 
 /// A walker within this of its goal has arrived (m).
@@ -169,9 +170,7 @@ fn near_walls(roots: &[Vec3], walls: &[[f32; 4]], seen: &mut Seen, time: f64) {
     for (k, p) in roots.iter().enumerate() {
         let p = Vec2::new(p.x, p.z);
         for &[x1, z1, x2, z2] in walls {
-            let (a, b) = (Vec2::new(x1, z1), Vec2::new(x2, z2));
-            let along = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-            let d = p.distance(a + (b - a) * along);
+            let (d, _) = point_segment(p, Vec2::new(x1, z1), Vec2::new(x2, z2));
             if d < seen.wall.0 {
                 seen.wall = (d, k, time);
             }

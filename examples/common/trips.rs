@@ -101,44 +101,48 @@ pub struct Passage {
 /// `corridor`, a 4 m wide corridor with 100 walking each way. `None` for another name.
 #[allow(dead_code)] // (the example's; the proptest's scenes are random squares)
 pub fn passage(name: &str) -> Option<Passage> {
-    let grid = |x0: f32, cols: usize, z0: f32, rows: usize| -> Vec<Vec2> {
-        (0..cols)
-            .flat_map(|i| {
-                (0..rows).map(move |j| Vec2::new(x0 + APART * i as f32, z0 + APART * j as f32))
-            })
-            .collect()
-    };
     match name {
-        "door" => {
-            // the wall along x = 0, its door from z = -0.45 to 0.45
-            let walls = vec![[0.0, -12.0, 0.0, -0.45], [0.0, 0.45, 0.0, 12.0]];
-            let left = grid(-5.2, 5, -2.0, 6);
-            let right = grid(2.0, 5, -2.0, 6);
-            let starts: Vec<Vec2> = left.iter().chain(&right).copied().collect();
-            // each crosses to 4 m beyond where the other side started
-            let goals = (left.iter().map(|p| *p + Vec2::new(11.2, 0.0)))
-                .chain(right.iter().map(|p| *p - Vec2::new(11.2, 0.0)))
-                .collect();
-            Some(Passage {
-                starts,
-                goals,
-                walls,
-            })
-        }
-        "corridor" => {
-            let walls = vec![[-45.0, -2.0, 45.0, -2.0], [-45.0, 2.0, 45.0, 2.0]];
-            let west = grid(-36.0, 20, -1.6, 5);
-            let east = grid(20.8, 20, -1.6, 5);
-            let starts: Vec<Vec2> = west.iter().chain(&east).copied().collect();
-            let goals = (west.iter().map(|p| *p + Vec2::new(56.8, 0.0)))
-                .chain(east.iter().map(|p| *p - Vec2::new(56.8, 0.0)))
-                .collect();
-            Some(Passage {
-                starts,
-                goals,
-                walls,
-            })
-        }
+        // the wall along x = 0, its door from z = -0.45 to 0.45; each crosses to 4 m beyond
+        // where the other side started
+        "door" => Some(crossing(
+            (-5.2, 2.0, 5),
+            (-2.0, 6),
+            11.2,
+            vec![[0.0, -12.0, 0.0, -0.45], [0.0, 0.45, 0.0, 12.0]],
+        )),
+        // each side ends where the other started
+        "corridor" => Some(crossing(
+            (-36.0, 20.8, 20),
+            (-1.6, 5),
+            56.8,
+            vec![[-45.0, -2.0, 45.0, -2.0], [-45.0, 2.0, 45.0, 2.0]],
+        )),
         _ => None,
+    }
+}
+
+/// Two groups crossing along x among `walls`: grids of `cols` × `rows` places [`APART`] apart,
+/// the west one from x = `west`, the east one from x = `east`, both from z = `z0`; each walker
+/// goes `shift` m east (west group) or west (east group).
+#[allow(dead_code)] // (the example's; the proptest's scenes are random squares)
+fn crossing(
+    (west, east, cols): (f32, f32, usize),
+    (z0, rows): (f32, usize),
+    shift: f32,
+    walls: Vec<[f32; 4]>,
+) -> Passage {
+    let grid = |x0: f32| {
+        (0..cols).flat_map(move |i| {
+            (0..rows).map(move |j| Vec2::new(x0 + APART * i as f32, z0 + APART * j as f32))
+        })
+    };
+    let starts: Vec<Vec2> = grid(west).chain(grid(east)).collect();
+    let goals = (grid(west).map(|p| p + Vec2::X * shift))
+        .chain(grid(east).map(|p| p - Vec2::X * shift))
+        .collect();
+    Passage {
+        starts,
+        goals,
+        walls,
     }
 }
