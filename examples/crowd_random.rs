@@ -16,6 +16,9 @@
 //! `door`: a wall with a 0.9 m door, 30 walkers on each side crossing to the other; `corridor`:
 //! a 4 m wide corridor, 100 walking each way (UNTIL 150 s). Printed besides: how near a root
 //! came to a wall.
+//!
+//! `PICTURE=file.png` draws a contact sheet of the floor from above every `PICTURE_EVERY`
+//! seconds (5) over the area `PICTURE_AREA=x0,z0,x1,z1` (the walkers' starts and goals).
 
 use std::time::Instant;
 
@@ -32,6 +35,8 @@ mod lcg;
 #[path = "common/trips.rs"]
 mod trips;
 use trips::{id, passage, trips, walking, SETTLE};
+#[path = "common/sheet.rs"]
+mod sheet;
 
 fn argument<T: std::str::FromStr>(k: usize, default: T) -> T {
     std::env::args()
@@ -94,6 +99,11 @@ fn main() {
     let mut last: Vec<Option<Vec3>> = vec![None; n];
     let mut frame = 0u32;
     let mut time = 0.0;
+    let picture = std::env::var("PICTURE").ok();
+    let every: f64 = (std::env::var("PICTURE_EVERY").ok())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5.0);
+    let mut sheet = sheet::Sheet::default();
     while time <= until {
         time = f64::from(frame) / fps;
         frame += 1;
@@ -121,12 +131,18 @@ fn main() {
         look(&roots, &mut last, &mut seen, time, fps);
         near_walls(&roots, &walls, &mut seen, time);
         trace(&roots, &goals, time, fps);
+        if picture.is_some() && ((time / every).round() * every - time).abs() < 0.5 / fps {
+            sheet.take(time, roots.iter().map(|p| Vec2::new(p.x, p.z)).collect());
+        }
         // (once every walk has ended, those who stepped aside for a late one go back)
         if ended.iter().all(|&e| e) && *all_ended.get_or_insert(time) + SETTLE <= time {
             break;
         }
     }
     let wall = clock.elapsed().as_secs_f64();
+    if let Some(path) = picture {
+        sheet.save(&path, area(&goals, last.as_slice()), &walls, &goals);
+    }
 
     let mut stranded = 0;
     for k in 0..n {
@@ -163,6 +179,23 @@ fn main() {
         println!("nearest a wall {d:.3} m ({} at {t:.1} s)", id(who));
     }
     println!("{time:.1} s of scene in {wall:.1} s wall");
+}
+
+/// The floor to draw: `PICTURE_AREA=x0,z0,x1,z1`, else round every goal and last place.
+fn area(goals: &[Vec2], last: &[Option<Vec3>]) -> (Vec2, Vec2) {
+    let given: Vec<f32> = (std::env::var("PICTURE_AREA").ok().into_iter())
+        .flat_map(|s| {
+            s.split(',')
+                .filter_map(|v| v.parse().ok())
+                .collect::<Vec<f32>>()
+        })
+        .collect();
+    if let [a, b, c, d] = given[..] {
+        return (Vec2::new(a, b), Vec2::new(c, d));
+    }
+    let places = (goals.iter().copied()).chain(last.iter().flatten().map(|p| Vec2::new(p.x, p.z)));
+    let (lo, hi) = places.fold((Vec2::MAX, Vec2::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    (lo - Vec2::ONE, hi + Vec2::ONE)
 }
 
 /// Notes the nearest any of `roots` came to one of `walls` (segments [x1, z1, x2, z2]).

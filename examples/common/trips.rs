@@ -6,7 +6,7 @@
 
 use bml_realizer::realizer::Realizer;
 use bml_realizer::world::World;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
 use crate::lcg::Lcg;
 
@@ -16,6 +16,18 @@ pub const APART: f32 = 0.8;
 /// How long a scene goes on after every walk has ended (s): one who stepped aside for a late
 /// walker goes back to its place before the walkers are judged.
 pub const SETTLE: f64 = 3.0;
+
+/// Who did not arrive: every walker whose `last` root is more than 0.3 m from its goal, or
+/// whose walk has not `ended`, with how far off it stands (m).
+#[allow(dead_code)] // (the tests'; the example says more of each)
+pub fn stranded(last: &[Option<Vec3>], goals: &[Vec2], ended: &[bool]) -> Vec<String> {
+    (0..goals.len())
+        .filter_map(|k| {
+            let off = last[k].map_or(f32::MAX, |p| Vec2::new(p.x, p.z).distance(goals[k]));
+            (off > 0.3 || !ended[k]).then(|| format!("{} {off:.2} m off", id(k)))
+        })
+        .collect()
+}
 
 /// Walker `k`'s id; its block is `b{k}`.
 pub fn id(k: usize) -> String {
@@ -124,8 +136,8 @@ pub fn passage(name: &str) -> Option<Passage> {
 /// Two groups crossing along x among `walls`: grids of `cols` × `rows` places [`APART`] apart,
 /// the west one from x = `west`, the east one from x = `east`, both from z = `z0`; each walker
 /// goes `shift` m east (west group) or west (east group).
-#[allow(dead_code)] // (the example's; the proptest's scenes are random squares)
-fn crossing(
+#[allow(dead_code)] // (the example's and the door test's; the proptest's scenes are random squares)
+pub fn crossing(
     (west, east, cols): (f32, f32, usize),
     (z0, rows): (f32, usize),
     shift: f32,

@@ -88,6 +88,17 @@ impl Realizer {
         }
         crowd.set_on_their_way(going);
         crowd.set_aside(aside);
+        // who is coming to a narrow door, and whose turn it is there
+        let narrows = self.world.obstacles().narrows();
+        if !narrows.is_empty() {
+            let passing: Vec<(usize, crate::world::crowd::doorway::Passing)> =
+                (self.characters.iter_mut())
+                    .filter_map(|(id, m)| Some((crowd.index(id)?, m.passing()?)))
+                    .collect();
+            crowd.set_passing(passing);
+            let turns = crate::world::crowd::doorway::turns(last.turns(), &crowd, narrows);
+            crowd.set_turns(turns);
+        }
         // (walkers of other realizers asking someone here)
         let remote = (self.remote_asks.iter())
             .filter_map(|(who, asked)| Some((crowd.index(asked)?, crowd.index(who)?)));

@@ -169,6 +169,12 @@ pub trait Travel {
         None
     }
 
+    /// The narrow door the character's walk goes through next, if one is near, and how
+    /// (`crowd::doorway`): the realizer decides the turns at doors from these.
+    fn passing(&self) -> Option<crate::world::crowd::doorway::Passing> {
+        None
+    }
+
     /// Whom the character attends to as it moves (the one it asks for room, the walker it
     /// makes room for): where they stand (world x, z) and how much (0 to 1, eased). Engines that
     /// [`Attend`] look there.

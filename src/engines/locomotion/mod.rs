@@ -58,6 +58,17 @@ struct Order {
     note: Option<String>,
 }
 
+/// The longest time waiting one's turn at doors puts off a walk's deadline (s): a walk held
+/// at a door for longer (turns that never come) fails with a warning rather than waiting for
+/// ever.
+pub const MOST_QUEUED: f64 = 300.0;
+
+/// Past its deadline, a walk goes on while it has come
+/// [`NEARER`](crate::world::locomotion::walker::NEARER) nearer its goal within this long (s).
+pub const STALL: f64 = 15.0;
+/// The longest a walk still getting nearer goes on past its deadline (s).
+pub const MOST_LATE: f64 = 120.0;
+
 /// What a unit is doing.
 #[derive(Debug, Clone, PartialEq)]
 struct WalkUnit {
@@ -65,7 +76,8 @@ struct WalkUnit {
     started: bool,
     /// Interrupted: slowing down to stand where it is.
     halted: bool,
-    /// A walk still going then has failed (global time).
+    /// A walk still going then has failed (global time), unless it is still getting nearer
+    /// (`fails_at`).
     deadline: f64,
 }
 
@@ -285,6 +297,22 @@ impl LocomotionEngine {
         }
     }
 
+    /// When walk `key` fails if it has not arrived: at its deadline, put off by the time it
+    /// waited its turn at doors (at most [`MOST_QUEUED`]) and, while it still gets nearer its
+    /// goal, until [`STALL`] after it last came nearer (at most [`MOST_LATE`] beyond), as a
+    /// person in a press goes on while the press moves. On the walker's steps alone, whatever
+    /// the host's frames.
+    pub(crate) fn fails_at(&self, key: &UnitKey) -> f64 {
+        let Some(u) = self.units.get(key) else {
+            return f64::INFINITY;
+        };
+        let Some(w) = self.walker.as_ref() else {
+            return u.deadline;
+        };
+        let due = u.deadline + w.queued.min(MOST_QUEUED);
+        due.max(w.nearest.1 + STALL).min(due + MOST_LATE)
+    }
+
     /// A walk that cannot go: a warning, and it ends at once where the character stands.
     fn fail(&mut self, key: &UnitKey, why: String) {
         self.warnings.push((key.clone(), why));
@@ -322,10 +350,11 @@ impl LocomotionEngine {
             return;
         };
         let m = ended.or_else(|| w.moments()).unwrap_or_default();
+        let fails_at = self.fails_at(&key);
         let Some((syncs, u)) = self.units.get_mut(&key) else {
             return;
         };
-        if ended.is_none() && now > u.deadline {
+        if ended.is_none() && now > fails_at {
             let why = format!(
                 "{key}: the walk to '{}' has not arrived {:.1} s after it set off; it stops where it is",
                 u.order.target,

@@ -47,9 +47,7 @@ impl Travel for LocomotionEngine {
             let until = next.unwrap_or(now).min(now);
             // a walk is stepped no further than its deadline at a time: a huge jump of the
             // clock ends it there instead of simulating all of it
-            let deadline = (self.current.as_ref())
-                .and_then(|k| self.units.get(k))
-                .map_or(f64::INFINITY, |u| u.deadline);
+            let deadline = (self.current.as_ref()).map_or(f64::INFINITY, |k| self.fails_at(k));
             let stop = until.min(deadline + walker::STEP);
             // (a walker that avoids only those it has seen knows them by name)
             let known: Option<Vec<usize>> = (self.walker.as_ref())
@@ -134,6 +132,10 @@ impl Travel for LocomotionEngine {
 
     fn asking(&self) -> Option<Vec2> {
         self.walker.as_ref().and_then(|w| w.asking)
+    }
+
+    fn passing(&self) -> Option<crate::world::crowd::doorway::Passing> {
+        (self.walker.as_ref()).and_then(|w| w.passing.filter(|_| self.current.is_some()))
     }
 
     fn attending(&self) -> Option<(Vec2, f32)> {

@@ -60,6 +60,11 @@ impl BlockManager {
         (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.asking()))
     }
 
+    /// The narrow door the character's walk goes through next, if one is near.
+    pub fn passing(&mut self) -> Option<crate::world::crowd::doorway::Passing> {
+        (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.passing()))
+    }
+
     /// Tells the engines that look ([`Attend`](crate::engines::interface::Attend)) whom the character's
     /// travel attends to now, at their eyes in the character's frame.
     pub(super) fn attend(&mut self) {

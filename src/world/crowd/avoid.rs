@@ -107,6 +107,11 @@ impl Avoider {
         Avoider::new(0x5eed ^ (u64::from(at.x.to_bits()) << 20) ^ u64::from(at.y.to_bits()))
     }
 
+    /// Counts `dt` seconds of not being held back (waiting one's turn): impatience fades.
+    pub fn calm(&mut self, dt: f32) {
+        self.waited = (self.waited - 2.0 * dt).max(0.0);
+    }
+
     /// Counts `dt` seconds of being held back (going at `velocity` the way `desired` points at
     /// under half the preferred speed `pref`, while avoiding) or of walking freely (which calms
     /// it twice as fast). Progress is what counts: a walker sliding along a row of people

@@ -5,7 +5,8 @@
 //! headings it considers the sooner the first contact comes, samples them in a fixed order
 //! (the desired velocity, then to the right, then to the left, each sample jittered) and takes
 //! the cheapest by a cost of effort, deviation and collision risk; once it has chosen a side it
-//! keeps it; it walks round the space of conversing groups ([`group`]) and asks those standing in its way to make room ([`negotiate`]). [`profile`] holds the per-character parameters, [`contact`] the time to contact,
+//! keeps it; it walks round the space of conversing groups ([`group`]) and asks those standing in its way to make room ([`negotiate`]); at a door too narrow to pass
+//! each other in, walkers coming from both sides take turns ([`doorway`]). [`profile`] holds the per-character parameters, [`contact`] the time to contact,
 //! [`snapshot`] the crowd as every walker sees it in a frame (with a uniform grid to find
 //! neighbours), [`avoid`] the choice itself. The realizer keeps the crowd on a fixed grid of
 //! times (every 0.1 s of global time, whatever the host's frames) and each walker
@@ -14,6 +15,7 @@
 
 pub mod avoid;
 pub mod contact;
+pub mod doorway;
 pub mod group;
 pub mod negotiate;
 pub mod profile;

@@ -10,6 +10,8 @@
 
 use glam::Vec2;
 
+use super::doorway::{Passing, Turn};
+
 /// How often walkers among others see where the others are (s): the realizer builds the crowd
 /// every this much global time, on a grid of its multiples, so that no result depends on the
 /// host's frames.
@@ -55,6 +57,10 @@ pub struct Crowd {
     going: Vec<u32>,
     /// Who stands (or walks) off its place to make room and will go back (indices, sorted).
     aside: Vec<u32>,
+    /// Who is coming to a narrow to go through it (index, which and how), by index.
+    passing: Vec<(u32, Passing)>,
+    /// Whose turn it is at each narrow of the world's obstacles (`crowd::doorway`).
+    turns: Vec<Turn>,
 }
 
 /// Indices as a sorted set (searched by `binary_search`).
@@ -119,7 +125,35 @@ impl Crowd {
             asks: Vec::new(),
             going: Vec::new(),
             aside: Vec::new(),
+            passing: Vec::new(),
+            turns: Vec::new(),
         }
+    }
+
+    /// Notes who is coming to a narrow to go through it (index, which and how).
+    pub fn set_passing(&mut self, passing: impl IntoIterator<Item = (usize, Passing)>) {
+        self.passing = (passing.into_iter()).map(|(i, p)| (i as u32, p)).collect();
+        self.passing.sort_by_key(|(i, _)| *i);
+    }
+
+    /// Who is coming to a narrow to go through it, by index.
+    pub fn passing(&self) -> &[(u32, Passing)] {
+        &self.passing
+    }
+
+    /// Notes whose turn it is at each narrow.
+    pub fn set_turns(&mut self, turns: Vec<Turn>) {
+        self.turns = turns;
+    }
+
+    /// Whose turn it is at narrow `n` (free when the crowd knows of none).
+    pub fn turn(&self, n: u32) -> Turn {
+        self.turns.get(n as usize).copied().unwrap_or_default()
+    }
+
+    /// Whose turn it is at every narrow.
+    pub fn turns(&self) -> &[Turn] {
+        &self.turns
     }
 
     /// Notes who asks whom to make room: for each asking character (index), the place of the

@@ -48,6 +48,8 @@ pub(super) struct Near<'a, 'b> {
     pub(super) goal: Vec2,
     /// How far its way still goes (m).
     pub(super) left: f32,
+    /// Whether it waits its turn at a door (`crowd::doorway`).
+    pub(super) waiting: bool,
 }
 
 impl Near<'_, '_> {
@@ -67,7 +69,12 @@ impl Near<'_, '_> {
         let velocity = Vec2::new(vehicle.velocity.x, vehicle.velocity.z);
         let tick = (self.time / STEP).round() as i64;
         let regular = tick % DECIDE_EVERY == 0;
-        if regular {
+        if regular && self.waiting {
+            // (waiting its turn at a door, it is held back by no one: it neither grows
+            // impatient nor asks)
+            avoider.calm(DECIDE_EVERY as f32 * STEP as f32);
+            *asking = None;
+        } else if regular {
             avoider.wait(DECIDE_EVERY as f32 * STEP as f32, velocity, desired, pref);
             // stuck (fully impatient), it asks whoever stands on its line, room beside them or
             // not: its avoidance found no way round them (wedged between two people standing,

@@ -8,6 +8,7 @@ use glam::Vec2;
 use serde::Deserialize;
 
 use super::distance::{point_segment, segment_segment};
+use super::narrows::Narrow;
 
 /// One obstacle.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,6 +43,16 @@ pub struct Obstacle {
     pub shape: Shape,
     /// Its height (2 m by default).
     pub height: f32,
+}
+
+impl Obstacle {
+    /// A wall from `a` to `b`, 2 m high.
+    pub fn wall(a: Vec2, b: Vec2) -> Obstacle {
+        Obstacle {
+            shape: Shape::Segment { a, b },
+            height: 2.0,
+        }
+    }
 }
 
 impl Shape {
@@ -182,6 +193,8 @@ pub struct Obstacles {
     buckets: std::collections::BTreeMap<(i32, i32), Vec<u32>>,
     /// Obstacles too large for buckets (more than 64 × 64 of them), tested always.
     large: Vec<u32>,
+    /// The gaps between them too narrow for two to pass in (`space::narrows`).
+    narrows: Vec<Narrow>,
 }
 
 fn bucket(p: Vec2) -> (i32, i32) {
@@ -209,7 +222,13 @@ impl Obstacles {
                 }
             }
         }
+        o.narrows = super::narrows::find(&o.list, |lo, hi, m| o.near_box(lo, hi, m));
         o
+    }
+
+    /// The gaps between the obstacles too narrow for two people to pass each other in.
+    pub fn narrows(&self) -> &[Narrow] {
+        &self.narrows
     }
 
     /// Every obstacle.

@@ -274,13 +274,7 @@ mod tests {
     }
 
     fn seg(a: (f32, f32), b: (f32, f32)) -> Obstacle {
-        Obstacle {
-            shape: Shape::Segment {
-                a: Vec2::new(a.0, a.1),
-                b: Vec2::new(b.0, b.1),
-            },
-            height: 2.0,
-        }
+        Obstacle::wall(Vec2::new(a.0, a.1), Vec2::new(b.0, b.1))
     }
 
     /// A U open away from the walker: the route leaves the cup round its rim.

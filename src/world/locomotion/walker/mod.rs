@@ -12,6 +12,7 @@ use super::among::neighbours;
 pub use super::among::Others;
 use super::gait::{angle_diff, Body, Gait};
 use super::steering::{ArriveParams, Behaviour, Combine, Part, Steering, Vehicle};
+use crate::world::crowd::doorway::Passing;
 use crate::world::crowd::{Avoider, Profile};
 use crate::world::space::path::{self, PathError};
 use crate::world::space::Obstacles;
@@ -36,6 +37,9 @@ pub const HALT_DECELERATION: f32 = 1.6;
 pub const STOP_RADIUS: f32 = 0.04;
 /// Held still this near its goal, a walker has arrived (m).
 pub const NEAR_ENOUGH: f32 = 0.1;
+/// A walk comes nearer its goal when it comes this much (m) nearer than it had been: who
+/// drives the walk may give it more time while it does.
+pub const NEARER: f32 = 0.5;
 /// Margin kept from obstacles beyond the body's radius when planning (m).
 pub const PLAN_MARGIN: f32 = 0.08;
 
@@ -111,6 +115,16 @@ pub struct Walker {
     /// Where the person standing in its way stands, whom it asks for room by looking at them
     /// (`crowd::negotiate`), while they shut its way.
     pub asking: Option<Vec2>,
+    /// The narrow door its route goes through next, if one is near (`crowd::doorway`).
+    pub passing: Option<Passing>,
+    /// Where it waits for its turn at that door, when it is not its turn.
+    pub waiting: Option<Vec2>,
+    /// How long the walk under way has waited for its turn at doors (s): a person in a queue
+    /// does not give up for the time the queue takes.
+    pub queued: f64,
+    /// The nearest the walk under way has come to its goal (m), and when it came [`NEARER`]
+    /// than before.
+    pub nearest: (f32, f64),
     /// Where the walker stands for whom it makes room (`locomotion::room`), whom it watches.
     pub watching: Option<Vec2>,
     /// How much it attends to the one it asks (0 to 1, eased in and out over a quarter of a
@@ -146,6 +160,10 @@ impl Walker {
             avoider: Avoider::starting_at(at),
             chosen: None,
             asking: None,
+            passing: None,
+            waiting: None,
+            queued: 0.0,
+            nearest: (f32::INFINITY, time),
             watching: None,
             attention: 0.0,
             asked_at: at,
@@ -275,6 +293,8 @@ impl Walker {
         }));
         self.vehicle.max_speed = walk.speed;
         self.stopped_at = None;
+        self.queued = 0.0;
+        self.nearest = (f32::INFINITY, self.time);
         // the velocity follows the steering within about 0.2 s, speeding up and braking at up
         // to about 2.3 m/s² walking, more running
         self.vehicle.max_force = self.vehicle.mass * (1.6 + 0.6 * walk.speed);
@@ -389,7 +409,9 @@ impl Walker {
         let Some(moments) = self.active.as_ref().map(|a| a.moments) else {
             return false;
         };
+        let (queued, nearest) = (self.queued, self.nearest);
         let ok = self.start(walk, obstacles).is_ok();
+        (self.queued, self.nearest) = (queued, nearest);
         if let (true, Some(a)) = (ok, self.active.as_mut()) {
             // (a relax that happened stays: it has been reported)
             a.moments = Moments {

@@ -8,9 +8,11 @@
 use glam::{Vec2, Vec3};
 
 use super::{
-    footstep_mode, turn_toward, Active, Moments, Others, Walker, HALT_DECELERATION, NEAR_ENOUGH,
-    REPLAN_EVERY, STEP, STOP_RADIUS, TURN_EASE, TURN_FIRST, TURN_ON_THE_SPOT, TURN_RATE,
+    footstep_mode, turn_toward, Active, Moments, Others, Walker, HALT_DECELERATION, NEARER,
+    NEAR_ENOUGH, REPLAN_EVERY, STEP, STOP_RADIUS, TURN_EASE, TURN_FIRST, TURN_ON_THE_SPOT,
+    TURN_RATE,
 };
+use crate::world::crowd::doorway::{self, Passing};
 use crate::world::locomotion::among::{neighbours, Near};
 use crate::world::locomotion::gait::{angle_diff, forward};
 use crate::world::locomotion::steering::{flat, Behaviour, Context};
@@ -70,7 +72,7 @@ impl Walker {
         // (one going round someone as its avoidance chose does not turn first toward its
         // goal: a walker that did, turning straight at one standing and then steering round
         // them again, swung between the two and crept 5 cm/s for 17 s)
-        let round = self.chosen.is_some_and(|v| v.length() > 0.1);
+        let round = self.chosen.is_some_and(|v| v.length() > 0.1) || self.waiting.is_some();
         let behind = wanted != Vec2::ZERO
             && !round
             && !a.walk.stepping
@@ -214,6 +216,17 @@ impl Walker {
                 let toward =
                     (route.get(1).copied().unwrap_or(a.walk.goal) - here).normalize_or_zero();
                 let slowing = (left / a.slow_radius()).clamp(0.1, 1.0);
+                let narrows = obstacles.narrows();
+                self.passing = (!narrows.is_empty())
+                    .then(|| Passing::on(route, narrows))
+                    .flatten();
+                // (not its turn at a narrow door: it waits in the queue on its right)
+                self.waiting = (self.passing)
+                    .filter(|p| !p.may_go(o.crowd.turn(p.narrow)))
+                    .map(|p| {
+                        let rank = o.me.map_or(0, |me| doorway::rank(o.crowd, me, p));
+                        p.waiting_spot(&narrows[p.narrow as usize], rank)
+                    });
                 let near = Near {
                     others: o,
                     time: self.time,
@@ -222,20 +235,40 @@ impl Walker {
                     obstacles,
                     goal: a.walk.goal,
                     left,
+                    waiting: self.waiting.is_some(),
                 };
-                let desired = toward * a.walk.speed * slowing;
-                near.steer(
+                let desired = match self.waiting {
+                    Some(spot) => doorway_arrival(spot - here, a.walk.speed),
+                    None => toward * a.walk.speed * slowing,
+                };
+                let steered = near.steer(
                     &mut self.avoider,
                     (&mut self.chosen, &mut self.asking),
                     &self.vehicle,
                     self.facing,
                     desired,
                     a.walk.speed,
-                )
-                .unwrap_or(f)
+                );
+                // (waiting, nobody in its way: it goes to its place in the queue, not on
+                // along its route)
+                let to_spot = Vec3::new(desired.x, 0.0, desired.y) - flat(self.vehicle.velocity);
+                steered.unwrap_or(if self.waiting.is_some() { to_spot } else { f })
             }
-            _ => f,
+            _ => {
+                self.passing = None;
+                self.waiting = None;
+                f
+            }
         };
+        let off = here.distance(a.walk.goal);
+        if off < self.nearest.0 - NEARER {
+            self.nearest = (off, self.time);
+        }
+        // (waiting its turn, or held back in the press before a door: queueing for it)
+        let slow = self.vehicle.speed() < 0.5 * a.walk.speed;
+        if self.waiting.is_some() || (self.passing.is_some() && slow) {
+            self.queued += f64::from(dt);
+        }
         self.vehicle.step(f, dt);
         if a.steering.parts().iter().all(|p| {
             !matches!(
@@ -301,6 +334,9 @@ impl Walker {
         let at = at + stepped_along(at, self.radius, out - at, &near);
         let out = obstacles.push_out(at, self.radius);
         let at = at + stepped_along(at, self.radius, out - at, &near);
+        // (a body is never left in a wall: pressed against one by another, it stays a hand
+        // nearer them rather than in the wall)
+        let at = obstacles.push_out(at, self.radius);
         self.vehicle.position = Vec3::new(at.x, 0.0, at.y);
     }
 
@@ -356,5 +392,16 @@ impl Walker {
             return Some(ended);
         }
         None
+    }
+}
+
+/// The velocity toward a waiting place `to` (from here) at walking `speed`, slowing within the
+/// last metre and standing within 10 cm of it.
+fn doorway_arrival(to: Vec2, speed: f32) -> Vec2 {
+    let d = to.length();
+    if d < 0.1 {
+        Vec2::ZERO
+    } else {
+        to / d * speed * d.min(1.0)
     }
 }
