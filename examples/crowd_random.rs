@@ -3,7 +3,7 @@
 //!
 //! ```sh
 //! cargo run --release --example crowd_random [N [SIDE [FPS [SEED [UNTIL]]]]]
-//! cargo run --release --example crowd_random door|corridor [FPS [UNTIL]]
+//! cargo run --release --example crowd_random door|door10|corridor [FPS [UNTIL]]
 //! ```
 //!
 //! N walkers (300 by default) start and end at random spots of a SIDE × SIDE m square (30),
@@ -13,12 +13,14 @@
 //! and what they said, the closest two roots came, the fastest a root moved between frames, the
 //! largest drop of the hips between frames, and the wall time against the scene's time.
 //!
-//! `door`: a wall with a 0.9 m door, 30 walkers on each side crossing to the other; `corridor`:
+//! `door`: a wall with a 0.9 m door, 30 walkers on each side crossing to the other (`door10`:
+//! 10 a side); `corridor`:
 //! a 4 m wide corridor, 100 walking each way (UNTIL 150 s). Printed besides: how near a root
 //! came to a wall.
 //!
 //! `PICTURE=file.png` draws a contact sheet of the floor from above every `PICTURE_EVERY`
-//! seconds (5) over the area `PICTURE_AREA=x0,z0,x1,z1` (the walkers' starts and goals).
+//! seconds (5) over the area `PICTURE_AREA=x0,z0,x1,z1` (the walkers' starts and goals),
+//! `PICTURE_COLUMNS` panels a row (4).
 
 use std::time::Instant;
 
@@ -67,7 +69,7 @@ fn main() {
                 walls,
             }) = passage(name)
             else {
-                eprintln!("crowd_random: no scene '{name}' (door or corridor)");
+                eprintln!("crowd_random: no scene '{name}' (door, door10 or corridor)");
                 std::process::exit(2);
             };
             let r = walking(&starts, &goals, &walls);
@@ -141,7 +143,16 @@ fn main() {
     }
     let wall = clock.elapsed().as_secs_f64();
     if let Some(path) = picture {
-        sheet.save(&path, area(&goals, last.as_slice()), &walls, &goals);
+        let columns = (std::env::var("PICTURE_COLUMNS").ok())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(4);
+        sheet.save(
+            &path,
+            area(&goals, last.as_slice()),
+            columns,
+            &walls,
+            &goals,
+        );
     }
 
     let mut stranded = 0;

@@ -19,7 +19,7 @@ use glam::{Vec2, Vec3};
 mod lcg;
 #[path = "../examples/common/trips.rs"]
 mod trips;
-use trips::{crossing, id, trips, walking, SETTLE};
+use trips::{id, trips, walking, SETTLE};
 
 /// What the frames of one scene showed.
 #[derive(Debug)]
@@ -126,11 +126,10 @@ fn one_near_its_goal_with_someone_standing_beyond_it_walks_on() {
 /// other, until the walks gave up (14 of 20 stood 7 to 9 m off their goals).
 #[test]
 fn ten_a_side_take_turns_at_a_narrow_door_and_all_get_through() {
-    let walls = [[0.0, -12.0, 0.0, -0.45], [0.0, 0.45, 0.0, 12.0]];
-    let scene = crossing((-2.8, 2.0, 2), (-1.6, 5), 9.6, walls.to_vec());
+    let scene = trips::passage("door10").expect("the scene");
     for fps in [10.0, 30.0] {
         let r = walking(&scene.starts, &scene.goals, &scene.walls);
-        let seen = judge(r, &scene.goals, &walls, fps, 120.0);
+        let seen = judge(r, &scene.goals, &scene.walls, fps, 120.0);
         let what = format!("{fps} fps: {seen:?}");
         eprintln!("{what}");
         assert!(seen.stranded.is_empty(), "{what}");

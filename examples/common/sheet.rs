@@ -13,8 +13,6 @@ pub struct Sheet {
 
 /// Pixels a metre.
 const SCALE: f32 = 40.0;
-/// Panels a row.
-const COLUMNS: usize = 4;
 
 impl Sheet {
     /// Keeps where everyone stands at `time`.
@@ -22,20 +20,28 @@ impl Sheet {
         self.panels.push((time, places));
     }
 
-    /// Draws the panels (the area `lo`..`hi` of the floor each) with `walls` (segments
-    /// [x1, z1, x2, z2]) and `goals`, and writes the PNG to `path`.
-    pub fn save(&self, path: &str, (lo, hi): (Vec2, Vec2), walls: &[[f32; 4]], goals: &[Vec2]) {
+    /// Draws the panels (the area `lo`..`hi` of the floor each), `columns` a row, with
+    /// `walls` (segments [x1, z1, x2, z2]) and `goals`, and writes the PNG to `path`.
+    pub fn save(
+        &self,
+        path: &str,
+        (lo, hi): (Vec2, Vec2),
+        columns: usize,
+        walls: &[[f32; 4]],
+        goals: &[Vec2],
+    ) {
+        let columns = columns.max(1);
         let size = (hi - lo) * SCALE;
-        let rows = self.panels.len().div_ceil(COLUMNS);
-        let (w, h) = (size.x * COLUMNS as f32, (size.y + 18.0) * rows as f32);
+        let rows = self.panels.len().div_ceil(columns);
+        let (w, h) = (size.x * columns as f32, (size.y + 18.0) * rows as f32);
         let mut svg = format!(
             r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}"><rect width="{w}" height="{h}" fill="white"/>"#
         );
         let at = |p: Vec2| (p - lo) * SCALE;
         for (n, (time, places)) in self.panels.iter().enumerate() {
             let (ox, oy) = (
-                (n % COLUMNS) as f32 * size.x,
-                (n / COLUMNS) as f32 * (size.y + 18.0),
+                (n % columns) as f32 * size.x,
+                (n / columns) as f32 * (size.y + 18.0),
             );
             svg += &format!(
                 r#"<g transform="translate({ox},{oy})"><clipPath id="c{n}"><rect width="{}" height="{}"/></clipPath><rect width="{}" height="{}" fill="none" stroke="gray"/>"#,

@@ -109,7 +109,8 @@ pub struct Passage {
     pub walls: Vec<[f32; 4]>,
 }
 
-/// A passage scene: `door`, a 0.9 m door in a wall with 30 walkers on each side crossing;
+/// A passage scene: `door`, a 0.9 m door in a wall with 30 walkers on each side crossing
+/// (`door10`: 10 a side);
 /// `corridor`, a 4 m wide corridor with 100 walking each way. `None` for another name.
 #[allow(dead_code)] // (the example's; the proptest's scenes are random squares)
 pub fn passage(name: &str) -> Option<Passage> {
@@ -120,6 +121,13 @@ pub fn passage(name: &str) -> Option<Passage> {
             (-5.2, 2.0, 5),
             (-2.0, 6),
             11.2,
+            vec![[0.0, -12.0, 0.0, -0.45], [0.0, 0.45, 0.0, 12.0]],
+        )),
+        // the same door, 10 a side (the press test's)
+        "door10" => Some(crossing(
+            (-2.8, 2.0, 2),
+            (-1.6, 5),
+            9.6,
             vec![[0.0, -12.0, 0.0, -0.45], [0.0, 0.45, 0.0, 12.0]],
         )),
         // each side ends where the other started
@@ -137,7 +145,7 @@ pub fn passage(name: &str) -> Option<Passage> {
 /// the west one from x = `west`, the east one from x = `east`, both from z = `z0`; each walker
 /// goes `shift` m east (west group) or west (east group).
 #[allow(dead_code)] // (the example's and the door test's; the proptest's scenes are random squares)
-pub fn crossing(
+fn crossing(
     (west, east, cols): (f32, f32, usize),
     (z0, rows): (f32, usize),
     shift: f32,

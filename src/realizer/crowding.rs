@@ -88,6 +88,10 @@ impl Realizer {
         }
         crowd.set_on_their_way(going);
         crowd.set_aside(aside);
+        let ways: Vec<(usize, glam::Vec2)> = (self.characters.iter_mut())
+            .filter_map(|(id, m)| Some((crowd.index(id)?, m.heading()?)))
+            .collect();
+        crowd.set_ways(ways);
         // who is coming to a narrow door, and whose turn it is there
         let narrows = self.world.obstacles().narrows();
         if !narrows.is_empty() {

@@ -175,6 +175,12 @@ pub trait Travel {
         None
     }
 
+    /// The way the character's walk goes now (world x, z, unit), if it walks among others:
+    /// others see one standing in a press as still going that way.
+    fn heading(&self) -> Option<glam::Vec2> {
+        None
+    }
+
     /// Whom the character attends to as it moves (the one it asks for room, the walker it
     /// makes room for): where they stand (world x, z) and how much (0 to 1, eased). Engines that
     /// [`Attend`] look there.

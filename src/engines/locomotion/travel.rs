@@ -138,6 +138,10 @@ impl Travel for LocomotionEngine {
         (self.walker.as_ref()).and_then(|w| w.passing.filter(|_| self.current.is_some()))
     }
 
+    fn heading(&self) -> Option<Vec2> {
+        (self.walker.as_ref()).and_then(|w| w.heading.filter(|_| self.current.is_some()))
+    }
+
     fn attending(&self) -> Option<(Vec2, f32)> {
         self.walker.as_ref().and_then(|w| w.attending())
     }

@@ -65,6 +65,11 @@ impl BlockManager {
         (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.passing()))
     }
 
+    /// The way the character's walk goes now, if it walks among others.
+    pub fn heading(&mut self) -> Option<glam::Vec2> {
+        (self.registry.engines_mut()).find_map(|e| e.as_travel().and_then(|t| t.heading()))
+    }
+
     /// Tells the engines that look ([`Attend`](crate::engines::interface::Attend)) whom the character's
     /// travel attends to now, at their eyes in the character's frame.
     pub(super) fn attend(&mut self) {

@@ -17,6 +17,7 @@ pub mod avoid;
 pub mod contact;
 pub mod doorway;
 pub mod group;
+pub mod lanes;
 pub mod negotiate;
 pub mod profile;
 pub mod quality;

@@ -61,6 +61,9 @@ pub struct Crowd {
     passing: Vec<(u32, Passing)>,
     /// Whose turn it is at each narrow of the world's obstacles (`crowd::doorway`).
     turns: Vec<Turn>,
+    /// The way each walker's walk goes (index, unit direction), by index: one standing in a
+    /// press still goes somewhere.
+    ways: Vec<(u32, Vec2)>,
 }
 
 /// Indices as a sorted set (searched by `binary_search`).
@@ -127,7 +130,23 @@ impl Crowd {
             aside: Vec::new(),
             passing: Vec::new(),
             turns: Vec::new(),
+            ways: Vec::new(),
         }
+    }
+
+    /// Notes the way each walker's walk goes (index, unit direction).
+    pub fn set_ways(&mut self, ways: impl IntoIterator<Item = (usize, Vec2)>) {
+        self.ways = (ways.into_iter()).map(|(i, w)| (i as u32, w)).collect();
+        self.ways.sort_by_key(|(i, _)| *i);
+    }
+
+    /// The way character `i`'s walk goes, if it walks somewhere.
+    pub fn way(&self, i: usize) -> Option<Vec2> {
+        (self
+            .ways
+            .binary_search_by_key(&(i as u32), |(k, _)| *k)
+            .ok())
+        .map(|k| self.ways[k].1)
     }
 
     /// Notes who is coming to a narrow to go through it (index, which and how).

@@ -119,6 +119,11 @@ pub struct Walker {
     pub passing: Option<Passing>,
     /// Where it waits for its turn at that door, when it is not its turn.
     pub waiting: Option<Vec2>,
+    /// The way its walk goes (unit), while it walks among others.
+    pub heading: Option<Vec2>,
+    /// The way it takes to keep to the right half of a passage with people coming the other
+    /// way (`crowd::lanes`), when it does.
+    pub lane: Option<Vec2>,
     /// How long the walk under way has waited for its turn at doors (s): a person in a queue
     /// does not give up for the time the queue takes.
     pub queued: f64,
@@ -162,6 +167,8 @@ impl Walker {
             asking: None,
             passing: None,
             waiting: None,
+            heading: None,
+            lane: None,
             queued: 0.0,
             nearest: (f32::INFINITY, time),
             watching: None,

@@ -13,7 +13,8 @@ use super::{
     TURN_RATE,
 };
 use crate::world::crowd::doorway::{self, Passing};
-use crate::world::locomotion::among::{neighbours, Near};
+use crate::world::crowd::lanes;
+use crate::world::locomotion::among::{neighbours, Near, DECIDE_EVERY};
 use crate::world::locomotion::gait::{angle_diff, forward};
 use crate::world::locomotion::steering::{flat, Behaviour, Context};
 use crate::world::space::obstacles::Obstacles;
@@ -237,9 +238,20 @@ impl Walker {
                     left,
                     waiting: self.waiting.is_some(),
                 };
+                // (in a passage with people coming the other way, it keeps to its right half;
+                // decided with its regular choices, and not in the last 2 m of its way)
+                self.heading = Some(toward).filter(|t| *t != Vec2::ZERO);
+                let tick = (self.time / STEP).round() as i64;
+                if tick % DECIDE_EVERY == 0 {
+                    let coming = lanes::oncoming(o.crowd, o.me, here, toward);
+                    self.lane = coming.filter(|_| left > 2.0).and_then(|(_, facing)| {
+                        lanes::keep_right(obstacles, here, toward, self.radius, facing)
+                    });
+                }
+                let way = self.lane.unwrap_or(toward);
                 let desired = match self.waiting {
                     Some(spot) => doorway_arrival(spot - here, a.walk.speed),
-                    None => toward * a.walk.speed * slowing,
+                    None => way * a.walk.speed * slowing,
                 };
                 let steered = near.steer(
                     &mut self.avoider,
@@ -249,14 +261,17 @@ impl Walker {
                     desired,
                     a.walk.speed,
                 );
-                // (waiting, nobody in its way: it goes to its place in the queue, not on
-                // along its route)
-                let to_spot = Vec3::new(desired.x, 0.0, desired.y) - flat(self.vehicle.velocity);
-                steered.unwrap_or(if self.waiting.is_some() { to_spot } else { f })
+                // (waiting, or keeping to its lane, with nobody in its way: it goes to its
+                // place in the queue, or along its lane, not on along its route)
+                let to_desired = Vec3::new(desired.x, 0.0, desired.y) - flat(self.vehicle.velocity);
+                let own = self.waiting.is_some() || self.lane.is_some();
+                steered.unwrap_or(if own { to_desired } else { f })
             }
             _ => {
                 self.passing = None;
                 self.waiting = None;
+                self.lane = None;
+                self.heading = None;
                 f
             }
         };
