@@ -3,7 +3,7 @@
 //!
 //! ```sh
 //! cargo run --release --example crowd_random [N [SIDE [FPS [SEED [UNTIL]]]]]
-//! cargo run --release --example crowd_random door|door10|corridor [FPS [UNTIL]]
+//! cargo run --release --example crowd_random door|door10|corridor|corridor15 [FPS [UNTIL]]
 //! ```
 //!
 //! N walkers (300 by default) start and end at random spots of a SIDE × SIDE m square (30),
@@ -14,7 +14,7 @@
 //! largest drop of the hips between frames, and the wall time against the scene's time.
 //!
 //! `door`: a wall with a 0.9 m door, 30 walkers on each side crossing to the other (`door10`:
-//! 10 a side); `corridor`:
+//! 10 a side); `corridor` (`corridor15`: 15 each way, 40 m long):
 //! a 4 m wide corridor, 100 walking each way (UNTIL 150 s). Printed besides: how near a root
 //! came to a wall.
 //!
@@ -69,7 +69,7 @@ fn main() {
                 walls,
             }) = passage(name)
             else {
-                eprintln!("crowd_random: no scene '{name}' (door, door10 or corridor)");
+                eprintln!("crowd_random: no scene '{name}' (door, door10, corridor or corridor15)");
                 std::process::exit(2);
             };
             let r = walking(&starts, &goals, &walls);

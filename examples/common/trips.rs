@@ -110,7 +110,7 @@ pub struct Passage {
 }
 
 /// A passage scene: `door`, a 0.9 m door in a wall with 30 walkers on each side crossing
-/// (`door10`: 10 a side);
+/// (`door10`: 10 a side); `corridor15`, 15 walking each way through a 4 m corridor;
 /// `corridor`, a 4 m wide corridor with 100 walking each way. `None` for another name.
 #[allow(dead_code)] // (the example's; the proptest's scenes are random squares)
 pub fn passage(name: &str) -> Option<Passage> {
@@ -129,6 +129,13 @@ pub fn passage(name: &str) -> Option<Passage> {
             (-1.6, 5),
             9.6,
             vec![[0.0, -12.0, 0.0, -0.45], [0.0, 0.45, 0.0, 12.0]],
+        )),
+        // a shorter corridor, 15 each way (the press test's)
+        "corridor15" => Some(crossing(
+            (-10.4, 8.8, 3),
+            (-1.6, 5),
+            20.8,
+            vec![[-20.0, -2.0, 20.0, -2.0], [-20.0, 2.0, 20.0, 2.0]],
         )),
         // each side ends where the other started
         "corridor" => Some(crossing(

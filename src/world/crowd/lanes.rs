@@ -24,6 +24,9 @@ pub const FACE_TO_FACE: f32 = 1.5;
 /// How much more a walker face to face with someone coming the other way turns right (as
 /// [`GAIN`] for a metre off its lane): a side step.
 pub const SIDESTEP: f32 = 1.5;
+/// Within this of its goal (m along its way) a walker keeps to no lane: it makes for its
+/// place, which may lie on the other side.
+pub const RELEASE: f32 = 2.0;
 /// The half-width of the probe that looks for the walls beside (m).
 const PROBE: f32 = 0.05;
 /// How steeply a walker makes for its lane: its way turns right by this much per metre it is

@@ -244,9 +244,11 @@ impl Walker {
                 let tick = (self.time / STEP).round() as i64;
                 if tick % DECIDE_EVERY == 0 {
                     let coming = lanes::oncoming(o.crowd, o.me, here, toward);
-                    self.lane = coming.filter(|_| left > 2.0).and_then(|(_, facing)| {
-                        lanes::keep_right(obstacles, here, toward, self.radius, facing)
-                    });
+                    self.lane = coming
+                        .filter(|_| left > lanes::RELEASE)
+                        .and_then(|(_, facing)| {
+                            lanes::keep_right(obstacles, here, toward, self.radius, facing)
+                        });
                 }
                 let way = self.lane.unwrap_or(toward);
                 let desired = match self.waiting {
