@@ -214,20 +214,7 @@ impl Walker {
         let f = match others {
             // (stepping aside for someone, it does not avoid them)
             Some(o) if o.crowd.len() > 1 && !a.walk.stepping => {
-                let toward =
-                    (route.get(1).copied().unwrap_or(a.walk.goal) - here).normalize_or_zero();
-                let slowing = (left / a.slow_radius()).clamp(0.1, 1.0);
-                let narrows = obstacles.narrows();
-                self.passing = (!narrows.is_empty())
-                    .then(|| Passing::on(route, narrows))
-                    .flatten();
-                // (not its turn at a narrow door: it waits in the queue on its right)
-                self.waiting = (self.passing)
-                    .filter(|p| !p.may_go(o.crowd.turn(p.narrow)))
-                    .map(|p| {
-                        let rank = o.me.map_or(0, |me| doorway::rank(o.crowd, me, p));
-                        p.waiting_spot(&narrows[p.narrow as usize], rank)
-                    });
+                let desired = self.desired_among(a, o, obstacles, route, left);
                 let near = Near {
                     others: o,
                     time: self.time,
@@ -237,23 +224,6 @@ impl Walker {
                     goal: a.walk.goal,
                     left,
                     waiting: self.waiting.is_some(),
-                };
-                // (in a passage with people coming the other way, it keeps to its right half;
-                // decided with its regular choices, and not in the last 2 m of its way)
-                self.heading = Some(toward).filter(|t| *t != Vec2::ZERO);
-                let tick = (self.time / STEP).round() as i64;
-                if tick % DECIDE_EVERY == 0 {
-                    let coming = lanes::oncoming(o.crowd, o.me, here, toward);
-                    self.lane = coming
-                        .filter(|_| left > lanes::RELEASE)
-                        .and_then(|(_, facing)| {
-                            lanes::keep_right(obstacles, here, toward, self.radius, facing)
-                        });
-                }
-                let way = self.lane.unwrap_or(toward);
-                let desired = match self.waiting {
-                    Some(spot) => doorway_arrival(spot - here, a.walk.speed),
-                    None => way * a.walk.speed * slowing,
                 };
                 let steered = near.steer(
                     &mut self.avoider,
@@ -277,15 +247,7 @@ impl Walker {
                 f
             }
         };
-        let off = here.distance(a.walk.goal);
-        if off < self.nearest.0 - NEARER {
-            self.nearest = (off, self.time);
-        }
-        // (waiting its turn, or held back in the press before a door: queueing for it)
-        let slow = self.vehicle.speed() < 0.5 * a.walk.speed;
-        if self.waiting.is_some() || (self.passing.is_some() && slow) {
-            self.queued += f64::from(dt);
-        }
+        self.note_progress(a, here, dt);
         self.vehicle.step(f, dt);
         if a.steering.parts().iter().all(|p| {
             !matches!(
@@ -295,6 +257,60 @@ impl Walker {
         }) {
             a.stopped = true;
             self.vehicle.velocity = Vec3::ZERO;
+        }
+    }
+
+    /// The velocity a walker among `o`thers wants along its `route` (`left` metres of it):
+    /// toward the route's next point, slowing at the end; along its lane in a passage with
+    /// people coming the other way (`crowd::lanes`, decided with its regular choices); or to
+    /// its place in the queue when it is not its turn at a narrow door (`crowd::doorway`).
+    fn desired_among(
+        &mut self,
+        a: &Active,
+        o: Others<'_>,
+        obstacles: &Obstacles,
+        route: &[Vec2],
+        left: f32,
+    ) -> Vec2 {
+        let here = self.body().at;
+        let toward = (route.get(1).copied().unwrap_or(a.walk.goal) - here).normalize_or_zero();
+        self.heading = Some(toward).filter(|t| *t != Vec2::ZERO);
+        let narrows = obstacles.narrows();
+        self.passing = (!narrows.is_empty())
+            .then(|| Passing::on(route, narrows))
+            .flatten();
+        self.waiting = (self.passing)
+            .filter(|p| !p.may_go(o.crowd.turn(p.narrow)))
+            .map(|p| {
+                let rank = o.me.map_or(0, |me| doorway::rank(o.crowd, me, p));
+                p.waiting_spot(&narrows[p.narrow as usize], rank)
+            });
+        if (self.time / STEP).round() as i64 % DECIDE_EVERY == 0 {
+            let coming = lanes::oncoming(o.crowd, o.me, here, toward);
+            self.lane = (coming.filter(|_| left > lanes::RELEASE)).and_then(|(_, facing)| {
+                lanes::keep_right(obstacles, here, toward, self.radius, facing)
+            });
+        }
+        match self.waiting {
+            Some(spot) => doorway_arrival(spot - here, a.walk.speed),
+            None => {
+                let slowing = (left / a.slow_radius()).clamp(0.1, 1.0);
+                self.lane.unwrap_or(toward) * a.walk.speed * slowing
+            }
+        }
+    }
+
+    /// Notes how near the walk has come to its goal, and how long it has queued for a narrow
+    /// door (waiting its turn, or held back in the press before it): who drives the walk gives
+    /// it more time for both.
+    fn note_progress(&mut self, a: &Active, here: Vec2, dt: f32) {
+        let off = here.distance(a.walk.goal);
+        if off < self.nearest.0 - NEARER {
+            self.nearest = (off, self.time);
+        }
+        let slow = self.vehicle.speed() < 0.5 * a.walk.speed;
+        if self.waiting.is_some() || (self.passing.is_some() && slow) {
+            self.queued += f64::from(dt);
         }
     }
 
