@@ -87,6 +87,8 @@ impl Passing {
     pub fn may_go(&self, turn: Turn) -> bool {
         turn.way == 0
             || (turn.way == self.way && (!turn.closing || self.distance < COMMITTED))
+            // (one already in the door's line goes on out rather than back against those
+            // coming)
             || self.distance < 0.2
     }
 
@@ -144,11 +146,7 @@ fn next(before: Turn, crowd: &Crowd, n: u32, narrow: &Narrow) -> Turn {
     if w == 0 {
         // free: the one nearest the door has it for its way
         return (coming().filter(|(_, p)| p.distance < QUEUE))
-            .min_by(|a, b| {
-                (a.1.distance, a.0)
-                    .partial_cmp(&(b.1.distance, b.0))
-                    .expect("finite")
-            })
+            .min_by(|a, b| (a.1.distance.total_cmp(&b.1.distance)).then(a.0.cmp(&b.0)))
             .map_or(before, |(_, p)| Turn {
                 way: p.way,
                 since: now,
